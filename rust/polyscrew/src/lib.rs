@@ -23,6 +23,7 @@
 
 pub mod channels;
 pub mod error;
+pub mod fastmath;
 pub mod pose;
 pub mod sample;
 pub mod screw;
