@@ -5,7 +5,8 @@
 # (git-ignored) so the source folder works as a development extension.
 #
 # Usage: scripts/build_extension.sh            (prints the .zip path last)
-# Env:   PYTHON, MATURIN (default: .venv/bin/python, .venv/bin/maturin, else from PATH)
+# Env:   PYTHON, MATURIN (default: .venv/bin/python, .venv/bin/maturin, else from PATH);
+#        SCREWBENDER_WHEEL: an already built polyscrew wheel to bundle (skips the maturin build)
 set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 cd "$ROOT"
@@ -17,6 +18,11 @@ PYTHON="$(pick "${PYTHON:-}" "$ROOT/.venv/bin/python" python3)"
 MATURIN="$(pick "${MATURIN:-}" "$ROOT/.venv/bin/maturin" maturin)"
 
 WHEEL_DIR="$ROOT/dist/wheels"
+mkdir -p "$WHEEL_DIR"
 rm -f "$WHEEL_DIR"/polyscrew-*.whl
-"$MATURIN" build --release --quiet -o "$WHEEL_DIR" >&2
+if [[ -n "${SCREWBENDER_WHEEL:-}" ]]; then
+    cp "$SCREWBENDER_WHEEL" "$WHEEL_DIR/"
+else
+    "$MATURIN" build --release --quiet -o "$WHEEL_DIR" >&2
+fi
 "$PYTHON" "$ROOT/scripts/package_extension.py" --wheels "$WHEEL_DIR" --out "$ROOT/dist"
