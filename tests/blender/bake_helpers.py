@@ -32,7 +32,9 @@ def rotation_from_matrix(matrix: np.ndarray, mode: str) -> list[float]:
         angle = float(np.linalg.norm(vec))
         axis = vec / angle if angle > 0 else np.array([0.0, 0.0, 1.0])
         return [angle, *axis]
-    return list(rot.as_euler(mode.lower()))  # lowercase = extrinsic = Blender's order
+    # lowercase = extrinsic = Blender's order; scipy lists angles in sequence order, Blender as x, y, z
+    angles = rot.as_euler(mode.lower())
+    return [float(angles[mode.index(axis)]) for axis in "XYZ"]
 
 
 def rotation_to_matrices(values: np.ndarray, mode: str) -> np.ndarray:
@@ -44,7 +46,8 @@ def rotation_to_matrices(values: np.ndarray, mode: str) -> np.ndarray:
     if mode == "AXIS_ANGLE":
         axis = values[:, 1:] / np.linalg.norm(values[:, 1:], axis=1)[:, None]
         return Rotation.from_rotvec(axis * values[:, :1]).as_matrix()
-    return Rotation.from_euler(mode.lower(), values).as_matrix()
+    in_sequence = values[:, ["XYZ".index(axis) for axis in mode]]
+    return Rotation.from_euler(mode.lower(), in_sequence).as_matrix()
 
 
 def compose(location, rotation3, scale=None) -> np.ndarray:
