@@ -90,13 +90,34 @@ def select_only(*objects: bpy.types.Object) -> None:
         bpy.context.view_layer.objects.active = objects[0]
 
 
+def continuous(value: list[float], previous: list[float] | None, mode: str) -> list[float]:
+    """Rotation channel values as an animator keys them: quaternion signs continuous, Euler
+    angles compatible with the previous key (mathutils), axis-angle axis not flipped."""
+    if previous is None:
+        return value
+    if mode == "QUATERNION" and np.dot(value, previous) < 0:
+        return [-v for v in value]
+    if mode == "AXIS_ANGLE" and np.dot(value[1:], previous[1:]) < 0:
+        return [2 * np.pi - value[0]] + [-v for v in value[1:]]
+    if mode in EULER_ORDERS:
+        from mathutils import Euler
+
+        euler = Euler(value, mode)
+        euler.make_compatible(Euler(previous, mode))
+        return list(euler)
+    return value
+
+
 def key_poses(obj, frames: Sequence[float], poses: np.ndarray, scales: np.ndarray | None = None) -> None:
     """Keys location, rotation (in the object's mode) and optionally scale at `frames`."""
     mode = obj.rotation_mode
     path = rotation_path(mode)
+    previous = None
     for i, frame in enumerate(frames):
         obj.location = poses[i, :3, 3]
-        setattr(obj, path, rotation_from_matrix(poses[i, :3, :3], mode))
+        value = continuous(rotation_from_matrix(poses[i, :3, :3], mode), previous, mode)
+        setattr(obj, path, value)
+        previous = value
         obj.keyframe_insert("location", frame=frame)
         obj.keyframe_insert(path, frame=frame)
         if scales is not None:
@@ -214,7 +235,7 @@ def circle_poses(thetas: np.ndarray, radius: float, pitch: float, tilt: np.ndarr
     `L0` sits at (radius, 0, 0) with orientation `tilt`; Screw(theta) rotates by theta about Z
     and slides pitch * theta along it.
     """
-    rz = Rotation.from_euler("z", thetas).as_matrix()
+    rz = Rotation.from_euler("z", np.asarray(thetas)[:, None]).as_matrix()
     location = np.einsum("nij,j->ni", rz, [radius, 0.0, 0.0])
     location[:, 2] += pitch * thetas
     return compose(location, rz @ tilt)
