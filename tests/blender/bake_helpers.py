@@ -216,7 +216,12 @@ def snapshot_action(action) -> dict:
 
 
 def snapshot_scene() -> dict:
-    """Objects, their actions, all actions' F-curves and fake users: what must survive a refusal."""
+    """Objects, their actions, all actions' F-curves and fake users: what must survive a refusal.
+
+    Object transforms are taken after evaluating the animation at the current frame.
+    """
+    scene = bpy.context.scene
+    scene.frame_set(scene.frame_current)
     return {
         "objects": {
             o.name: (
