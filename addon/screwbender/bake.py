@@ -178,11 +178,14 @@ def smooth(
     objects: Iterable[bpy.types.Object],
     options: Options,
     progress: Callable[[int, int], None] | None = None,
+    strict: bool = False,
 ) -> tuple[list[bpy.types.Action], list[str]]:
     """Smooths `objects`; returns the new actions and the messages of skipped objects.
 
     Objects that cannot be smoothed are skipped and left unchanged; the others get their new
-    action. `progress(done, total)` is called after each object is sampled and written.
+    action (with `strict`, any skipped object raises :class:`SmoothError` listing them all,
+    before anything is changed). `progress(done, total)` is called after each object is
+    sampled and written.
     """
     objects = list(objects)
     total = 2 * len(objects)
@@ -194,6 +197,8 @@ def smooth(
         skipped += messages
         if progress is not None:
             progress(i + 1, total)
+    if strict and skipped:
+        raise SmoothError("; ".join(skipped))
     actions = []
     for i, baked in enumerate(bakes):
         actions.append(write(baked))
