@@ -23,6 +23,7 @@
 
 pub mod angular_velocity;
 mod banded;
+pub mod channels;
 pub mod error;
 pub mod pose;
 pub mod quat_spline;
@@ -36,6 +37,7 @@ pub use angular_velocity::{
     fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
     FitStatus,
 };
+pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use quat_spline::{QuatJet, QuatSpline};
