@@ -27,7 +27,7 @@ import bmesh
 import bpy
 import numpy as np
 import polyscrew
-from bpy.props import FloatProperty, IntProperty
+from bpy.props import EnumProperty, FloatProperty, IntProperty
 
 from . import bake, channels, keys
 from .keys import SmoothError
@@ -191,35 +191,67 @@ def add_sketch(context: bpy.types.Context, obj: bpy.types.Object) -> bpy.types.O
     return sphere
 
 
-def read_sketch(sphere: bpy.types.Object) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+#: How the stroke's points are spread over the frame range.
+STROKE_TIMINGS = (
+    ("POINTS", "Per Point", "Points evenly spaced in time (the generated sketch: one point per frame)"),
+    ("LENGTH", "By Length", "Time proportional to the angle travelled on the sphere (a hand-drawn stroke)"),
+)
+#: Points per Bezier segment when a drawn (Bezier) stroke is tessellated.
+BEZIER_SAMPLES = 12
+
+
+def _spline_points(spline) -> np.ndarray:
+    """The spline's points in curve space: poly/NURBS points as they are, a Bezier spline
+    tessellated (BEZIER_SAMPLES points per segment, as drawn)."""
+    if spline.type != "BEZIER":
+        co = np.empty(4 * len(spline.points))
+        spline.points.foreach_get("co", co)
+        return co.reshape(-1, 4)[:, :3]
+    n = len(spline.bezier_points)
+    co, left, right = (np.empty(3 * n) for _ in range(3))
+    spline.bezier_points.foreach_get("co", co)
+    spline.bezier_points.foreach_get("handle_left", left)
+    spline.bezier_points.foreach_get("handle_right", right)
+    co, left, right = co.reshape(n, 3), left.reshape(n, 3), right.reshape(n, 3)
+    s = np.linspace(0.0, 1.0, BEZIER_SAMPLES, endpoint=False)[:, None]
+    parts = [
+        (1 - s) ** 3 * co[i] + 3 * (1 - s) ** 2 * s * right[i] + 3 * (1 - s) * s**2 * left[i + 1] + s**3 * co[i + 1]
+        for i in range(n - 1)
+    ]
+    return np.concatenate(parts + [co[-1:]]) if parts else co
+
+
+def read_sketch(sphere: bpy.types.Object, timing: str = "POINTS") -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The sketched target: frames (P,), directions (P, 3) in the sphere's frame, speeds (P,).
 
-    The last spline of the sketch curve runs from the first to the last frame of the range,
-    its points evenly spaced in time; directions are the points seen from the sphere's centre
-    (normalised by `polyscrew`, so a stroke near the surface is fine); the speed is the
+    The last spline of the sketch curve (the stroke drawn last) runs from the first to the
+    last frame of the range, its points evenly spaced in time ("POINTS") or by the angle
+    travelled on the sphere ("LENGTH"); directions are the points seen from the sphere's
+    centre (normalised by `polyscrew`, so a stroke near the surface is fine); the speed is the
     `screwbender_speed` F-curve of the sphere at those frames.
     """
     sketch = sphere.get(SKETCH_KEY)
     if not isinstance(sketch, bpy.types.Object) or sketch.type != "CURVE" or not sketch.data.splines:
         raise SmoothError(f"{sphere.name}: its direction sketch curve is missing or empty")
-    spline = sketch.data.splines[-1]
-    pts = spline.bezier_points if spline.type == "BEZIER" else spline.points
-    n = len(pts)
+    local = _spline_points(sketch.data.splines[-1])
+    n = len(local)
     if n < 2:
         raise SmoothError(f"{sketch.name}: the sketch needs at least two points")
-    if spline.type == "BEZIER":
-        co = np.empty(3 * n)
-        pts.foreach_get("co", co)
-        local = co.reshape(n, 3)
-    else:
-        co = np.empty(4 * n)
-        pts.foreach_get("co", co)
-        local = co.reshape(n, 4)[:, :3]
     # Sketch point -> world -> sphere frame (directions about the sphere's centre).
     to_sphere = np.array(sphere.matrix_world.inverted()) @ np.array(sketch.matrix_world)
     directions = local @ to_sphere[:3, :3].T + to_sphere[:3, 3]
     start, end = (float(v) for v in sphere[RANGE_KEY])
-    frames = np.linspace(start, end, n)
+    if timing == "LENGTH":
+        unit = _unit_rows(directions)
+        step = np.arccos(np.clip(np.sum(unit[1:] * unit[:-1], axis=1), -1.0, 1.0))
+        keep = np.concatenate(([True], step > 1e-9))  # repeated points would share a time
+        directions, unit = directions[keep], unit[keep]
+        travelled = np.concatenate(([0.0], np.cumsum(step[keep[1:]])))
+        if len(directions) < 2 or travelled[-1] <= 0.0:
+            raise SmoothError(f"{sketch.name}: the stroke does not move on the sphere")
+        frames = start + (end - start) * travelled / travelled[-1]
+    else:
+        frames = np.linspace(start, end, n)
     fcurve = next(
         (fc for fc in channels.object_fcurves(sphere) if fc.data_path == f'["{SPEED_PROP}"]'), None
     )
@@ -252,6 +284,7 @@ def fit(
     alpha: float = 0.002,
     delta: float = 0.1,
     max_frames: int = 10,
+    timing: str = "POINTS",
 ) -> polyscrew.AngularVelocityFit:
     """Fits `obj`'s rotation to its sketch and bakes it into a new action; draws the fit.
 
@@ -263,7 +296,7 @@ def fit(
         raise SmoothError(f"{obj.name}: no angular velocity sketch: add one first")
     motion = keys.read(obj, "OFF")
     fps = frames_per_second(context.scene)
-    target_frames, directions, speeds = read_sketch(sphere)
+    target_frames, directions, speeds = read_sketch(sphere, timing)
     # Directions are drawn in the sphere's frame; the fit works in the object's parent space.
     to_parent = np.array(sphere.matrix_world)[:3, :3]
     if obj.parent is not None:
@@ -365,6 +398,12 @@ class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
         soft_max=30,
         description="Most control frames the fit may add between keys",
     )
+    stroke_timing: EnumProperty(
+        name="Stroke Timing",
+        items=STROKE_TIMINGS,
+        default="POINTS",
+        description="How the direction stroke's points are spread from the first to the last frame",
+    )
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
@@ -380,7 +419,7 @@ class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
         try:
-            result = fit(context, obj, self.alpha, self.delta, self.max_frames)
+            result = fit(context, obj, self.alpha, self.delta, self.max_frames, self.stroke_timing)
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}

@@ -81,9 +81,13 @@ def snapshot(obj, path):
 
 
 def select_rotation_keys(obj, chosen_frames):
+    select_rotation_keys_path(obj, chosen_frames, "rotation_quaternion")
+
+
+def select_rotation_keys_path(obj, chosen_frames, path):
     for fc in fcurves(obj):
         for kp in fc.keyframe_points:
-            selected = fc.data_path == "rotation_quaternion" and np.min(np.abs(chosen_frames - kp.co[0])) < 1e-3
+            selected = fc.data_path == path and np.min(np.abs(chosen_frames - kp.co[0])) < 1e-3
             kp.select_control_point = kp.select_left_handle = kp.select_right_handle = bool(selected)
 
 
@@ -180,3 +184,54 @@ def test_infeasible_sketch_is_refused_and_nothing_changes(top):
 def test_fit_needs_a_sketch(top):
     obj, _ = top
     assert not bpy.ops.screwbender.fit_angular_velocity.poll()
+
+
+def test_drawn_bezier_stroke_timed_by_length(top):
+    obj, frames = top
+    assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
+    av = addon_module("angvel")
+    sphere = av.sphere_of(obj)
+    sketch = sphere[av.SKETCH_KEY]
+    # A hand-drawn stroke: a Bezier spline along the equator, 90 degrees then 180 more.
+    spline = sketch.data.splines.new("BEZIER")
+    spline.bezier_points.add(2)
+    for bp, a in zip(spline.bezier_points, (0.0, np.pi / 2, 3 * np.pi / 2)):
+        bp.co = (np.cos(a), np.sin(a), 0.0)
+        bp.handle_left_type = bp.handle_right_type = "AUTO"
+    target_frames, directions, _ = av.read_sketch(sphere, "LENGTH")
+    assert target_frames[0] == 1.0 and target_frames[-1] == LAST
+    assert np.all(np.diff(target_frames) > 0)
+    angle = np.unwrap(np.arctan2(directions[:, 1], directions[:, 0]))
+    # By length: the 90-degree part takes about a third of the range.
+    at_90 = np.interp(np.pi / 2, angle, target_frames)
+    assert abs((at_90 - 1.0) / (LAST - 1.0) - 1 / 3) < 0.05, at_90
+    # Per point: the stroke's two segments share the range equally.
+    per_point, _, _ = av.read_sketch(sphere, "POINTS")
+    assert abs((np.interp(np.pi / 2, angle, per_point) - 1.0) / (LAST - 1.0) - 0.5) < 0.01
+
+
+def test_euler_object_fits_and_keeps_held_keys_and_location():
+    scene = bpy.context.scene
+    scene.render.fps, scene.render.fps_base = FPS, 1.0
+    obj = new_object("EulerTop", mode="XYZ")
+    frames = 1.0 + 5.0 * np.arange(N_KEYS)
+    t = (frames - 1.0) / FPS
+    location = np.stack([t, 0 * t, 0 * t], axis=1)
+    key_poses(obj, frames, rigid(location, top_rotation(t).as_matrix()))
+    select_only(obj)
+    bpy.context.view_layer.objects.active = obj
+    assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
+    held = frames[::4]
+    select_rotation_keys_path(obj, held, "rotation_euler")
+    location_before = snapshot(obj, "location")
+    assert bpy.ops.screwbender.fit_angular_velocity() == {"FINISHED"}
+    assert snapshot(obj, "location") == location_before
+    rot = {fc.array_index: curve_points(fc) for fc in fcurves(obj) if fc.data_path == "rotation_euler"}
+    baked_frames = rot[0][:, 0]
+    euler = np.stack([rot[i][:, 1] for i in range(3)], axis=1)
+    idx = [int(np.argmin(np.abs(baked_frames - f))) for f in held]
+    got = Rotation.from_euler("xyz", euler[idx])
+    want = top_rotation((held - 1.0) / FPS)
+    assert (got * want.inv()).magnitude().max() < 1e-5
+    # Compatible Euler angles: no jump between baked frames.
+    assert np.abs(np.diff(euler, axis=0)).max() < np.pi / 2
