@@ -7,8 +7,13 @@ use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
-use polyscrew::angular_velocity::{
-    DEFAULT_ALPHA, DEFAULT_DELTA, DEFAULT_MAX_FRAMES, DEFAULT_MAX_ITERATIONS,
+// The defaults are written as literals so that Python's signature shows them; they are
+// the core's DEFAULT_ALPHA, DEFAULT_DELTA, DEFAULT_MAX_ITERATIONS and DEFAULT_MAX_FRAMES,
+// checked below at compile time.
+const _: () = {
+    use polyscrew::angular_velocity as av;
+    assert!(av::DEFAULT_ALPHA == 0.002 && av::DEFAULT_DELTA == 0.1);
+    assert!(av::DEFAULT_MAX_ITERATIONS == 200 && av::DEFAULT_MAX_FRAMES == 10);
 };
 use polyscrew::{
     fit_angular_velocity as core_fit, AngularVelocityFit, AngularVelocityTarget, FitOptions,
@@ -259,8 +264,8 @@ impl PyAngularVelocityFit {
 #[pyfunction]
 #[pyo3(signature = (
     key_quaternions, key_times, target_times, target_omega, constrained=None,
-    alpha=DEFAULT_ALPHA, delta=DEFAULT_DELTA, max_iterations=DEFAULT_MAX_ITERATIONS,
-    max_frames=DEFAULT_MAX_FRAMES, sample_times=None, *, target_speed=None,
+    alpha=0.002, delta=0.1, max_iterations=200, max_frames=10, sample_times=None, *,
+    target_speed=None,
     fragment_duration=None
 ))]
 #[allow(clippy::too_many_arguments)]
