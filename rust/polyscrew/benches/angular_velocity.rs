@@ -16,7 +16,12 @@ fn top_case(n: usize) -> (Vec<f64>, Vec<DQuat>, Vec<bool>, AngularVelocityTarget
     let constrained = (0..n).map(|i| i % 3 == 0 || i == n - 1).collect();
     let tt: Vec<f64> = (0..=240).map(|j| 4.0 * j as f64 / 240.0).collect();
     let omega: Vec<DVec3> = tt.iter().map(|&t| top.target(t)).collect();
-    (times, keys, constrained, AngularVelocityTarget::new(&tt, &omega).unwrap())
+    (
+        times,
+        keys,
+        constrained,
+        AngularVelocityTarget::new(&tt, &omega).unwrap(),
+    )
 }
 
 fn bench_fit(c: &mut Criterion) {
