@@ -199,6 +199,8 @@ def render_filmstrip(mesh, before: list[Matrix], after: list[Matrix], path: Path
     scene.render.resolution_x = 1600
     scene.render.resolution_y = int(1600 * 4.2 / cam_data.ortho_scale)
     scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.compression = 100
     scene.view_settings.view_transform = "Standard"
     shading = scene.display.shading
     shading.light = "STUDIO"
