@@ -35,14 +35,20 @@ fn main() {
         }
         "between" => {
             for i in 0..n {
-                let sc = polyscrew::Screw::between(black_box(&poses[i % 1024]), black_box(&poses[(i + 1) % 1024]));
+                let sc = polyscrew::Screw::between(
+                    black_box(&poses[i % 1024]),
+                    black_box(&poses[(i + 1) % 1024]),
+                );
                 acc += black_box(sc).angle();
             }
         }
         "atan" => {
             for i in 0..n {
                 let p = black_box(&poses[i % 1024]);
-                acc += polyscrew::fastmath::atan2_first_quadrant(p.rotation.x.abs(), p.rotation.w.abs());
+                acc += polyscrew::fastmath::atan2_first_quadrant(
+                    p.rotation.x.abs(),
+                    p.rotation.w.abs(),
+                );
             }
         }
         "stdatan" => {
@@ -53,7 +59,9 @@ fn main() {
         }
         "eval" => {
             // The screw built once per pair, evaluated n times (sampling's hot path).
-            let screws: Vec<polyscrew::Screw> = (0..1024).map(|i| polyscrew::Screw::between(&poses[i], &poses[(i + 1) % 1024])).collect();
+            let screws: Vec<polyscrew::Screw> = (0..1024)
+                .map(|i| polyscrew::Screw::between(&poses[i], &poses[(i + 1) % 1024]))
+                .collect();
             for i in 0..n {
                 acc += black_box(&screws[i % 1024]).eval(0.37).translation.x;
             }
@@ -61,7 +69,13 @@ fn main() {
         "subdivide" => {
             // The case: 100 keys (closed), 6 levels, Jarek; n runs.
             for _ in 0..n {
-                let d = polyscrew::subdivide(black_box(&poses[..100]), polyscrew::Scheme::Jarek, 6, true).unwrap();
+                let d = polyscrew::subdivide(
+                    black_box(&poses[..100]),
+                    polyscrew::Scheme::Jarek,
+                    6,
+                    true,
+                )
+                .unwrap();
                 acc += d[7].translation.x;
             }
         }
