@@ -114,7 +114,14 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
             values["scale"] = np.exp(log_scale)
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
-    cyclic = motion.cyclic and motion.closed and options.frame_range is None
+    # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
+    # that was cyclic in the source.
+    cyclic = (
+        motion.cyclic
+        and motion.closed
+        and options.frame_range is None
+        and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
+    )
     return Baked(obj=obj, motion=motion, frames=frames, values=values, cyclic=cyclic)
 
 

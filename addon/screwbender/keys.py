@@ -65,7 +65,7 @@ class KeyedMotion:
     first_rotation: np.ndarray
     #: Whether the motion is a cycle.
     closed: bool
-    #: Cycle length in frames for a closed motion (None: the core closes after a mean spacing).
+    #: Cycle length in frames for a closed motion (None for an open one).
     period: float | None
     #: Whether a Cycles modifier was found on the transform curves.
     cyclic: bool
@@ -243,6 +243,9 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
                 raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
             period = float(frames[-1] - frames[0])
             frames, poses, scale, rotation = frames[:-1], poses[:-1], scale[:-1], rotation[:-1]
+        else:
+            # no closing key: the last key returns to the first after the mean key spacing
+            period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
     scale_keyed = any(path == "scale" for path, _ in curves)
     return KeyedMotion(
         frames=frames,
