@@ -93,7 +93,6 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
     """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes)."""
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
-    frames = bake_frames(start, end, options.step)
     spec = dict(
         scheme=options.scheme,
         levels=options.levels,
@@ -102,6 +101,7 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         timing=options.timing,
     )
     try:
+        frames = bake_frames(start, end, options.step)
         poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
@@ -112,9 +112,16 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         if motion.scale_keyed:
             log_scale = polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec)
             values["scale"] = np.exp(log_scale)
-    except ValueError as err:
+    except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{obj.name}: {err}") from err
-    cyclic = motion.cyclic and motion.closed and options.frame_range is None
+    # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
+    # that was cyclic in the source.
+    cyclic = (
+        motion.cyclic
+        and motion.closed
+        and options.frame_range is None
+        and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
+    )
     return Baked(obj=obj, motion=motion, frames=frames, values=values, cyclic=cyclic)
 
 
