@@ -228,7 +228,17 @@ def _style(scene: bpy.types.Scene) -> _Style:
 
 
 def parent_space(obj: bpy.types.Object) -> Matrix:
-    """The world matrix of the space `matrix_basis` lives in, at the current frame."""
+    """The world matrix of the space `matrix_basis` lives in, at the current frame.
+
+    World space without a parent; `parent.matrix_world @ matrix_parent_inverse` under an
+    object parent; for bone and vertex parents, the evaluated `matrix_world @ matrix_basis^-1`.
+    (Constraints and delta transforms are not drawn.)
+    """
+    parent = obj.parent
+    if parent is None:
+        return Matrix.Identity(4)
+    if obj.parent_type == "OBJECT":
+        return parent.matrix_world @ obj.matrix_parent_inverse
     return obj.matrix_world @ obj.matrix_basis.inverted_safe()
 
 

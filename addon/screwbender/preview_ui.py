@@ -119,11 +119,11 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
     bl_options = {"REGISTER", "UNDO"}
 
     max_translation: FloatProperty(
-        name="Largest Move", subtype="DISTANCE", options={"SKIP_SAVE"},
+        name="Largest Move", subtype="DISTANCE",
         description="Largest displacement of an object's origin that the new key caused (output)",
     )
     max_angle: FloatProperty(
-        name="Largest Turn", subtype="ANGLE", options={"SKIP_SAVE"},
+        name="Largest Turn", subtype="ANGLE",
         description="Largest change of orientation that the new key caused (output)",
     )
 
