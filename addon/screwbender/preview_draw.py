@@ -37,7 +37,8 @@ SCENE_PROP = "screwbender_preview"
 #: Builtin shader names, the same in Blender 4.2 and 5.x (4.0 dropped the "3D_" prefixes).
 LINE_SHADER = "POLYLINE_UNIFORM_COLOR"
 FACE_SHADER = "UNIFORM_COLOR"
-POINT_SHADER = "POINT_UNIFORM_COLOR"
+#: Round points (Blender 4.4+); 4.2 draws square points with FACE_SHADER instead.
+POINT_SHADERS = ("POINT_UNIFORM_COLOR", FACE_SHADER)
 
 #: Opacity of the faint solid instances, relative to the instance colour's alpha.
 SOLID_ALPHA = 0.25
@@ -251,13 +252,22 @@ def _geometry_key(obj: bpy.types.Object, style: _Style) -> tuple:
     )
 
 
+def _point_shader() -> gpu.types.GPUShader:
+    for name in POINT_SHADERS:
+        try:
+            return gpu.shader.from_builtin(name)
+        except ValueError:  # not a builtin shader of this Blender
+            continue
+    raise ValueError(f"none of the shaders {POINT_SHADERS} is built in")
+
+
 def _build(entry: preview.PreviewEntry, geometry: preview.Geometry, style: _Style) -> dict:
     """GPU batches for one object: {name: (batch, shader name)}."""
     b = entry.batches
     out = {}
     line_shader = gpu.shader.from_builtin(LINE_SHADER)
     face_shader = gpu.shader.from_builtin(FACE_SHADER)
-    point_shader = gpu.shader.from_builtin(POINT_SHADER)
+    point_shader = _point_shader()
     v = len(geometry.points)
 
     def lines(matrices: np.ndarray):
@@ -279,7 +289,7 @@ def _build(entry: preview.PreviewEntry, geometry: preview.Geometry, style: _Styl
     out["keys"] = (lines(b.keys), LINE_SHADER)
     out["key_points"] = (
         batch_for_shader(point_shader, "POINTS", {"pos": b.keys[:, :3, 3].astype(np.float32)}),
-        POINT_SHADER,
+        "points",
     )
     out["trajectory"] = (
         batch_for_shader(line_shader, "LINE_STRIP", {"pos": b.trajectory.astype(np.float32)}), LINE_SHADER
@@ -306,7 +316,7 @@ def _batches_for(obj: bpy.types.Object, entry: preview.PreviewEntry, style: _Sty
 def _draw_one(batches: dict, style: _Style, viewport_size: tuple[float, float]) -> None:
     line = gpu.shader.from_builtin(LINE_SHADER)
     face = gpu.shader.from_builtin(FACE_SHADER)
-    point = gpu.shader.from_builtin(POINT_SHADER)
+    point = _point_shader()
 
     def draw_lines(name: str, color: tuple, width: float) -> None:
         if name not in batches:
