@@ -299,7 +299,8 @@ def object_geometry(obj: bpy.types.Object, heavy_limit: int) -> Geometry:
 def instance_vertices(points: np.ndarray, matrices: np.ndarray) -> np.ndarray:
     """`points` (V, 3) placed by each of `matrices` (N, 4, 4): (N * V, 3) float32."""
     m = np.asarray(matrices, dtype=np.float32)
-    out = np.einsum("nij,vj->nvi", m[:, :3, :3], points) + m[:, None, :3, 3]
+    out = np.matmul(np.asarray(points, dtype=np.float32)[None], m[:, :3, :3].transpose(0, 2, 1))
+    out += m[:, None, :3, 3]
     return out.reshape(-1, 3)
 
 
