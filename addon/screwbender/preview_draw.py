@@ -149,6 +149,15 @@ def _on_depsgraph_update(scene: bpy.types.Scene, depsgraph: bpy.types.Depsgraph)
     changed = refresh(scene) or changed
     if changed:
         tag_redraw()
+    if not CACHE.entries and not any(getattr(obj, OBJECT_PROP, False) for obj in bpy.data.objects):
+        # The last previewed object was deleted. A handler must not remove itself while
+        # Blender walks the handler list: disable from a timer instead (UI sessions only).
+        if not bpy.app.timers.is_registered(_deferred_sync):
+            bpy.app.timers.register(_deferred_sync, first_interval=0.0)
+
+
+def _deferred_sync() -> None:
+    sync()
 
 
 def refresh(scene: bpy.types.Scene) -> bool:
@@ -180,6 +189,8 @@ def register() -> None:
 def unregister() -> None:
     """Removes every handler of the overlay."""
     disable()
+    if bpy.app.timers.is_registered(_deferred_sync):
+        bpy.app.timers.unregister(_deferred_sync)
     for handlers in (bpy.app.handlers.load_post, bpy.app.handlers.undo_post, bpy.app.handlers.redo_post):
         while sync_persistent in handlers:
             handlers.remove(sync_persistent)

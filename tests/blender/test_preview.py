@@ -141,6 +141,36 @@ def test_unpreviewable_keys_give_a_message_not_a_crash(pd):
     assert entry.batches is None and "only one key frame" in entry.error
 
 
+def test_instance_geometry_wireframe_and_bounding_box(pd):
+    preview = addon_module("preview")
+    obj = keyed_object()
+    matrices = entry_of_enabled(pd, obj).instances
+    mesh_points = np.array([v.co for v in obj.data.vertices])
+    geometry = preview.object_geometry(obj, heavy_limit=100)
+    assert geometry.kind == "MESH" and len(geometry.edges) == len(obj.data.edges)
+    placed = preview.instance_vertices(geometry.points, matrices).reshape(len(matrices), -1, 3)
+    expected = np.einsum("nij,vj->nvi", matrices[:, :3, :3], mesh_points) + matrices[:, None, :3, 3]
+    np.testing.assert_allclose(placed, expected, rtol=0, atol=1e-5 * (1 + np.abs(expected).max()))
+    indices = preview.instance_indices(geometry.edges, len(geometry.points), len(matrices))
+    assert indices.shape == (len(matrices) * len(geometry.edges), 2) and indices.max() == placed.size // 3 - 1
+    # a mesh above the vertex limit is drawn as its bounding box
+    box = preview.object_geometry(obj, heavy_limit=3)
+    assert box.kind == "BOX" and box.edges.shape == (12, 2) and box.tris.shape == (12, 3)
+    np.testing.assert_allclose(box.points.min(axis=0), mesh_points.min(axis=0))
+    np.testing.assert_allclose(box.points.max(axis=0), mesh_points.max(axis=0))
+    lengths = np.linalg.norm(box.points[box.edges[:, 0]] - box.points[box.edges[:, 1]], axis=1)
+    np.testing.assert_allclose(np.sort(lengths), np.repeat(np.sort(np.ptp(mesh_points, axis=0)), 4), rtol=1e-6)
+    # an empty is drawn as its axes
+    empty = bpy.data.objects.new("Empty", None)
+    bpy.context.scene.collection.objects.link(empty)
+    assert preview.object_geometry(empty, heavy_limit=100).kind == "AXES"
+
+
+def entry_of_enabled(pd, obj):
+    obj.screwbender_preview = True
+    return entry_of(pd, obj)
+
+
 # Live update ----------------------------------------------------------------------------
 
 
@@ -224,6 +254,19 @@ def test_enabling_and_disabling_leaves_no_handler_behind(pd):
     for _ in range(5):
         a.screwbender_preview = True
         a.screwbender_preview = False
+    assert not pd.is_enabled() and pd.our_handlers() == persistent
+
+    # deleting the last previewed object: the depsgraph handler schedules the clean-up on a
+    # timer (a handler must not remove itself mid-walk); timers do not run in background
+    # mode, so the timer's call is made here
+    doomed = keyed_object("Doomed")
+    doomed.screwbender_preview = True
+    bpy.context.view_layer.update()
+    bpy.data.objects.remove(doomed)
+    bpy.context.view_layer.update()
+    assert bpy.app.timers.is_registered(pd._deferred_sync)
+    bpy.app.timers.unregister(pd._deferred_sync)
+    pd._deferred_sync()
     assert not pd.is_enabled() and pd.our_handlers() == persistent
 
     # disabling the add-on with the preview on removes every handler
