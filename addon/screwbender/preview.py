@@ -21,6 +21,7 @@ multiplies by the parent's world matrix.
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 from dataclasses import astuple, dataclass, field
 
@@ -143,13 +144,33 @@ def compute(motion: keys.KeyedMotion, options: PreviewOptions) -> PreviewBatches
     return batches
 
 
-def key_hash(obj: bpy.types.Object, options: PreviewOptions) -> bytes:
-    """A digest of everything :func:`keys.read` reads from `obj`, and of `options`.
+#: Current transform values differing from the curves by more than this (relative) at a key
+#: frame mean the user is moving the object there.
+LIVE_TOLERANCE = 1e-5
+
+
+@dataclass
+class LiveKey:
+    """The object's current transform at one of its key frames, differing from the keys
+    there: the user is moving or rotating that key pose (before auto-keying writes it)."""
+
+    frame: float
+    #: location (3,), rotation channel values, scale (3,).
+    location: np.ndarray
+    rotation: np.ndarray
+    scale: np.ndarray
+
+
+def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None) -> tuple[bytes, LiveKey | None]:
+    """A digest of everything :func:`keys.read` reads from `obj`, and of `options`; and the
+    live key at `frame` (see :class:`LiveKey`), which enters the digest too.
 
     Raw F-curve data of the transform channels (key coordinates, handles, interpolation,
     easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
     transform channels, the action and slot, NLA strips and transform drivers. Reading it is a
-    few `foreach_get` calls: far cheaper than reading and sampling the keys.
+    few `foreach_get` calls: far cheaper than reading and sampling the keys. The current
+    transform enters only when `frame` is a key frame and it differs from the curves there,
+    so playing or scrubbing the timeline never recomputes anything.
     """
     digest = hashlib.blake2b(digest_size=16)
     digest.update(repr(options.key()).encode())
@@ -164,11 +185,12 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions) -> bytes:
             f"|{sum(len(t.strips) for t in adt.nla_tracks)}"
             f"|{sorted((d.data_path, d.array_index) for d in adt.drivers if d.data_path in paths)}".encode()
         )
-    keyed = set()
+    curves = {}
+    at_key = False
     for fc in channels.object_fcurves(obj):
         if fc.data_path not in paths:
             continue
-        keyed.add((fc.data_path, fc.array_index))
+        curves[(fc.data_path, fc.array_index)] = fc
         points = fc.keyframe_points
         count = len(points)
         digest.update(
@@ -179,12 +201,42 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions) -> bytes:
             buf = np.empty(width * count, dtype=dtype)
             points.foreach_get(attr, buf)
             digest.update(buf.tobytes())
+            if attr == "co" and frame is not None and count and not fc.mute:
+                at_key = at_key or bool(np.any(np.abs(buf[0::2] - frame) < keys.FRAME_TOLERANCE))
     # Unkeyed channels enter the key poses with their current (static) value.
+    current = {}
+    changed = False
     for path in paths:
-        values = getattr(obj, path)
-        static = [v for i, v in enumerate(values) if (path, i) not in keyed]
+        values = np.array(getattr(obj, path), dtype=np.float64)
+        current[path] = values
+        static = [v for i, v in enumerate(values) if (path, i) not in curves]
         digest.update(np.asarray(static, dtype=np.float64).tobytes())
-    return digest.digest()
+        if at_key:
+            for i, value in enumerate(values):
+                fc = curves.get((path, i))
+                if fc is not None and not fc.mute and abs(fc.evaluate(frame) - value) > LIVE_TOLERANCE * (1.0 + abs(value)):
+                    changed = True
+    live = None
+    if changed:
+        live = LiveKey(frame, current[paths[0]], current[paths[1]], current[paths[2]])
+        digest.update(np.concatenate([[frame], live.location, live.rotation, live.scale]).tobytes())
+    return digest.digest(), live
+
+
+def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
+    """`motion` with the key pose at `live.frame` replaced by the live transform."""
+    hits = np.flatnonzero(np.abs(motion.frames - live.frame) < keys.FRAME_TOLERANCE)
+    if len(hits) == 0:  # e.g. the key closing a cycle: it repeats the first pose
+        return motion
+    k = hits[0]
+    poses = motion.poses.copy()
+    scales = motion.scales.copy()
+    rotation = keys.rotation_matrices(live.rotation[None, :], motion.rotation_mode)
+    poses[k] = keys.compose(live.location[None, :], rotation)[0]
+    scales[k] = live.scale
+    if not np.all(scales[k] > 0.0):
+        return motion
+    return dataclasses.replace(motion, poses=poses, scales=scales)
 
 
 @dataclass
@@ -206,15 +258,23 @@ class PreviewCache:
         #: How many times each object (by name) was recomputed: for tests and statistics.
         self.recomputed: dict[str, int] = {}
 
-    def refresh(self, obj: bpy.types.Object, options: PreviewOptions) -> tuple[PreviewEntry, bool]:
-        """The preview of `obj` and whether it was recomputed now (its hash changed)."""
-        digest = key_hash(obj, options)
+    def refresh(
+        self, obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None
+    ) -> tuple[PreviewEntry, bool]:
+        """The preview of `obj` and whether it was recomputed now (its hash changed).
+
+        `frame` is the current frame: when it is a key frame and the object is being moved
+        there, the preview shows the motion with the object's current pose as that key.
+        """
+        digest, live = key_hash(obj, options, frame)
         uid = obj.session_uid
         entry = self.entries.get(uid)
         if entry is not None and entry.digest == digest:
             return entry, False
         try:
             motion = keys.read(obj, options.smooth.closed)
+            if live is not None:
+                motion = with_live_key(motion, live)
             entry = PreviewEntry(digest, compute(motion, options))
         except (SmoothError, ValueError) as err:
             message = str(err)

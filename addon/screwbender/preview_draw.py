@@ -77,9 +77,21 @@ def smooth_options(scene: bpy.types.Scene) -> bake.Options:
     return preview_options(scene).smooth
 
 
+def current_frame(scene: bpy.types.Scene) -> float:
+    """The scene's current frame, with its subframe."""
+    return scene.frame_current + scene.frame_subframe
+
+
 def enabled_objects(scene: bpy.types.Scene) -> list[bpy.types.Object]:
     """The objects of `scene` whose preview is on."""
     return [obj for obj in scene.objects if getattr(obj, OBJECT_PROP, False)]
+
+
+def moved_unkeyed(scene: bpy.types.Scene, objects: list[bpy.types.Object]) -> list[str]:
+    """Names of `objects` moved at a key frame and not keyed (the preview shows a live key)."""
+    options = preview_options(scene)
+    frame = current_frame(scene)
+    return [obj.name for obj in objects if preview.key_hash(obj, options, frame)[1] is not None]
 
 
 # Handlers ---------------------------------------------------------------------------------
@@ -166,8 +178,9 @@ def refresh(scene: bpy.types.Scene) -> bool:
     options = preview_options(scene)
     objects = enabled_objects(scene)
     changed = False
+    frame = current_frame(scene)
     for obj in objects:
-        changed = CACHE.refresh(obj, options)[1] or changed
+        changed = CACHE.refresh(obj, options, frame)[1] or changed
     keep = {obj.session_uid for obj in objects}
     CACHE.forget(keep)
     for uid in [u for u in _gpu_batches if u not in keep]:
@@ -364,6 +377,7 @@ def draw_previews(
     matrices; returns how many objects were drawn."""
     options = preview_options(scene)
     style = _style(scene)
+    frame = current_frame(scene)
     drawn = 0
     gpu.state.blend_set("ALPHA")
     gpu.state.depth_test_set("LESS_EQUAL")
@@ -372,7 +386,7 @@ def draw_previews(
         for obj in enabled_objects(scene):
             if not obj.visible_get(view_layer=view_layer):
                 continue
-            entry, _ = CACHE.refresh(obj, options)
+            entry, _ = CACHE.refresh(obj, options, frame)
             if entry.batches is None:
                 continue
             batches = _batches_for(obj, entry, style)

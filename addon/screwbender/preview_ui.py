@@ -92,6 +92,14 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         objects = sorted(preview_draw.enabled_objects(context.scene), key=lambda o: o.name)
+        moved = preview_draw.moved_unkeyed(context.scene, objects)
+        if moved:
+            self.report(
+                {"ERROR"},
+                f"{', '.join(moved)}: moved at a key frame but not keyed; the preview shows that pose, "
+                "the keys do not: key it (or undo the move) before applying",
+            )
+            return {"CANCELLED"}
         try:
             actions, skipped = bake.smooth(objects, preview_draw.smooth_options(context.scene))
         except SmoothError as err:
