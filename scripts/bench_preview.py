@@ -12,6 +12,10 @@ scheme, 5 levels, smooth timing. Timed, each as the median of many repetitions:
   hash      what the handler costs when nothing changed: the key hash check only;
   vertices  placing a 1,000-vertex mesh at the 64 instances (the GPU batch's positions).
 
+Wall-clock medians, fastest runs and the median CPU time of the calling thread are printed;
+the target is judged on the CPU median, which does not count time the process spends
+waiting for a core on a shared machine (polyscrew runs on the calling thread).
+
 Run with the bpy wheel after scripts/build_extension.sh (the add-on is installed from the
 built .zip into a temporary Blender user directory):
     PYTHONPATH=<polyscrew target>:.venv/bpy/5.0 .venv/bin/python scripts/bench_preview.py [--quick]
@@ -62,17 +66,18 @@ def keyed_object() -> bpy.types.Object:
     return obj
 
 
-def median_ms(run, repeat: int) -> tuple[float, float, float]:
-    """Median, fastest and 90th percentile, milliseconds."""
+def median_ms(run, repeat: int) -> dict[str, float]:
+    """Milliseconds per run: median and fastest wall-clock time, and median CPU time of this
+    thread (what the run itself costs, whatever else the machine is doing)."""
     for _ in range(max(3, repeat // 20)):  # warm up
         run()
-    times = []
+    wall, cpu = [], []
     for _ in range(repeat):
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.thread_time()
         run()
-        times.append((time.perf_counter() - start) * 1e3)
-    times.sort()
-    return statistics.median(times), times[0], times[int(0.9 * (len(times) - 1))]
+        cpu.append((time.thread_time() - start_cpu) * 1e3)
+        wall.append((time.perf_counter() - start) * 1e3)
+    return {"wall": statistics.median(wall), "fastest": min(wall), "cpu": statistics.median(cpu)}
 
 
 def main() -> None:
@@ -116,14 +121,16 @@ def main() -> None:
         f"Blender {bpy.app.version_string}; {KEYS} keys, {LEVELS} levels ({dense} dense poses), "
         f"{INSTANCES} instances, {TRAJECTORY} trajectory points; median of {repeat} runs"
     )
-    for name, (median, fastest, p90) in rows:
-        print(f"  {name:<9} median {median:7.3f} ms   fastest {fastest:7.3f} ms   p90 {p90:7.3f} ms")
-    compute = rows[0][1][0]
-    verdict = "meets" if compute < TARGET_MS else "MISSES"
-    print(f"recompute {compute:.3f} ms (median) {verdict} the {TARGET_MS:g} ms target")
+    for name, t in rows:
+        print(f"  {name:<9} wall median {t['wall']:7.3f} ms   fastest {t['fastest']:7.3f} ms   CPU median {t['cpu']:7.3f} ms")
+    compute = rows[0][1]
+    verdict = "meets" if compute["cpu"] < TARGET_MS else "MISSES"
+    print(
+        f"recompute: CPU median {compute['cpu']:.3f} ms, wall median {compute['wall']:.3f} ms, "
+        f"fastest {compute['fastest']:.3f} ms: {verdict} the {TARGET_MS:g} ms target (CPU median)"
+    )
     if hasattr(os, "getloadavg"):
-        print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (timings are noisy under load)")
-
+        print(f"machine: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f} (wall times are noisy under load)")
 
 if __name__ == "__main__":
     main()

@@ -42,11 +42,19 @@ _KEY_ATTRS = (
     ("handle_left", 2, np.float32),
     ("handle_right", 2, np.float32),
     ("interpolation", 1, np.int32),
+)
+#: ... and those that matter only for the easing interpolations (Sine ... Elastic).
+_EASING_ATTRS = (
     ("easing", 1, np.int32),
     ("back", 1, np.float32),
     ("amplitude", 1, np.float32),
     ("period", 1, np.float32),
 )
+_INTERPOLATIONS = {item.identifier: item.value for item in bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items}
+#: Interpolation values above this are easing interpolations (Blender numbers Constant,
+#: Linear, Bezier first); checked here rather than assumed.
+_PLAIN_MAX = max(_INTERPOLATIONS[name] for name in ("CONSTANT", "LINEAR", "BEZIER"))
+assert all(v > _PLAIN_MAX for k, v in _INTERPOLATIONS.items() if k not in ("CONSTANT", "LINEAR", "BEZIER"))
 
 
 @dataclass(frozen=True)
@@ -203,6 +211,11 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None
             digest.update(buf.tobytes())
             if attr == "co" and frame is not None and count and not fc.mute:
                 at_key = at_key or bool(np.any(np.abs(buf[0::2] - frame) < keys.FRAME_TOLERANCE))
+        if count and int(buf.max()) > _PLAIN_MAX:  # buf: the interpolations
+            for attr, width, dtype in _EASING_ATTRS:
+                extra = np.empty(width * count, dtype=dtype)
+                points.foreach_get(attr, extra)
+                digest.update(extra.tobytes())
     # Unkeyed channels enter the key poses with their current (static) value.
     current = {}
     changed = False
