@@ -220,6 +220,15 @@ def test_editing_a_key_recomputes_through_the_depsgraph_handler(pd):
     body.keyframe_insert("location", frame=33)
     bpy.context.view_layer.update()
     assert pd.CACHE.recomputed["Body"] == count["Body"] + 2
+    # interpolation and easing parameters decide values between keys: they are hashed too
+    point = curve.keyframe_points[1]
+    point.interpolation = "ELASTIC"
+    bpy.context.view_layer.update()
+    assert pd.CACHE.recomputed["Body"] == count["Body"] + 3
+    point.amplitude += 0.5
+    bpy.context.view_layer.update()
+    assert pd.CACHE.recomputed["Body"] == count["Body"] + 4
+    count["Body"] += 2
     # a scheme change recomputes both previewed objects, and nothing else. (A scene setting
     # does not trigger a depsgraph update; the panel redraws the viewport, and every redraw
     # starts with this same hash check.)
@@ -403,6 +412,25 @@ def test_offscreen_drawing(pd):
         y = (p[1] - center[1]) / size * height + height / 2
         window = red[max(0, int(y) - 2) : int(y) + 3, max(0, int(x) - 2) : int(x) + 3]
         assert window.any(), (p, x, y)
+    # the draw handler's own callback (what the viewport calls) draws the same, without error
+    import gpu
+
+    offscreen = gpu.types.GPUOffScreen(width, height)
+    try:
+        with offscreen.bind():
+            framebuffer = gpu.state.active_framebuffer_get()
+            framebuffer.clear(color=(1.0, 1.0, 1.0, 1.0), depth=1.0)
+            with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
+                gpu.matrix.load_matrix(view)
+                gpu.matrix.load_projection_matrix(projection)
+                pd._draw_callback()
+            buffer = framebuffer.read_color(0, 0, width, height, 4, 0, "FLOAT")
+            buffer.dimensions = width * height * 4
+            from_callback = np.array(buffer, dtype=np.float32).reshape(height, width, 4)
+    finally:
+        offscreen.free()
+    assert pd._last_draw_error == ""
+    np.testing.assert_allclose(from_callback, pixels, atol=1e-6)
     # nothing drawn once the preview is off
     obj.screwbender_preview = False
     pixels, drawn = pd.render_offscreen(scene, bpy.context.view_layer, view, projection, width, height)
