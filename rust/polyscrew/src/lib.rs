@@ -34,6 +34,6 @@ pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use sample::{sample, Motion, MotionSpec};
-pub use screw::{s, Screw};
+pub use screw::{midpoint, s, Screw};
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
 pub use timing::{check_key_times, TimeMap, Timing};

@@ -183,6 +183,33 @@ impl Screw {
     }
 }
 
+/// `s(a, 1/2, b)`, the pose halfway along the minimal screw, without trigonometry.
+///
+/// With `q = (w, v) = (cos h, sin h S)` the relative rotation (`w >= 0`) and `tau` its
+/// translation, the half-angle identities give
+/// `q^(1/2) = (c, v / (2 c))` with `c = cos(h / 2) = sqrt((1 + w) / 2)`, and the
+/// translation of `M^(1/2)` is `tau / 2 - (v x tau) / (2 (1 + w))` (`A = 1/2`,
+/// `B S = -tan(h / 2) S / 2 = -v / (2 (1 + w))` in [`Screw::motion`]). Exact at `h = 0`,
+/// regular up to the half turn. The outer step of every Split&Tweak rule.
+#[inline]
+pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
+    let mut q = b.rotation * a.rotation.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let q = q.normalize();
+    let v = q.xyz();
+    let tau = b.translation - q * a.translation;
+    let c = (0.5 * (1.0 + q.w)).sqrt();
+    let half_v = v * (0.5 / c);
+    let rotation = DQuat::from_xyzw(half_v.x, half_v.y, half_v.z, c);
+    let translation = 0.5 * tau - v.cross(tau) * (0.5 / (1.0 + q.w));
+    Pose {
+        rotation: (rotation * a.rotation).normalize(),
+        translation: rotation * a.translation + translation,
+    }
+}
+
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
 #[inline]
@@ -246,6 +273,21 @@ mod tests {
                 let err = sc.eval(t).max_abs_diff(&e);
                 assert!(err < 1e-12, "angle {angle:e} t {t}: error {err:e}");
             }
+        }
+    }
+
+    #[test]
+    fn midpoint_equals_half_screw() {
+        let a = Pose::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
+            DVec3::new(1.0, 2.0, -0.5),
+        );
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        let p = DVec3::new(0.5, -0.3, 0.1);
+        for angle in [0.0, 1e-12, 1e-6, 0.5, 2.0, PI - 1e-6] {
+            let b = exact(axis, p, angle, 0.7, 1.0, &a);
+            let err = midpoint(&a, &b).max_abs_diff(&exact(axis, p, angle, 0.7, 0.5, &a));
+            assert!(err < 1e-13, "angle {angle:e}: error {err:e}");
         }
     }
 
