@@ -249,7 +249,10 @@ def register_properties() -> None:
     )
     bpy.types.VIEW3D_MT_object_animation.append(menu_func)
     preview_draw.register()
-    preview_draw.sync()
+    try:
+        preview_draw.sync()  # the add-on enabled in a session where objects have the preview on
+    except AttributeError:
+        pass  # bpy.data is restricted while Blender starts up: load_post syncs once the file is loaded
 
 
 def unregister_properties() -> None:
