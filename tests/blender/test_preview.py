@@ -289,6 +289,33 @@ def test_moving_the_object_at_a_key_frame_previews_the_moved_key(pd):
     np.testing.assert_allclose(entry_of(pd, obj).instances, keyed.instances, atol=1e-12)
 
 
+def test_drawn_in_the_parents_space_without_recomputing(pd):
+    """Batches are in the parent's space; drawn under the parent's world matrix they land on
+    the object's world poses as Blender evaluates them, and moving the parent recomputes nothing."""
+    scene = bpy.context.scene
+    set_smooth(scene, "four_point", 3, "smooth")
+    parent = bpy.data.objects.new("Parent", None)
+    scene.collection.objects.link(parent)
+    parent.location = (10.0, -3.0, 2.0)
+    parent.rotation_euler = (0.4, 0.0, 1.2)
+    parent.scale = (2.0, 2.0, 2.0)
+    obj = keyed_object()
+    obj.parent = parent
+    obj.screwbender_preview = True
+    bpy.context.view_layer.update()
+    b = entry_of(pd, obj)
+    count = pd.CACHE.recomputed["Body"]
+    for i, frame in enumerate(FRAMES):
+        scene.frame_set(int(frame))
+        world = np.array(pd.parent_space(obj)) @ b.keys[i]
+        np.testing.assert_allclose(world, np.array(obj.matrix_world), atol=1e-5)
+    parent.location = (0.0, 5.0, 0.0)
+    bpy.context.view_layer.update()
+    pd.refresh(scene)
+    assert pd.CACHE.recomputed["Body"] == count
+    np.testing.assert_allclose(np.array(pd.parent_space(obj))[:3, 3], (0.0, 5.0, 0.0), atol=1e-6)
+
+
 # Handlers -------------------------------------------------------------------------------
 
 
