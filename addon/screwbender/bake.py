@@ -80,25 +80,16 @@ class Baked:
     cyclic: bool
 
 
-def bake_frames(start: float, end: float, step: float) -> np.ndarray:
-    """Frames from `start` to `end` (included when on the grid) every `step` frames."""
-    if not step > 0.0:
-        raise SmoothError(f"step must be positive, got {step:g}")
-    if not end > start:
-        raise SmoothError(f"frame range {start:g} to {end:g} is empty")
-    count = int(np.floor((end - start) / step + 1e-9)) + 1
-    return start + step * np.arange(count, dtype=np.float64)
-
-
 def sample_poses(
     motion: keys.KeyedMotion, frames: np.ndarray, options: Options
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """The smoothed motion at `frames`: rigid poses (len(frames), 4, 4) and, when scale is
     keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses,
-    one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError` from polyscrew.
+    one `polyscrew.sample_vectors` call for log-scale, with exactly the arguments
+    :func:`sample_channels` uses. Raises `ValueError` from polyscrew.
 
-    Everything that samples a motion (the bake, the live preview, Insert Key on Motion)
-    goes through here, so they all show and write the same motion.
+    The live preview and Insert Key on Motion sample through here, so they show and key the
+    motion Smooth Motion bakes (tests/blender/test_preview.py checks the keys bit for bit).
     """
     spec = dict(
         scheme=options.scheme,
@@ -114,37 +105,60 @@ def sample_poses(
     return poses, scales
 
 
+def bake_frames(start: float, end: float, step: float) -> np.ndarray:
+    """Frames from `start` to `end` (included when on the grid) every `step` frames."""
+    if not step > 0.0:
+        raise SmoothError(f"step must be positive, got {step:g}")
+    if not end > start:
+        raise SmoothError(f"frame range {start:g} to {end:g} is empty")
+    count = int(np.floor((end - start) / step + 1e-9)) + 1
+    return start + step * np.arange(count, dtype=np.float64)
+
+
 def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
     """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes)."""
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
     frames = bake_frames(start, end, options.step)
+    spec = dict(
+        scheme=options.scheme,
+        levels=options.levels,
+        closed=motion.closed,
+        period=motion.period,
+        timing=options.timing,
+    )
     try:
-        poses, scales = sample_poses(motion, frames, options)
+        poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         values = {
             "location": poses[:, :3, 3].copy(),
             keys.rotation_path(mode): polyscrew.rotation_channels(poses, mode, previous=previous),
         }
-        if scales is not None:
-            values["scale"] = scales
+        if motion.scale_keyed:
+            log_scale = polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec)
+            values["scale"] = np.exp(log_scale)
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
     cyclic = motion.cyclic and motion.closed and options.frame_range is None
     return Baked(obj=obj, motion=motion, frames=frames, values=values, cyclic=cyclic)
 
 
-def _write_curve(bag, path: str, index: int, frames: np.ndarray, values: np.ndarray, cyclic: bool) -> None:
-    fcurve = channels.new_fcurve(bag, path, index)
-    points = fcurve.keyframe_points
-    points.add(len(frames))
-    co = np.empty((len(frames), 2), dtype=np.float32)
+def _write_curves(bag, path: str, frames: np.ndarray, values: np.ndarray, cyclic: bool) -> None:
+    """One dense linear F-curve per column of `values`, keyed at `frames`."""
+    co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
     co[:, 0] = frames
-    co[:, 1] = values
-    points.foreach_set("co", co.ravel())
-    points.foreach_set("interpolation", np.full(len(frames), _LINEAR, dtype=np.int32))
-    if cyclic:
-        fcurve.modifiers.new("CYCLES")
+    # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
+    # for an enum property (measured in Blender 4.2 and 5.0).
+    linear = (_LINEAR,) * len(frames)
+    for index in range(values.shape[1]):
+        fcurve = channels.new_fcurve(bag, path, index)
+        points = fcurve.keyframe_points
+        points.add(len(frames))
+        co[:, 1] = values[:, index]
+        points.foreach_set("co", co.ravel())
+        points.foreach_set("interpolation", linear)
+        if cyclic:
+            fcurve.modifiers.new("CYCLES")
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
@@ -165,8 +179,7 @@ def write(baked: Baked) -> bpy.types.Action:
     for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced and fc.data_path in baked_paths]:
         bag.fcurves.remove(fcurve)
     for path, values in baked.values.items():
-        for index in range(values.shape[1]):
-            _write_curve(bag, path, index, baked.frames, values[:, index], baked.cyclic)
+        _write_curves(bag, path, baked.frames, values, baked.cyclic)
     smoothed[SOURCE_KEY] = source
     smoothed[SOURCE_SLOT_KEY] = identifier
     smoothed[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
