@@ -113,6 +113,23 @@ def test_batches_equal_polyscrew_sample(pd, scheme, levels, timing):
     np.testing.assert_allclose(b.raw_trajectory, raw_traj[:, :3, 3], rtol=0, atol=1e-9)
 
 
+@pytest.mark.parametrize("closed", [False, True])
+def test_preview_sampler_is_the_bakes(sb, closed):
+    """bake.sample_poses (preview, Insert Key) and bake.sample_channels (Smooth Motion) give
+    the same numbers, bit for bit."""
+    obj = keyed_object(scale=True)
+    if closed:
+        for fc in fcurves(obj):
+            fc.modifiers.new("CYCLES")
+    options = sb.bake.Options(scheme="jarek", levels=4, timing="smooth", step=0.5)
+    motion = sb.keys.read(obj, options.closed)
+    assert motion.closed == closed
+    baked = sb.bake.sample_channels(obj, motion, options)
+    poses, scales = sb.bake.sample_poses(motion, baked.frames, options)
+    np.testing.assert_array_equal(baked.values["location"], poses[:, :3, 3])
+    np.testing.assert_array_equal(baked.values["scale"], scales)
+
+
 def test_cycle_instances_leave_out_the_closing_pose(pd):
     scene = bpy.context.scene
     obj = new_object("Cycle")
