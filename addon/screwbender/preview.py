@@ -159,8 +159,9 @@ LIVE_TOLERANCE = 1e-5
 
 @dataclass
 class LiveKey:
-    """The object's current transform at one of its key frames, differing from the keys
-    there: the user is moving or rotating that key pose (before auto-keying writes it)."""
+    """The object's current transform, differing from its animation at the current frame:
+    the user is moving or rotating it. At a key frame it stands for that key pose; elsewhere
+    (with auto-keying on) for the key auto-keying will insert there."""
 
     frame: float
     #: location (3,), rotation channel values, scale (3,).
@@ -169,7 +170,9 @@ class LiveKey:
     scale: np.ndarray
 
 
-def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None) -> tuple[bytes, LiveKey | None]:
+def key_hash(
+    obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
+) -> tuple[bytes, LiveKey | None]:
     """A digest of everything :func:`keys.read` reads from `obj`, and of `options`; and the
     live key at `frame` (see :class:`LiveKey`), which enters the digest too.
 
@@ -177,8 +180,8 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None
     easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
     transform channels, the action and slot, NLA strips and transform drivers. Reading it is a
     few `foreach_get` calls: far cheaper than reading and sampling the keys. The current
-    transform enters only when `frame` is a key frame and it differs from the curves there,
-    so playing or scrubbing the timeline never recomputes anything.
+    transform enters only when `frame` is a key frame (or `auto_key` is on) and it differs
+    from the curves there, so playing or scrubbing the timeline never recomputes anything.
     """
     digest = hashlib.blake2b(digest_size=16)
     digest.update(repr(options.key()).encode())
@@ -224,7 +227,7 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None
         current[path] = values
         static = [v for i, v in enumerate(values) if (path, i) not in curves]
         digest.update(np.asarray(static, dtype=np.float64).tobytes())
-        if at_key:
+        if at_key or (auto_key and frame is not None):
             for i, value in enumerate(values):
                 fc = curves.get((path, i))
                 if fc is not None and not fc.mute and abs(fc.evaluate(frame) - value) > LIVE_TOLERANCE * (1.0 + abs(value)):
@@ -237,19 +240,27 @@ def key_hash(obj: bpy.types.Object, options: PreviewOptions, frame: float | None
 
 
 def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
-    """`motion` with the key pose at `live.frame` replaced by the live transform."""
-    hits = np.flatnonzero(np.abs(motion.frames - live.frame) < keys.FRAME_TOLERANCE)
-    if len(hits) == 0:  # e.g. the key closing a cycle: it repeats the first pose
+    """`motion` with the live transform as its key at `live.frame`: replacing the key pose
+    there, or inserted as a new key (open motions; a cycle keeps its keys)."""
+    if not np.all(live.scale > 0.0):
         return motion
-    k = hits[0]
-    poses = motion.poses.copy()
-    scales = motion.scales.copy()
     rotation = keys.rotation_matrices(live.rotation[None, :], motion.rotation_mode)
-    poses[k] = keys.compose(live.location[None, :], rotation)[0]
-    scales[k] = live.scale
-    if not np.all(scales[k] > 0.0):
+    pose = keys.compose(live.location[None, :], rotation)[0]
+    hits = np.flatnonzero(np.abs(motion.frames - live.frame) < keys.FRAME_TOLERANCE)
+    if len(hits):
+        k = hits[0]
+        poses, scales = motion.poses.copy(), motion.scales.copy()
+        poses[k], scales[k] = pose, live.scale
+        return dataclasses.replace(motion, poses=poses, scales=scales)
+    if motion.closed:
         return motion
-    return dataclasses.replace(motion, poses=poses, scales=scales)
+    k = int(np.searchsorted(motion.frames, live.frame))
+    return dataclasses.replace(
+        motion,
+        frames=np.insert(motion.frames, k, live.frame),
+        poses=np.insert(motion.poses, k, pose, axis=0),
+        scales=np.insert(motion.scales, k, live.scale, axis=0),
+    )
 
 
 @dataclass
@@ -272,14 +283,15 @@ class PreviewCache:
         self.recomputed: dict[str, int] = {}
 
     def refresh(
-        self, obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None
+        self, obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
     ) -> tuple[PreviewEntry, bool]:
         """The preview of `obj` and whether it was recomputed now (its hash changed).
 
-        `frame` is the current frame: when it is a key frame and the object is being moved
-        there, the preview shows the motion with the object's current pose as that key.
+        `frame` is the current frame: when the object is being moved there, at a key frame or
+        with auto-keying on (`auto_key`), the preview shows the motion with the object's
+        current pose as the key at that frame.
         """
-        digest, live = key_hash(obj, options, frame)
+        digest, live = key_hash(obj, options, frame, auto_key)
         uid = obj.session_uid
         entry = self.entries.get(uid)
         if entry is not None and entry.digest == digest:

@@ -82,6 +82,11 @@ def current_frame(scene: bpy.types.Scene) -> float:
     return scene.frame_current + scene.frame_subframe
 
 
+def auto_keying(scene: bpy.types.Scene) -> bool:
+    """Whether auto-keying is on in `scene`."""
+    return bool(scene.tool_settings.use_keyframe_insert_auto)
+
+
 def enabled_objects(scene: bpy.types.Scene) -> list[bpy.types.Object]:
     """The objects of `scene` whose preview is on."""
     return [obj for obj in scene.objects if getattr(obj, OBJECT_PROP, False)]
@@ -91,7 +96,8 @@ def moved_unkeyed(scene: bpy.types.Scene, objects: list[bpy.types.Object]) -> li
     """Names of `objects` moved at a key frame and not keyed (the preview shows a live key)."""
     options = preview_options(scene)
     frame = current_frame(scene)
-    return [obj.name for obj in objects if preview.key_hash(obj, options, frame)[1] is not None]
+    auto = auto_keying(scene)
+    return [obj.name for obj in objects if preview.key_hash(obj, options, frame, auto)[1] is not None]
 
 
 # Handlers ---------------------------------------------------------------------------------
@@ -179,8 +185,9 @@ def refresh(scene: bpy.types.Scene) -> bool:
     objects = enabled_objects(scene)
     changed = False
     frame = current_frame(scene)
+    auto = auto_keying(scene)
     for obj in objects:
-        changed = CACHE.refresh(obj, options, frame)[1] or changed
+        changed = CACHE.refresh(obj, options, frame, auto)[1] or changed
     keep = {obj.session_uid for obj in objects}
     CACHE.forget(keep)
     for uid in [u for u in _gpu_batches if u not in keep]:
@@ -378,6 +385,7 @@ def draw_previews(
     options = preview_options(scene)
     style = _style(scene)
     frame = current_frame(scene)
+    auto = auto_keying(scene)
     drawn = 0
     gpu.state.blend_set("ALPHA")
     gpu.state.depth_test_set("LESS_EQUAL")
@@ -386,7 +394,7 @@ def draw_previews(
         for obj in enabled_objects(scene):
             if not obj.visible_get(view_layer=view_layer):
                 continue
-            entry, _ = CACHE.refresh(obj, options, frame)
+            entry, _ = CACHE.refresh(obj, options, frame, auto)
             if entry.batches is None:
                 continue
             batches = _batches_for(obj, entry, style)

@@ -306,6 +306,35 @@ def test_moving_the_object_at_a_key_frame_previews_the_moved_key(pd):
     np.testing.assert_allclose(entry_of(pd, obj).instances, keyed.instances, atol=1e-12)
 
 
+def test_with_auto_keying_moving_between_keys_previews_the_new_key(pd):
+    scene = bpy.context.scene
+    set_smooth(scene, "jarek", 3, "smooth")
+    obj = keyed_object()
+    obj.screwbender_preview = True
+    scene.frame_set(33)  # between the keys at 26 and 41
+    original = entry_of(pd, obj).instances.copy()
+    obj.location = (2.0, 6.0, 1.0)
+    bpy.context.view_layer.update()
+    # auto-keying off: a move between keys is not a key; nothing changes
+    np.testing.assert_array_equal(entry_of(pd, obj).instances, original)
+    scene.tool_settings.use_keyframe_insert_auto = True
+    bpy.context.view_layer.update()
+    live = entry_of(pd, obj)
+    frames, key_matrices = baked_matrices(obj)
+    assert list(live.key_frames) == sorted(list(frames) + [33.0])
+    current = rigid(np.array(obj.location), Rotation.from_euler("xyz", np.array(obj.rotation_euler)).as_matrix())
+    expected = polyscrew.sample(
+        np.insert(key_matrices, 4, current[0], axis=0), np.insert(frames, 4, 33.0), live.instance_times,
+        scheme="jarek", levels=3, timing="smooth",
+    )
+    np.testing.assert_allclose(live.instances, expected, atol=1e-9)
+    # what auto-keying writes on confirm is what was previewed
+    obj.keyframe_insert("location", frame=33)
+    obj.keyframe_insert("rotation_euler", frame=33)
+    bpy.context.view_layer.update()
+    np.testing.assert_allclose(entry_of(pd, obj).instances, live.instances, atol=1e-5)
+
+
 def test_drawn_in_the_parents_space_without_recomputing(pd):
     """Batches are in the parent's space; drawn under the parent's world matrix they land on
     the object's world poses as Blender evaluates them, and moving the parent recomputes nothing."""
