@@ -80,6 +80,31 @@ class Baked:
     cyclic: bool
 
 
+def sample_poses(
+    motion: keys.KeyedMotion, frames: np.ndarray, options: Options
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """The smoothed motion at `frames`: rigid poses (len(frames), 4, 4) and, when scale is
+    keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses,
+    one `polyscrew.sample_vectors` call for log-scale, with exactly the arguments
+    :func:`sample_channels` uses. Raises `ValueError` from polyscrew.
+
+    The live preview and Insert Key on Motion sample through here, so they show and key the
+    motion Smooth Motion bakes (tests/blender/test_preview.py checks the keys bit for bit).
+    """
+    spec = dict(
+        scheme=options.scheme,
+        levels=options.levels,
+        closed=motion.closed,
+        period=motion.period,
+        timing=options.timing,
+    )
+    poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
+    scales = None
+    if motion.scale_keyed:
+        scales = np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
+    return poses, scales
+
+
 def bake_frames(start: float, end: float, step: float) -> np.ndarray:
     """Frames from `start` to `end` (included when on the grid) every `step` frames."""
     if not step > 0.0:
