@@ -26,6 +26,7 @@ pub mod pose;
 pub mod sample;
 pub mod screw;
 pub mod subdivision;
+pub mod sweep;
 pub mod timing;
 
 pub use error::{Error, PoseDefect, Result};
@@ -33,4 +34,5 @@ pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use sample::{sample, Motion, MotionSpec};
 pub use screw::{s, Screw};
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
+pub use sweep::{sweep, sweep_mesh, Body, Generator, SweepOptions, SweptMesh};
 pub use timing::{check_key_times, TimeMap, Timing};
