@@ -21,6 +21,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod channels;
 pub mod error;
 pub mod pose;
 pub mod sample;
@@ -29,6 +30,7 @@ pub mod subdivision;
 pub mod sweep;
 pub mod timing;
 
+pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use sample::{sample, Motion, MotionSpec};
