@@ -21,6 +21,11 @@
 //!   are added there (a superset of those points, a thin band along the silhouette for a
 //!   smooth motion).
 //!
+//! A quad `(a_j, b_j, b_{j+1}, a_{j+1})` is twisted: its two triangles leave the ruled
+//! surface swept by `(a, b)` by up to `|omega x (b - a)| / (4 k)` (`omega = r S`), first order
+//! in the step. Long segments are therefore cut into `n` equal pieces with
+//! `|omega x (b - a)| / (4 k n) <= TWIST_REL * extent` (at most [`MAX_PIECES`]).
+//!
 //! Triangles whose area is below [`DEGENERATE_REL`] (points on the axis of a rotation, which
 //! do not move) are left out.
 
@@ -44,6 +49,13 @@ pub const MAX_STEPS: u32 = 4096;
 /// An output triangle whose `|(b - a) x (c - a)|` is at most `DEGENERATE_REL` times the
 /// square of the body's extent is degenerate and left out.
 pub const DEGENERATE_REL: f64 = 1e-12;
+
+/// Largest twist of a swept quad, as a fraction of the body's extent, before the generator
+/// segment is cut into pieces (see the module documentation).
+pub const TWIST_REL: f64 = 1e-3;
+
+/// Most pieces a generator segment is cut into against twist.
+pub const MAX_PIECES: u32 = 256;
 
 /// Options of [`sweep`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -121,6 +133,8 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
     let mut keep = vec![false; nf];
     let mut prev_max = vec![0.0; nf];
     let mut prev_tol = 0.0;
+    let mut points: Vec<DVec3> = Vec::new();
+    let mut segments: Vec<[u32; 2]> = Vec::new();
     for (i, pair) in poses.windows(2).enumerate() {
         let (a, b) = (&pair[0], &pair[1]);
         let screw = Screw::between(&Pose::IDENTITY, &a.inverse().mul_pose(b));
@@ -142,7 +156,26 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         if gen.segments.is_empty() {
             continue;
         }
-        let g = gen.points.len();
+        // Cut long segments against twist: extra points after the generator's own.
+        points.clear();
+        points.extend_from_slice(&gen.points);
+        segments.clear();
+        let twist_max = 4.0 * k as f64 * TWIST_REL * body.extent();
+        for s in &gen.segments {
+            let [sa, sb] = s.ends;
+            let (pa, pb) = (gen.points[sa as usize], gen.points[sb as usize]);
+            let twist = velocity.omega.cross(pb - pa).length();
+            let n = ((twist / twist_max).ceil() as u32).clamp(1, MAX_PIECES);
+            let mut prev = sa;
+            for piece in 1..n {
+                let next = points.len() as u32;
+                points.push(pa.lerp(pb, piece as f64 / n as f64));
+                segments.push([prev, next]);
+                prev = next;
+            }
+            segments.push([prev, sb]);
+        }
+        let g = points.len();
         let total = out.vertices.len() as u64 + (k as u64 + 1) * g as u64;
         if total > u32::MAX as u64 {
             return Err(Error::Invalid {
@@ -154,11 +187,10 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         for j in 0..=k {
             let pose = a.mul_pose(&screw.motion(j as f64 / k as f64));
             out.vertices
-                .extend(gen.points.iter().map(|&p| pose.transform_point3(p)));
+                .extend(points.iter().map(|&p| pose.transform_point3(p)));
         }
-        out.triangles.reserve(2 * k as usize * gen.segments.len());
-        for s in &gen.segments {
-            let [sa, sb] = s.ends;
+        out.triangles.reserve(2 * k as usize * segments.len());
+        for &[sa, sb] in &segments {
             for j in 0..k {
                 let a0 = base + j * g as u32 + sa;
                 let b0 = base + j * g as u32 + sb;
