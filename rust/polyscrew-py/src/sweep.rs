@@ -24,7 +24,11 @@ fn read_points(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResu
 }
 
 /// Reads `(T, 3)` integer triangles.
-fn read_triangles(function: &str, what: &str, array: ArrayViewD<'_, i64>) -> PyResult<Vec<[i64; 3]>> {
+fn read_triangles(
+    function: &str,
+    what: &str,
+    array: ArrayViewD<'_, i64>,
+) -> PyResult<Vec<[i64; 3]>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 3 {
         return Err(shape_err(function, what, "(T, 3)", shape));
