@@ -20,11 +20,12 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
 
     steps: IntProperty(
         name="Steps per Span",
-        default=4,
+        default=2,
         min=1,
         max=256,
         soft_max=32,
-        description="Quads each silhouette segment sweeps between two sampled poses",
+        description="Quads each silhouette segment sweeps between two sampled poses (long segments "
+        "that twist are cut further)",
     )
     caps: BoolProperty(
         name="Caps", default=True, description="Include the object at the first and last pose"

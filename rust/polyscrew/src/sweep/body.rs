@@ -63,6 +63,7 @@ pub struct Body {
     normals: Vec<DVec3>,
     edges: Vec<Edge>,
     face_edges: Vec<[u32; 3]>,
+    edge_corners: Vec<[u8; 4]>,
     closed: bool,
     reoriented: bool,
     extent: f64,
@@ -154,6 +155,7 @@ impl Body {
             normals,
             edges: Vec::new(),
             face_edges: Vec::new(),
+            edge_corners: Vec::new(),
             closed: false,
             reoriented: false,
             extent: (max - min).length(),
@@ -240,6 +242,27 @@ impl Body {
             edges.push(edge);
             i = j;
         }
+        let slot = |f: u32, v: u32| -> u8 {
+            if f == NO_FACE {
+                return 0;
+            }
+            let t = self.triangles[f as usize];
+            if t[0] == v {
+                0
+            } else if t[1] == v {
+                1
+            } else {
+                2
+            }
+        };
+        self.edge_corners = edges
+            .iter()
+            .map(|e| {
+                let [v0, v1] = e.vertices;
+                let [f0, f1] = e.faces;
+                [slot(f0, v0), slot(f0, v1), slot(f1, v0), slot(f1, v1)]
+            })
+            .collect();
         self.edges = edges;
         self.face_edges = face_edges;
         self.closed = closed;
@@ -298,6 +321,12 @@ impl Body {
     /// For each triangle, its edges: `face_edges()[f][k]` joins corners `k` and `k + 1`.
     pub fn face_edges(&self) -> &[[u32; 3]] {
         &self.face_edges
+    }
+
+    /// For each edge, the corners (0, 1 or 2) of its end vertices in its faces:
+    /// `[v0 in faces[0], v1 in faces[0], v0 in faces[1], v1 in faces[1]]`.
+    pub fn edge_corners(&self) -> &[[u8; 4]] {
+        &self.edge_corners
     }
 
     /// Whether every edge has exactly two consistently oriented faces.

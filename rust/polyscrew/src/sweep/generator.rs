@@ -203,6 +203,7 @@ impl Generator {
         };
         let fv = &scratch.face_values;
         let tangent = &scratch.tangent;
+        let corners = body.edge_corners();
 
         // Characteristic segments inside faces.
         for f in 0..nf {
@@ -292,8 +293,10 @@ impl Generator {
                         }
                         continue;
                     }
-                    let gl = edge_values(body, fv, fl, i0, i1);
-                    let gr = edge_values(body, fv, fr, i0, i1);
+                    let c = corners[e as usize];
+                    let (vl, vr) = (fv[fl as usize], fv[fr as usize]);
+                    let gl = (vl[c[0] as usize], vl[c[1] as usize]);
+                    let gr = (vr[c[2] as usize], vr[c[3] as usize]);
                     // Cheap rejection: same strict sign everywhere on the edge.
                     let sl = sign_on(gl, tol);
                     let sr = sign_on(gr, tol);
@@ -340,23 +343,6 @@ impl Generator {
         scratch.used_vertices.clear();
         tol
     }
-}
-
-/// `n_f . v` at the edge's ends `i0`, `i1`, read from the face's corner values.
-#[inline]
-fn edge_values(body: &Body, fv: &[[f64; 3]], f: u32, i0: u32, i1: u32) -> (f64, f64) {
-    let t = body.triangles()[f as usize];
-    let vals = fv[f as usize];
-    let at = |i: u32| {
-        if t[0] == i {
-            vals[0]
-        } else if t[1] == i {
-            vals[1]
-        } else {
-            vals[2]
-        }
-    };
-    (at(i0), at(i1))
 }
 
 /// Whether an affine function with these end values changes strict sign inside the edge.

@@ -52,7 +52,7 @@ pub const DEGENERATE_REL: f64 = 1e-12;
 
 /// Largest twist of a swept quad, as a fraction of the body's extent, before the generator
 /// segment is cut into pieces (see the module documentation).
-pub const TWIST_REL: f64 = 1e-3;
+pub const TWIST_REL: f64 = 5e-3;
 
 /// Most pieces a generator segment is cut into against twist.
 pub const MAX_PIECES: u32 = 256;
