@@ -67,6 +67,27 @@ fn bench(c: &mut Criterion) {
         out.cap_triangles,
         (64 * 8 + 1) * t.len()
     );
+    // CPU time of the thread (Linux /proc/thread-self/schedstat, ns on CPU): on a shared,
+    // loaded machine the wall times below include waiting for a core.
+    let cpu_ns = || -> Option<u64> {
+        let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
+        s.split_whitespace().next()?.parse().ok()
+    };
+    if let Some(before) = cpu_ns() {
+        let runs = 5;
+        let wall = std::time::Instant::now();
+        for _ in 0..runs {
+            black_box(sweep_mesh(&v, &t, &poses, &opts).unwrap());
+        }
+        let wall = wall.elapsed().as_secs_f64() / runs as f64;
+        if let Some(after) = cpu_ns() {
+            println!(
+                "sweep: CPU time per sweep (from arrays) {:.3} s (wall {:.3} s)",
+                (after - before) as f64 * 1e-9 / runs as f64,
+                wall
+            );
+        }
+    }
     let mut g = c.benchmark_group("sweep");
     g.sample_size(10);
     g.bench_function("100k triangles, 64 screws, 8 steps (from arrays)", |b| {

@@ -42,6 +42,15 @@ pub const TANGENT_REL: f64 = 1e-9;
 /// move the body: it has an empty generator.
 pub const MOTIONLESS_REL: f64 = 1e-12;
 
+/// Face class: `n . v > tol` on every corner.
+const POSITIVE: u8 = 1;
+/// Face class: `n . v < -tol` on every corner.
+const NEGATIVE: u8 = 2;
+/// Face class: the zero set of `n . v` meets the face (a characteristic segment or point).
+const MIXED: u8 = 3;
+/// Face class: `|n . v| <= tol` on every corner: the face sweeps into itself.
+const TANGENT: u8 = 4;
+
 /// The body-frame velocity field of a screw, `v(q) = c + r S x q` with `c = d S - r S x P`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Velocity {
@@ -127,7 +136,8 @@ enum PointKey {
 pub struct Scratch {
     speeds: Vec<DVec3>,
     face_values: Vec<[f64; 3]>,
-    tangent: Vec<bool>,
+    /// Per face: [`POSITIVE`], [`NEGATIVE`], [`MIXED`] or [`TANGENT`].
+    face_sign: Vec<u8>,
     vertex_point: Vec<u32>,
     used_vertices: Vec<u32>,
     edge_points: HashMap<(u32, u32), u32>,
@@ -164,10 +174,10 @@ impl Generator {
             .fold(0.0, f64::max);
         let vmax = vmax2.sqrt();
         scratch.face_values.clear();
-        scratch.tangent.clear();
+        scratch.face_sign.clear();
         if vmax <= MOTIONLESS_REL * body.extent() || vmax.is_nan() {
             scratch.face_values.resize(nf, [0.0; 3]);
-            scratch.tangent.resize(nf, true);
+            scratch.face_sign.resize(nf, TANGENT);
             return 0.0;
         }
         let tol = TANGENT_REL * vmax;
@@ -181,12 +191,21 @@ impl Generator {
                     n.dot(speeds[t[2] as usize]),
                 ]
             }));
-        scratch.tangent.extend(
-            scratch
-                .face_values
-                .iter()
-                .map(|f| f.iter().all(|x| x.abs() <= tol)),
-        );
+        scratch
+            .face_sign
+            .extend(scratch.face_values.iter().map(|f| {
+                let lo = f[0].min(f[1]).min(f[2]);
+                let hi = f[0].max(f[1]).max(f[2]);
+                if lo > tol {
+                    POSITIVE
+                } else if hi < -tol {
+                    NEGATIVE
+                } else if lo >= -tol && hi <= tol {
+                    TANGENT
+                } else {
+                    MIXED
+                }
+            }));
         if scratch.vertex_point.len() != verts.len() {
             scratch.vertex_point.clear();
             scratch.vertex_point.resize(verts.len(), u32::MAX);
@@ -202,21 +221,15 @@ impl Generator {
             edge_points: &mut scratch.edge_points,
         };
         let fv = &scratch.face_values;
-        let tangent = &scratch.tangent;
+        let sign = &scratch.face_sign;
         let corners = body.edge_corners();
 
         // Characteristic segments inside faces.
         for f in 0..nf {
+            if sign[f] != MIXED {
+                continue;
+            }
             let vals = fv[f];
-            if tangent[f] {
-                continue;
-            }
-            let pos = vals.iter().any(|&x| x > tol);
-            let neg = vals.iter().any(|&x| x < -tol);
-            let zero = vals.iter().any(|x| x.abs() <= tol);
-            if !(pos && neg) && !(zero && (pos || neg)) {
-                continue;
-            }
             let t = tris[f];
             let mut found: [(PointKey, DVec3); 3] = [(PointKey::Vertex(0), DVec3::ZERO); 3];
             let mut count = 0;
@@ -285,7 +298,11 @@ impl Generator {
                 }
                 EdgeKind::Concave if body.is_closed() => {}
                 _ => {
-                    let (tl, tr) = (tangent[fl as usize], tangent[fr as usize]);
+                    let (sl, sr) = (sign[fl as usize], sign[fr as usize]);
+                    if sl == sr && sl != MIXED && sl != TANGENT {
+                        continue; // both faces egress, or both ingress, everywhere
+                    }
+                    let (tl, tr) = (sl == TANGENT, sr == TANGENT);
                     let m = normals[fl as usize] + normals[fr as usize];
                     if tl || tr {
                         if !(tl && tr) {

@@ -124,13 +124,13 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
     let min_cross = DEGENERATE_REL * body.extent() * body.extent();
     let mut out = SweptMesh::default();
     let mut remap = vec![u32::MAX; body.vertices().len()];
-    let all = vec![true; nf];
+    let all: Vec<u32> = (0..nf as u32).collect();
     if options.caps {
         add_faces(&mut out, body, &poses[0], &all, &mut remap);
     }
     let mut gen = Generator::default();
     let mut scratch = Scratch::default();
-    let mut keep = vec![false; nf];
+    let mut keep: Vec<u32> = Vec::new();
     let mut prev_max = vec![0.0; nf];
     let mut prev_tol = 0.0;
     let mut points: Vec<DVec3> = Vec::new();
@@ -141,15 +141,16 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         let velocity = Velocity::of_screw(&screw);
         let tol = gen.build(body, &velocity, &mut scratch);
         let fv = scratch.face_values();
-        if i > 0 {
-            for f in 0..nf {
-                let lo = fv[f][0].min(fv[f][1]).min(fv[f][2]);
-                keep[f] = prev_max[f] >= -prev_tol && lo <= tol;
+        keep.clear();
+        for (f, (vals, prev)) in fv.iter().zip(prev_max.iter_mut()).enumerate() {
+            let lo = vals[0].min(vals[1]).min(vals[2]);
+            if i > 0 && *prev >= -prev_tol && lo <= tol {
+                keep.push(f as u32);
             }
-            add_faces(&mut out, body, a, &keep, &mut remap);
+            *prev = vals[0].max(vals[1]).max(vals[2]);
         }
-        for f in 0..nf {
-            prev_max[f] = fv[f][0].max(fv[f][1]).max(fv[f][2]);
+        if i > 0 {
+            add_faces(&mut out, body, a, &keep, &mut remap);
         }
         prev_tol = tol;
         out.generator_segments += gen.segments.len();
@@ -216,11 +217,13 @@ fn push_triangle(out: &mut SweptMesh, t: [u32; 3], min_cross: f64) {
     }
 }
 
-/// Adds the faces `keep` of `body` placed at `pose`, sharing their vertices.
-fn add_faces(out: &mut SweptMesh, body: &Body, pose: &Pose, keep: &[bool], remap: &mut [u32]) {
+/// Adds the faces `faces` of `body` placed at `pose`, sharing their vertices.
+fn add_faces(out: &mut SweptMesh, body: &Body, pose: &Pose, faces: &[u32], remap: &mut [u32]) {
     let verts = body.vertices();
-    for (t, _) in body.triangles().iter().zip(keep).filter(|(_, &k)| k) {
-        let tri = t.map(|i| {
+    let tris = body.triangles();
+    out.triangles.reserve(faces.len());
+    for &f in faces {
+        let tri = tris[f as usize].map(|i| {
             let slot = &mut remap[i as usize];
             if *slot == u32::MAX {
                 *slot = out.vertices.len() as u32;
@@ -229,10 +232,10 @@ fn add_faces(out: &mut SweptMesh, body: &Body, pose: &Pose, keep: &[bool], remap
             *slot
         });
         out.triangles.push(tri);
-        out.cap_triangles += 1;
     }
-    for t in body.triangles().iter().zip(keep).filter(|(_, &k)| k) {
-        for &i in t.0 {
+    out.cap_triangles += faces.len();
+    for &f in faces {
+        for i in tris[f as usize] {
             remap[i as usize] = u32::MAX;
         }
     }
