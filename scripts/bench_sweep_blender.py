@@ -63,6 +63,9 @@ def main() -> None:
     start = time.perf_counter()
     computed = swept.compute(obj, bpy.context, STEPS, True)
     compute_s = time.perf_counter() - start
+    for o in bpy.context.view_layer.objects:
+        o.select_set(o is obj)
+    bpy.context.view_layer.objects.active = obj
     start = time.perf_counter()
     assert bpy.ops.screwbender.sweep(steps=STEPS, caps=True) == {"FINISHED"}
     operator_s = time.perf_counter() - start

@@ -130,7 +130,8 @@ def collection(scene: bpy.types.Scene) -> bpy.types.Collection:
 
 
 def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> bpy.types.Mesh:
-    """A new triangle mesh from (V, 3) vertices and (T, 3) triangles (bulk foreach_set)."""
+    """A new triangle mesh from (V, 3) vertices and (T, 3) triangles (bulk foreach_set; the
+    indices are trusted: `polyscrew.sweep` returns them in range and non-degenerate)."""
     mesh = bpy.data.meshes.new(name)
     n = len(triangles)
     mesh.vertices.add(len(vertices))
@@ -139,8 +140,7 @@ def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> 
     mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, dtype=np.int32).ravel())
     mesh.polygons.add(n)
     mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * n, 3, dtype=np.int32))
-    mesh.update()
-    mesh.validate(clean_customdata=False)
+    mesh.update(calc_edges=True)
     return mesh
 
 

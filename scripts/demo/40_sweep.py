@@ -2,7 +2,7 @@
 
 Opens out/demo.blend (from 20_smooth.py), sweeps the Jarek-smoothed Flyer and SpinBlock with
 the installed extension's `screwbender.sweep` operator (the smoothed motion at its baked
-keys, 4 steps per span), and renders with Workbench, side by side: a few instances of the
+keys, 1 step per span: the baked keys are one frame apart), and renders with Workbench, side by side: a few instances of the
 body along the motion over the translucent swept region, and the swept region alone.
 Prints triangles and time, against the triangles of stroboscopic instancing at every baked
 key. Writes out/demo_sweep_<motion>.png and copies them into docs/images/.
@@ -40,7 +40,7 @@ def sweep(obj: bpy.types.Object) -> tuple[bpy.types.Object, float]:
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
     start = time.perf_counter()
-    result = bpy.ops.screwbender.sweep(steps=4, caps=True)
+    result = bpy.ops.screwbender.sweep(steps=1, caps=True)
     seconds = time.perf_counter() - start
     if result != {"FINISHED"}:
         sys.exit(f"40_sweep: Build Swept Region failed on {obj.name}")

@@ -196,7 +196,7 @@ def test_far_fewer_triangles_than_instances_at_equal_depth_error():
 
         e_sweep = error([depth_image(view, sv, st) for view in views])
         found = None
-        for m in [4, 8, 16, 32, 64, 128, 256, 512, 1024]:
+        for m in [4, 8, 16, 32, 48, 64, 96, 128, 192, 256, 512, 1024]:
             strobe = polyscrew.interpolate(poses[0], poses[1], np.linspace(0, 1, m))
             e = error([instances_depth_image(view, v, t, strobe) for view in views])
             if e <= e_sweep:

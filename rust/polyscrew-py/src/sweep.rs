@@ -2,6 +2,7 @@
 
 use numpy::ndarray::{Array2, ArrayViewD};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLikeDyn};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::DVec3;
@@ -83,22 +84,20 @@ fn sweep<'py>(
     let (vo, to) = py
         .detach(|| {
             sweep_mesh(&v, &t, &p, &options).map(|out| {
-                let mut vo = Array2::<f64>::zeros((out.vertices.len(), 3));
-                for (mut row, q) in vo.rows_mut().into_iter().zip(&out.vertices) {
-                    row[0] = q.x;
-                    row[1] = q.y;
-                    row[2] = q.z;
-                }
-                let mut to = Array2::<i64>::zeros((out.triangles.len(), 3));
-                for (mut row, tri) in to.rows_mut().into_iter().zip(&out.triangles) {
-                    row[0] = tri[0] as i64;
-                    row[1] = tri[1] as i64;
-                    row[2] = tri[2] as i64;
-                }
+                let flat: Vec<f64> = out.vertices.iter().flat_map(|q| q.to_array()).collect();
+                let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat);
+                let flat: Vec<i64> = out
+                    .triangles
+                    .iter()
+                    .flat_map(|t| t.map(|i| i as i64))
+                    .collect();
+                let to = Array2::from_shape_vec((out.triangles.len(), 3), flat);
                 (vo, to)
             })
         })
         .map_err(|e| to_py_err(F, e))?;
+    let shape_bug = |e: numpy::ndarray::ShapeError| PyValueError::new_err(format!("{F}: {e}"));
+    let (vo, to) = (vo.map_err(shape_bug)?, to.map_err(shape_bug)?);
     Ok((vo.into_pyarray(py), to.into_pyarray(py)))
 }
 
