@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import bpy
 
-from . import operators, sweep_ops, ui
+from . import angvel, operators, sweep_ops, ui
 
-_register_classes, _unregister_classes = bpy.utils.register_classes_factory(operators.classes + sweep_ops.classes + ui.classes)
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(
+    operators.classes + ui.classes + angvel.classes + sweep_ops.classes
+)
 
 
 def register() -> None:
