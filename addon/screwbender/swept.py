@@ -134,10 +134,19 @@ def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> 
     indices are trusted: `polyscrew.sweep` returns them in range and non-degenerate)."""
     mesh = bpy.data.meshes.new(name)
     n = len(triangles)
+    co = np.ascontiguousarray(vertices, dtype=np.float32).ravel()
+    corners = np.ascontiguousarray(triangles, dtype=np.int32).ravel()
     mesh.vertices.add(len(vertices))
-    mesh.vertices.foreach_set("co", np.ascontiguousarray(vertices, dtype=np.float32).ravel())
     mesh.loops.add(3 * n)
-    mesh.loops.foreach_set("vertex_index", np.ascontiguousarray(triangles, dtype=np.int32).ravel())
+    position = mesh.attributes.get("position")
+    corner_vert = mesh.attributes.get(".corner_vert")
+    if position is not None and corner_vert is not None:
+        # The generic attributes take raw buffers (MeshLoop.vertex_index goes item by item).
+        position.data.foreach_set("vector", co)
+        corner_vert.data.foreach_set("value", corners)
+    else:
+        mesh.vertices.foreach_set("co", co)
+        mesh.loops.foreach_set("vertex_index", corners)
     mesh.polygons.add(n)
     mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * n, 3, dtype=np.int32))
     mesh.update(calc_edges=True)
