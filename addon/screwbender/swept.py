@@ -225,10 +225,35 @@ def _nearest(tree: BVHTree, points: list[Vector]) -> float:
     return best
 
 
+def is_closed(polys: list[tuple[int, ...]]) -> bool:
+    """Whether every edge of the polygons is shared by exactly two of them (watertight)."""
+    keys = [tuple(sorted((p[i], p[(i + 1) % len(p)]))) for p in polys for i in range(len(p))]
+    if not keys:
+        return False
+    _, counts = np.unique(np.array(keys), axis=0, return_counts=True)
+    return bool(np.all(counts == 2))
+
+
+def inside(tree: BVHTree, point: Vector, scale: float) -> bool:
+    """Whether `point` is inside the closed mesh of `tree`: odd number of crossings of a ray
+    (in a direction unlikely to graze edges)."""
+    direction = Vector((0.5773, 0.5774, 0.5773)).normalized()
+    origin, crossings = point.copy(), 0
+    for _ in range(10000):
+        hit, _normal, _index, _dist = tree.ray_cast(origin, direction)
+        if hit is None:
+            break
+        crossings += 1
+        origin = hit + direction * (1e-7 * scale)
+    return crossings % 2 == 1
+
+
 def clearance(a: bpy.types.Object, b: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> Clearance:
-    """Whether the surfaces of `a` and `b` intersect (BVH overlap of their polygons) and their
-    smallest distance (every vertex of each against the other's surface: exact for
-    face-to-vertex and face-to-face closeness, within the edge length for edge-to-edge)."""
+    """Whether `a` and `b` intersect (BVH overlap of their polygons, or, for a closed mesh,
+    one holding a vertex of the other inside) and their smallest distance (every vertex of
+    each against the other's surface: exact for face-to-vertex and face-to-face closeness,
+    within the edge length for edge-to-edge). The open superset made by Build Swept Region
+    without Closed Volume has no inside: only its surface counts."""
     va, pa = world_polygons(a, depsgraph)
     vb, pb = world_polygons(b, depsgraph)
     if not pa or not pb:
@@ -238,6 +263,10 @@ def clearance(a: bpy.types.Object, b: bpy.types.Object, depsgraph: bpy.types.Dep
     pairs = ta.overlap(tb)
     if pairs:
         return Clearance(True, 0.0, sorted({i for i, _ in pairs}), sorted({j for _, j in pairs}))
+    scale = max((max(v) - min(v) for v in zip(*(va + vb))), default=1.0)
+    for tree, polys, other in ((ta, pa, vb), (tb, pb, va)):
+        if other and is_closed(polys) and inside(tree, other[0], scale):
+            return Clearance(True, 0.0, [], [])
     distance = min(_nearest(ta, vb), _nearest(tb, va))
     return Clearance(False, distance, [], [])
 

@@ -142,6 +142,22 @@ def test_clearance_of_a_box_sliding_past_a_wall(closed):
     assert not any(p.select for p in wall.data.polygons)
 
 
+def test_clearance_sees_an_object_inside_a_closed_volume():
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 10
+    box = mesh_object("Box", CUBE_V, CUBE_F, scale=(2, 2, 2))
+    key(box, 1, (0, -2, 0))
+    key(box, 10, (0, 2, 0))
+    pebble = mesh_object("Pebble", CUBE_V, CUBE_F, location=(0.1, 0.5, 0.1), scale=(0.1, 0.1, 0.1))
+    h.select_only(box)
+    assert bpy.ops.screwbender.sweep(steps=2, closed=True, voxel_size=0.05) == {"FINISHED"}
+    (region,) = swept_objects()
+    h.select_only(region, pebble)
+    assert bpy.ops.screwbender.check_clearance() == {"FINISHED"}
+    assert list(region["screwbender_intersects"]) == ["Pebble"]
+    assert region["screwbender_clearance"]["Pebble"] == 0.0
+
+
 def snapshot():
     return (
         sorted(o.name for o in bpy.data.objects),
