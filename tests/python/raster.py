@@ -10,7 +10,7 @@ Written for the tests only: an oracle independent of the Rust code.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 #: Barycentric slack that closes cracks along shared edges.
 INSIDE_SLACK = 1e-9
@@ -87,6 +87,28 @@ def _raster_instances(verts, tris, mats, depth, cull):
             sy[i] = m[1, 0] * px + m[1, 1] * py + m[1, 2] * pz + m[1, 3]
             sz[i] = m[2, 0] * px + m[2, 1] * py + m[2, 2] * pz + m[2, 3]
         _raster(sx, sy, sz, tris, depth, cull)
+
+
+@njit(cache=True, parallel=True)
+def _raster_instances_views(verts, tris, mats, depth, cull):
+    # mats (views, instances, 3, 4); depth (views, res, res): one view per thread.
+    for k in prange(mats.shape[0]):
+        _raster_instances(verts, tris, mats[k], depth[k], cull)
+
+
+def instances_depth_images(views: list[View], vertices, triangles, poses, cull: bool = True) -> list[np.ndarray]:
+    """:func:`instances_depth_image` for several views at once, in parallel over the views."""
+    poses = np.asarray(poses, float)
+    mats = np.stack([np.einsum("ij,mjk->mik", v.matrix, poses) for v in views])
+    depth = np.stack([v.empty() for v in views])
+    _raster_instances_views(
+        np.ascontiguousarray(vertices, dtype=float),
+        np.ascontiguousarray(triangles, dtype=np.int64),
+        np.ascontiguousarray(mats),
+        depth,
+        cull,
+    )
+    return list(depth)
 
 
 def depth_image(view: View, vertices, triangles, cull: bool = False) -> np.ndarray:

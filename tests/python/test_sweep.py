@@ -17,7 +17,7 @@ import pytest
 
 import polyscrew
 from conftest import rigid
-from raster import View, depth_image, fibonacci_directions, instances_depth_image
+from raster import View, depth_image, fibonacci_directions, instances_depth_image, instances_depth_images
 
 INSTANCES = 2000
 VIEWS = 20
@@ -137,12 +137,8 @@ def compare(a, b, tol):
 
 
 def render_all(views, mesh_v, mesh_t, body_v, body_t, inst):
-    out = []
-    for view in views:
-        ds = depth_image(view, mesh_v, mesh_t)
-        di = instances_depth_image(view, body_v, body_t, inst)
-        out.append((ds, di))
-    return out
+    swept = [depth_image(view, mesh_v, mesh_t) for view in views]
+    return list(zip(swept, instances_depth_images(views, body_v, body_t, inst)))
 
 
 @pytest.mark.parametrize("motion", list(MOTIONS))
@@ -181,7 +177,7 @@ def test_far_fewer_triangles_than_instances_at_equal_depth_error():
         center, size = scene(v, inst)
         views = [View(d, center, 1.05 * size, RES) for d in fibonacci_directions(8)]
         tol = DEPTH_TOL * size
-        refs = [instances_depth_image(view, v, t, inst) for view in views]
+        refs = instances_depth_images(views, v, t, inst)
 
         def error(images):
             # Fraction of the union of covered pixels that differ from the reference by
@@ -198,7 +194,7 @@ def test_far_fewer_triangles_than_instances_at_equal_depth_error():
         found = None
         for m in [4, 8, 16, 32, 48, 64, 96, 128, 192, 256, 512, 1024]:
             strobe = polyscrew.interpolate(poses[0], poses[1], np.linspace(0, 1, m))
-            e = error([instances_depth_image(view, v, t, strobe) for view in views])
+            e = error(instances_depth_images(views, v, t, strobe))
             if e <= e_sweep:
                 found = (m, e)
                 break
