@@ -11,10 +11,10 @@ from __future__ import annotations
 
 import bpy
 
-from . import angvel, operators, preview_ui, ui
+from . import angvel, operators, preview_ui, sweep_ops, ui
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(
-    operators.classes + ui.classes + angvel.classes + preview_ui.classes
+    operators.classes + ui.classes + angvel.classes + sweep_ops.classes + preview_ui.classes
 )
 
 

@@ -228,3 +228,34 @@ def fit_angular_velocity(
             latter two cases the exception's ``result`` attribute holds the best
             ``AngularVelocityFit`` found.
     """
+
+MAX_STEPS: int
+"""The largest accepted number of sweep steps per screw (4096)."""
+
+IntArray = npt.NDArray[np.int64]
+
+def sweep(
+    vertices: ArrayLike,
+    triangles: ArrayLike,
+    poses: ArrayLike,
+    steps: int = 8,
+    caps: bool = True,
+) -> tuple[FloatArray, IntArray]:
+    """The region swept by a triangle mesh moving through ``poses``, as one triangle mesh.
+
+    ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame; ``poses``
+    (N >= 2, 4, 4) its world poses, one screw per span (Rossignac-Kim, "Swept volumes").
+    Each screw's generator (silhouette edge segments and characteristic segments inside
+    faces, computed in the body frame) is swept in ``steps`` quads; ``caps`` adds the body
+    at the first and the last pose; at interior poses the faces where the motion turns back
+    are added. The result is a superset of the swept region's boundary whose excess lies
+    inside the region: its depth image from outside equals that of the union of the body's
+    instances (in the limit of fine steps).
+
+    Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
+    triangles counter-clockwise seen from outside, none degenerate.
+
+    Raises ``ValueError`` for an empty mesh, a NaN or infinite vertex, a triangle with an
+    index out of range or zero area (naming the triangle), fewer than 2 poses, a non-rigid
+    pose (naming it), or ``steps`` outside ``1..=MAX_STEPS``.
+    """

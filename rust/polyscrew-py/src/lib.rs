@@ -3,6 +3,8 @@
 //! Every function has the same shape: take array-likes, check shapes, release the GIL, call
 //! the core, map the error once (`to_py_err`), wrap the result as numpy arrays.
 
+mod sweep;
+
 use numpy::ndarray::{Array2, Array3, ArrayViewD};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn};
 use pyo3::exceptions::PyValueError;
@@ -458,5 +460,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add("MAX_LEVELS", MAX_LEVELS)?;
     angular_velocity::register(m)?;
+    sweep::register(m)?;
     Ok(())
 }

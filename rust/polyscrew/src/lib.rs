@@ -32,6 +32,7 @@ pub mod sample;
 pub mod screw;
 pub mod spinning_top;
 pub mod subdivision;
+pub mod sweep;
 pub mod timing;
 
 pub use angular_velocity::{
@@ -46,4 +47,5 @@ pub use sample::{sample, Motion, MotionSpec};
 pub use screw::{midpoint, s, Screw};
 pub use spinning_top::SpinningTop;
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
+pub use sweep::{sweep, sweep_mesh, Body, Generator, SweepOptions, SweptMesh};
 pub use timing::{check_key_times, TimeMap, Timing};

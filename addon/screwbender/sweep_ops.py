@@ -1,0 +1,145 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Build Swept Region and Check Clearance: collect options, call :mod:`swept`, report."""
+
+from __future__ import annotations
+
+import time
+
+import bpy
+from bpy.props import BoolProperty, FloatProperty, IntProperty
+
+from . import swept
+
+
+class SCREWBENDER_OT_sweep(bpy.types.Operator):
+    """Build the region swept by each selected mesh object along its motion over the frame range (the smoothed motion where there is one, otherwise its animation sampled at every frame) as a new object in the "Swept Regions" collection"""
+
+    bl_idname = "screwbender.sweep"
+    bl_label = "Build Swept Region"
+    bl_options = {"REGISTER", "UNDO"}
+
+    steps: IntProperty(
+        name="Steps per Span",
+        default=2,
+        min=1,
+        max=256,
+        soft_max=32,
+        description="Quads each silhouette segment sweeps between two sampled poses (long segments "
+        "that twist are cut further)",
+    )
+    caps: BoolProperty(
+        name="Caps", default=True, description="Include the object at the first and last pose"
+    )
+    closed: BoolProperty(
+        name="Closed Volume",
+        default=False,
+        description="Turn the swept surfaces into a closed manifold mesh with a voxel remesh",
+    )
+    voxel_size: FloatProperty(
+        name="Voxel Size",
+        default=0.05,
+        min=1e-4,
+        soft_max=1.0,
+        subtype="DISTANCE",
+        description="Voxel size of the closed volume (smaller is more accurate and slower)",
+    )
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode")
+            return False
+        if not any(o.type == "MESH" for o in context.selected_objects):
+            cls.poll_message_set("Select one or more moving mesh objects")
+            return False
+        return True
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        layout.use_property_split = True
+        layout.prop(self, "steps")
+        layout.prop(self, "caps")
+        layout.prop(self, "closed")
+        row = layout.row()
+        row.enabled = self.closed
+        row.prop(self, "voxel_size")
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
+        start = time.perf_counter()
+        try:
+            computed = [swept.compute(o, context, self.steps, self.caps) for o in objects]
+            created = [swept.create_object(s, context, self.closed, self.voxel_size) for s in computed]
+        except swept.SweepError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        seconds = time.perf_counter() - start
+        for obj in context.selected_objects:
+            obj.select_set(False)
+        for obj in created:
+            obj.select_set(True)
+        context.view_layer.objects.active = created[-1]
+        tris = sum(swept.triangle_count(o.data) for o in created)
+        sweep_ms = 1e3 * sum(s.seconds for s in computed)
+        self.report(
+            {"INFO"},
+            f"Swept {len(created)} object(s): {tris} triangles in {seconds:.2f} s (sweep {sweep_ms:.1f} ms)",
+        )
+        return {"FINISHED"}
+
+
+class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
+    """Check the active object (a swept region) against the other selected objects: whether they intersect and their smallest distance; the colliding faces are selected"""
+
+    bl_idname = "screwbender.check_clearance"
+    bl_label = "Check Clearance"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        active = context.active_object
+        if context.mode != "OBJECT" or active is None or active.type != "MESH":
+            cls.poll_message_set("Make a swept region (a mesh) the active object, in Object Mode")
+            return False
+        if not any(o is not active and o.type == "MESH" for o in context.selected_objects):
+            cls.poll_message_set("Also select the objects to check against")
+            return False
+        return True
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        region = context.active_object
+        others = sorted((o for o in context.selected_objects if o is not region and o.type == "MESH"), key=lambda o: o.name)
+        depsgraph = context.evaluated_depsgraph_get()
+        try:
+            results = {o.name: swept.clearance(region, o, depsgraph) for o in others}
+        except swept.SweepError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        swept.select_faces(region, sorted({f for r in results.values() for f in r.faces_a}))
+        for o in others:
+            swept.select_faces(o, results[o.name].faces_b)
+        region["screwbender_clearance"] = {name: r.distance for name, r in results.items()}
+        region["screwbender_intersects"] = [name for name, r in results.items() if r.intersects]
+        for name, r in results.items():
+            if r.intersects:
+                self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")
+            else:
+                self.report({"INFO"}, f"{region.name} clears {name} by {r.distance:.6g}")
+        return {"FINISHED"}
+
+
+class VIEW3D_PT_screwbender_sweep(bpy.types.Panel):
+    """Swept regions in the 3D Viewport sidebar, Animation tab."""
+
+    bl_label = "ScrewBender Swept Region"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Animation"
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        layout.operator(SCREWBENDER_OT_sweep.bl_idname, icon="MOD_SCREW")
+        layout.operator(SCREWBENDER_OT_check_clearance.bl_idname, icon="MOD_BOOLEAN")
+
+
+classes = (SCREWBENDER_OT_sweep, SCREWBENDER_OT_check_clearance, VIEW3D_PT_screwbender_sweep)
