@@ -21,16 +21,24 @@
 //! ```
 #![deny(missing_docs)]
 
+pub(crate) mod banded;
+pub mod eigen;
 pub mod error;
+pub mod inertia;
 pub mod pose;
+pub mod registration;
 pub mod sample;
 pub mod screw;
 pub mod subdivision;
 pub mod timing;
+pub mod variational;
 
 pub use error::{Error, PoseDefect, Result};
+pub use inertia::InertiaFrame;
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
+pub use registration::register;
 pub use sample::{sample, Motion, MotionSpec};
 pub use screw::{s, Screw};
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
 pub use timing::{check_key_times, TimeMap, Timing};
+pub use variational::{variational_curve, variational_subdivide, Parametrization, Stiffness};
