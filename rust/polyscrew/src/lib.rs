@@ -24,6 +24,7 @@
 pub(crate) mod banded;
 pub mod eigen;
 pub mod error;
+pub mod feature_motion;
 pub mod inertia;
 pub mod pose;
 pub mod registration;
@@ -34,6 +35,10 @@ pub mod timing;
 pub mod variational;
 
 pub use error::{Error, PoseDefect, Result};
+pub use feature_motion::{
+    feature_motion, feature_motion_timed, sample_feature_motion, CurveScheme, FeatureSpec,
+    UNIT_FRAME_POINTS,
+};
 pub use inertia::InertiaFrame;
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use registration::register;

@@ -190,7 +190,7 @@ fn check_clouds(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use nalgebra::{Matrix3, Vector3};
 
