@@ -22,6 +22,7 @@
 #![deny(missing_docs)]
 
 pub(crate) mod banded;
+pub mod channels;
 pub mod eigen;
 pub mod error;
 pub mod feature_motion;
@@ -34,6 +35,7 @@ pub mod subdivision;
 pub mod timing;
 pub mod variational;
 
+pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use feature_motion::{
     feature_motion, feature_motion_timed, sample_feature_motion, CurveScheme, FeatureSpec,

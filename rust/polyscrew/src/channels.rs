@@ -1,0 +1,339 @@
+//! Rotations as Blender's animation channels, continuous from one frame to the next:
+//! quaternions `(w, x, y, z)` without sign flips, axis-angle `(angle, x, y, z)` unwrapped, and
+//! Euler angles in any of the six orders, each frame made compatible with the previous one
+//! (no jump above 180 degrees on an axis).
+//!
+//! Euler conventions are Blender's: the angles are stored per axis `(x, y, z)` whatever the
+//! order, and order `"XYZ"` means `R = Rz(z) Ry(y) Rx(x)` (X applied first). The extraction
+//! and the compatibility rule follow Blender's `mat3_normalized_to_compatible_eulO`: of the
+//! two Euler triples of a matrix, each wrapped by multiples of 2 pi towards the previous
+//! frame, the one nearer to it (sum of absolute differences) is kept.
+
+use std::f64::consts::{PI, TAU};
+
+use glam::{DMat3, DQuat, DVec3};
+
+use crate::error::{Error, Result};
+
+/// Below this `cos(middle angle)` an Euler triple is in gimbal lock: the first and last axes
+/// coincide and the last angle is set to 0 (as Blender does, with its f32 threshold scaled).
+pub const GIMBAL_LOCK_COS: f64 = 16.0 * f64::EPSILON;
+
+/// A Blender rotation mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RotationMode {
+    /// `rotation_quaternion`, `(w, x, y, z)`.
+    Quaternion,
+    /// `rotation_axis_angle`, `(angle, x, y, z)`.
+    AxisAngle,
+    /// `rotation_euler` in the given order.
+    Euler(EulerOrder),
+}
+
+/// The six Euler orders, named as in Blender (`"XYZ"`: X applied first).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum EulerOrder {
+    /// `R = Rz Ry Rx`.
+    Xyz,
+    /// `R = Ry Rz Rx`.
+    Xzy,
+    /// `R = Rz Rx Ry`.
+    Yxz,
+    /// `R = Rx Rz Ry`.
+    Yzx,
+    /// `R = Ry Rx Rz`.
+    Zxy,
+    /// `R = Rx Ry Rz`.
+    Zyx,
+}
+
+impl EulerOrder {
+    /// The axes in the order they are applied, and whether that permutation is odd
+    /// (Blender's `RotOrderInfo`).
+    fn axes(self) -> ([usize; 3], bool) {
+        match self {
+            Self::Xyz => ([0, 1, 2], false),
+            Self::Xzy => ([0, 2, 1], true),
+            Self::Yxz => ([1, 0, 2], true),
+            Self::Yzx => ([1, 2, 0], false),
+            Self::Zxy => ([2, 0, 1], false),
+            Self::Zyx => ([2, 1, 0], true),
+        }
+    }
+
+    /// The rotation matrix of Euler angles `e = (x, y, z)` in this order.
+    pub fn to_mat3(self, e: DVec3) -> DMat3 {
+        let (axes, _) = self.axes();
+        let about = |axis: usize| match axis {
+            0 => DMat3::from_rotation_x(e.x),
+            1 => DMat3::from_rotation_y(e.y),
+            _ => DMat3::from_rotation_z(e.z),
+        };
+        about(axes[2]) * about(axes[1]) * about(axes[0])
+    }
+
+    /// Both Euler triples of a rotation matrix (equal in gimbal lock).
+    fn two_triples(self, m: &DMat3) -> (DVec3, DVec3) {
+        let ([i, j, k], odd) = self.axes();
+        // Blender's mat[a][b] is column a, row b.
+        let at = |a: usize, b: usize| m.col(a)[b];
+        let cy = at(i, i).hypot(at(i, j));
+        let mut e1 = [0.0; 3];
+        let mut e2 = [0.0; 3];
+        if cy > GIMBAL_LOCK_COS {
+            e1[i] = at(j, k).atan2(at(k, k));
+            e1[j] = (-at(i, k)).atan2(cy);
+            e1[k] = at(i, j).atan2(at(i, i));
+            e2[i] = (-at(j, k)).atan2(-at(k, k));
+            e2[j] = (-at(i, k)).atan2(-cy);
+            e2[k] = (-at(i, j)).atan2(-at(i, i));
+        } else {
+            e1[i] = (-at(k, j)).atan2(at(j, j));
+            e1[j] = (-at(i, k)).atan2(cy);
+            e1[k] = 0.0;
+            e2 = e1;
+        }
+        let (mut a, mut b) = (DVec3::from_array(e1), DVec3::from_array(e2));
+        if odd {
+            a = -a;
+            b = -b;
+        }
+        (a, b)
+    }
+}
+
+impl RotationMode {
+    /// Parses a Blender `rotation_mode` string: `"QUATERNION"`, `"AXIS_ANGLE"`, `"XYZ"`,
+    /// `"XZY"`, `"YXZ"`, `"YZX"`, `"ZXY"`, `"ZYX"`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for anything else.
+    pub fn from_name(name: &str) -> Result<Self> {
+        Ok(match name {
+            "QUATERNION" => Self::Quaternion,
+            "AXIS_ANGLE" => Self::AxisAngle,
+            "XYZ" => Self::Euler(EulerOrder::Xyz),
+            "XZY" => Self::Euler(EulerOrder::Xzy),
+            "YXZ" => Self::Euler(EulerOrder::Yxz),
+            "YZX" => Self::Euler(EulerOrder::Yzx),
+            "ZXY" => Self::Euler(EulerOrder::Zxy),
+            "ZYX" => Self::Euler(EulerOrder::Zyx),
+            _ => return Err(Error::Invalid {
+                what: "rotation mode",
+                reason: format!(
+                    "{name:?} is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
+                ),
+            }),
+        })
+    }
+
+    /// The number of channels: 4 for quaternion and axis-angle, 3 for Euler.
+    pub fn width(self) -> usize {
+        match self {
+            Self::Euler(_) => 3,
+            _ => 4,
+        }
+    }
+}
+
+/// `x` plus the multiple of `2 pi` that brings it within `pi` of `reference`.
+#[inline]
+fn wrap_towards(x: f64, reference: f64) -> f64 {
+    x - ((x - reference) / TAU).round() * TAU
+}
+
+/// Euler angles of `m` in `order`, compatible with `previous` when given (Blender's
+/// `mat3_normalized_to_compatible_eulO`), else the triple with the smaller absolute sum.
+pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -> DVec3 {
+    let (e1, e2) = order.two_triples(m);
+    match previous {
+        None => {
+            if e1.abs().element_sum() > e2.abs().element_sum() {
+                e2
+            } else {
+                e1
+            }
+        }
+        Some(p) => {
+            let wrap = |e: DVec3| {
+                DVec3::new(
+                    wrap_towards(e.x, p.x),
+                    wrap_towards(e.y, p.y),
+                    wrap_towards(e.z, p.z),
+                )
+            };
+            let (c1, c2) = (wrap(e1), wrap(e2));
+            if (c1 - p).abs().element_sum() > (c2 - p).abs().element_sum() {
+                c2
+            } else {
+                c1
+            }
+        }
+    }
+}
+
+/// Channel values of a sequence of rotations in `mode`, continuous frame to frame.
+///
+/// `previous` (3 values for Euler, 4 otherwise) is the value just before the first frame;
+/// the first frame is made compatible with it. Without it: quaternions start with `w >= 0`,
+/// axis-angle with an angle in `[0, pi]`, Euler with the triple of smaller absolute sum.
+/// Each output row has [`RotationMode::width`] values.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
+/// it holds NaN or infinity.
+pub fn rotation_channels(
+    rotations: &[DQuat],
+    mode: RotationMode,
+    previous: Option<&[f64]>,
+) -> Result<Vec<f64>> {
+    let width = mode.width();
+    if let Some(p) = previous {
+        if p.len() != width {
+            return Err(Error::LengthMismatch {
+                what: "previous",
+                expected: width,
+                got: p.len(),
+            });
+        }
+        if let Some(index) = p.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NotFinite {
+                what: "previous value",
+                index,
+            });
+        }
+    }
+    let mut out = Vec::with_capacity(rotations.len() * width);
+    match mode {
+        RotationMode::Quaternion => {
+            let mut prev = previous.map(|p| DQuat::from_xyzw(p[1], p[2], p[3], p[0]));
+            for q in rotations {
+                let mut q = q.normalize();
+                let flip = match prev {
+                    Some(p) => q.dot(p) < 0.0,
+                    None => q.w < 0.0,
+                };
+                if flip {
+                    q = -q;
+                }
+                out.extend_from_slice(&[q.w, q.x, q.y, q.z]);
+                prev = Some(q);
+            }
+        }
+        RotationMode::AxisAngle => {
+            let mut prev: Option<(f64, DVec3)> =
+                previous.map(|p| (p[0], DVec3::new(p[1], p[2], p[3])));
+            let mut prev_q: Option<DQuat> = None;
+            // An identity rotation has no axis: borrow the first defined one, so a motion that
+            // starts at rest does not jump from an arbitrary axis on its second frame.
+            let first_axis = rotations
+                .iter()
+                .find_map(|q| {
+                    q.xyz()
+                        .try_normalize()
+                        .map(|a| if q.w < 0.0 { -a } else { a })
+                })
+                .unwrap_or(DVec3::Y);
+            for q in rotations {
+                // Sign-continuous quaternion, then angle in [0, 2 pi] and its axis.
+                let mut q = q.normalize();
+                if prev_q.map_or(q.w < 0.0, |p| q.dot(p) < 0.0) {
+                    q = -q;
+                }
+                prev_q = Some(q);
+                let v = q.xyz();
+                let sin_h = v.length();
+                let mut angle = 2.0 * sin_h.atan2(q.w);
+                let mut axis = if sin_h > 0.0 {
+                    v / sin_h
+                } else {
+                    prev.map_or(first_axis, |(_, a)| a)
+                };
+                if let Some((prev_angle, prev_axis)) = prev {
+                    // (angle, axis) and (-angle, -axis) are the same rotation; so are angles
+                    // 2 pi apart: pick the representative nearest the previous frame.
+                    if axis.dot(prev_axis) < 0.0 {
+                        axis = -axis;
+                        angle = -angle;
+                    }
+                    angle = wrap_towards(angle, prev_angle);
+                }
+                out.extend_from_slice(&[angle, axis.x, axis.y, axis.z]);
+                prev = Some((angle, axis));
+            }
+        }
+        RotationMode::Euler(order) => {
+            let mut prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
+            for q in rotations {
+                let e = euler_compatible(&DMat3::from_quat(*q), order, prev);
+                out.extend_from_slice(&e.to_array());
+                prev = Some(e);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The largest jump between consecutive rows on any channel (for tests and reports).
+pub fn max_channel_jump(values: &[f64], width: usize) -> f64 {
+    values
+        .chunks_exact(width)
+        .zip(values.chunks_exact(width).skip(1))
+        .flat_map(|(a, b)| a.iter().zip(b).map(|(x, y)| (x - y).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// `pi`, re-exported for the bound of Euler jumps in tests.
+pub const HALF_TURN: f64 = PI;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const ORDERS: [EulerOrder; 6] = [
+        EulerOrder::Xyz,
+        EulerOrder::Xzy,
+        EulerOrder::Yxz,
+        EulerOrder::Yzx,
+        EulerOrder::Zxy,
+        EulerOrder::Zyx,
+    ];
+
+    #[test]
+    fn euler_round_trip_every_order() {
+        let e = DVec3::new(0.3, -1.1, 2.5);
+        for order in ORDERS {
+            let m = order.to_mat3(e);
+            let got = euler_compatible(&m, order, None);
+            let back = order.to_mat3(got);
+            let err = (back - m)
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(err < 1e-14, "{order:?}: {got} -> error {err}");
+        }
+    }
+
+    #[test]
+    fn spinning_several_turns_has_no_flips() {
+        let axis = DVec3::new(0.2, 0.5, 1.0).normalize();
+        let rots: Vec<DQuat> = (0..2000)
+            .map(|i| DQuat::from_axis_angle(axis, i as f64 * 0.02))
+            .collect();
+        for order in ORDERS {
+            let v = rotation_channels(&rots, RotationMode::Euler(order), None).unwrap();
+            assert!(max_channel_jump(&v, 3) < 0.2, "{order:?}");
+            for (row, q) in v.chunks_exact(3).zip(&rots) {
+                let m = order.to_mat3(DVec3::from_slice(row));
+                let want = DMat3::from_quat(*q);
+                assert!((m - want).to_cols_array().iter().all(|d| d.abs() < 1e-12));
+            }
+        }
+        let quats = rotation_channels(&rots, RotationMode::Quaternion, None).unwrap();
+        assert!(max_channel_jump(&quats, 4) < 0.05);
+        let aa = rotation_channels(&rots, RotationMode::AxisAngle, None).unwrap();
+        assert!(max_channel_jump(&aa, 4) < 0.05);
+        // The angle keeps growing past 2 pi.
+        assert!(aa[aa.len() - 4] > 39.0, "final angle {}", aa[aa.len() - 4]);
+    }
+}
