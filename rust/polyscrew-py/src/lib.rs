@@ -9,6 +9,8 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::DVec3;
+
+mod feature;
 use polyscrew::{
     rotation_channels as core_rotation_channels, subdivide as core_subdivide, Error, Motion,
     MotionSpec, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
@@ -455,5 +457,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add("MAX_LEVELS", MAX_LEVELS)?;
+    feature::register(m)?;
     Ok(())
 }
