@@ -118,12 +118,14 @@ impl RotationMode {
             "YZX" => Self::Euler(EulerOrder::Yzx),
             "ZXY" => Self::Euler(EulerOrder::Zxy),
             "ZYX" => Self::Euler(EulerOrder::Zyx),
-            _ => return Err(Error::Invalid {
-                what: "rotation mode",
-                reason: format!(
+            _ => {
+                return Err(Error::Invalid {
+                    what: "rotation mode",
+                    reason: format!(
                     "{name:?} is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
                 ),
-            }),
+                })
+            }
         })
     }
 

@@ -31,17 +31,39 @@ pub const JACOBI_MAX_SWEEPS: usize = 64;
 /// Repeated eigenvalues are fine here; which basis of their eigenspace is returned is then
 /// arbitrary. Callers that need a unique vector check the gap themselves.
 pub fn symmetric_eigen<const N: usize>(a: &[[f64; N]; N]) -> ([f64; N], [[f64; N]; N]) {
-    let mut m = *a;
+    let identity = std::array::from_fn(|k| std::array::from_fn(|i| f64::from(u8::from(i == k))));
+    symmetric_eigen_from(a, &identity)
+}
+
+/// [`symmetric_eigen`] started from an orthonormal `basis` (`basis[k]` the `k`-th vector,
+/// for example the eigenvectors of a nearby matrix): Jacobi runs on `B^T A B`, which is
+/// nearly diagonal when the basis is nearly right, so one or two sweeps suffice. The result
+/// does not depend on the basis beyond rounding (and the choice inside repeated eigenvalues).
+pub fn symmetric_eigen_from<const N: usize>(
+    a: &[[f64; N]; N],
+    basis: &[[f64; N]; N],
+) -> ([f64; N], [[f64; N]; N]) {
+    let mut full = *a;
     for i in 0..N {
         for j in 0..i {
-            m[i][j] = m[j][i];
+            full[i][j] = full[j][i];
         }
     }
-    let mut v = [[0.0; N]; N];
-    for (i, row) in v.iter_mut().enumerate() {
-        row[i] = 1.0;
+    // v[i][k] = basis[k][i]; m = V^T A V.
+    let mut v: [[f64; N]; N] = std::array::from_fn(|i| std::array::from_fn(|k| basis[k][i]));
+    let av: [[f64; N]; N] = std::array::from_fn(|i| {
+        std::array::from_fn(|k| (0..N).map(|j| full[i][j] * v[j][k]).sum())
+    });
+    let mut m: [[f64; N]; N] =
+        std::array::from_fn(|k| std::array::from_fn(|l| (0..N).map(|i| v[i][k] * av[i][l]).sum()));
+    for k in 0..N {
+        for l in 0..k {
+            let mean = 0.5 * (m[k][l] + m[l][k]);
+            m[k][l] = mean;
+            m[l][k] = mean;
+        }
     }
-    let norm2: f64 = m.iter().flatten().map(|x| x * x).sum();
+    let norm2: f64 = full.iter().flatten().map(|x| x * x).sum();
     let limit = JACOBI_TOLERANCE * JACOBI_TOLERANCE * norm2;
     for _ in 0..JACOBI_MAX_SWEEPS {
         let mut off2 = 0.0;

@@ -28,7 +28,7 @@ use glam::DVec3;
 use crate::error::{Error, Result};
 use crate::inertia::InertiaFrame;
 use crate::pose::Pose;
-use crate::registration::{cross_covariance, rotation_from_covariance};
+use crate::registration::{cross_covariance, rotation_from_covariance_warm, IDENTITY4};
 use crate::sample::Motion;
 use crate::subdivision::{check_subdivision, subdivide, Scheme};
 use crate::timing::Timing;
@@ -201,6 +201,8 @@ pub fn feature_motion(
     let keep_keys = spec.interpolates_keys();
     let m = dense_tracks[0].len();
     let mut out: Vec<Pose> = Vec::with_capacity(m);
+    // Eigenvectors of the previous sample's Horn matrix: a warm start for the next.
+    let mut basis = IDENTITY4;
     for j in 0..m {
         let pose = if keep_keys && j % per_span == 0 {
             keys[j / per_span]
@@ -213,7 +215,7 @@ pub fn feature_motion(
             ];
             let distorted = frame.affine_images(&images);
             let (xbar, ybar, s) = cross_covariance(&six, &distorted, None)?;
-            let rotation = rotation_from_covariance(&s).map_err(|e| {
+            let rotation = rotation_from_covariance_warm(&s, &mut basis).map_err(|e| {
                 let key = j / per_span;
                 Error::Invalid {
                     what: "registration",

@@ -10,7 +10,10 @@ use proptest::prelude::*;
 const SCHEMES: [Scheme; 3] = [Scheme::FourPoint, Scheme::BSpline, Scheme::Jarek];
 
 fn config() -> ProptestConfig {
-    ProptestConfig { cases: 2000, ..ProptestConfig::default() }
+    ProptestConfig {
+        cases: 2000,
+        ..ProptestConfig::default()
+    }
 }
 
 fn unit() -> impl Strategy<Value = DVec3> {
@@ -24,15 +27,19 @@ fn point(range: f64) -> impl Strategy<Value = DVec3> {
 }
 
 fn pose() -> impl Strategy<Value = Pose> {
-    (unit(), 0.0..PI, point(2.0))
-        .prop_map(|(axis, angle, t)| Pose::from_rotation_translation(DQuat::from_axis_angle(axis, angle), t))
+    (unit(), 0.0..PI, point(2.0)).prop_map(|(axis, angle, t)| {
+        Pose::from_rotation_translation(DQuat::from_axis_angle(axis, angle), t)
+    })
 }
 
 /// The exact screw motion by its parameters, evaluated directly: rotation by `u * angle`
 /// about the line through `p` along `axis`, plus `u * slide` along it, applied to `x`.
 fn exact(axis: DVec3, p: DVec3, angle: f64, slide: f64, u: f64, x: &Pose) -> Pose {
     let r = DQuat::from_axis_angle(axis, u * angle);
-    Pose { rotation: r * x.rotation, translation: r * (x.translation - p) + p + u * slide * axis }
+    Pose {
+        rotation: r * x.rotation,
+        translation: r * (x.translation - p) + p + u * slide * axis,
+    }
 }
 
 /// Largest deviation of a pose's matrix from orthonormality.
