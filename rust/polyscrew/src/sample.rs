@@ -68,7 +68,7 @@ impl<T: Interpolant> Motion<T> {
     }
 
     /// A motion from dense elements computed elsewhere (for example by
-    /// [`crate::feature_motion`]): `dense` must hold `subdivided_len(n, levels, closed)`
+    /// [`crate::feature_motion()`]): `dense` must hold `subdivided_len(n, levels, closed)`
     /// elements for the `n = key_times.len()` keys, element `i 2^levels` belonging to key `i`.
     ///
     /// # Errors
