@@ -1,0 +1,24 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""ScrewBender: smooth an object's keyed motion into a coordinate-free screw motion.
+
+Modules: :mod:`channels` (legacy and slotted actions), :mod:`keys` (F-curves -> key poses),
+:mod:`bake` (polyscrew sampling -> new action, revert), :mod:`operators`, :mod:`ui`.
+"""
+
+from __future__ import annotations
+
+import bpy
+
+from . import operators, ui
+
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(operators.classes + ui.classes)
+
+
+def register() -> None:
+    _register_classes()
+    ui.register_properties()
+
+
+def unregister() -> None:
+    ui.unregister_properties()
+    _unregister_classes()

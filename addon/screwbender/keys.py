@@ -1,0 +1,260 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Reading an object's keyed transform into arrays.
+
+An object's key poses are its transform F-curves (location, rotation in the object's
+rotation mode, scale) evaluated at the union of their key frames, in the object's own
+(parent) space: exactly `obj.matrix_basis` at those frames (delta transforms aside, which
+are left to the untouched `delta_*` channels). Rotation and location become rigid 4x4
+poses for `polyscrew`; scale is kept apart, because the core only accepts rigid poses.
+
+Nothing here changes Blender data; every problem raises :class:`SmoothError` with a message
+meant for the animator.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+
+from . import channels
+
+#: Rotation modes and the property holding the rotation in each.
+ROTATION_PATHS = {
+    "QUATERNION": "rotation_quaternion",
+    "AXIS_ANGLE": "rotation_axis_angle",
+    "XYZ": "rotation_euler",
+    "XZY": "rotation_euler",
+    "YXZ": "rotation_euler",
+    "YZX": "rotation_euler",
+    "ZXY": "rotation_euler",
+    "ZYX": "rotation_euler",
+}
+
+#: Every transform property the add-on may read or bake.
+TRANSFORM_PATHS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
+
+#: Two key frames closer than this (in frames) are the same frame.
+FRAME_TOLERANCE = 1e-4
+
+#: A last key whose pose and scale differ from the first by less than this (per matrix entry,
+#: relative to the motion's size) repeats the first pose: it closes a cyclic motion's period.
+REPEAT_TOLERANCE = 1e-5
+
+
+class SmoothError(ValueError):
+    """Input the add-on refuses, with a message naming the object and the reason."""
+
+
+@dataclass
+class KeyedMotion:
+    """The key poses of one object, ready for `polyscrew.sample`."""
+
+    #: Key frames, strictly increasing, shape (K,).
+    frames: np.ndarray
+    #: Rigid poses (translation and rotation) at those frames, shape (K, 4, 4).
+    poses: np.ndarray
+    #: Scale at those frames, shape (K, 3), all positive.
+    scales: np.ndarray
+    #: Whether any scale channel is keyed (unkeyed scale is left alone).
+    scale_keyed: bool
+    #: The object's rotation mode ("QUATERNION", "AXIS_ANGLE" or an Euler order).
+    rotation_mode: str
+    #: The rotation channel values at the first key (for sign and Euler continuity).
+    first_rotation: np.ndarray
+    #: Whether the motion is a cycle.
+    closed: bool
+    #: Cycle length in frames for a closed motion (None for an open one).
+    period: float | None
+    #: Whether a Cycles modifier was found on the transform curves.
+    cyclic: bool
+
+    @property
+    def frame_range(self) -> tuple[float, float]:
+        """First and last key frame, including the key closing a cycle."""
+        end = self.frames[0] + self.period if self.period is not None else self.frames[-1]
+        return float(self.frames[0]), float(end)
+
+
+def rotation_path(mode: str) -> str:
+    """The rotation property animated in rotation mode `mode`."""
+    return ROTATION_PATHS[mode]
+
+
+def transform_paths(mode: str) -> tuple[str, str, str]:
+    """Location, rotation (for `mode`) and scale property names."""
+    return ("location", rotation_path(mode), "scale")
+
+
+def rotation_matrices(values: np.ndarray, mode: str) -> np.ndarray:
+    """(N, 3, 3) rotation matrices from (N, k) rotation channel values in Blender's `mode`.
+
+    Follows Blender: quaternions (w, x, y, z) are normalised (zero gives the identity),
+    axis-angle is (angle, x, y, z) with the axis normalised (zero gives the identity), and
+    Euler order "XYZ" means X is applied first: `R = Rz Ry Rx`.
+    """
+    values = np.asarray(values, dtype=np.float64)
+    n = values.shape[0]
+    if mode == "QUATERNION":
+        norm = np.linalg.norm(values, axis=1)
+        q = np.where(norm[:, None] > 0.0, values / np.where(norm > 0.0, norm, 1.0)[:, None], [1.0, 0.0, 0.0, 0.0])
+        w, x, y, z = q.T
+        return np.stack(
+            [
+                np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
+                np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
+                np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
+            ],
+            axis=1,
+        )
+    if mode == "AXIS_ANGLE":
+        angle = values[:, 0]
+        axis = values[:, 1:4]
+        norm = np.linalg.norm(axis, axis=1)
+        angle = np.where(norm > 0.0, angle, 0.0)
+        axis = np.where(norm[:, None] > 0.0, axis / np.where(norm > 0.0, norm, 1.0)[:, None], [0.0, 0.0, 1.0])
+        k = np.zeros((n, 3, 3))
+        k[:, 0, 1], k[:, 0, 2] = -axis[:, 2], axis[:, 1]
+        k[:, 1, 0], k[:, 1, 2] = axis[:, 2], -axis[:, 0]
+        k[:, 2, 0], k[:, 2, 1] = -axis[:, 1], axis[:, 0]
+        s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+        return np.eye(3) + s * k + (1 - c) * (k @ k)
+    if mode in ROTATION_PATHS:
+        out = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
+        for axis_name in mode:  # first letter applied first
+            i = "XYZ".index(axis_name)
+            a = values[:, i]
+            s, c = np.sin(a), np.cos(a)
+            r = np.zeros((n, 3, 3))
+            j, k = (i + 1) % 3, (i + 2) % 3
+            r[:, i, i] = 1.0
+            r[:, j, j], r[:, j, k] = c, -s
+            r[:, k, j], r[:, k, k] = s, c
+            out = r @ out
+        return out
+    raise SmoothError(f"unknown rotation mode {mode!r}")
+
+
+def compose(locations: np.ndarray, rotations: np.ndarray, scales: np.ndarray | None = None) -> np.ndarray:
+    """(N, 4, 4) matrices `T R S` from (N, 3) locations, (N, 3, 3) rotations, (N, 3) scales."""
+    n = locations.shape[0]
+    out = np.zeros((n, 4, 4))
+    out[:, :3, :3] = rotations if scales is None else rotations * scales[:, None, :]
+    out[:, :3, 3] = locations
+    out[:, 3, 3] = 1.0
+    return out
+
+
+def _key_frames(fcurve: bpy.types.FCurve) -> np.ndarray:
+    co = np.empty(2 * len(fcurve.keyframe_points), dtype=np.float32)
+    fcurve.keyframe_points.foreach_get("co", co)
+    return co[0::2].astype(np.float64)
+
+
+def _union(frames: list[np.ndarray]) -> np.ndarray:
+    merged = np.unique(np.concatenate(frames))
+    keep = np.concatenate(([True], np.diff(merged) > FRAME_TOLERANCE))
+    return merged[keep]
+
+
+def check_editable(obj: bpy.types.Object) -> None:
+    """Raises :class:`SmoothError` unless `obj` has an editable action driving its transform."""
+    name = obj.name
+    if obj.library is not None or getattr(obj, "override_library", None) is not None:
+        raise SmoothError(f"{name}: object is linked from a library and cannot be edited: skipped")
+    adt = obj.animation_data
+    if adt is None or adt.action is None:
+        raise SmoothError(f"{name}: no animation (no active action): skipped")
+    action = adt.action
+    if action.library is not None or not getattr(action, "is_editable", True):
+        raise SmoothError(f"{name}: action '{action.name}' is linked from a library and cannot be edited: skipped")
+    strips = sum(len(track.strips) for track in adt.nla_tracks)
+    if strips:
+        raise SmoothError(
+            f"{name}: has {strips} NLA strip(s); the baked action would not be what the NLA plays: skipped"
+        )
+    paths = transform_paths(obj.rotation_mode)
+    driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
+    if driven:
+        raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
+
+
+def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
+    """The key poses of `obj`.
+
+    `closed` is "AUTO" (closed when a Cycles modifier is on a transform F-curve), "ON" or
+    "OFF". For a closed motion whose last key repeats the first pose, that key only closes the
+    period: it is dropped from the poses and `period` is its distance from the first key.
+
+    Raises :class:`SmoothError` for anything the add-on cannot smooth.
+    """
+    check_editable(obj)
+    name = obj.name
+    mode = obj.rotation_mode
+    paths = transform_paths(mode)
+    curves = {
+        (fc.data_path, fc.array_index): fc
+        for fc in channels.object_fcurves(obj)
+        if fc.data_path in paths and not fc.mute and len(fc.keyframe_points) > 0
+    }
+    if not curves:
+        raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
+    frames = _union([_key_frames(fc) for fc in curves.values()])
+    if len(frames) < 2:
+        raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
+
+    def evaluate(path: str, size: int) -> np.ndarray:
+        static = np.array(getattr(obj, path), dtype=np.float64)
+        out = np.empty((len(frames), size))
+        for i in range(size):
+            fc = curves.get((path, i))
+            # A loop over keys (not frames): F-curves are evaluated only at their key frames.
+            out[:, i] = [fc.evaluate(f) for f in frames] if fc is not None else static[i]
+        return out
+
+    location = evaluate("location", 3)
+    rotation = evaluate(paths[1], 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)
+    scale = evaluate("scale", 3)
+    for label, values in (("location", location), (paths[1], rotation), ("scale", scale)):
+        if not np.all(np.isfinite(values)):
+            raise SmoothError(f"{name}: {label} has a non-finite key value: skipped")
+    bad = np.argwhere(scale <= 0.0)
+    if len(bad):
+        k, axis = bad[0]
+        raise SmoothError(
+            f"{name}: scale {'XYZ'[axis]} is {scale[k, axis]:g} at frame {frames[k]:g}; "
+            "zero or negative scale cannot be smoothed: skipped"
+        )
+
+    poses = compose(location, rotation_matrices(rotation, mode))
+    cyclic = any(
+        m.type == "CYCLES" and not m.mute for fc in curves.values() for m in fc.modifiers
+    )
+    is_closed = cyclic if closed == "AUTO" else closed == "ON"
+    period = None
+    if is_closed:
+        size = 1.0 + float(np.max(np.abs(location)))
+        repeats = np.allclose(poses[-1], poses[0], atol=REPEAT_TOLERANCE * size) and np.allclose(
+            np.log(scale[-1]), np.log(scale[0]), atol=REPEAT_TOLERANCE
+        )
+        if repeats:
+            if len(frames) < 3:
+                raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
+            period = float(frames[-1] - frames[0])
+            frames, poses, scale, rotation = frames[:-1], poses[:-1], scale[:-1], rotation[:-1]
+        else:
+            # no closing key: the last key returns to the first after the mean key spacing
+            period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
+    scale_keyed = any(path == "scale" for path, _ in curves)
+    return KeyedMotion(
+        frames=frames,
+        poses=poses,
+        scales=scale,
+        scale_keyed=scale_keyed,
+        rotation_mode=mode,
+        first_rotation=rotation[0].copy(),
+        closed=is_closed,
+        period=period,
+        cyclic=cyclic,
+    )
