@@ -24,7 +24,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, keys
+from . import channels, feature, keys
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -65,6 +65,14 @@ class Options:
     frame_range: tuple[float, float] | None = None
     #: Frames between baked keys (1 frame, or less for subframes).
     step: float = 1.0
+    #: "SCREW" (screw subdivision) or "FEATURE" (feature points, see :mod:`feature`).
+    method: str = "SCREW"
+    #: Feature points: "uniform" or "centripetal" spacing of the variational curves.
+    parametrization: str = "uniform"
+    #: Feature points: approximate the unselected keys (else every key is hit).
+    approximate: bool = False
+    #: Feature points: spring stiffness of the approximated keys (smaller is smoother).
+    stiffness: float = 1.0
 
 
 @dataclass
@@ -102,7 +110,10 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         timing=options.timing,
     )
     try:
-        poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
+        if options.method == "FEATURE":
+            poses = feature.sample_poses(obj, motion, frames, options)
+        else:
+            poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         values = {
