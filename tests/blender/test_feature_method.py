@@ -112,3 +112,29 @@ def test_default_method_unchanged(sb):
     frames, baked = h.baked_matrices(obj)
     expected = polyscrew.sample(motion.poses, motion.frames, frames, scheme="jarek", levels=4)
     assert np.abs(baked - expected).max() < SAMPLE_TOLERANCE
+
+
+def test_smooth_blend_script_feature_method(tmp_path):
+    """scripts/smooth_blend.py --method FEATURE gives the operator's F-curves."""
+    from test_smooth_blend import SCENE, SCRIPT, curves_of, run
+
+    done = run(SCENE, "--out-dir", tmp_path)
+    assert done.returncode == 0, done.stderr
+    source = tmp_path / "demo_source.blend"
+    result = tmp_path / "smoothed.blend"
+    args = ("--method", "FEATURE", "--parametrization", "centripetal", "--stiffness", "0.5", "--levels", "4")
+    done = run(SCRIPT, source, "--objects", "Flyer", *args, "--out", result)
+    assert done.returncode == 0, done.stderr
+    bpy.ops.wm.open_mainfile(filepath=str(source))
+    h.select_only(bpy.data.objects["Flyer"])
+    assert bpy.ops.screwbender.smooth(
+        method="FEATURE", parametrization="centripetal", approximate=True, stiffness=0.5, levels=4
+    ) == {"FINISHED"}
+    expected = curves_of(bpy.data.objects["Flyer"])
+    bpy.ops.wm.open_mainfile(filepath=str(result))
+    got = curves_of(bpy.data.objects["Flyer"])
+    assert got.keys() == expected.keys()
+    for path, (points, _) in expected.items():
+        np.testing.assert_array_equal(got[path][0], points, err_msg=str(path))
+    bad = run(SCRIPT, source, "--stiffness", "1", "--out", result)
+    assert bad.returncode == 2 and "--stiffness needs --method FEATURE" in bad.stderr
