@@ -26,18 +26,19 @@
 
 use glam::{DQuat, DVec3};
 
+use crate::fastmath;
 use crate::pose::Pose;
 
 /// Below this `|x|`, `sin(x) / x` is evaluated by its Taylor series (error below 1e-20).
 const SINC_SERIES_BELOW: f64 = 1e-4;
 
-/// `sin(x) / x`, exact to rounding for all `x` including 0.
+/// `sin(x) / x` given `sin(x)`, exact to rounding for all `x` including 0.
 #[inline]
-pub(crate) fn sinc(x: f64) -> f64 {
+fn sinc_from(x: f64, sin_x: f64) -> f64 {
     if x.abs() < SINC_SERIES_BELOW {
         1.0 - x * x / 6.0
     } else {
-        x.sin() / x
+        sin_x / x
     }
 }
 
@@ -52,7 +53,9 @@ pub struct Screw {
     rotation: DQuat,
     /// Half the rotation angle, `h = atan2(|q.xyz|, q.w)`, in `[0, pi / 2]`.
     half_angle: f64,
-    /// `sinc(h)`, cached.
+    /// `sin(h) = |q.xyz|`, cached.
+    sin_half: f64,
+    /// `sinc(h) = sin(h) / h`, cached.
     sinc_half: f64,
     /// Unit axis direction `S` (the translation's direction for a pure translation, `+z` for
     /// the identity).
@@ -75,7 +78,7 @@ impl Screw {
         let q = q.normalize();
         let v = q.xyz();
         let sin_h = v.length();
-        let half_angle = sin_h.atan2(q.w);
+        let half_angle = fastmath::atan2_first_quadrant(sin_h, q.w);
         let tau = b.translation - q * a.translation;
         let axis = if sin_h > 0.0 {
             v / sin_h
@@ -86,7 +89,8 @@ impl Screw {
             base: *a,
             rotation: q,
             half_angle,
-            sinc_half: sinc(half_angle),
+            sin_half: sin_h,
+            sinc_half: sinc_from(half_angle, sin_h),
             axis,
             tau,
         }
@@ -98,13 +102,17 @@ impl Screw {
     pub fn motion(&self, t: f64) -> Pose {
         let h = self.half_angle;
         let th = t * h;
-        let (sin_th, cos_th) = th.sin_cos();
-        // rho = sin(t h) / sin(h), stable at h = 0.
-        let rho = t * sinc(th) / self.sinc_half;
+        let (sin_th, cos_th) = fastmath::sin_cos(th);
+        let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
+        // rho = sin(t h) / sin(h); near h = 0 as t sinc(t h) / sinc(h), exact at h = 0.
+        let rho = if h < SINC_SERIES_BELOW {
+            t * sinc_from(th, sin_th) / self.sinc_half
+        } else {
+            sin_th / sin_h
+        };
         let v = self.rotation.xyz();
         let rotation = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
         // cos((t-1)h), sin((t-1)h) from the angle-difference identities.
-        let (sin_h, cos_h) = (v.length(), self.rotation.w);
         let a = rho * (cos_th * cos_h + sin_th * sin_h);
         let b = rho * (sin_th * cos_h - cos_th * sin_h);
         let s = self.axis;
@@ -175,6 +183,33 @@ impl Screw {
     }
 }
 
+/// `s(a, 1/2, b)`, the pose halfway along the minimal screw, without trigonometry.
+///
+/// With `q = (w, v) = (cos h, sin h S)` the relative rotation (`w >= 0`) and `tau` its
+/// translation, the half-angle identities give
+/// `q^(1/2) = (c, v / (2 c))` with `c = cos(h / 2) = sqrt((1 + w) / 2)`, and the
+/// translation of `M^(1/2)` is `tau / 2 - (v x tau) / (2 (1 + w))` (`A = 1/2`,
+/// `B S = -tan(h / 2) S / 2 = -v / (2 (1 + w))` in [`Screw::motion`]). Exact at `h = 0`,
+/// regular up to the half turn. The outer step of every Split&Tweak rule.
+#[inline]
+pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
+    let mut q = b.rotation * a.rotation.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let q = q.normalize();
+    let v = q.xyz();
+    let tau = b.translation - q * a.translation;
+    let c = (0.5 * (1.0 + q.w)).sqrt();
+    let half_v = v * (0.5 / c);
+    let rotation = DQuat::from_xyzw(half_v.x, half_v.y, half_v.z, c);
+    let translation = 0.5 * tau - v.cross(tau) * (0.5 / (1.0 + q.w));
+    Pose {
+        rotation: (rotation * a.rotation).normalize(),
+        translation: rotation * a.translation + translation,
+    }
+}
+
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
 #[inline]
@@ -238,6 +273,21 @@ mod tests {
                 let err = sc.eval(t).max_abs_diff(&e);
                 assert!(err < 1e-12, "angle {angle:e} t {t}: error {err:e}");
             }
+        }
+    }
+
+    #[test]
+    fn midpoint_equals_half_screw() {
+        let a = Pose::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
+            DVec3::new(1.0, 2.0, -0.5),
+        );
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        let p = DVec3::new(0.5, -0.3, 0.1);
+        for angle in [0.0, 1e-12, 1e-6, 0.5, 2.0, PI - 1e-6] {
+            let b = exact(axis, p, angle, 0.7, 1.0, &a);
+            let err = midpoint(&a, &b).max_abs_diff(&exact(axis, p, angle, 0.7, 0.5, &a));
+            assert!(err < 1e-13, "angle {angle:e}: error {err:e}");
         }
     }
 

@@ -1,0 +1,62 @@
+//! Runs `s(a, t, b)` (ours or nalgebra's ScLERP) a given number of times, for instruction
+//! counts under `valgrind --tool=callgrind`, which are stable on a shared machine:
+//! `cargo build --release --example count_s && valgrind --tool=callgrind target/release/examples/count_s ours 100000`
+use std::hint::black_box;
+
+use glam::{DQuat, DVec3};
+use polyscrew::{s, Pose};
+
+fn pose(i: usize) -> Pose {
+    let x = i as f64;
+    let axis = DVec3::new(x.sin(), (1.3 * x).cos(), 0.5).normalize();
+    Pose::from_rotation_translation(
+        DQuat::from_axis_angle(axis, 0.3 + (x * 0.7).sin().abs() * 2.5),
+        DVec3::new(x.cos(), 1.0, -x.sin()),
+    )
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let which = args.get(1).map(String::as_str).unwrap_or("ours");
+    let n: usize = args.get(2).and_then(|v| v.parse().ok()).unwrap_or(100_000);
+    let poses: Vec<Pose> = (0..1024).map(pose).collect();
+    let mut acc = 0.0;
+    match which {
+        "ours" => {
+            for i in 0..n {
+                let p = s(
+                    black_box(&poses[i % 1024]),
+                    0.37,
+                    black_box(&poses[(i + 1) % 1024]),
+                );
+                acc += p.translation.x;
+            }
+        }
+        _ => {
+            let na: Vec<_> = poses
+                .iter()
+                .map(|p| {
+                    let q = p.rotation;
+                    nalgebra::UnitDualQuaternion::from_parts(
+                        nalgebra::Translation3::new(
+                            p.translation.x,
+                            p.translation.y,
+                            p.translation.z,
+                        ),
+                        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(
+                            q.w, q.x, q.y, q.z,
+                        )),
+                    )
+                })
+                .collect();
+            for i in 0..n {
+                if let Some(p) =
+                    black_box(&na[i % 1024]).try_sclerp(black_box(&na[(i + 1) % 1024]), 0.37, 1e-12)
+                {
+                    acc += p.translation().vector.x;
+                }
+            }
+        }
+    }
+    println!("{which}: {n} evaluations, checksum {acc:.6}");
+}
