@@ -4,6 +4,10 @@
 //! (Rossignac-Kim), polyscrew subdivision by the 4-point, cubic B-spline and Jarek
 //! Split&Tweak schemes (Powell-Rossignac, ScrewBender), a monotone C1 timing map from key
 //! times to the motion parameter, and sampling of the subdivided motion at any time.
+//! A second method designs motions from feature points (Hofer-Pottmann-Ravani,
+//! [`feature_motion()`]): curve schemes, including Kobbelt's variational subdivision
+//! ([`variational`]), on the feature points' trajectories, then Horn's registration
+//! ([`registration`]) of the rigid body at every sample.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
 //! through [`Error`], never by panicking.
