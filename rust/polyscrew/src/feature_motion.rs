@@ -22,6 +22,31 @@
 //! (Theorem 1) wherever the largest eigenvalue of Horn's matrix is simple; where it is not
 //! (the distorted body is degenerate, for example two keys half a turn apart averaged by an
 //! approximating scheme), the motion is undefined and an error names the sample.
+//!
+//! ```
+//! use glam::{DQuat, DVec3};
+//! use polyscrew::{feature_motion, FeatureSpec, Pose, Stiffness};
+//!
+//! let keys: Vec<Pose> = (0..6)
+//!     .map(|i| {
+//!         let a = i as f64;
+//!         Pose::from_rotation_translation(DQuat::from_rotation_z(a), DVec3::new(a, a.sin(), 0.0))
+//!     })
+//!     .collect();
+//! // The paper's Table 1 case: 6 closed keys, 7 levels of closed uniform interpolating design.
+//! let spec = FeatureSpec { levels: 7, closed: true, ..FeatureSpec::default() };
+//! let dense = feature_motion(&keys, None, &spec).unwrap();
+//! assert_eq!(dense.len(), 768);
+//! assert_eq!(dense[128], keys[1]); // every key is hit
+//! // Approximating: inner keys on springs of stiffness 0.5, the ends hit.
+//! let inf = f64::INFINITY;
+//! let spec = FeatureSpec {
+//!     stiffness: Stiffness::keys(vec![inf, 0.5, 0.5, 0.5, 0.5, inf]),
+//!     ..FeatureSpec::default()
+//! };
+//! let smooth = feature_motion(&keys, None, &spec).unwrap();
+//! assert_eq!(smooth.len(), 5 * 32 + 1);
+//! ```
 
 use glam::DVec3;
 
