@@ -182,6 +182,13 @@ pub fn spans_spacing(
     parametrization: Parametrization,
 ) -> Result<Vec<f64>> {
     let n = curves.first().map_or(0, Vec::len);
+    if let Some(bad) = curves.iter().find(|c| c.len() != n) {
+        return Err(Error::LengthMismatch {
+            what: "curves",
+            expected: n,
+            got: bad.len(),
+        });
+    }
     let spans = if closed { n } else { n.saturating_sub(1) };
     match parametrization {
         Parametrization::Uniform => Ok(vec![1.0; spans]),
@@ -227,11 +234,38 @@ impl VariationalLevel {
     /// (`n - 1` open, `n` closed, any positive scale) and per-point springs (`inf` = kept).
     ///
     /// # Errors
-    /// [`Error::Invalid`] (`what = "stiffness"`) when the system is not positive definite
-    /// (too few springs to pin the curve).
+    /// [`Error::TooFew`] for fewer than 2 points, [`Error::LengthMismatch`] for a wrong
+    /// number of spacings or springs, [`Error::Invalid`] for a spacing that is not finite and
+    /// positive, and [`Error::Invalid`] (`what = "stiffness"`) when the system is not positive
+    /// definite (too few springs to pin the curve, or a NaN spring).
     pub fn new(n: usize, closed: bool, spacing: &[f64], lambda: &[f64]) -> Result<Self> {
-        debug_assert_eq!(spacing.len(), if closed { n } else { n - 1 });
-        debug_assert_eq!(lambda.len(), n);
+        if n < 2 {
+            return Err(Error::TooFew { got: n, need: 2 });
+        }
+        let spans = if closed { n } else { n - 1 };
+        if spacing.len() != spans {
+            return Err(Error::LengthMismatch {
+                what: "spacing",
+                expected: spans,
+                got: spacing.len(),
+            });
+        }
+        if lambda.len() != n {
+            return Err(Error::LengthMismatch {
+                what: "stiffness",
+                expected: n,
+                got: lambda.len(),
+            });
+        }
+        if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
+            return Err(Error::Invalid {
+                what: "spacing",
+                reason: format!(
+                    "span {i} has spacing {}, need finite and positive",
+                    spacing[i]
+                ),
+            });
+        }
         let m = if closed { 2 * n } else { 2 * n - 1 };
         // Refined spacings: each span halved, then rescaled to mean 1.
         let mean = spacing.iter().sum::<f64>() / spacing.len() as f64;
@@ -317,24 +351,50 @@ impl VariationalLevel {
     }
 
     /// Refines one curve `v` (`n` points) into `2n - 1` (open) or `2n` (closed) points.
-    pub fn refine(&self, v: &[DVec3]) -> Vec<DVec3> {
-        debug_assert_eq!(v.len(), self.n);
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `v` does not have the system's `n` points.
+    pub fn refine(&self, v: &[DVec3]) -> Result<Vec<DVec3>> {
+        self.check_len(v.len())?;
         let mut x = self.rhs(v);
         self.factor.solve(&mut x);
-        self.unknown
+        Ok(self
+            .unknown
             .iter()
             .enumerate()
             .map(|(j, u)| match u {
                 Some(u) => x[*u],
                 None => v[j / 2],
             })
-            .collect()
+            .collect())
+    }
+
+    fn check_len(&self, got: usize) -> Result<()> {
+        if got != self.n {
+            return Err(Error::LengthMismatch {
+                what: "points",
+                expected: self.n,
+                got,
+            });
+        }
+        Ok(())
     }
 
     /// The scaled residual of the level's linear system `H x = g` (`H = grad^2 F / 2`) at a
     /// refined curve `w` of `v`: `max_u |(H x - g)_u| / H_uu`, row `u` divided by its
     /// diagonal so that stiff springs (`lambda ~ 1e8`) do not inflate it.
-    pub fn residual(&self, v: &[DVec3], w: &[DVec3]) -> f64 {
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `v` or `w` has the wrong number of points.
+    pub fn residual(&self, v: &[DVec3], w: &[DVec3]) -> Result<f64> {
+        self.check_len(v.len())?;
+        if w.len() != self.unknown.len() {
+            return Err(Error::LengthMismatch {
+                what: "refined points",
+                expected: self.unknown.len(),
+                got: w.len(),
+            });
+        }
         let x: Vec<DVec3> = self
             .unknown
             .iter()
@@ -351,11 +411,12 @@ impl VariationalLevel {
                 }
             }
         }
-        hx.iter()
+        Ok(hx
+            .iter()
             .zip(&g)
             .zip(&diag)
             .map(|((a, b), d)| (*a - *b).abs().max_element() / d)
-            .fold(0.0, f64::max)
+            .fold(0.0, f64::max))
     }
 
     fn matrix_mul(&self, x: &[DVec3]) -> Vec<DVec3> {
@@ -442,7 +503,7 @@ pub fn variational_subdivide(
             .collect();
         let system = VariationalLevel::new(len, closed, &spacing, &lambda)?;
         for c in current.iter_mut() {
-            *c = system.refine(c);
+            *c = system.refine(c)?;
         }
         spacing = spacing.iter().flat_map(|d| [0.5 * d, 0.5 * d]).collect();
     }
@@ -618,8 +679,8 @@ mod tests {
                     let curves = vec![f.clone()];
                     let spacing = spans_spacing(&curves, closed, param).unwrap();
                     let sys = VariationalLevel::new(6, closed, &spacing, &lambda).unwrap();
-                    let w = sys.refine(&f);
-                    let r = sys.residual(&f, &w);
+                    let w = sys.refine(&f).unwrap();
+                    let r = sys.residual(&f, &w).unwrap();
                     assert!(r < 1e-10, "{closed} {param:?}: residual {r:e}");
                     let energy = |w: &[DVec3]| -> f64 {
                         let fair: f64 = sys
