@@ -4,7 +4,7 @@ others pulled by the Stiffness spring). Writes out/demo_feature.blend, a strobos
 Workbench render out/demo_feature.png (copied to docs/images/) and the figures of the README
 in out/demo_feature.txt.
 
-Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/demo/40_feature.py [--out-dir out]
+Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/demo/50_feature.py [--out-dir out]
 (scripts/demo.sh runs it after building the extension).
 """
 

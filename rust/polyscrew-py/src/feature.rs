@@ -126,7 +126,7 @@ fn inertia_points<'py>(
     Ok(vec3s_to_array(&frame.inertia_points()).into_pyarray(py))
 }
 
-/// feature_motion(poses, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=inf) -> ndarray
+/// feature_motion(poses, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None) -> ndarray
 ///
 /// Feature-point motion design (Hofer-Pottmann-Ravani): the curve scheme runs on the
 /// homologous positions of the feature points of the key poses (N, 4, 4), and the rigid
@@ -135,7 +135,7 @@ fn inertia_points<'py>(
 /// belongs to key i.
 #[pyfunction]
 #[pyo3(signature = (poses, scheme="variational", levels=5, closed=false, feature_points=None,
-    parametrization="uniform", stiffness=None, inserted_stiffness=f64::INFINITY))]
+    parametrization="uniform", stiffness=None, inserted_stiffness=None))]
 #[allow(clippy::too_many_arguments)]
 fn feature_motion<'py>(
     py: Python<'py>,
@@ -146,7 +146,7 @@ fn feature_motion<'py>(
     feature_points: Option<FloatArray<'py>>,
     parametrization: &str,
     stiffness: Option<&Bound<'py, PyAny>>,
-    inserted_stiffness: f64,
+    inserted_stiffness: Option<f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = "feature_motion";
     let keys = read_keys(F, &poses)?;
@@ -158,7 +158,7 @@ fn feature_motion<'py>(
         closed,
         parametrization,
         stiffness,
-        inserted_stiffness,
+        inserted_stiffness.unwrap_or(f64::INFINITY),
     )?;
     let points = feature_points
         .map(|p| read_points(F, "feature_points", p.as_array()))
@@ -169,7 +169,7 @@ fn feature_motion<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// sample_feature(poses, key_times, times, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=inf, period=None, timing="smooth") -> ndarray
+/// sample_feature(poses, key_times, times, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None, period=None, timing="smooth") -> ndarray
 ///
 /// `feature_motion` as a function of time, evaluated at `times` (M,): (M, 4, 4). Key i
 /// sits at `key_times[i]` (strictly increasing); `period`, `timing` and the screw between
@@ -177,7 +177,7 @@ fn feature_motion<'py>(
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, scheme="variational", levels=5, closed=false,
     feature_points=None, parametrization="uniform", stiffness=None,
-    inserted_stiffness=f64::INFINITY, period=None, timing="smooth"))]
+    inserted_stiffness=None, period=None, timing="smooth"))]
 #[allow(clippy::too_many_arguments)]
 fn sample_feature<'py>(
     py: Python<'py>,
@@ -190,7 +190,7 @@ fn sample_feature<'py>(
     feature_points: Option<FloatArray<'py>>,
     parametrization: &str,
     stiffness: Option<&Bound<'py, PyAny>>,
-    inserted_stiffness: f64,
+    inserted_stiffness: Option<f64>,
     period: Option<f64>,
     timing: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
@@ -204,7 +204,7 @@ fn sample_feature<'py>(
         closed,
         parametrization,
         stiffness,
-        inserted_stiffness,
+        inserted_stiffness.unwrap_or(f64::INFINITY),
     )?;
     let timing = Timing::from_name(timing).map_err(|e| to_py_err(F, e))?;
     let key_times = read_vector(F, "key_times", key_times.as_array())?;

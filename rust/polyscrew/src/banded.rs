@@ -1,274 +1,110 @@
-//! Symmetric positive definite systems with half-bandwidth 2, optionally cyclic (the
-//! variational subdivision systems of `004_*` eqs. 23, 24, 26-27 and their closed and
-//! non-uniform versions).
-//!
-//! Open: a band Cholesky `H = L L^T` in `O(n)`. Cyclic: the last `b = 2` unknowns form a
-//! border; with `H = [[H11, H12], [H21, H22]]` and `H11` banded (no wrap-around entries),
-//!
-//! ```text
-//! Y = H11^-1 H12,   S = H22 - H21 Y          (b x b Schur complement)
-//! z = H11^-1 g1,    x2 = S^-1 (g2 - H21 z),   x1 = z - Y x2
-//! ```
-//!
-//! also `O(n)`; no dense inverse is ever formed.
+//! Symmetric banded matrices and their Cholesky factorisation, for the normal equations of
+//! spline fits: a Hermite spline couples only neighbouring control points, so `J^T J` is
+//! block tridiagonal and factorises in `O(n b^2)` instead of `O(n^3)`.
 
-#![allow(clippy::needless_range_loop)] // index loops mirror the matrix formulas
-#![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(d > 0.0)` rejects NaN pivots too
+// Index loops mirror the textbook band algorithms; iterator forms would hide the band.
+#![allow(clippy::needless_range_loop)]
 
-use std::ops::{Mul, Sub};
-
-/// Values a system can be solved for: scalars and 3D points (one coordinate at a time, the
-/// matrix being the same for all three).
-pub(crate) trait Lin: Copy + Sub<Output = Self> + Mul<f64, Output = Self> {
-    /// The additive identity.
-    const ZERO: Self;
-}
-
-impl Lin for f64 {
-    const ZERO: Self = 0.0;
-}
-
-impl Lin for glam::DVec3 {
-    const ZERO: Self = glam::DVec3::ZERO;
-}
-
-/// Width of the cyclic border.
-const BORDER: usize = 2;
-
-/// An assembled symmetric matrix of half-bandwidth 2 (cyclic when it has a border).
-#[derive(Debug, Clone)]
-pub(crate) struct BandMatrix {
-    /// Interior size `n1`.
-    n1: usize,
-    /// Border size `b` (0 open, 2 cyclic).
+/// A symmetric `n x n` matrix with half-bandwidth `b` (`a[i][j] = 0` for `|i - j| > b`),
+/// stored as its lower band: row `i` holds `a[i][i - b ..= i]`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SymBand {
+    n: usize,
     b: usize,
-    diag: Vec<f64>,
-    sub1: Vec<f64>,
-    sub2: Vec<f64>,
-    /// `cross[i][k] = H[i][n1 + k]`.
-    cross: Vec<[f64; BORDER]>,
-    corner: [[f64; BORDER]; BORDER],
+    data: Vec<f64>,
 }
 
-/// The factorisation of a [`BandMatrix`].
-#[derive(Debug, Clone)]
-pub(crate) struct BandFactor {
-    n1: usize,
-    b: usize,
-    /// `L` of `H11 = L L^T`: diagonal, first and second subdiagonal.
-    l0: Vec<f64>,
-    l1: Vec<f64>,
-    l2: Vec<f64>,
-    cross: Vec<[f64; BORDER]>,
-    /// `Y = H11^-1 H12`, row by row.
-    y: Vec<[f64; BORDER]>,
-    /// Cholesky factor of the Schur complement (lower).
-    schur: [[f64; BORDER]; BORDER],
-}
-
-impl BandMatrix {
-    /// A zero matrix of size `n`; `cyclic` adds the border (needs `n >= 2`).
-    pub(crate) fn zeros(n: usize, cyclic: bool) -> Self {
-        let b = if cyclic { BORDER.min(n) } else { 0 };
-        let n1 = n - b;
+impl SymBand {
+    /// The zero matrix.
+    pub(crate) fn zeros(n: usize, b: usize) -> Self {
         Self {
-            n1,
+            n,
             b,
-            diag: vec![0.0; n1],
-            sub1: vec![0.0; n1],
-            sub2: vec![0.0; n1],
-            cross: vec![[0.0; BORDER]; n1],
-            corner: [[0.0; BORDER]; BORDER],
+            data: vec![0.0; n * (b + 1)],
         }
     }
 
-    /// `H[i][j] += v` and, for `i != j`, `H[j][i] += v`. The pair must be within the band
-    /// (cyclically, for a bordered matrix).
+    /// Size `n`.
+    pub(crate) fn len(&self) -> usize {
+        self.n
+    }
+
+    /// Half-bandwidth `b`.
+    pub(crate) fn bandwidth(&self) -> usize {
+        self.b
+    }
+
+    #[inline]
+    fn idx(&self, i: usize, j: usize) -> usize {
+        debug_assert!(j <= i && i - j <= self.b && i < self.n);
+        i * (self.b + 1) + (self.b - (i - j))
+    }
+
+    /// `a[i][j]` for `j <= i` within the band.
+    #[inline]
+    pub(crate) fn get(&self, i: usize, j: usize) -> f64 {
+        self.data[self.idx(i, j)]
+    }
+
+    /// `a[i][j] += v` for `j <= i` within the band (the symmetric entry is implied).
+    #[inline]
     pub(crate) fn add(&mut self, i: usize, j: usize, v: f64) {
-        let (i, j) = if i >= j { (i, j) } else { (j, i) };
-        let n1 = self.n1;
-        if i < n1 {
-            match i - j {
-                0 => self.diag[i] += v,
-                1 => self.sub1[i] += v,
-                2 => self.sub2[i] += v,
-                d => debug_assert!(false, "entry ({i}, {j}) outside the band ({d})"),
-            }
-        } else if j < n1 {
-            self.cross[j][i - n1] += v;
-        } else {
-            self.corner[i - n1][j - n1] += v;
-            if i != j {
-                self.corner[j - n1][i - n1] += v;
-            }
-        }
+        let k = self.idx(i, j);
+        self.data[k] += v;
     }
 
-    /// `H x` (for residual checks).
-    #[cfg(test)]
-    pub(crate) fn mul<T: Lin + std::ops::Add<Output = T>>(&self, x: &[T]) -> Vec<T> {
-        let n1 = self.n1;
-        let mut out = vec![T::ZERO; n1 + self.b];
-        for i in 0..n1 {
-            out[i] = out[i] + x[i] * self.diag[i];
-            for (d, s) in [(1, &self.sub1), (2, &self.sub2)] {
-                if i >= d {
-                    out[i] = out[i] + x[i - d] * s[i];
-                    out[i - d] = out[i - d] + x[i] * s[i];
-                }
-            }
-            for k in 0..self.b {
-                out[i] = out[i] + x[n1 + k] * self.cross[i][k];
-                out[n1 + k] = out[n1 + k] + x[i] * self.cross[i][k];
-            }
-        }
-        for k in 0..self.b {
-            for l in 0..self.b {
-                out[n1 + k] = out[n1 + k] + x[n1 + l] * self.corner[k][l];
-            }
-        }
-        out
-    }
-
-    /// Cholesky factorisation.
+    /// Solves `a x = rhs` by Cholesky factorisation `a = L L^T` within the band.
     ///
-    /// # Errors
-    /// The index of the first non-positive (or non-finite) pivot: the matrix is not
-    /// positive definite.
-    pub(crate) fn factor(&self) -> Result<BandFactor, usize> {
-        let n1 = self.n1;
-        let (mut l0, mut l1, mut l2) = (vec![0.0; n1], vec![0.0; n1], vec![0.0; n1]);
-        for i in 0..n1 {
-            let a2 = if i >= 2 {
-                self.sub2[i] / l0[i - 2]
-            } else {
-                0.0
-            };
-            let a1 = if i >= 1 {
-                let prev = if i >= 2 { l1[i - 1] } else { 0.0 };
-                (self.sub1[i] - a2 * prev) / l0[i - 1]
-            } else {
-                0.0
-            };
-            let d = self.diag[i] - a1 * a1 - a2 * a2;
-            if !(d > 0.0) || !d.is_finite() {
-                return Err(i);
+    /// Returns `None` when `a` is not (numerically) positive definite.
+    pub(crate) fn solve(&self, rhs: &[f64]) -> Option<Vec<f64>> {
+        let (n, b) = (self.n, self.b);
+        debug_assert_eq!(rhs.len(), n);
+        let mut l = self.clone();
+        for j in 0..n {
+            let lo = j.saturating_sub(b);
+            let mut d = l.get(j, j);
+            for k in lo..j {
+                let v = l.get(j, k);
+                d -= v * v;
             }
-            l0[i] = d.sqrt();
-            l1[i] = a1;
-            l2[i] = a2;
-        }
-        let mut f = BandFactor {
-            n1,
-            b: self.b,
-            l0,
-            l1,
-            l2,
-            cross: self.cross.clone(),
-            y: vec![[0.0; BORDER]; n1],
-            schur: [[0.0; BORDER]; BORDER],
-        };
-        let b = self.b;
-        let mut s = self.corner;
-        for k in 0..b {
-            let mut col: Vec<f64> = self.cross.iter().map(|r| r[k]).collect();
-            f.band_solve(&mut col);
-            for (row, v) in f.y.iter_mut().zip(&col) {
-                row[k] = *v;
+            if d.is_nan() || d <= 0.0 {
+                return None;
             }
-        }
-        for k in 0..b {
-            for l in 0..b {
-                s[k][l] -= (0..n1).map(|i| self.cross[i][k] * f.y[i][l]).sum::<f64>();
-            }
-        }
-        // Cholesky of the b x b Schur complement.
-        for k in 0..b {
-            let mut d = s[k][k];
-            for m in 0..k {
-                d -= f.schur[k][m] * f.schur[k][m];
-            }
-            if !(d > 0.0) || !d.is_finite() {
-                return Err(n1 + k);
-            }
-            f.schur[k][k] = d.sqrt();
-            for r in k + 1..b {
-                let mut v = s[r][k];
-                for m in 0..k {
-                    v -= f.schur[r][m] * f.schur[k][m];
+            let d = d.sqrt();
+            let k = l.idx(j, j);
+            l.data[k] = d;
+            for i in j + 1..(j + b + 1).min(n) {
+                let lo_i = i.saturating_sub(b).max(lo);
+                let mut s = l.get(i, j);
+                for k in lo_i..j {
+                    s -= l.get(i, k) * l.get(j, k);
                 }
-                f.schur[r][k] = v / f.schur[k][k];
+                let k = l.idx(i, j);
+                l.data[k] = s / d;
             }
         }
-        Ok(f)
-    }
-}
-
-impl BandFactor {
-    /// Solves `H11 x = g` in place (forward then backward substitution).
-    fn band_solve<T: Lin>(&self, g: &mut [T]) {
-        let n1 = self.n1;
-        for i in 0..n1 {
-            let mut v = g[i];
-            if i >= 1 {
-                v = v - g[i - 1] * self.l1[i];
+        // L y = rhs
+        let mut x = rhs.to_vec();
+        for i in 0..n {
+            let mut s = x[i];
+            for k in i.saturating_sub(b)..i {
+                s -= l.get(i, k) * x[k];
             }
-            if i >= 2 {
-                v = v - g[i - 2] * self.l2[i];
-            }
-            g[i] = v * (1.0 / self.l0[i]);
+            x[i] = s / l.get(i, i);
         }
-        for i in (0..n1).rev() {
-            let mut v = g[i];
-            if i + 1 < n1 {
-                v = v - g[i + 1] * self.l1[i + 1];
+        // L^T x = y
+        for i in (0..n).rev() {
+            let mut s = x[i];
+            for k in i + 1..(i + b + 1).min(n) {
+                s -= l.get(k, i) * x[k];
             }
-            if i + 2 < n1 {
-                v = v - g[i + 2] * self.l2[i + 2];
-            }
-            g[i] = v * (1.0 / self.l0[i]);
+            x[i] = s / l.get(i, i);
         }
-    }
-
-    /// Solves `H x = g` in place.
-    pub(crate) fn solve<T: Lin>(&self, g: &mut [T]) {
-        let (n1, b) = (self.n1, self.b);
-        let (g1, g2) = g.split_at_mut(n1);
-        self.band_solve(g1);
-        if b == 0 {
-            return;
+        if x.iter().all(|v| v.is_finite()) {
+            Some(x)
+        } else {
+            None
         }
-        // r2 = g2 - H21 z, then x2 = S^-1 r2 by the Schur Cholesky factor.
-        let mut r = [T::ZERO; BORDER];
-        for k in 0..b {
-            let mut v = g2[k];
-            for (i, z) in g1.iter().enumerate() {
-                v = v - *z * self.cross[i][k];
-            }
-            r[k] = v;
-        }
-        for k in 0..b {
-            let mut v = r[k];
-            for m in 0..k {
-                v = v - r[m] * self.schur[k][m];
-            }
-            r[k] = v * (1.0 / self.schur[k][k]);
-        }
-        for k in (0..b).rev() {
-            let mut v = r[k];
-            for m in k + 1..b {
-                v = v - r[m] * self.schur[m][k];
-            }
-            r[k] = v * (1.0 / self.schur[k][k]);
-        }
-        for (i, z) in g1.iter_mut().enumerate() {
-            let mut v = *z;
-            for (k, rk) in r.iter().enumerate().take(b) {
-                v = v - *rk * self.y[i][k];
-            }
-            *z = v;
-        }
-        g2[..b].copy_from_slice(&r[..b]);
     }
 }
 
@@ -276,46 +112,46 @@ impl BandFactor {
 mod tests {
     use super::*;
 
-    /// A random SPD cyclic pentadiagonal matrix solved and checked by multiplication.
     #[test]
-    fn solves_band_and_cyclic() {
-        for n in 2..12 {
-            for cyclic in [false, true] {
-                let mut m = BandMatrix::zeros(n, cyclic);
-                let mut seed = 1.0f64 + n as f64;
-                let mut next = || {
-                    seed = (seed * 7.31 + 0.17).fract();
-                    seed - 0.5
+    fn solves_a_banded_system_like_a_dense_solver() {
+        let (n, b) = (9, 3);
+        let mut a = SymBand::zeros(n, b);
+        let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
+        for i in 0..n {
+            for j in i.saturating_sub(b)..=i {
+                let v = if i == j {
+                    10.0 + i as f64
+                } else {
+                    ((i * 7 + j * 3) % 5) as f64 - 2.0
                 };
-                for i in 0..n {
-                    m.add(i, i, 6.0);
-                    for d in 1..=2 {
-                        if cyclic || i + d < n {
-                            m.add(i, (i + d) % n, next());
-                        }
-                    }
-                }
-                let f = m.factor().unwrap();
-                let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
-                let mut g = m.mul(&x);
-                f.solve(&mut g);
-                for (a, b) in g.iter().zip(&x) {
-                    assert!(
-                        (a - b).abs() < 1e-13,
-                        "n {n} cyclic {cyclic}: {g:?} vs {x:?}"
-                    );
-                }
+                a.add(i, j, v);
+                dense[(i, j)] = v;
+                dense[(j, i)] = v;
             }
         }
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let x = a.solve(&rhs).unwrap();
+        let expected = dense
+            .cholesky()
+            .unwrap()
+            .solve(&nalgebra::DVector::from_vec(rhs.clone()));
+        for i in 0..n {
+            assert!(
+                (x[i] - expected[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                x[i],
+                expected[i]
+            );
+        }
+        assert_eq!(a.len(), n);
     }
 
     #[test]
-    fn detects_indefinite() {
-        let mut m = BandMatrix::zeros(4, false);
-        for i in 0..4 {
-            m.add(i, i, 1.0);
-        }
-        m.add(2, 1, 2.0);
-        assert_eq!(m.factor().unwrap_err(), 2);
+    fn refuses_an_indefinite_matrix() {
+        let mut a = SymBand::zeros(2, 1);
+        a.add(0, 0, 1.0);
+        a.add(1, 0, 2.0);
+        a.add(1, 1, 1.0);
+        assert!(a.solve(&[1.0, 1.0]).is_none());
     }
 }

@@ -25,21 +25,29 @@
 //! ```
 #![deny(missing_docs)]
 
-pub(crate) mod banded;
+pub mod angular_velocity;
+mod banded;
 pub mod channels;
+pub(crate) mod cyclic_band;
 pub mod eigen;
 pub mod error;
 pub mod fastmath;
 pub mod feature_motion;
 pub mod inertia;
 pub mod pose;
+pub mod quat_spline;
 pub mod registration;
 pub mod sample;
 pub mod screw;
+pub mod spinning_top;
 pub mod subdivision;
 pub mod timing;
 pub mod variational;
 
+pub use angular_velocity::{
+    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
+    FitStatus,
+};
 pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use feature_motion::{
@@ -48,9 +56,11 @@ pub use feature_motion::{
 };
 pub use inertia::InertiaFrame;
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
+pub use quat_spline::{QuatJet, QuatSpline};
 pub use registration::register;
 pub use sample::{sample, Motion, MotionSpec};
 pub use screw::{midpoint, s, Screw};
+pub use spinning_top::SpinningTop;
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
 pub use timing::{check_key_times, TimeMap, Timing};
 pub use variational::{variational_curve, variational_subdivide, Parametrization, Stiffness};

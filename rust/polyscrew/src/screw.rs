@@ -55,8 +55,8 @@ pub struct Screw {
     half_angle: f64,
     /// `sin(h) = |q.xyz|`, cached.
     sin_half: f64,
-    /// `sinc(h) = sin(h) / h`, cached.
-    sinc_half: f64,
+    /// `1 / sin(h)` (0 when `h = 0`), cached.
+    inv_sin_half: f64,
     /// Unit axis direction `S` (the translation's direction for a pure translation, `+z` for
     /// the identity).
     axis: DVec3,
@@ -71,26 +71,28 @@ impl Screw {
     /// the one of the quaternion with `w >= 0` as computed is taken.
     #[inline]
     pub fn between(a: &Pose, b: &Pose) -> Self {
+        // A product of unit quaternions is unit to rounding: no normalisation on this path
+        // (every division and square root here is on the critical path of `s`).
         let mut q = b.rotation * a.rotation.conjugate();
         if q.w < 0.0 {
             q = -q;
         }
-        let q = q.normalize();
         let v = q.xyz();
         let sin_h = v.length();
         let half_angle = fastmath::atan2_first_quadrant(sin_h, q.w);
         let tau = b.translation - q * a.translation;
-        let axis = if sin_h > 0.0 {
-            v / sin_h
+        let (inv_sin_half, axis) = if sin_h > 0.0 {
+            let inv = 1.0 / sin_h;
+            (inv, v * inv)
         } else {
-            tau.try_normalize().unwrap_or(DVec3::Z)
+            (0.0, tau.try_normalize().unwrap_or(DVec3::Z))
         };
         Self {
             base: *a,
             rotation: q,
             half_angle,
             sin_half: sin_h,
-            sinc_half: sinc_from(half_angle, sin_h),
+            inv_sin_half,
             axis,
             tau,
         }
@@ -106,9 +108,9 @@ impl Screw {
         let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
         // rho = sin(t h) / sin(h); near h = 0 as t sinc(t h) / sinc(h), exact at h = 0.
         let rho = if h < SINC_SERIES_BELOW {
-            t * sinc_from(th, sin_th) / self.sinc_half
+            t * sinc_from(th, sin_th) / (1.0 - h * h / 6.0)
         } else {
-            sin_th / sin_h
+            sin_th * self.inv_sin_half
         };
         let v = self.rotation.xyz();
         let rotation = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);

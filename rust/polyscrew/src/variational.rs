@@ -41,7 +41,7 @@
 
 use glam::DVec3;
 
-use crate::banded::BandMatrix;
+use crate::cyclic_band::BandMatrix;
 use crate::error::{Error, Result};
 use crate::subdivision::{check_subdivision, subdivided_len};
 
@@ -226,7 +226,7 @@ pub struct VariationalLevel {
     stencils: Vec<([usize; 3], [f64; 3])>,
     /// Spring weight of each unknown (0 for new points).
     springs: Vec<f64>,
-    factor: crate::banded::BandFactor,
+    factor: crate::cyclic_band::BandFactor,
 }
 
 impl VariationalLevel {
