@@ -101,7 +101,6 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
     """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes)."""
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
-    frames = bake_frames(start, end, options.step)
     spec = dict(
         scheme=options.scheme,
         levels=options.levels,
@@ -110,6 +109,7 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         timing=options.timing,
     )
     try:
+        frames = bake_frames(start, end, options.step)
         if options.method == "FEATURE":
             poses = feature.sample_poses(obj, motion, frames, options)
         else:
@@ -123,7 +123,7 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         if motion.scale_keyed:
             log_scale = polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec)
             values["scale"] = np.exp(log_scale)
-    except ValueError as err:
+    except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{obj.name}: {err}") from err
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
     # that was cyclic in the source.

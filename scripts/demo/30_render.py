@@ -52,7 +52,7 @@ SHOTS = {
     ),
 }
 PANEL_LABELS = {"Raw polyscrew": "raw polyscrew", "4-point": "4-point", "B-spline": "B-spline", "Jarek": "Jarek"}
-PANEL_PIXELS = (760, 900)
+PANEL_PIXELS = (640, 760)
 #: Share of a panel's height for the motion (the rest: label, speed graph, title).
 MOTION_SHARE = 0.66
 KEY_COLOR = (0.85, 0.08, 0.08, 1.0)
@@ -243,6 +243,8 @@ def render_shot(source_scene, motion: str, out: Path) -> Path:
     scene.render.resolution_y = PANEL_PIXELS[1]
     scene.render.resolution_percentage = 100
     scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGB"
+    scene.render.image_settings.compression = 100
     scene.view_settings.view_transform = "Standard"
     scene.display.render_aa = "8"
     shading = scene.display.shading
