@@ -185,6 +185,8 @@ def main() -> None:
     render.display.shading.show_object_outline = True
     render.render.resolution_x, render.render.resolution_y = 1400, 1400
     render.render.image_settings.file_format = "PNG"
+    render.render.image_settings.color_mode = "RGB"
+    render.render.image_settings.compression = 100
     render.world = bpy.data.worlds.new("White")
     render.world.color = (1.0, 1.0, 1.0)
     path = out / "demo_feature.png"
