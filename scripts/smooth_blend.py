@@ -56,7 +56,7 @@ def parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--parametrization", choices=("uniform", "centripetal"), default="uniform",
                         help="FEATURE: spacing of the keys along the variational curves")
     parser.add_argument("--stiffness", type=float, metavar="LAMBDA",
-                        help="FEATURE: approximate the keys not selected (and not first/last of an open "
+                        help="FEATURE: approximate the selected keys (not the first/last of an open "
                         "motion) with this spring stiffness (default: hit every key)")
     target = parser.add_mutually_exclusive_group(required=True)
     target.add_argument("--out", type=Path, help="where to save the result")

@@ -8,9 +8,11 @@ approximating some of them with a spring, and at every baked frame the rigid obj
 registered (Horn's method) to the distorted points. All of it is one
 `polyscrew.sample_feature` call per object; this module only gathers its inputs.
 
-Per-key stiffness comes from the key selection: keys selected on any transform F-curve (in
-the Graph Editor or Dope Sheet) are hit exactly, the others are approximated with the
-Stiffness option; the first and last key of an open motion are always hit.
+Per-key stiffness comes from the key selection, as for the Graph Editor's Smooth Keys: keys
+selected on any transform F-curve (Graph Editor or Dope Sheet) are approximated with the
+Stiffness option, unselected keys are hit exactly, and so are the first and last key of an
+open motion. Freshly inserted keys are selected, so by default every inner key is
+approximated.
 """
 
 from __future__ import annotations
@@ -81,11 +83,11 @@ def feature_points(obj: bpy.types.Object, scale: np.ndarray) -> np.ndarray | Non
 
 
 def key_stiffness(motion: keys.KeyedMotion, selected: np.ndarray, approximate: bool, stiffness: float):
-    """Spring lambda per key: None (hit every key) unless `approximate`; then selected keys and
-    the ends of an open motion are hit (inf), the others get `stiffness`."""
+    """Spring lambda per key: None (hit every key) unless `approximate`; then selected keys get
+    `stiffness`, unselected keys and the ends of an open motion are hit (inf)."""
     if not approximate:
         return None
-    lam = np.where(selected, np.inf, float(stiffness))
+    lam = np.where(selected, float(stiffness), np.inf)
     if not motion.closed:
         lam[0] = lam[-1] = np.inf
     return lam

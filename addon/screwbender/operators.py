@@ -53,16 +53,17 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     approximate: BoolProperty(
         name="Approximate Keys",
         default=False,
-        description="Feature Points: pass near the unselected keys instead of through them (for "
-        "noisy or roughly blocked keys). Keys selected on any transform F-curve, and the first and "
-        "last key of an open motion, are still hit exactly",
+        description="Feature Points: pass near the selected keys instead of through them (for noisy "
+        "or roughly blocked keys; select them in the Graph Editor or Dope Sheet as for Smooth Keys, "
+        "new keys are selected). Unselected keys, and the first and last key of an open motion, "
+        "are hit exactly",
     )
     stiffness: FloatProperty(
         name="Stiffness",
         default=1.0,
         min=0.0,
         soft_max=100.0,
-        description="Feature Points, Approximate Keys: how hard the unselected keys pull the motion "
+        description="Feature Points, Approximate Keys: how hard the selected keys pull the motion "
         "(spring lambda of variational subdivision). Small is smoother and strays further from the "
         "keys; large comes close to hitting them",
     )

@@ -1,6 +1,6 @@
 """Demo part: noisy keys smoothed by feature-point motion design (Hofer-Pottmann-Ravani),
 interpolating (every key hit) beside approximating (only the first and last key hit, the
-others pulled by the Stiffness spring). Writes out/demo_feature.blend, a stroboscopic
+others, all selected, pulled by the Stiffness spring). Writes out/demo_feature.blend, a stroboscopic
 Workbench render out/demo_feature.png (copied to docs/images/) and the figures of the README
 in out/demo_feature.txt.
 
@@ -76,7 +76,7 @@ def keyed_object(name: str, mesh, frames, poses, offset: Vector) -> bpy.types.Ob
 
 
 def select_keys(obj, frames) -> None:
-    """Selects exactly the keys at `frames` (the keys hit by Approximate Keys)."""
+    """Selects exactly the keys at `frames` (the keys Approximate Keys works on)."""
     from bl_ext.user_default.screwbender import channels
 
     for fcurve in channels.object_fcurves(obj):
@@ -138,8 +138,9 @@ def main() -> None:
     mesh = dart_mesh()
     exact = keyed_object("Interpolating", mesh, key_frames, poses, Vector())
     approx = keyed_object("Approximating", mesh, key_frames, poses, PANEL_OFFSET)
-    select_keys(exact, [])
-    select_keys(approx, [key_frames[0], key_frames[-1]])
+    # Approximate Keys works on the selected keys (all of them after keying, as here); the
+    # first and last key of an open motion are hit anyway.
+    select_keys(approx, key_frames)
     common = dict(method="FEATURE", levels=LEVELS)
     bake.smooth([exact], bake.Options(**common), strict=True)
     bake.smooth([approx], bake.Options(**common, approximate=True, stiffness=STIFFNESS), strict=True)

@@ -1,6 +1,6 @@
 """Smooth Motion's "Feature Points" method (Hofer-Pottmann-Ravani): the baked channels are
-`polyscrew.sample_feature` of the key poses with the mesh's inertia points, selected keys are
-hit exactly and the others approximated with the Stiffness option."""
+`polyscrew.sample_feature` of the key poses with the mesh's inertia points; with Approximate
+Keys the selected keys are approximated with the Stiffness option and the others hit."""
 
 from __future__ import annotations
 
@@ -67,15 +67,18 @@ def test_baked_channels_are_sample_feature(sb, parametrization, kind):
     assert np.abs(baked - screw).max() > 1e-3
 
 
-def test_selected_keys_hit_others_approximated(sb):
+def test_selected_keys_approximated_others_hit(sb):
     obj = keyed(seed=8)
     motion = sb.keys.read(obj)
-    select_keys(obj, [FRAMES[3]])
+    # Freshly inserted keys are all selected: by default every inner key is approximated.
+    assert all(p.select_control_point for fc in h.fcurves(obj) for p in fc.keyframe_points)
+    select_keys(obj, [f for i, f in enumerate(FRAMES) if i != 3])
     assert bpy.ops.screwbender.smooth(method="FEATURE", approximate=True, stiffness=0.5, levels=4) == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     at_keys = np.searchsorted(frames, motion.frames)
     miss = np.abs(baked[at_keys] - motion.poses).max(axis=(1, 2))
-    # Selected key and the two ends of the open motion: hit; the other keys: approximated.
+    # The unselected key and the two ends of the open motion: hit; the selected inner keys:
+    # approximated.
     hit = [0, 3, len(FRAMES) - 1]
     assert miss[hit].max() < 1e-5, miss
     assert np.delete(miss, hit).min() > 1e-3, miss
