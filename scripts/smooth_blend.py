@@ -51,12 +51,21 @@ def parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--closed", choices=("AUTO", "ON", "OFF"), default="AUTO", type=str.upper)
     parser.add_argument("--step", type=float, default=1.0, help="frames between baked keys (default 1)")
     parser.add_argument("--frame-range", nargs=2, type=float, metavar=("START", "END"), help="default: the keys' range")
+    parser.add_argument("--method", choices=("SCREW", "FEATURE"), default="SCREW", type=str.upper,
+                        help="SCREW: screw subdivision (default); FEATURE: feature points (variational)")
+    parser.add_argument("--parametrization", choices=("uniform", "centripetal"), default="uniform",
+                        help="FEATURE: spacing of the keys along the variational curves")
+    parser.add_argument("--stiffness", type=float, metavar="LAMBDA",
+                        help="FEATURE: approximate the selected keys (not the first/last of an open "
+                        "motion) with this spring stiffness (default: hit every key)")
     target = parser.add_mutually_exclusive_group(required=True)
     target.add_argument("--out", type=Path, help="where to save the result")
     target.add_argument("--in-place", action="store_true", help="save over the opened file")
     args = parser.parse_args(argv)
     if not args.step > 0:
         parser.error(f"--step must be positive, got {args.step:g}")
+    if args.stiffness is not None and (args.method != "FEATURE" or not args.stiffness >= 0):
+        parser.error("--stiffness needs --method FEATURE and a value >= 0")
     return args
 
 
@@ -103,6 +112,10 @@ def run(args: argparse.Namespace) -> str:
         closed=args.closed,
         frame_range=tuple(args.frame_range) if args.frame_range else None,
         step=args.step,
+        method=args.method,
+        parametrization=args.parametrization,
+        approximate=args.stiffness is not None,
+        stiffness=args.stiffness if args.stiffness is not None else 1.0,
     )
     try:
         # named objects must all be smoothable (checked before anything changes)

@@ -24,7 +24,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, keys
+from . import channels, feature, keys
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -65,6 +65,14 @@ class Options:
     frame_range: tuple[float, float] | None = None
     #: Frames between baked keys (1 frame, or less for subframes).
     step: float = 1.0
+    #: "SCREW" (screw subdivision) or "FEATURE" (feature points, see :mod:`feature`).
+    method: str = "SCREW"
+    #: Feature points: "uniform" or "centripetal" spacing of the variational curves.
+    parametrization: str = "uniform"
+    #: Feature points: approximate the unselected keys (else every key is hit).
+    approximate: bool = False
+    #: Feature points: spring stiffness of the approximated keys (smaller is smoother).
+    stiffness: float = 1.0
 
 
 @dataclass
@@ -81,11 +89,16 @@ class Baked:
 
 
 def sample_poses(
-    motion: keys.KeyedMotion, frames: np.ndarray, options: Options
+    motion: keys.KeyedMotion,
+    frames: np.ndarray,
+    options: Options,
+    obj: bpy.types.Object | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """The smoothed motion at `frames`: rigid poses (len(frames), 4, 4) and, when scale is
-    keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses,
-    one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError` from polyscrew.
+    keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses
+    (`polyscrew.sample_feature` for the Feature Points method, which needs `obj` for its mesh
+    and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
+    from polyscrew.
 
     Smooth Motion's bake, the live preview and Insert Key on Motion all sample through here,
     so they show, key and bake the same motion.
@@ -97,7 +110,10 @@ def sample_poses(
         period=motion.period,
         timing=options.timing,
     )
-    poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
+    if options.method == "FEATURE" and obj is not None:
+        poses = feature.sample_poses(obj, motion, frames, options)
+    else:
+        poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
     scales = None
     if motion.scale_keyed:
         scales = np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
@@ -119,7 +135,7 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
     try:
         frames = bake_frames(start, end, options.step)
-        poses, scales = sample_poses(motion, frames, options)
+        poses, scales = sample_poses(motion, frames, options, obj)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         values = {

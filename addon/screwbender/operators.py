@@ -3,9 +3,9 @@
 
 
 import bpy
-from bpy.props import EnumProperty, FloatProperty, IntProperty
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty
 
-from . import bake
+from . import bake, feature
 from .keys import SmoothError
 
 RANGE_MODES = (
@@ -20,6 +20,17 @@ def _report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str
         operator.report({level}, message)
 
 
+def draw_method(layout: bpy.types.UILayout, settings) -> None:
+    """The Method option and, for Feature Points, its own options (operator and panel)."""
+    layout.prop(settings, "method")
+    if settings.method == "FEATURE":
+        layout.prop(settings, "parametrization")
+        layout.prop(settings, "approximate")
+        row = layout.row()
+        row.active = settings.approximate
+        row.prop(settings, "stiffness")
+
+
 class SCREWBENDER_OT_smooth(bpy.types.Operator):
     """Replace the keyed motion of the selected objects by a smooth screw motion through their key poses, baked into a new action (the old one is kept)"""
 
@@ -27,6 +38,35 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     bl_label = "Smooth Motion"
     bl_options = {"REGISTER", "UNDO"}
 
+    method: EnumProperty(
+        name="Method",
+        items=feature.METHODS,
+        default="SCREW",
+        description="How the key poses become a smooth motion",
+    )
+    parametrization: EnumProperty(
+        name="Spacing",
+        items=feature.PARAMETRIZATIONS,
+        default="uniform",
+        description="Feature Points: how the keys are spaced along the variational curves",
+    )
+    approximate: BoolProperty(
+        name="Approximate Keys",
+        default=False,
+        description="Feature Points: pass near the selected keys instead of through them (for noisy "
+        "or roughly blocked keys; select them in the Graph Editor or Dope Sheet as for Smooth Keys, "
+        "new keys are selected). Unselected keys, and the first and last key of an open motion, "
+        "are hit exactly",
+    )
+    stiffness: FloatProperty(
+        name="Stiffness",
+        default=1.0,
+        min=0.0,
+        soft_max=100.0,
+        description="Feature Points, Approximate Keys: how hard the selected keys pull the motion "
+        "(spring lambda of variational subdivision). Small is smoother and strays further from the "
+        "keys; large comes close to hitting them",
+    )
     scheme: EnumProperty(
         name="Scheme",
         items=bake.SCHEMES,
@@ -89,6 +129,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
+        draw_method(layout, self)
         for name in ("scheme", "levels", "timing", "closed", "range_mode"):
             layout.prop(self, name)
         if self.range_mode == "CUSTOM":
@@ -112,6 +153,10 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
             closed=self.closed,
             frame_range=frame_range,
             step=self.step,
+            method=self.method,
+            parametrization=self.parametrization,
+            approximate=self.approximate,
+            stiffness=self.stiffness,
         )
 
     def execute(self, context: bpy.types.Context) -> set[str]:

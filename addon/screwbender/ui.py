@@ -5,9 +5,12 @@
 import bpy
 from bpy.props import PointerProperty
 
-from .operators import SCREWBENDER_OT_revert, SCREWBENDER_OT_smooth
+from .operators import SCREWBENDER_OT_revert, SCREWBENDER_OT_smooth, draw_method
 
-_OPTION_NAMES = ("scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step")
+_OPTION_NAMES = (
+    "method", "parametrization", "approximate", "stiffness",
+    "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
+)
 
 
 def _same_property(name: str):
@@ -19,6 +22,10 @@ def _same_property(name: str):
 class ScrewBenderSettings(bpy.types.PropertyGroup):
     """The panel's Smooth Motion options, stored in the scene."""
 
+    method: _same_property("method")
+    parametrization: _same_property("parametrization")
+    approximate: _same_property("approximate")
+    stiffness: _same_property("stiffness")
     scheme: _same_property("scheme")
     levels: _same_property("levels")
     timing: _same_property("timing")
@@ -38,6 +45,7 @@ class _SmoothPanel:
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
+        draw_method(layout, settings)
         for name in ("scheme", "levels", "timing", "closed", "range_mode"):
             layout.prop(settings, name)
         if settings.range_mode == "CUSTOM":

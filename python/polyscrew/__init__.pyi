@@ -259,3 +259,75 @@ def sweep(
     index out of range or zero area (naming the triangle), fewer than 2 poses, a non-rigid
     pose (naming it), or ``steps`` outside ``1..=MAX_STEPS``.
     """
+
+# --- Feature-point motion design (Hofer-Pottmann-Ravani), issue 5 -------------------------
+
+CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
+ParametrizationName = Literal["uniform", "centripetal"]
+
+def register_points(src: ArrayLike, dst: ArrayLike, weights: ArrayLike | None = None) -> FloatArray:
+    """The rigid pose (4, 4) minimising ``sum_k w_k |pose(src_k) - dst_k|^2`` (Horn's method).
+
+    ``src``, ``dst``: (K, 3) corresponding points, K >= 3; ``weights``: (K,) >= 0, default 1.
+    The rotation is the eigenvector of the largest eigenvalue of Horn's symmetric 4x4
+    matrix; when that eigenvalue is repeated (collinear points, or a target too distorted to
+    have a unique best fit) ValueError is raised instead of an arbitrary rotation.
+    """
+
+def inertia_points(points: ArrayLike) -> FloatArray:
+    """The six inertia points (6, 3) of a cloud ``points`` (K, 3): barycentre
+    ``+- sqrt(lambda_j / 2) e_j`` along the principal axes of its inertia tensor.
+
+    They share the cloud's barycentre and inertia tensor, so they stand in for a whole mesh
+    as ``feature_points``. Raises ValueError for fewer than 3 or collinear points.
+    """
+
+def feature_motion(
+    poses: ArrayLike,
+    scheme: CurveSchemeName = "variational",
+    levels: int = 5,
+    closed: bool = False,
+    feature_points: ArrayLike | None = None,
+    parametrization: ParametrizationName = "uniform",
+    stiffness: float | ArrayLike | None = None,
+    inserted_stiffness: float | None = None,
+) -> FloatArray:
+    """Feature-point motion design (Hofer-Pottmann-Ravani) of the keys ``poses`` (N, 4, 4).
+
+    The curve ``scheme`` runs on the homologous positions of ``feature_points`` (K, 3, in
+    the body frame; default the six unit points +-x, +-y, +-z, whose isotropic inertia makes
+    the result independent of how the local axes are turned), then the rigid body is
+    registered to the distorted points at every output pose. Returns (N * 2**levels, 4, 4)
+    closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose ``i * 2**levels`` belongs to key i.
+    Rigid (unit quaternions) and independent of the world frame.
+
+    ``"variational"`` is Kobbelt's variational subdivision (C2), the only scheme that takes
+    ``parametrization`` (``"centripetal"``: spacing sqrt of the feature points' distance
+    between keys) and ``stiffness``: the spring lambda per key, a float for all keys or an
+    (N,) array; ``inf`` (or ``None``) hits that key exactly, a finite lambda >= 0 lets the
+    motion pass near it (smaller = smoother; an open motion needs two keys and a closed one
+    one key with lambda > 0). ``inserted_stiffness`` is lambda for the poses inserted at
+    earlier levels (``None`` = ``inf``: kept once inserted). ``"four_point"`` interpolates (C1),
+    ``"bspline"`` and ``"jarek"`` approximate (C2).
+    Raises ValueError naming the bad pose, key or sample and the reason.
+    """
+
+def sample_feature(
+    poses: ArrayLike,
+    key_times: ArrayLike,
+    times: ArrayLike,
+    scheme: CurveSchemeName = "variational",
+    levels: int = 5,
+    closed: bool = False,
+    feature_points: ArrayLike | None = None,
+    parametrization: ParametrizationName = "uniform",
+    stiffness: float | ArrayLike | None = None,
+    inserted_stiffness: float | None = None,
+    period: float | None = None,
+    timing: TimingName = "smooth",
+) -> FloatArray:
+    """``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).
+
+    Key i sits at ``key_times[i]`` (finite, strictly increasing); ``period`` and ``timing``
+    as in ``sample``; between dense poses the motion is the screw joining them.
+    """

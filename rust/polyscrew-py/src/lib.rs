@@ -3,16 +3,15 @@
 //! Every function has the same shape: take array-likes, check shapes, release the GIL, call
 //! the core, map the error once (`to_py_err`), wrap the result as numpy arrays.
 
+mod angular_velocity;
+mod feature;
 mod sweep;
 
+use glam::DVec3;
 use numpy::ndarray::{Array2, Array3, ArrayViewD};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
-
-mod angular_velocity;
-
-use glam::DVec3;
 use polyscrew::{
     rotation_channels as core_rotation_channels, subdivide as core_subdivide, Error, Motion,
     MotionSpec, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
@@ -461,5 +460,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_LEVELS", MAX_LEVELS)?;
     angular_velocity::register(m)?;
     sweep::register(m)?;
+    feature::register(m)?;
     Ok(())
 }

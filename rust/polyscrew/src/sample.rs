@@ -67,6 +67,39 @@ impl<T: Interpolant> Motion<T> {
         })
     }
 
+    /// A motion from dense elements computed elsewhere (for example by
+    /// [`crate::feature_motion()`]): `dense` must hold `subdivided_len(n, levels, closed)`
+    /// elements for the `n = key_times.len()` keys, element `i 2^levels` belonging to key `i`.
+    ///
+    /// # Errors
+    /// [`Error::Levels`] for levels above [`crate::MAX_LEVELS`], [`Error::LengthMismatch`]
+    /// when `dense` has the wrong length, then the errors of [`TimeMap::new`].
+    pub fn from_dense(
+        dense: Vec<T>,
+        key_times: &[f64],
+        levels: u32,
+        closed: bool,
+        period: Option<f64>,
+        timing: Timing,
+    ) -> Result<Self> {
+        crate::subdivision::check_subdivision(key_times.len(), levels)?;
+        let expected = crate::subdivision::subdivided_len(key_times.len(), levels, closed);
+        if dense.len() != expected {
+            return Err(Error::LengthMismatch {
+                what: "dense poses",
+                expected,
+                got: dense.len(),
+            });
+        }
+        let map = TimeMap::new(key_times, closed, period, timing)?;
+        Ok(Self {
+            dense,
+            map,
+            per_span: 1 << levels,
+            closed,
+        })
+    }
+
     /// The dense (subdivided) elements.
     pub fn dense(&self) -> &[T] {
         &self.dense
