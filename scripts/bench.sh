@@ -49,7 +49,7 @@ cargo bench -p polyscrew --bench core --bench scaling -- "${crit_args[@]}" 2>&1 
 
 stage "callgrind instruction counts"
 if command -v valgrind >/dev/null; then
-  cargo build --release -p polyscrew --example count_s --example count_subdivide 2>&1 | grep -v '^ *Compiling' || true
+  cargo build --profile bench -p polyscrew --example count_s --example count_subdivide 2>&1 | grep -v '^ *Compiling' || true
   n=100000; [ "$quick" = 1 ] && n=10000
   echo "$n" > "$run/callgrind-n.txt"
   cg() { valgrind --tool=callgrind --callgrind-out-file="$1" "${@:2}" 2>&1 | grep -E 'Collected|evaluations|runs of' ; }
