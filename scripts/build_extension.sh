@@ -19,10 +19,15 @@ MATURIN="$(pick "${MATURIN:-}" "$ROOT/.venv/bin/maturin" maturin)"
 
 WHEEL_DIR="$ROOT/dist/wheels"
 mkdir -p "$WHEEL_DIR"
-rm -f "$WHEEL_DIR"/polyscrew-*.whl
 if [[ -n "${SCREWBENDER_WHEEL:-}" ]]; then
-    cp "$SCREWBENDER_WHEEL" "$WHEEL_DIR/"
+    wheel="$(cd "$(dirname "$SCREWBENDER_WHEEL")" && pwd)/$(basename "$SCREWBENDER_WHEEL")"
+    [[ -f "$wheel" ]] || { echo "build_extension: no wheel $SCREWBENDER_WHEEL" >&2; exit 1; }
+    for old in "$WHEEL_DIR"/polyscrew-*.whl; do
+        [[ -e "$old" && "$old" != "$wheel" ]] && rm -f "$old"
+    done
+    [[ "$(dirname "$wheel")" == "$WHEEL_DIR" ]] || cp "$wheel" "$WHEEL_DIR/"
 else
+    rm -f "$WHEEL_DIR"/polyscrew-*.whl
     "$MATURIN" build --release --quiet -o "$WHEEL_DIR" >&2
 fi
 "$PYTHON" "$ROOT/scripts/package_extension.py" --wheels "$WHEEL_DIR" --out "$ROOT/dist"

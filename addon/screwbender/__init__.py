@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import bpy
 
-from . import operators, ui
+from . import angvel, operators, ui
 
-_register_classes, _unregister_classes = bpy.utils.register_classes_factory(operators.classes + ui.classes)
+_register_classes, _unregister_classes = bpy.utils.register_classes_factory(
+    operators.classes + ui.classes + angvel.classes
+)
 
 
 def register() -> None:

@@ -65,7 +65,7 @@ class KeyedMotion:
     first_rotation: np.ndarray
     #: Whether the motion is a cycle.
     closed: bool
-    #: Cycle length in frames for a closed motion (None: the core closes after a mean spacing).
+    #: Cycle length in frames for a closed motion (None for an open one).
     period: float | None
     #: Whether a Cycles modifier was found on the transform curves.
     cyclic: bool
@@ -146,10 +146,11 @@ def compose(locations: np.ndarray, rotations: np.ndarray, scales: np.ndarray | N
     return out
 
 
-def _key_frames(fcurve: bpy.types.FCurve) -> np.ndarray:
+def _key_points(fcurve: bpy.types.FCurve) -> np.ndarray:
+    """(K, 2) key frames and values of an F-curve."""
     co = np.empty(2 * len(fcurve.keyframe_points), dtype=np.float32)
     fcurve.keyframe_points.foreach_get("co", co)
-    return co[0::2].astype(np.float64)
+    return co.reshape(-1, 2).astype(np.float64)
 
 
 def _union(frames: list[np.ndarray]) -> np.ndarray:
@@ -200,7 +201,8 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
     }
     if not curves:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    frames = _union([_key_frames(fc) for fc in curves.values()])
+    points = {key: _key_points(fc) for key, fc in curves.items()}
+    frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
 
@@ -209,8 +211,13 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
         out = np.empty((len(frames), size))
         for i in range(size):
             fc = curves.get((path, i))
-            # A loop over keys (not frames): F-curves are evaluated only at their key frames.
-            out[:, i] = [fc.evaluate(f) for f in frames] if fc is not None else static[i]
+            if fc is None:
+                out[:, i] = static[i]
+            elif len(fc.modifiers) == 0 and np.array_equal(points[path, i][:, 0], frames):
+                out[:, i] = points[path, i][:, 1]  # keyed on every key frame: its key values
+            else:
+                # A loop over keys (not frames): the curve evaluated at the other curves' keys.
+                out[:, i] = [fc.evaluate(f) for f in frames]
         return out
 
     location = evaluate("location", 3)
@@ -243,6 +250,9 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
                 raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
             period = float(frames[-1] - frames[0])
             frames, poses, scale, rotation = frames[:-1], poses[:-1], scale[:-1], rotation[:-1]
+        else:
+            # no closing key: the last key returns to the first after the mean key spacing
+            period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
     scale_keyed = any(path == "scale" for path, _ in curves)
     return KeyedMotion(
         frames=frames,

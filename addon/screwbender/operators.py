@@ -119,7 +119,9 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 2 * len(objects))
         try:
-            actions, skipped = bake.smooth(objects, self.smooth_options(context), lambda done, _total: wm.progress_update(done))
+            actions, skipped = bake.smooth(
+                objects, self.smooth_options(context), lambda done, _total: wm.progress_update(done)
+            )
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}

@@ -58,6 +58,12 @@ def blender_with_addon():
         raise RuntimeError("blender_with_addon() must run before bpy is imported")
     user = Path(tempfile.mkdtemp(prefix="screwbender-demo-user-"))
     os.environ["BLENDER_USER_RESOURCES"] = str(user)
+    # Where Blender unpacks the extension's wheels: put it first on the path so that the
+    # bundled polyscrew is used even when an older one is installed in the Python running bpy.
+    version = f"python{sys.version_info.major}.{sys.version_info.minor}"
+    wheels = user / "extensions" / ".local" / "lib" / version / "site-packages"
+    wheels.mkdir(parents=True)
+    sys.path.insert(0, str(wheels))
     import atexit
     import importlib
 
@@ -69,4 +75,8 @@ def blender_with_addon():
     )
     if result != {"FINISHED"}:
         sys.exit(f"demo: could not install {extension_zip()}")
+    import polyscrew
+
+    if not Path(polyscrew.__file__).resolve().is_relative_to(wheels.resolve()):
+        sys.exit(f"demo: polyscrew comes from {polyscrew.__file__}, not from the extension")
     return importlib.import_module("bl_ext.user_default.screwbender.bake")

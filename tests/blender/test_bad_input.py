@@ -115,3 +115,11 @@ def test_poll_explains_itself():
     h.select_only()
     with pytest.raises(RuntimeError, match="Select one or more keyed objects"):
         bpy.ops.screwbender.smooth()
+
+
+def test_empty_custom_frame_range():
+    keyed()
+    before = h.snapshot_scene()
+    with pytest.raises(RuntimeError, match=r"Body: frame range 20 to 10 is empty"):
+        bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=20, frame_end=10)
+    assert h.snapshot_scene() == before

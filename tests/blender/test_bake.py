@@ -39,7 +39,7 @@ def keyed(mode: str, seed: int, name: str = "Body", parent: bool = True):
 def check_against_sample(sb, obj, motion, scheme, levels, timing, step):
     frames, baked = h.baked_matrices(obj, with_scale=False)
     start, end = motion.frame_range
-    np.testing.assert_allclose(frames, np.arange(start, end + step / 2, step), atol=1e-4)
+    np.testing.assert_allclose(frames, np.arange(start, end + 1e-9, step), atol=1e-4)
     spec = dict(scheme=scheme, levels=levels, closed=motion.closed, period=motion.period, timing=timing)
     expected = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
     error = np.abs(baked - expected).max()
@@ -136,3 +136,14 @@ def test_several_objects_in_one_run(sb):
     for obj, motion, source in zip(objects, motions, sources):
         assert obj.animation_data.action != source
         check_against_sample(sb, obj, motion, "jarek", 3, "smooth", 1.0)
+
+
+def test_forced_cycle_without_closing_key(sb):
+    """Closed ON and no key repeating the first pose: the cycle closes after the mean spacing."""
+    obj = keyed("YXZ", seed=9, parent=False)
+    motion = sb.keys.read(obj, closed="ON")
+    assert motion.period == pytest.approx(39.0 * 5 / 4)
+    assert bpy.ops.screwbender.smooth(closed="ON", levels=4) == {"FINISHED"}
+    frames = check_against_sample(sb, obj, motion, "jarek", 4, "smooth", 1.0)
+    assert frames[-1] == 49.0  # every whole frame of the period 1 .. 49.75
+    assert all(len(fc.modifiers) == 0 for fc in h.fcurves(obj))  # no Cycles modifier was there

@@ -60,3 +60,15 @@ def test_axis_angle_is_continuous(sb):
           f"smallest dot of consecutive axes {axis_dots.min():.3f}")
     assert np.degrees(angle_step) < 45.0  # no jump by 2 pi or to the opposite axis
     assert axis_dots.min() > 0.0  # the axis never flips
+
+
+def test_euler_bake_starts_on_the_animators_winding(sb):
+    """Keys that start two turns in (z = 720 degrees) bake to angles that start there too."""
+    obj = h.new_object("Wound", "MESH", "XYZ")
+    for frame, z in ((1, 4 * np.pi), (11, 4 * np.pi + 1.0), (30, 4 * np.pi + 2.5)):
+        obj.rotation_euler = (0.2, 0.1, z)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    _, values = h.channel(obj, "rotation_euler", 3)
+    np.testing.assert_allclose(values[0], [0.2, 0.1, 4 * np.pi], atol=1e-5)
+    np.testing.assert_allclose(values[-1], [0.2, 0.1, 4 * np.pi + 2.5], atol=1e-5)

@@ -8,6 +8,8 @@ use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod angular_velocity;
+
 use glam::DVec3;
 use polyscrew::{
     rotation_channels as core_rotation_channels, subdivide as core_subdivide, Error, Motion,
@@ -455,5 +457,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add("MAX_LEVELS", MAX_LEVELS)?;
+    angular_velocity::register(m)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! Runs `s(a, t, b)` (ours or nalgebra's ScLERP) a given number of times, for instruction
 //! counts under `valgrind --tool=callgrind`, which are stable on a shared machine:
 //! `cargo build --release --example count_s && valgrind --tool=callgrind target/release/examples/count_s ours 100000`
+//! (`subdivide N` instead runs N subdivisions of 100 keys by 6 levels with Jarek).
 use std::hint::black_box;
 
 use glam::{DQuat, DVec3};
@@ -30,6 +31,52 @@ fn main() {
                     black_box(&poses[(i + 1) % 1024]),
                 );
                 acc += p.translation.x;
+            }
+        }
+        "between" => {
+            for i in 0..n {
+                let sc = polyscrew::Screw::between(
+                    black_box(&poses[i % 1024]),
+                    black_box(&poses[(i + 1) % 1024]),
+                );
+                acc += black_box(sc).angle();
+            }
+        }
+        "atan" => {
+            for i in 0..n {
+                let p = black_box(&poses[i % 1024]);
+                acc += polyscrew::fastmath::atan2_first_quadrant(
+                    p.rotation.x.abs(),
+                    p.rotation.w.abs(),
+                );
+            }
+        }
+        "stdatan" => {
+            for i in 0..n {
+                let p = black_box(&poses[i % 1024]);
+                acc += p.rotation.x.abs().atan2(p.rotation.w.abs());
+            }
+        }
+        "eval" => {
+            // The screw built once per pair, evaluated n times (sampling's hot path).
+            let screws: Vec<polyscrew::Screw> = (0..1024)
+                .map(|i| polyscrew::Screw::between(&poses[i], &poses[(i + 1) % 1024]))
+                .collect();
+            for i in 0..n {
+                acc += black_box(&screws[i % 1024]).eval(0.37).translation.x;
+            }
+        }
+        "subdivide" => {
+            // The case: 100 keys (closed), 6 levels, Jarek; n runs.
+            for _ in 0..n {
+                let d = polyscrew::subdivide(
+                    black_box(&poses[..100]),
+                    polyscrew::Scheme::Jarek,
+                    6,
+                    true,
+                )
+                .unwrap();
+                acc += d[7].translation.x;
             }
         }
         _ => {

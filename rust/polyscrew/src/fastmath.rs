@@ -6,6 +6,9 @@
 //! The polynomial kernels are fdlibm's (`k_sin.c`, `k_cos.c`, `s_atan.c`, Sun Microsystems,
 //! 1993), accurate to about 1 ulp on their reduced ranges; the tests compare with std.
 
+// The constants are fdlibm's, digit for digit.
+#![allow(clippy::excessive_precision)]
+
 use std::f64::consts::FRAC_PI_2;
 
 /// `1.5 * 2^52`: adding it rounds an f64 below `2^51` in magnitude to an integer.
@@ -47,7 +50,8 @@ fn kernel(r: f64) -> (f64, f64) {
 /// `(sin x, cos x)` with one range reduction.
 #[inline]
 pub fn sin_cos(x: f64) -> (f64, f64) {
-    if !(x.abs() < FAST_REDUCTION_BELOW) {
+    // NaN and infinities go to std too.
+    if x.is_nan() || x.abs() >= FAST_REDUCTION_BELOW {
         return x.sin_cos();
     }
     // Round to nearest by adding and subtracting 1.5 * 2^52 (exact for |x| < 2^51; std's
@@ -79,7 +83,7 @@ const AT: [f64; 11] = [
 // atan(0.5) and atan(1), in two parts each.
 const ATAN_HALF_HI: f64 = 4.636_476_090_008_060_935_15e-1;
 const ATAN_HALF_LO: f64 = 2.269_877_745_296_168_709_24e-17;
-const ATAN_ONE_HI: f64 = 7.853_981_633_974_482_789_99e-1;
+const ATAN_ONE_HI: f64 = std::f64::consts::FRAC_PI_4;
 const ATAN_ONE_LO: f64 = 3.061_616_997_868_383_017_93e-17;
 const PIO2_ATAN_LO: f64 = 6.123_233_995_736_766_035_87e-17;
 

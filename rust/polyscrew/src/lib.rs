@@ -21,19 +21,29 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod angular_velocity;
+mod banded;
 pub mod channels;
 pub mod error;
 pub mod fastmath;
 pub mod pose;
+pub mod quat_spline;
 pub mod sample;
 pub mod screw;
+pub mod spinning_top;
 pub mod subdivision;
 pub mod timing;
 
+pub use angular_velocity::{
+    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
+    FitStatus,
+};
 pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
 pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
+pub use quat_spline::{QuatJet, QuatSpline};
 pub use sample::{sample, Motion, MotionSpec};
-pub use screw::{s, Screw};
+pub use screw::{midpoint, s, Screw};
+pub use spinning_top::SpinningTop;
 pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
 pub use timing::{check_key_times, TimeMap, Timing};

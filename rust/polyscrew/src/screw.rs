@@ -55,8 +55,8 @@ pub struct Screw {
     half_angle: f64,
     /// `sin(h) = |q.xyz|`, cached.
     sin_half: f64,
-    /// `sinc(h) = sin(h) / h`, cached.
-    sinc_half: f64,
+    /// `1 / sin(h)` (0 when `h = 0`), cached.
+    inv_sin_half: f64,
     /// Unit axis direction `S` (the translation's direction for a pure translation, `+z` for
     /// the identity).
     axis: DVec3,
@@ -71,26 +71,28 @@ impl Screw {
     /// the one of the quaternion with `w >= 0` as computed is taken.
     #[inline]
     pub fn between(a: &Pose, b: &Pose) -> Self {
+        // A product of unit quaternions is unit to rounding: no normalisation on this path
+        // (every division and square root here is on the critical path of `s`).
         let mut q = b.rotation * a.rotation.conjugate();
         if q.w < 0.0 {
             q = -q;
         }
-        let q = q.normalize();
         let v = q.xyz();
         let sin_h = v.length();
         let half_angle = fastmath::atan2_first_quadrant(sin_h, q.w);
         let tau = b.translation - q * a.translation;
-        let axis = if sin_h > 0.0 {
-            v / sin_h
+        let (inv_sin_half, axis) = if sin_h > 0.0 {
+            let inv = 1.0 / sin_h;
+            (inv, v * inv)
         } else {
-            tau.try_normalize().unwrap_or(DVec3::Z)
+            (0.0, tau.try_normalize().unwrap_or(DVec3::Z))
         };
         Self {
             base: *a,
             rotation: q,
             half_angle,
             sin_half: sin_h,
-            sinc_half: sinc_from(half_angle, sin_h),
+            inv_sin_half,
             axis,
             tau,
         }
@@ -106,9 +108,9 @@ impl Screw {
         let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
         // rho = sin(t h) / sin(h); near h = 0 as t sinc(t h) / sinc(h), exact at h = 0.
         let rho = if h < SINC_SERIES_BELOW {
-            t * sinc_from(th, sin_th) / self.sinc_half
+            t * sinc_from(th, sin_th) / (1.0 - h * h / 6.0)
         } else {
-            sin_th / sin_h
+            sin_th * self.inv_sin_half
         };
         let v = self.rotation.xyz();
         let rotation = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
@@ -183,6 +185,33 @@ impl Screw {
     }
 }
 
+/// `s(a, 1/2, b)`, the pose halfway along the minimal screw, without trigonometry.
+///
+/// With `q = (w, v) = (cos h, sin h S)` the relative rotation (`w >= 0`) and `tau` its
+/// translation, the half-angle identities give
+/// `q^(1/2) = (c, v / (2 c))` with `c = cos(h / 2) = sqrt((1 + w) / 2)`, and the
+/// translation of `M^(1/2)` is `tau / 2 - (v x tau) / (2 (1 + w))` (`A = 1/2`,
+/// `B S = -tan(h / 2) S / 2 = -v / (2 (1 + w))` in [`Screw::motion`]). Exact at `h = 0`,
+/// regular up to the half turn. The outer step of every Split&Tweak rule.
+#[inline]
+pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
+    let mut q = b.rotation * a.rotation.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let q = q.normalize();
+    let v = q.xyz();
+    let tau = b.translation - q * a.translation;
+    let c = (0.5 * (1.0 + q.w)).sqrt();
+    let half_v = v * (0.5 / c);
+    let rotation = DQuat::from_xyzw(half_v.x, half_v.y, half_v.z, c);
+    let translation = 0.5 * tau - v.cross(tau) * (0.5 / (1.0 + q.w));
+    Pose {
+        rotation: (rotation * a.rotation).normalize(),
+        translation: rotation * a.translation + translation,
+    }
+}
+
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
 #[inline]
@@ -246,6 +275,21 @@ mod tests {
                 let err = sc.eval(t).max_abs_diff(&e);
                 assert!(err < 1e-12, "angle {angle:e} t {t}: error {err:e}");
             }
+        }
+    }
+
+    #[test]
+    fn midpoint_equals_half_screw() {
+        let a = Pose::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
+            DVec3::new(1.0, 2.0, -0.5),
+        );
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        let p = DVec3::new(0.5, -0.3, 0.1);
+        for angle in [0.0, 1e-12, 1e-6, 0.5, 2.0, PI - 1e-6] {
+            let b = exact(axis, p, angle, 0.7, 1.0, &a);
+            let err = midpoint(&a, &b).max_abs_diff(&exact(axis, p, angle, 0.7, 0.5, &a));
+            assert!(err < 1e-13, "angle {angle:e}: error {err:e}");
         }
     }
 

@@ -81,6 +81,11 @@ pub trait Interpolant: Copy {
     fn s(a: &Self, t: f64, b: &Self) -> Self {
         Self::eval(&Self::segment(a, b), t)
     }
+    /// `s(a, 1/2, b)`; implementations may have a cheaper formula.
+    #[inline]
+    fn midpoint(a: &Self, b: &Self) -> Self {
+        Self::s(a, 0.5, b)
+    }
 }
 
 impl Interpolant for Pose {
@@ -92,6 +97,10 @@ impl Interpolant for Pose {
     #[inline]
     fn eval(seg: &Screw, t: f64) -> Self {
         seg.eval(t)
+    }
+    #[inline]
+    fn midpoint(a: &Self, b: &Self) -> Self {
+        crate::screw::midpoint(a, b)
     }
 }
 
@@ -220,9 +229,9 @@ fn old_rule<T: Interpolant>(scheme: Scheme, b: &T, e_in: &T::Segment, e_out: &T:
     match scheme {
         Scheme::FourPoint => *b,
         // s(s(b, 1/4, a), 1/2, s(b, 1/4, c)) with s(b, 1/4, a) = s(a, 3/4, b).
-        Scheme::BSpline => T::s(&T::eval(e_in, 0.75), 0.5, &T::eval(e_out, 0.25)),
+        Scheme::BSpline => T::midpoint(&T::eval(e_in, 0.75), &T::eval(e_out, 0.25)),
         // s(s(a, 7/8, b), 1/2, s(c, 7/8, b)) with s(c, 7/8, b) = s(b, 1/8, c).
-        Scheme::Jarek => T::s(&T::eval(e_in, 0.875), 0.5, &T::eval(e_out, 0.125)),
+        Scheme::Jarek => T::midpoint(&T::eval(e_in, 0.875), &T::eval(e_out, 0.125)),
     }
 }
 
@@ -235,7 +244,7 @@ fn new_rule<T: Interpolant>(
     e_cd: &T::Segment,
 ) -> T {
     // s(s(a, w, b), 1/2, s(d, w, c)) with s(d, w, c) = s(c, 1 - w, d).
-    let tweak = |w: f64| T::s(&T::eval(e_ab, w), 0.5, &T::eval(e_cd, 1.0 - w));
+    let tweak = |w: f64| T::midpoint(&T::eval(e_ab, w), &T::eval(e_cd, 1.0 - w));
     match scheme {
         Scheme::BSpline => T::eval(e_bc, 0.5),
         Scheme::FourPoint => tweak(9.0 / 8.0),

@@ -1,0 +1,354 @@
+//! `fit_angular_velocity`: the binding of `polyscrew::fit_angular_velocity` (Xie et al.
+//! 2011). Conversion only: quaternions arrive and leave as `(N, 4)` w, x, y, z arrays.
+
+use glam::{DQuat, DVec3};
+use numpy::ndarray::{Array1, Array2, ArrayViewD};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+// The defaults are written as literals so that Python's signature shows them; they are
+// the core's DEFAULT_ALPHA, DEFAULT_DELTA, DEFAULT_MAX_ITERATIONS and DEFAULT_MAX_FRAMES,
+// checked below at compile time.
+const _: () = {
+    use polyscrew::angular_velocity as av;
+    assert!(av::DEFAULT_ALPHA == 0.002 && av::DEFAULT_DELTA == 0.1);
+    assert!(av::DEFAULT_MAX_ITERATIONS == 200 && av::DEFAULT_MAX_FRAMES == 10);
+};
+use polyscrew::{
+    fit_angular_velocity as core_fit, AngularVelocityFit, AngularVelocityTarget, FitOptions,
+    FitStatus,
+};
+
+use crate::{read_vector, shape_err, to_py_err, FloatArray};
+
+const F: &str = "fit_angular_velocity";
+
+/// Reads `(N, 4)` quaternions in w, x, y, z order (normalised by the core).
+fn read_quaternions(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DQuat>> {
+    let shape = array.shape();
+    if shape.len() != 2 || shape[1] != 4 {
+        return Err(shape_err(F, what, "(N, 4)", shape));
+    }
+    let flat: Vec<f64> = array.iter().copied().collect();
+    Ok(flat
+        .chunks_exact(4)
+        .map(|q| DQuat::from_xyzw(q[1], q[2], q[3], q[0]))
+        .collect())
+}
+
+/// Reads `(M, 3)` vectors without judging their values (the core names the bad one).
+fn read_rows3(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
+    let shape = array.shape();
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(shape_err(F, what, "(M, 3)", shape));
+    }
+    let flat: Vec<f64> = array.iter().copied().collect();
+    Ok(flat.chunks_exact(3).map(DVec3::from_slice).collect())
+}
+
+/// `constrained`: `None` (all keys), a boolean mask of length N, or key indices
+/// (negative indices count from the end, as in numpy).
+fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<Vec<bool>> {
+    let Some(c) = constrained else {
+        return Ok(vec![true; n]);
+    };
+    if let Ok(mask) = c.extract::<Vec<bool>>() {
+        if !mask.is_empty() {
+            if mask.len() != n {
+                return Err(PyValueError::new_err(format!(
+                    "{F}: constrained: boolean mask has {} entries for {n} keys",
+                    mask.len()
+                )));
+            }
+            return Ok(mask);
+        }
+    }
+    let indices: Vec<i64> = c.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{F}: constrained: expected None, a boolean mask of length {n} or key indices"
+        ))
+    })?;
+    let mut mask = vec![false; n];
+    for i in indices {
+        let j = if i < 0 { i + n as i64 } else { i };
+        if j < 0 || j >= n as i64 {
+            return Err(PyValueError::new_err(format!(
+                "{F}: constrained: index {i} out of range for {n} keys"
+            )));
+        }
+        mask[j as usize] = true;
+    }
+    Ok(mask)
+}
+
+/// Quaternions as an `(N, 4)` w, x, y, z array.
+fn quaternions_to_array(q: &[DQuat]) -> Array2<f64> {
+    let mut out = Array2::<f64>::zeros((q.len(), 4));
+    for (i, r) in q.iter().enumerate() {
+        out[[i, 0]] = r.w;
+        out[[i, 1]] = r.x;
+        out[[i, 2]] = r.y;
+        out[[i, 3]] = r.z;
+    }
+    out
+}
+
+fn vectors_to_array(v: &[DVec3]) -> Array2<f64> {
+    let mut out = Array2::<f64>::zeros((v.len(), 3));
+    for (i, p) in v.iter().enumerate() {
+        out[[i, 0]] = p.x;
+        out[[i, 1]] = p.y;
+        out[[i, 2]] = p.z;
+    }
+    out
+}
+
+/// The result of `fit_angular_velocity`: the fitted rotation and how well it fits.
+#[pyclass(frozen, module = "polyscrew", name = "AngularVelocityFit")]
+pub struct PyAngularVelocityFit {
+    inner: AngularVelocityFit,
+    sample_times: Vec<f64>,
+    quaternions: Vec<DQuat>,
+    omega: Vec<DVec3>,
+}
+
+#[pymethods]
+impl PyAngularVelocityFit {
+    /// Fitted orientations at `sample_times`, (S, 4) w, x, y, z, unit and sign-continuous.
+    #[getter]
+    fn quaternions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        quaternions_to_array(&self.quaternions).into_pyarray(py)
+    }
+
+    /// The times the orientations were sampled at, (S,).
+    #[getter]
+    fn sample_times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.sample_times.clone()).into_pyarray(py)
+    }
+
+    /// Fitted world-frame angular velocity `vec(2 q' q^-1)` at `sample_times`, (S, 3).
+    #[getter]
+    fn omega<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        vectors_to_array(&self.omega).into_pyarray(py)
+    }
+
+    /// Fitted orientation at each key time, (N, 4) w, x, y, z.
+    #[getter]
+    fn key_quaternions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        quaternions_to_array(&self.inner.keys).into_pyarray(py)
+    }
+
+    /// Times of the variable frames inserted, (F,).
+    #[getter]
+    fn frame_times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.frame_times.clone()).into_pyarray(py)
+    }
+
+    /// The largest per-fragment error `max F_n` (Xie et al. eq. 2).
+    #[getter]
+    fn fit_error(&self) -> f64 {
+        self.inner.fit_error
+    }
+
+    /// Every fragment error `F_n`, in time order.
+    #[getter]
+    fn fragment_errors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from(self.inner.fragment_errors.clone()).into_pyarray(py)
+    }
+
+    /// The fragment length used.
+    #[getter]
+    fn fragment_duration(&self) -> f64 {
+        self.inner.fragment_duration
+    }
+
+    /// Levenberg-Marquardt steps over all rounds.
+    #[getter]
+    fn iterations(&self) -> usize {
+        self.inner.iterations
+    }
+
+    /// Optimisation rounds.
+    #[getter]
+    fn rounds(&self) -> usize {
+        self.inner.rounds
+    }
+
+    /// Whether the optimiser converged with every fragment error at most `delta`.
+    #[getter]
+    fn converged(&self) -> bool {
+        self.inner.converged()
+    }
+
+    /// "converged", "iteration_limit" or "above_delta".
+    #[getter]
+    fn status(&self) -> &'static str {
+        match self.inner.status {
+            FitStatus::Converged => "converged",
+            FitStatus::IterationLimit => "iteration_limit",
+            _ => "above_delta",
+        }
+    }
+
+    /// The energy `alpha W_T + W_A`.
+    #[getter]
+    fn energy(&self) -> f64 {
+        self.inner.energy
+    }
+
+    /// The tangential acceleration term `W_T`.
+    #[getter]
+    fn tangential(&self) -> f64 {
+        self.inner.tangential
+    }
+
+    /// The deviation term `W_A`.
+    #[getter]
+    fn deviation(&self) -> f64 {
+        self.inner.deviation
+    }
+
+    /// The `delta` the fit was held to.
+    #[getter]
+    fn delta(&self) -> f64 {
+        self.inner.delta
+    }
+
+    /// Fitted orientations at `times` (T,) within the key range: (T, 4) w, x, y, z.
+    fn sample<'py>(
+        &self,
+        py: Python<'py>,
+        times: FloatArray<'py>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let times = read_vector("AngularVelocityFit.sample", "times", times.as_array())?;
+        let q = self
+            .inner
+            .sample(&times)
+            .map_err(|e| to_py_err("AngularVelocityFit.sample", e))?;
+        Ok(quaternions_to_array(&q).into_pyarray(py))
+    }
+
+    /// Fitted world-frame angular velocity at `times` (T,) within the key range: (T, 3).
+    fn angular_velocity<'py>(
+        &self,
+        py: Python<'py>,
+        times: FloatArray<'py>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        const G: &str = "AngularVelocityFit.angular_velocity";
+        let times = read_vector(G, "times", times.as_array())?;
+        self.inner.sample(&times).map_err(|e| to_py_err(G, e))?;
+        let w: Vec<DVec3> = times
+            .iter()
+            .map(|t| self.inner.angular_velocity(*t))
+            .collect();
+        Ok(vectors_to_array(&w).into_pyarray(py))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "AngularVelocityFit(status={:?}, fit_error={:.4e}, frames={}, iterations={})",
+            self.status(),
+            self.inner.fit_error,
+            self.inner.frame_times.len(),
+            self.inner.iterations
+        )
+    }
+}
+
+/// fit_angular_velocity(key_quaternions, key_times, target_times, target_omega, constrained=None, alpha=0.002, delta=0.1, max_iterations=200, max_frames=10, sample_times=None, *, target_speed=None, fragment_duration=None) -> AngularVelocityFit
+///
+/// Fits the rotation between keys to a target angular velocity (Xie et al. 2011). See the
+/// stub for the full contract. Raises ValueError for bad input, and for a fit that does not
+/// converge or stays above `delta`, with the best result as the exception's `result`.
+#[pyfunction]
+#[pyo3(signature = (
+    key_quaternions, key_times, target_times, target_omega, constrained=None,
+    alpha=0.002, delta=0.1, max_iterations=200, max_frames=10, sample_times=None, *,
+    target_speed=None,
+    fragment_duration=None
+))]
+#[allow(clippy::too_many_arguments)]
+fn fit_angular_velocity(
+    py: Python<'_>,
+    key_quaternions: FloatArray<'_>,
+    key_times: FloatArray<'_>,
+    target_times: FloatArray<'_>,
+    target_omega: FloatArray<'_>,
+    constrained: Option<&Bound<'_, PyAny>>,
+    alpha: f64,
+    delta: f64,
+    max_iterations: usize,
+    max_frames: usize,
+    sample_times: Option<FloatArray<'_>>,
+    target_speed: Option<FloatArray<'_>>,
+    fragment_duration: Option<f64>,
+) -> PyResult<PyAngularVelocityFit> {
+    let keys = read_quaternions("key_quaternions", key_quaternions.as_array())?;
+    if keys.len() < 2 {
+        return Err(PyValueError::new_err(format!(
+            "{F}: key_quaternions: {} keys given, at least 2 needed",
+            keys.len()
+        )));
+    }
+    let key_times = read_vector(F, "key_times", key_times.as_array())?;
+    let target_times = read_vector(F, "target_times", target_times.as_array())?;
+    let target_omega = read_rows3("target_omega", target_omega.as_array())?;
+    let target_speed = target_speed
+        .map(|s| read_vector(F, "target_speed", s.as_array()))
+        .transpose()?;
+    let sample_times = match sample_times {
+        Some(s) => read_vector(F, "sample_times", s.as_array())?,
+        None => key_times.clone(),
+    };
+    let constrained = read_constrained(constrained, keys.len())?;
+    let options = FitOptions {
+        alpha,
+        delta,
+        max_iterations,
+        max_frames,
+        fragment_duration,
+    };
+    let (fit, quaternions, omega) = py
+        .detach(|| {
+            let target = match &target_speed {
+                Some(speed) => {
+                    AngularVelocityTarget::from_directions(&target_times, &target_omega, speed)
+                }
+                None => AngularVelocityTarget::new(&target_times, &target_omega),
+            }?;
+            let fit = core_fit(&keys, &key_times, &constrained, &target, &options)?;
+            let q = fit.sample(&sample_times)?;
+            let w: Vec<DVec3> = sample_times
+                .iter()
+                .map(|t| fit.angular_velocity(*t))
+                .collect();
+            Ok((fit, q, w))
+        })
+        .map_err(|e| to_py_err(F, e))?;
+    let result = PyAngularVelocityFit {
+        inner: fit,
+        sample_times,
+        quaternions,
+        omega,
+    };
+    if result.inner.converged() {
+        return Ok(result);
+    }
+    let message = match result.inner.clone().into_result() {
+        Err(failure) => failure.to_string(),
+        Ok(_) => String::from("fit failed"),
+    };
+    let err = PyValueError::new_err(format!(
+        "{F}: {message}; the best result is the exception's `result` attribute"
+    ));
+    err.value(py).setattr("result", Py::new(py, result)?)?;
+    Err(err)
+}
+
+/// Adds `fit_angular_velocity` and `AngularVelocityFit` to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyAngularVelocityFit>()?;
+    m.add_function(wrap_pyfunction!(fit_angular_velocity, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,117 @@
+"""Benchmark: ScrewBender's bake against Blender's own `bpy.ops.nla.bake`, same objects and frames.
+
+Two cases, both in the same Blender session:
+  1. one object baked over 100,000 frames;
+  2. 100 objects baked over 1,000 frames.
+Each object has location, rotation (XYZ Euler) and scale keys (ten keys at uneven frames),
+so both bakers write the same ten dense F-curves per object, one key per frame.
+ScrewBender's time covers everything the Smooth Motion operator does (reading keys,
+polyscrew sampling, writing the new action); nla.bake's time is the operator call.
+
+Run with the bpy wheel after scripts/build_extension.sh (the add-on is installed from the
+built .zip into a temporary Blender user directory):
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_bake.py [--quick]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+import demo_common  # noqa: E402
+
+bake = demo_common.blender_with_addon()
+import bpy  # noqa: E402
+
+
+def keyed_objects(count: int, frames: int) -> list[bpy.types.Object]:
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    mesh = bpy.data.meshes.new("Block")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)], [], [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)])
+    objects = []
+    for n in range(count):
+        obj = bpy.data.objects.new(f"Body{n:03d}", mesh)
+        scene.collection.objects.link(obj)
+        for k in range(10):
+            u = (k / 9) ** 1.2  # uneven key spacing
+            frame = 1 + round(u * (frames - 1))
+            obj.location = (3 * math.cos(4 * u + n), 3 * math.sin(3 * u), u * 2 + 0.01 * n)
+            obj.rotation_euler = (0.5 * math.sin(5 * u), 0.3 * u, 6 * u + n)
+            obj.scale = (1 + 0.3 * math.sin(7 * u), 1.0, 1 + 0.2 * u)
+            for path in ("location", "rotation_euler", "scale"):
+                obj.keyframe_insert(path, frame=frame)
+        objects.append(obj)
+    scene.frame_start, scene.frame_end = 1, frames
+    return objects
+
+
+def select(objects) -> None:
+    for obj in bpy.context.view_layer.objects:
+        obj.select_set(obj in objects)
+    bpy.context.view_layer.objects.active = objects[0]
+
+
+def run_case(count: int, frames: int) -> tuple[float, float]:
+    objects = keyed_objects(count, frames)
+    select(objects)
+    start = time.perf_counter()
+    actions, skipped = bake.smooth(objects, bake.Options(scheme="jarek", levels=4))
+    ours = time.perf_counter() - start
+    assert len(actions) == count and not skipped, skipped
+    keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(objects[0]))
+
+    # Blender's baker on the same (source) actions and frames
+    for obj in objects:
+        from_action = obj.animation_data.action[bake.SOURCE_KEY]
+        obj.animation_data.action = from_action
+        if hasattr(obj.animation_data, "action_slot") and len(from_action.slots):
+            obj.animation_data.action_slot = from_action.slots[0]
+    select(objects)
+    start = time.perf_counter()
+    result = bpy.ops.nla.bake(
+        frame_start=1, frame_end=frames, step=1, only_selected=True, visual_keying=False,
+        clear_constraints=False, clear_parents=False, use_current_action=False, bake_types={"OBJECT"},
+    )
+    theirs = time.perf_counter() - start
+    assert result == {"FINISHED"}, result
+    their_keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(objects[0]))
+    print(
+        f"{count:4d} object(s) x {frames:6d} frames: ScrewBender {ours:7.3f} s, nla.bake {theirs:7.3f} s, "
+        f"ratio {theirs / ours:6.1f}x  (keys per object: {keys} vs {their_keys})"
+    )
+    return ours, theirs
+
+
+def bake_fcurves(obj):
+    adt = obj.animation_data
+    action = adt.action
+    if hasattr(action, "layers"):
+        from bpy_extras import anim_utils
+
+        return list(anim_utils.action_get_channelbag_for_slot(action, adt.action_slot).fcurves)
+    return list(action.fcurves)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="a tenth of the frames (a smoke run)")
+    parser.add_argument("--repeat", type=int, default=3, help="runs per case; the best time of each baker counts")
+    args = parser.parse_args()
+    scale = 10 if args.quick else 1
+    print(f"Blender {bpy.app.version_string}, bake over every frame, jarek 4 levels")
+    ratios = []
+    for count, frames in ((1, 100_000 // scale), (100, 1_000 // scale)):
+        runs = [run_case(count, frames) for _ in range(args.repeat)]
+        ours, theirs = min(r[0] for r in runs), min(r[1] for r in runs)
+        print(f"  best of {args.repeat}: ScrewBender {ours:.3f} s, nla.bake {theirs:.3f} s, ratio {theirs / ours:.1f}x")
+        ratios.append(theirs / ours)
+    print(f"ScrewBender is {min(ratios):.0f}x to {max(ratios):.0f}x faster than nla.bake (best of {args.repeat} runs each)")
+
+
+if __name__ == "__main__":
+    main()

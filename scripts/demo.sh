@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# The ScrewBender demo, one command on a fresh machine:
+#   1. scripts/bootstrap.sh: .venv with numpy, pytest, maturin and the bpy wheels;
+#   2. scripts/build_extension.sh: the polyscrew wheel and the installable extension .zip;
+#   3. every scripts/demo/NN_*.py in order, each a standalone script run with the Blender 5.0
+#      bpy wheel and `--out-dir out`:
+#        10_scene.py   the keyed demo scene           -> out/demo_source.blend
+#        20_smooth.py  smoothed with every scheme     -> out/demo.blend
+#        30_render.py  stroboscopic Workbench renders -> out/demo_*.png (+ docs/images/)
+#      Other features add their own NN_*.py parts; they run in the same way.
+set -euo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+start=$(date +%s)
+stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
+
+stage "bootstrap"
+scripts/bootstrap.sh
+py="$root/.venv/bin/python"
+bpy_dir="$root/.venv/bpy/5.0"
+[ -d "$bpy_dir" ] || { echo "demo: $bpy_dir missing (scripts/bootstrap.sh installs it)" >&2; exit 1; }
+
+stage "build the extension"
+zip=$(PYTHON="$py" MATURIN="$root/.venv/bin/maturin" scripts/build_extension.sh | tail -n 1)
+export SCREWBENDER_EXTENSION_ZIP="$zip"
+echo "$zip"
+
+mkdir -p out
+for part in scripts/demo/[0-9][0-9]_*.py; do
+  stage "$part"
+  # (headless Workbench renders print harmless "EGL Error" lines: filtered out)
+  if ! PYTHONPATH="$bpy_dir" "$py" "$part" --out-dir "$root/out" 2>&1 | { grep -v '^EGL Error' || true; }; then
+    echo "demo: $part failed" >&2; exit 1
+  fi
+done
+stage "demo done"
+ls -1 out/*.blend out/*.png
