@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs every benchmark of issue 7 and writes BENCHMARKS.md (machine, versions, medians,
 # ratios). One command: scripts/bench.sh. Each comparison runs side by side in one process:
-#   - criterion (rust/polyscrew/benches/core.rs, scaling.rs): s(a, t, b) ours vs nalgebra,
-#     subdivision per scheme, growth over 10 .. 10,000 keys x 1 .. 8 levels (thread CPU time);
+#   - criterion (every rust/polyscrew/benches/*.rs): s(a, t, b) ours vs nalgebra, subdivision
+#     per scheme, growth over 10 .. 10,000 keys x 1 .. 8 levels (core.rs, scaling.rs: thread
+#     CPU time), and the other issues' benches (angular velocity, ...);
 #   - callgrind instruction counts of s (ours vs nalgebra) and of one subdivision;
 #   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
 #   - scripts/bench_bake.py (the add-on's bake vs nla.bake) when it is in this checkout.
@@ -41,11 +42,14 @@ else
   echo "bench: the wheel did not build; the Python parts will be missing"
 fi
 
-stage "criterion: benches/core.rs and benches/scaling.rs"
+# Every criterion bench of the core crate (core.rs, scaling.rs, and those the other issues add).
+benches=()
+for f in rust/polyscrew/benches/*.rs; do benches+=(--bench "$(basename "$f" .rs)"); done
+stage "criterion: ${benches[*]}"
 crit_args=()
 [ "$quick" = 1 ] && crit_args=(--warm-up-time 0.1 --measurement-time 0.3 --sample-size 10)
-cargo bench -p polyscrew --bench core --bench scaling -- "${crit_args[@]}" 2>&1 \
-  | grep -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' || true
+cargo bench -p polyscrew "${benches[@]}" -- "${crit_args[@]}" 2>&1 \
+  | grep -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
 
 stage "callgrind instruction counts"
 if command -v valgrind >/dev/null; then
