@@ -102,3 +102,17 @@ def test_points_x_is_the_world_x_of_a_body_point():
     poses = np.array([plot.euler_xyz_matrix((k, 0.0, 1.0), (0, 0, 90 * k)) for k in range(4)])
     # Body point (2, 0, 0) turned by 90 degrees per pose about z: x = k + 2 cos(90 k).
     assert np.allclose(plot.points_x(poses, (2.0, 0.0, 0.0)), [2.0, 1.0, 0.0, 3.0], atol=1e-12)
+
+
+def test_bake_ratios_are_read_from_the_best_of_lines(tmp_path):
+    (tmp_path / "bake.txt").write_text(
+        "Blender 5.0.1, bake over every frame, jarek 4 levels\n"
+        "   1 object(s) x 100000 frames: ScrewBender   0.100 s, nla.bake  30.000 s, ratio  300.0x  (keys)\n"
+        "  best of 3: ScrewBender 0.090 s, nla.bake 29.000 s, ratio 322.2x\n"
+        " 100 object(s) x   1000 frames: ScrewBender   0.500 s, nla.bake   8.000 s, ratio   16.0x  (keys)\n"
+        "  best of 3: ScrewBender 0.450 s, nla.bake 8.100 s, ratio 18.0x\n")
+    rep = report.Report(tmp_path, {})
+    rep.bake_section()
+    name, measured, verdict = rep.targets[-1]
+    assert name.startswith("bake") and measured == "322.2x, 18.0x" and verdict == "**missed**"
+    assert any("keyframe_insert" in line for line in rep.lines)
