@@ -49,7 +49,7 @@ stage "criterion: ${benches[*]}"
 crit_args=()
 [ "$quick" = 1 ] && crit_args=(--warm-up-time 0.1 --measurement-time 0.3 --sample-size 10)
 cargo bench -p polyscrew "${benches[@]}" -- "${crit_args[@]}" 2>&1 \
-  | grep -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
+  | grep --line-buffered -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
 
 stage "callgrind instruction counts"
 if command -v valgrind >/dev/null; then
