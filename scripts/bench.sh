@@ -63,8 +63,26 @@ if command -v valgrind >/dev/null; then
   done
   cg "$run/callgrind-subdivide-0.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 0
   cg "$run/callgrind-subdivide-1.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1
+  # What limits the targets: instructions per output pose across sizes (algorithmic
+  # linearity), simulated branch mispredictions of s (ours vs nalgebra).
+  for kl in "100 6" "10000 6"; do
+    set -- $kl
+    cg "$run/callgrind-subdivide-$1x$2-0.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 0 "$1" "$2"
+    cg "$run/callgrind-subdivide-$1x$2-1.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1 "$1" "$2"
+  done
+  for which in ours nalgebra; do
+    valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$run/branches-$which-0.out" \
+      "$CARGO_TARGET_DIR/release/examples/count_s" "$which" 0 >/dev/null 2>&1
+    valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$run/branches-$which-N.out" \
+      "$CARGO_TARGET_DIR/release/examples/count_s" "$which" "$n" >/dev/null 2>&1
+  done
 else
   echo "not available: valgrind is not installed (apt-get install valgrind)"
+fi
+if [ -x /usr/bin/time ] && [ -x "$CARGO_TARGET_DIR/release/examples/count_subdivide" ]; then
+  # User and system (page-fault) time of the largest subdivision, 10,000 keys x 8 levels.
+  /usr/bin/time -o "$run/time-10000x8.txt" -f "%U %S %R %M" \
+    "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1 10000 8 && cat "$run/time-10000x8.txt"
 fi
 
 pyargs=(); [ "$quick" = 1 ] && pyargs=(--n 2000 --repeat 3)

@@ -13,7 +13,9 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use common::{keys, CpuTime};
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput};
+use criterion::{
+    criterion_group, criterion_main, BenchmarkId, Criterion, SamplingMode, Throughput,
+};
 use polyscrew::{subdivide, subdivided_len, Scheme};
 
 /// The largest output (poses) benchmarked; larger combinations are skipped and reported.
@@ -31,7 +33,9 @@ fn bench_scaling(c: &mut Criterion<CpuTime>) {
             for levels in 1..=8u32 {
                 let out = subdivided_len(n, levels, true);
                 if out > MAX_OUTPUT {
-                    println!("scaling: skipped {scheme:?} {n}x{levels} ({out} poses > {MAX_OUTPUT})");
+                    println!(
+                        "scaling: skipped {scheme:?} {n}x{levels} ({out} poses > {MAX_OUTPUT})"
+                    );
                     continue;
                 }
                 g.throughput(Throughput::Elements(out as u64));

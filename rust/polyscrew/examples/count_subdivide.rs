@@ -2,6 +2,8 @@
 //! more), for instruction counts under `valgrind --tool=callgrind` (stable on a shared
 //! machine): the count for 1 minus the count for 0 is one subdivision without the set-up.
 //! `cargo build --release --example count_subdivide && valgrind --tool=callgrind target/release/examples/count_subdivide 1`
+//! Optional second and third arguments: keys (default 1000) and levels (default 6), to check
+//! that the instructions per output pose do not grow with the size.
 use std::hint::black_box;
 
 use glam::{DQuat, DVec3};
@@ -12,8 +14,11 @@ fn main() {
         .nth(1)
         .and_then(|v| v.parse().ok())
         .unwrap_or(1);
+    let mut args = std::env::args().skip(2);
+    let count: usize = args.next().and_then(|v| v.parse().ok()).unwrap_or(1000);
+    let levels: u32 = args.next().and_then(|v| v.parse().ok()).unwrap_or(6);
     // A tumbling walk: each key a screw of about a radian from the previous one.
-    let keys: Vec<Pose> = (0..1000)
+    let keys: Vec<Pose> = (0..count)
         .map(|i| {
             let x = i as f64;
             let axis = DVec3::new(x.sin(), (1.3 * x).cos(), 0.5).normalize();
@@ -25,8 +30,8 @@ fn main() {
         .collect();
     let mut acc = 0.0;
     for _ in 0..n {
-        let out = subdivide(black_box(&keys), Scheme::Jarek, 6, true).expect("valid keys");
+        let out = subdivide(black_box(&keys), Scheme::Jarek, levels, true).expect("valid keys");
         acc += out[17].translation.x;
     }
-    println!("subdivide: {n} runs of 1000 keys x 6 levels Jarek, checksum {acc:.6}");
+    println!("subdivide: {n} runs of {count} keys x {levels} levels Jarek, checksum {acc:.6}");
 }

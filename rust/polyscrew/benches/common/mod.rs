@@ -85,7 +85,12 @@ impl ValueFormatter for NanosFormatter {
         values.iter_mut().for_each(|v| *v *= factor);
         unit
     }
-    fn scale_throughputs(&self, typical: f64, throughput: &Throughput, values: &mut [f64]) -> &'static str {
+    fn scale_throughputs(
+        &self,
+        typical: f64,
+        throughput: &Throughput,
+        values: &mut [f64],
+    ) -> &'static str {
         let per = match *throughput {
             Throughput::Elements(n) | Throughput::ElementsAndBytes { elements: n, .. } => n as f64,
             Throughput::Bytes(n) | Throughput::BytesDecimal(n) => n as f64,
