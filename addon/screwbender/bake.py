@@ -80,6 +80,30 @@ class Baked:
     cyclic: bool
 
 
+def sample_poses(
+    motion: keys.KeyedMotion, frames: np.ndarray, options: Options
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """The smoothed motion at `frames`: rigid poses (len(frames), 4, 4) and, when scale is
+    keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses,
+    one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError` from polyscrew.
+
+    Smooth Motion's bake, the live preview and Insert Key on Motion all sample through here,
+    so they show, key and bake the same motion.
+    """
+    spec = dict(
+        scheme=options.scheme,
+        levels=options.levels,
+        closed=motion.closed,
+        period=motion.period,
+        timing=options.timing,
+    )
+    poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
+    scales = None
+    if motion.scale_keyed:
+        scales = np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
+    return poses, scales
+
+
 def bake_frames(start: float, end: float, step: float) -> np.ndarray:
     """Frames from `start` to `end` (included when on the grid) every `step` frames."""
     if not step > 0.0:
@@ -93,25 +117,17 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
     """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes)."""
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
-    spec = dict(
-        scheme=options.scheme,
-        levels=options.levels,
-        closed=motion.closed,
-        period=motion.period,
-        timing=options.timing,
-    )
     try:
         frames = bake_frames(start, end, options.step)
-        poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
+        poses, scales = sample_poses(motion, frames, options)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         values = {
             "location": poses[:, :3, 3].copy(),
             keys.rotation_path(mode): polyscrew.rotation_channels(poses, mode, previous=previous),
         }
-        if motion.scale_keyed:
-            log_scale = polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec)
-            values["scale"] = np.exp(log_scale)
+        if scales is not None:
+            values["scale"] = scales
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{obj.name}: {err}") from err
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion

@@ -1,0 +1,123 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Insert Key on Motion: key the smoothed motion's own pose at a frame, to refine locally.
+
+Rossignac-Kim: "interpolations should be stable under sub-sampling". Inserting, at frame f,
+the pose the motion has there changes nothing for the raw polyscrew (0 levels, linear
+timing): the screw from P_i to P_{i+1} split at s(P_i, a, P_{i+1}) gives two screws that
+trace exactly the same poses (`(M^a)^v = M^(a v)`). With subdivision the refined motion
+moves slightly; :func:`insert_key` measures by how much, by sampling the motion read back
+from the F-curves before and after, at every whole frame of the keyed range and at f.
+
+Keys are written with `FCurve.keyframe_points.insert` on every keyed transform channel
+(location and rotation always, scale when it is keyed), in the object's rotation mode and
+continuous with the curve there (quaternion sign, compatible Euler angles). F-curves store
+float32: the inserted pose is the motion's pose rounded to float32 channel values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import bpy
+import numpy as np
+import polyscrew
+
+from . import bake, channels, keys
+from .keys import SmoothError
+
+
+@dataclass
+class InsertResult:
+    """What one insertion did."""
+
+    frame: float
+    #: property name -> the inserted channel values.
+    values: dict[str, np.ndarray]
+    #: Largest displacement of the object's origin over the checked frames (scene units).
+    max_translation: float
+    #: Largest rotation between the old and new orientation over the checked frames (radians).
+    max_angle: float
+    #: Frame where the largest displacement happens.
+    worst_frame: float
+    #: The frames the motion was compared at.
+    checked_frames: np.ndarray
+
+
+def check_frames(before: keys.KeyedMotion, frame: float) -> np.ndarray:
+    """Every whole frame of the keyed range (widened to include `frame`), and `frame`."""
+    start, end = before.frame_range
+    start, end = min(start, frame), max(end, frame)
+    whole = np.arange(np.ceil(start), np.floor(end) + 1.0)
+    return np.union1d(whole, [frame])
+
+
+def pose_change(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per pose: origin displacement |t_b - t_a| and rotation angle of `R_a^T R_b` (radians)."""
+    translation = np.linalg.norm(b[:, :3, 3] - a[:, :3, 3], axis=1)
+    relative = np.einsum("nji,njk->nik", a[:, :3, :3], b[:, :3, :3])
+    cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    # arccos loses precision near 0: use the antisymmetric part for small angles.
+    skew = np.stack(
+        [relative[:, 2, 1] - relative[:, 1, 2], relative[:, 0, 2] - relative[:, 2, 0], relative[:, 1, 0] - relative[:, 0, 1]],
+        axis=1,
+    )
+    angle = np.arctan2(np.linalg.norm(skew, axis=1) / 2.0, cos)
+    return translation, angle
+
+
+def _current_values(obj: bpy.types.Object, curves: dict, path: str, size: int, frame: float) -> np.ndarray:
+    static = np.array(getattr(obj, path), dtype=np.float64)
+    return np.array(
+        [curves[(path, i)].evaluate(frame) if (path, i) in curves else static[i] for i in range(size)]
+    )
+
+
+def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options) -> InsertResult:
+    """Keys the pose the smoothed motion of `obj` has at `frame` on its transform channels.
+
+    Raises :class:`SmoothError` (nothing changed) when the keys cannot be smoothed.
+    """
+    before = keys.read(obj, options.closed)
+    frames = check_frames(before, frame)
+    try:
+        poses_before, _ = bake.sample_poses(before, frames, options)
+        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options)
+    except ValueError as err:
+        raise SmoothError(f"{obj.name}: {err}") from err
+
+    mode = obj.rotation_mode
+    rotation_path = keys.rotation_path(mode)
+    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
+    curves = {(fc.data_path, fc.array_index): fc for fc in channels.object_fcurves(obj)}
+    previous = _current_values(obj, curves, rotation_path, size, frame)
+    values = {
+        "location": pose[0, :3, 3].copy(),
+        rotation_path: polyscrew.rotation_channels(pose, mode, previous=previous)[0],
+    }
+    if before.scale_keyed:
+        values["scale"] = scale[0]
+
+    adt = obj.animation_data
+    bag = channels.ensure_container(adt.action, channels.assigned_slot(obj))
+    for path, vector in values.items():
+        for index, value in enumerate(vector):
+            fcurve = curves.get((path, index))
+            if fcurve is None:
+                fcurve = channels.new_fcurve(bag, path, index)
+            fcurve.keyframe_points.insert(frame, float(value))
+
+    after = keys.read(obj, options.closed)
+    try:
+        poses_after, _ = bake.sample_poses(after, frames, options)
+    except ValueError as err:
+        raise SmoothError(f"{obj.name}: {err}") from err
+    translation, angle = pose_change(poses_before, poses_after)
+    worst = int(np.argmax(translation))
+    return InsertResult(
+        frame=frame,
+        values=values,
+        max_translation=float(translation.max()),
+        max_angle=float(angle.max()),
+        worst_frame=float(frames[worst]),
+        checked_frames=frames,
+    )

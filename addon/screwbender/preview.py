@@ -1,0 +1,395 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The live stroboscopic preview's data: what the overlay draws, computed without a GPU.
+
+For each previewed object (ScrewBender paper, section 5 and figure 13: the "3D rubber band"):
+
+- N instances of the object at evenly spaced times over the motion's frame range,
+- the trajectory of its origin at M evenly spaced times,
+- the key poses,
+- optionally the raw polyscrew (0 levels, linear timing: one screw per key span).
+
+The keys are read by :func:`keys.read` and the motion sampled by :func:`bake.sample_poses`,
+the very functions Smooth Motion bakes with, in ONE `polyscrew.sample` call for instances and
+trajectory together (plus one `sample_vectors` call when scale is keyed, plus one call for
+the raw polyscrew when it is shown). :class:`PreviewCache` keeps the result per object under
+a hash of the object's transform F-curves (raw key data: co, handles, interpolation, ...) and
+the settings, and recomputes only when that hash changes. Nothing here writes Blender data.
+
+All matrices are in the object's parent space (what `matrix_basis` means); the draw code
+multiplies by the parent's world matrix.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from dataclasses import astuple, dataclass, field
+
+import bpy
+import numpy as np
+
+from . import bake, channels, keys
+from .keys import SmoothError
+
+#: Default number of stroboscopic instances.
+DEFAULT_INSTANCES = 16
+#: Default number of trajectory points.
+DEFAULT_TRAJECTORY_POINTS = 200
+
+#: Keyframe attributes that decide the value of an F-curve anywhere: (name, width, dtype).
+_KEY_ATTRS = (
+    ("co", 2, np.float32),
+    ("handle_left", 2, np.float32),
+    ("handle_right", 2, np.float32),
+    ("interpolation", 1, np.int32),
+)
+#: ... and those that matter only for the easing interpolations (Sine ... Elastic).
+_EASING_ATTRS = (
+    ("easing", 1, np.int32),
+    ("back", 1, np.float32),
+    ("amplitude", 1, np.float32),
+    ("period", 1, np.float32),
+)
+_INTERPOLATIONS = {item.identifier: item.value for item in bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items}
+#: Interpolation values above this are easing interpolations (Blender numbers Constant,
+#: Linear, Bezier first); checked here rather than assumed.
+_PLAIN_MAX = max(_INTERPOLATIONS[name] for name in ("CONSTANT", "LINEAR", "BEZIER"))
+assert all(v > _PLAIN_MAX for k, v in _INTERPOLATIONS.items() if k not in ("CONSTANT", "LINEAR", "BEZIER"))
+
+
+@dataclass(frozen=True)
+class PreviewOptions:
+    """What the preview of one object depends on besides its keys."""
+
+    #: Smooth Motion's options (scheme, levels, timing, cycle, frame range): shared with the bake.
+    smooth: bake.Options = field(default_factory=bake.Options)
+    #: Number of stroboscopic instances.
+    instances: int = DEFAULT_INSTANCES
+    #: Number of trajectory points.
+    trajectory_points: int = DEFAULT_TRAJECTORY_POINTS
+    #: Whether the raw polyscrew (0 levels, linear timing) is computed for comparison.
+    show_raw: bool = False
+
+    def key(self) -> tuple:
+        """A hashable summary of these options."""
+        return (astuple(self.smooth), self.instances, self.trajectory_points, self.show_raw)
+
+
+@dataclass
+class PreviewBatches:
+    """Everything the overlay draws for one object, as arrays (parent space, float64)."""
+
+    #: Times of the instances, shape (N,).
+    instance_times: np.ndarray
+    #: Object matrices (rigid pose times scale) at those times, shape (N, 4, 4).
+    instances: np.ndarray
+    #: Times of the trajectory points, shape (M,).
+    trajectory_times: np.ndarray
+    #: The origin at those times, shape (M, 3).
+    trajectory: np.ndarray
+    #: Key frames, shape (K,).
+    key_frames: np.ndarray
+    #: Object matrices at the key poses, shape (K, 4, 4).
+    keys: np.ndarray
+    #: Raw polyscrew instances (N, 4, 4) and trajectory (M, 3), when asked for.
+    raw_instances: np.ndarray | None = None
+    raw_trajectory: np.ndarray | None = None
+
+
+def _times(start: float, end: float, count: int, closed: bool) -> np.ndarray:
+    """`count` evenly spaced times from `start` to `end`; a cycle leaves out `end` (= `start`)."""
+    if closed:
+        return start + (end - start) * np.arange(count, dtype=np.float64) / count
+    return np.linspace(start, end, count)
+
+
+def frame_range(motion: keys.KeyedMotion, options: bake.Options) -> tuple[float, float]:
+    """The frames the preview spans: the bake's range (Smooth Motion's Frame Range setting)."""
+    if options.frame_range is not None:
+        return float(options.frame_range[0]), float(options.frame_range[1])
+    return motion.frame_range
+
+
+def with_scale(poses: np.ndarray, scales: np.ndarray) -> np.ndarray:
+    """Object matrices `pose @ diag(scale)` from rigid poses (N, 4, 4) and scales (N, 3)."""
+    out = poses.copy()
+    out[:, :3, :3] *= scales[:, None, :]
+    return out
+
+
+def compute(motion: keys.KeyedMotion, options: PreviewOptions) -> PreviewBatches:
+    """The preview of `motion`: one :func:`bake.sample_poses` call for instances and trajectory.
+
+    Raises `ValueError` from polyscrew for motions it refuses.
+    """
+    start, end = frame_range(motion, options.smooth)
+    # A cycle over one period ends where it starts: the last instance would repeat the first.
+    cycle = motion.closed and motion.period is not None and options.smooth.frame_range is None
+    instance_times = _times(start, end, max(1, options.instances), cycle)
+    trajectory_times = _times(start, end, max(2, options.trajectory_points), False)
+    times = np.concatenate([instance_times, trajectory_times])
+    n = len(instance_times)
+    poses, scales = bake.sample_poses(motion, times, options.smooth)
+    if scales is None:  # unkeyed scale: the object's own, constant
+        scales = np.broadcast_to(motion.scales[0], (len(times), 3))
+    matrices = with_scale(poses, scales)
+    batches = PreviewBatches(
+        instance_times=instance_times,
+        instances=matrices[:n],
+        trajectory_times=trajectory_times,
+        trajectory=poses[n:, :3, 3].copy(),
+        key_frames=motion.frames.copy(),
+        keys=with_scale(motion.poses, motion.scales),
+    )
+    if options.show_raw:
+        raw = bake.Options(scheme=options.smooth.scheme, levels=0, timing="linear", closed=options.smooth.closed)
+        raw_poses, raw_scales = bake.sample_poses(motion, times, raw)
+        if raw_scales is None:
+            raw_scales = scales
+        raw_matrices = with_scale(raw_poses, raw_scales)
+        batches.raw_instances = raw_matrices[:n]
+        batches.raw_trajectory = raw_poses[n:, :3, 3].copy()
+    return batches
+
+
+#: Current transform values differing from the curves by more than this (relative) at a key
+#: frame mean the user is moving the object there.
+LIVE_TOLERANCE = 1e-5
+
+
+@dataclass
+class LiveKey:
+    """The object's current transform, differing from its animation at the current frame:
+    the user is moving or rotating it. At a key frame it stands for that key pose; elsewhere
+    (with auto-keying on) for the key auto-keying will insert there."""
+
+    frame: float
+    #: location (3,), rotation channel values, scale (3,).
+    location: np.ndarray
+    rotation: np.ndarray
+    scale: np.ndarray
+
+
+def key_hash(
+    obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
+) -> tuple[bytes, LiveKey | None]:
+    """A digest of everything :func:`keys.read` reads from `obj`, and of `options`; and the
+    live key at `frame` (see :class:`LiveKey`), which enters the digest too.
+
+    Raw F-curve data of the transform channels (key coordinates, handles, interpolation,
+    easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
+    transform channels, the action and slot, NLA strips and transform drivers. Reading it is a
+    few `foreach_get` calls: far cheaper than reading and sampling the keys. The current
+    transform enters only when `frame` is a key frame (or `auto_key` is on) and it differs
+    from the curves there, so playing or scrubbing the timeline never recomputes anything.
+    """
+    digest = hashlib.blake2b(digest_size=16)
+    digest.update(repr(options.key()).encode())
+    mode = obj.rotation_mode
+    paths = keys.transform_paths(mode)
+    adt = obj.animation_data
+    digest.update(f"{mode}|{obj.name_full}".encode())
+    if adt is not None:
+        action = adt.action
+        digest.update(
+            f"|{action.name_full if action else ''}|{channels.slot_identifier(obj)}"
+            f"|{sum(len(t.strips) for t in adt.nla_tracks)}"
+            f"|{sorted((d.data_path, d.array_index) for d in adt.drivers if d.data_path in paths)}".encode()
+        )
+    curves = {}
+    at_key = False
+    for fc in channels.object_fcurves(obj):
+        if fc.data_path not in paths:
+            continue
+        curves[(fc.data_path, fc.array_index)] = fc
+        points = fc.keyframe_points
+        count = len(points)
+        digest.update(
+            f"|{fc.data_path}[{fc.array_index}]{count}{fc.mute}{fc.extrapolation}"
+            f"{[(m.type, m.mute) for m in fc.modifiers]}".encode()
+        )
+        for attr, width, dtype in _KEY_ATTRS:
+            buf = np.empty(width * count, dtype=dtype)
+            points.foreach_get(attr, buf)
+            digest.update(buf.tobytes())
+            if attr == "co" and frame is not None and count and not fc.mute:
+                at_key = at_key or bool(np.any(np.abs(buf[0::2] - frame) < keys.FRAME_TOLERANCE))
+        if count and int(buf.max()) > _PLAIN_MAX:  # buf: the interpolations
+            for attr, width, dtype in _EASING_ATTRS:
+                extra = np.empty(width * count, dtype=dtype)
+                points.foreach_get(attr, extra)
+                digest.update(extra.tobytes())
+    # Unkeyed channels enter the key poses with their current (static) value.
+    current = {}
+    changed = False
+    for path in paths:
+        values = np.array(getattr(obj, path), dtype=np.float64)
+        current[path] = values
+        static = [v for i, v in enumerate(values) if (path, i) not in curves]
+        digest.update(np.asarray(static, dtype=np.float64).tobytes())
+        if at_key or (auto_key and frame is not None):
+            for i, value in enumerate(values):
+                fc = curves.get((path, i))
+                if fc is not None and not fc.mute and abs(fc.evaluate(frame) - value) > LIVE_TOLERANCE * (1.0 + abs(value)):
+                    changed = True
+    live = None
+    if changed:
+        live = LiveKey(frame, current[paths[0]], current[paths[1]], current[paths[2]])
+        digest.update(np.concatenate([[frame], live.location, live.rotation, live.scale]).tobytes())
+    return digest.digest(), live
+
+
+def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
+    """`motion` with the live transform as its key at `live.frame`: replacing the key pose
+    there, or inserted as a new key (open motions; a cycle keeps its keys)."""
+    if not np.all(live.scale > 0.0):
+        return motion
+    rotation = keys.rotation_matrices(live.rotation[None, :], motion.rotation_mode)
+    pose = keys.compose(live.location[None, :], rotation)[0]
+    hits = np.flatnonzero(np.abs(motion.frames - live.frame) < keys.FRAME_TOLERANCE)
+    if len(hits):
+        k = hits[0]
+        poses, scales = motion.poses.copy(), motion.scales.copy()
+        poses[k], scales[k] = pose, live.scale
+        return dataclasses.replace(motion, poses=poses, scales=scales)
+    if motion.closed:
+        return motion
+    k = int(np.searchsorted(motion.frames, live.frame))
+    return dataclasses.replace(
+        motion,
+        frames=np.insert(motion.frames, k, live.frame),
+        poses=np.insert(motion.poses, k, pose, axis=0),
+        scales=np.insert(motion.scales, k, live.scale, axis=0),
+    )
+
+
+@dataclass
+class PreviewEntry:
+    """The cached preview of one object."""
+
+    digest: bytes
+    #: The batches, or None when the object's keys cannot be previewed.
+    batches: PreviewBatches | None
+    #: Why there is nothing to draw ("" when there is).
+    error: str = ""
+
+
+class PreviewCache:
+    """Previews per object (by `session_uid`), recomputed only when their key hash changes."""
+
+    def __init__(self) -> None:
+        self.entries: dict[int, PreviewEntry] = {}
+        #: How many times each object (by name) was recomputed: for tests and statistics.
+        self.recomputed: dict[str, int] = {}
+
+    def refresh(
+        self, obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
+    ) -> tuple[PreviewEntry, bool]:
+        """The preview of `obj` and whether it was recomputed now (its hash changed).
+
+        `frame` is the current frame: when the object is being moved there, at a key frame or
+        with auto-keying on (`auto_key`), the preview shows the motion with the object's
+        current pose as the key at that frame.
+        """
+        digest, live = key_hash(obj, options, frame, auto_key)
+        uid = obj.session_uid
+        entry = self.entries.get(uid)
+        if entry is not None and entry.digest == digest:
+            return entry, False
+        try:
+            motion = keys.read(obj, options.smooth.closed)
+            if live is not None:
+                motion = with_live_key(motion, live)
+            entry = PreviewEntry(digest, compute(motion, options))
+        except (SmoothError, ValueError) as err:
+            message = str(err)
+            entry = PreviewEntry(digest, None, message if message.startswith(obj.name) else f"{obj.name}: {message}")
+        self.entries[uid] = entry
+        self.recomputed[obj.name] = self.recomputed.get(obj.name, 0) + 1
+        return entry, True
+
+    def forget(self, keep: set[int] | None = None) -> None:
+        """Drops every entry (or every entry whose object is not in `keep`)."""
+        if keep is None:
+            self.entries.clear()
+        else:
+            for uid in [u for u in self.entries if u not in keep]:
+                del self.entries[uid]
+
+
+# Geometry drawn per instance --------------------------------------------------------------
+
+#: Edges of a box whose corners are numbered like `Object.bound_box` (bit 2: x, bit 1: y, bit 0: z).
+BOX_EDGES = np.array(
+    [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4), (0, 4), (1, 5), (2, 6), (3, 7)],
+    dtype=np.int32,
+)
+#: Triangles of the same box.
+BOX_TRIS = np.array(
+    [
+        (0, 1, 2), (0, 2, 3), (4, 6, 5), (4, 7, 6), (0, 4, 5), (0, 5, 1),
+        (1, 5, 6), (1, 6, 2), (2, 6, 7), (2, 7, 3), (3, 7, 4), (3, 4, 0),
+    ],
+    dtype=np.int32,
+)
+
+
+@dataclass
+class Geometry:
+    """What one instance looks like, in the object's local coordinates."""
+
+    points: np.ndarray  # (V, 3) float32
+    edges: np.ndarray  # (E, 2) int32
+    tris: np.ndarray  # (T, 3) int32
+    #: "MESH", "BOX" (bounding box of a heavy mesh or of a non-mesh object) or "AXES".
+    kind: str
+
+
+def box_corners(low: np.ndarray, high: np.ndarray) -> np.ndarray:
+    """The 8 corners of the box [low, high], numbered like `Object.bound_box`."""
+    return np.array(
+        [[(low, high)[(i >> 2) & 1][0], (low, high)[(i >> 1) & 1][1], (low, high)[i & 1][2]] for i in (0, 1, 3, 2, 4, 5, 7, 6)],
+        dtype=np.float32,
+    )
+
+
+def object_geometry(obj: bpy.types.Object, heavy_limit: int) -> Geometry:
+    """The instance shape of `obj`: its mesh, its mesh's bounding box when the mesh has more
+    than `heavy_limit` vertices, its bounding box (non-mesh objects) or axes (empties)."""
+    if obj.type == "MESH":
+        mesh = obj.data
+        n = len(mesh.vertices)
+        co = np.empty(3 * n, dtype=np.float32)
+        mesh.vertices.foreach_get("co", co)
+        co = co.reshape(-1, 3)
+        if n > heavy_limit:
+            return Geometry(box_corners(co.min(axis=0), co.max(axis=0)), BOX_EDGES, BOX_TRIS, "BOX")
+        edges = np.empty(2 * len(mesh.edges), dtype=np.int32)
+        mesh.edges.foreach_get("vertices", edges)
+        tris_rna = mesh.loop_triangles
+        if len(tris_rna) == 0 and len(mesh.polygons) > 0:
+            mesh.calc_loop_triangles()  # runtime cache only, not saved data
+            tris_rna = mesh.loop_triangles
+        tris = np.empty(3 * len(tris_rna), dtype=np.int32)
+        tris_rna.foreach_get("vertices", tris)
+        return Geometry(co, edges.reshape(-1, 2), tris.reshape(-1, 3), "MESH")
+    corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float32)
+    if obj.type != "EMPTY" and np.ptp(corners, axis=0).max() > 0.0:
+        return Geometry(corners, BOX_EDGES, BOX_TRIS, "BOX")
+    size = float(getattr(obj, "empty_display_size", 1.0))
+    axes = np.array([(0, 0, 0), (size, 0, 0), (0, 0, 0), (0, size, 0), (0, 0, 0), (0, 0, size)], dtype=np.float32)
+    return Geometry(axes, np.array([(0, 1), (2, 3), (4, 5)], dtype=np.int32), np.zeros((0, 3), dtype=np.int32), "AXES")
+
+
+def instance_vertices(points: np.ndarray, matrices: np.ndarray) -> np.ndarray:
+    """`points` (V, 3) placed by each of `matrices` (N, 4, 4): (N * V, 3) float32."""
+    m = np.asarray(matrices, dtype=np.float32)
+    out = np.matmul(np.asarray(points, dtype=np.float32)[None], m[:, :3, :3].transpose(0, 2, 1))
+    out += m[:, None, :3, 3]
+    return out.reshape(-1, 3)
+
+
+def instance_indices(elements: np.ndarray, vertex_count: int, instances: int) -> np.ndarray:
+    """Index arrays `elements` (E, k) repeated for `instances` copies of `vertex_count` vertices."""
+    offsets = (np.arange(instances, dtype=np.int32) * vertex_count)[:, None, None]
+    return (elements[None, :, :] + offsets).reshape(-1, elements.shape[1]).astype(np.int32)

@@ -1,0 +1,462 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The live preview overlay: a `gpu` draw handler in the 3D Viewport, kept up to date.
+
+- :func:`sync` installs the draw handler (`SpaceView3D.draw_handler_add`, POST_VIEW) and a
+  `depsgraph_update_post` handler while at least one object has its preview on, and removes
+  both as soon as none has: nothing is left behind.
+- The depsgraph handler only checks each previewed object's key hash
+  (:func:`preview.key_hash`); an object is recomputed only when its hash changed, and the
+  viewports are redrawn only then.
+- :func:`draw_previews` draws the cached batches (also into an offscreen buffer:
+  :func:`render_offscreen`). It reads Blender data and never writes any.
+
+Batches are built in each object's parent space and drawn under its parent's current world
+matrix (`matrix_world @ matrix_basis^-1`), so moving a parent does not recompute anything.
+"""
+
+from __future__ import annotations
+
+import types
+from dataclasses import dataclass
+
+import bpy
+import gpu
+import numpy as np
+from bpy.app.handlers import persistent
+from gpu_extras.batch import batch_for_shader
+from mathutils import Matrix
+
+from . import bake, preview
+from .operators import SCREWBENDER_OT_smooth
+
+#: The object property that turns an object's preview on.
+OBJECT_PROP = "screwbender_preview"
+#: The scene property holding the display settings.
+SCENE_PROP = "screwbender_preview"
+
+#: Builtin shader names, the same in Blender 4.2 and 5.x (4.0 dropped the "3D_" prefixes).
+LINE_SHADER = "POLYLINE_UNIFORM_COLOR"
+FACE_SHADER = "UNIFORM_COLOR"
+#: Round points (Blender 4.4+); 4.2 draws square points with FACE_SHADER instead.
+POINT_SHADERS = ("POINT_UNIFORM_COLOR", FACE_SHADER)
+
+#: Opacity of the faint solid instances, relative to the instance colour's alpha.
+SOLID_ALPHA = 0.25
+#: Size of the key origin points, pixels.
+KEY_POINT_SIZE = 8.0
+
+#: The previews of all objects.
+CACHE = preview.PreviewCache()
+
+_draw_handle = None
+#: object session_uid -> (batch key, {name: (batch, shader name)})
+_gpu_batches: dict[int, tuple[tuple, dict]] = {}
+#: object session_uid -> counter bumped when the depsgraph reports its geometry changed.
+_geometry_generation: dict[int, int] = {}
+_last_draw_error = ""
+
+
+# Settings ---------------------------------------------------------------------------------
+
+
+def preview_options(scene: bpy.types.Scene) -> preview.PreviewOptions:
+    """The preview options of `scene`: Smooth Motion's panel settings (shared) and the
+    preview's own display settings."""
+    smooth = SCREWBENDER_OT_smooth.smooth_options(scene.screwbender, types.SimpleNamespace(scene=scene))
+    display = getattr(scene, SCENE_PROP)
+    return preview.PreviewOptions(
+        smooth=smooth,
+        instances=display.instances,
+        trajectory_points=display.trajectory_points,
+        show_raw=display.show_raw,
+    )
+
+
+def smooth_options(scene: bpy.types.Scene) -> bake.Options:
+    """Smooth Motion's options as set in the panel of `scene` (what Apply bakes with)."""
+    return preview_options(scene).smooth
+
+
+def current_frame(scene: bpy.types.Scene) -> float:
+    """The scene's current frame, with its subframe."""
+    return scene.frame_current + scene.frame_subframe
+
+
+def auto_keying(scene: bpy.types.Scene) -> bool:
+    """Whether auto-keying is on in `scene`."""
+    return bool(scene.tool_settings.use_keyframe_insert_auto)
+
+
+def enabled_objects(scene: bpy.types.Scene) -> list[bpy.types.Object]:
+    """The objects of `scene` whose preview is on."""
+    return [obj for obj in scene.objects if getattr(obj, OBJECT_PROP, False)]
+
+
+def moved_unkeyed(scene: bpy.types.Scene, objects: list[bpy.types.Object]) -> list[str]:
+    """Names of `objects` moved at a key frame and not keyed (the preview shows a live key)."""
+    options = preview_options(scene)
+    frame = current_frame(scene)
+    auto = auto_keying(scene)
+    return [obj.name for obj in objects if preview.key_hash(obj, options, frame, auto)[1] is not None]
+
+
+# Handlers ---------------------------------------------------------------------------------
+
+
+def is_enabled() -> bool:
+    """Whether the overlay's handlers are installed."""
+    return _draw_handle is not None
+
+
+def draw_handle():
+    """The current draw handler handle (None when disabled): for tests."""
+    return _draw_handle
+
+
+def enable() -> None:
+    """Installs the draw and depsgraph handlers (once)."""
+    global _draw_handle
+    if _draw_handle is None:
+        _draw_handle = bpy.types.SpaceView3D.draw_handler_add(_draw_callback, (), "WINDOW", "POST_VIEW")
+    if _on_depsgraph_update not in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.append(_on_depsgraph_update)
+    tag_redraw()
+
+
+def disable() -> None:
+    """Removes the draw and depsgraph handlers and drops every cached batch."""
+    global _draw_handle
+    if _draw_handle is not None:
+        bpy.types.SpaceView3D.draw_handler_remove(_draw_handle, "WINDOW")
+        _draw_handle = None
+    while _on_depsgraph_update in bpy.app.handlers.depsgraph_update_post:
+        bpy.app.handlers.depsgraph_update_post.remove(_on_depsgraph_update)
+    CACHE.forget()
+    _gpu_batches.clear()
+    _geometry_generation.clear()
+    tag_redraw()
+
+
+def sync(*_args) -> None:
+    """Enables the overlay when any object has its preview on, disables it otherwise."""
+    if any(getattr(obj, OBJECT_PROP, False) for obj in bpy.data.objects):
+        enable()
+    else:
+        disable()
+
+
+def tag_redraw() -> None:
+    """Asks every 3D Viewport to redraw (nothing to do without windows)."""
+    wm = bpy.context.window_manager
+    if wm is None:
+        return
+    for window in wm.windows:
+        for area in window.screen.areas:
+            if area.type == "VIEW_3D":
+                area.tag_redraw()
+
+
+@persistent
+def _on_depsgraph_update(scene: bpy.types.Scene, depsgraph: bpy.types.Depsgraph) -> None:
+    changed = False
+    for update in depsgraph.updates:
+        if update.is_updated_geometry and isinstance(update.id, bpy.types.Object):
+            uid = update.id.original.session_uid
+            _geometry_generation[uid] = _geometry_generation.get(uid, 0) + 1
+            changed = True
+    changed = refresh(scene) or changed
+    if changed:
+        tag_redraw()
+    if not CACHE.entries and not any(getattr(obj, OBJECT_PROP, False) for obj in bpy.data.objects):
+        # The last previewed object was deleted. A handler must not remove itself while
+        # Blender walks the handler list: disable from a timer instead (UI sessions only).
+        if not bpy.app.timers.is_registered(_deferred_sync):
+            bpy.app.timers.register(_deferred_sync, first_interval=0.0)
+
+
+def _deferred_sync() -> None:
+    sync()
+
+
+def refresh(scene: bpy.types.Scene) -> bool:
+    """Checks the key hash of every previewed object of `scene`, recomputing those whose hash
+    changed; returns whether any was recomputed. Forgets objects no longer previewed."""
+    options = preview_options(scene)
+    objects = enabled_objects(scene)
+    changed = False
+    frame = current_frame(scene)
+    auto = auto_keying(scene)
+    for obj in objects:
+        changed = CACHE.refresh(obj, options, frame, auto)[1] or changed
+    keep = {obj.session_uid for obj in objects}
+    CACHE.forget(keep)
+    for uid in [u for u in _gpu_batches if u not in keep]:
+        del _gpu_batches[uid]
+    return changed
+
+
+#: :func:`sync` as a handler that survives loading files.
+sync_persistent = persistent(sync)
+
+
+def register() -> None:
+    """Installs the handlers that re-sync the overlay after loading a file, undo and redo."""
+    for handlers in (bpy.app.handlers.load_post, bpy.app.handlers.undo_post, bpy.app.handlers.redo_post):
+        if sync_persistent not in handlers:
+            handlers.append(sync_persistent)
+
+
+def unregister() -> None:
+    """Removes every handler of the overlay."""
+    disable()
+    if bpy.app.timers.is_registered(_deferred_sync):
+        bpy.app.timers.unregister(_deferred_sync)
+    for handlers in (bpy.app.handlers.load_post, bpy.app.handlers.undo_post, bpy.app.handlers.redo_post):
+        while sync_persistent in handlers:
+            handlers.remove(sync_persistent)
+
+
+def our_handlers() -> list[str]:
+    """Names of `bpy.app.handlers` lists holding a function of this module: for tests."""
+    found = []
+    for name in dir(bpy.app.handlers):
+        handlers = getattr(bpy.app.handlers, name)
+        if isinstance(handlers, list) and any(getattr(f, "__module__", "") == __name__ for f in handlers):
+            found.append(name)
+    return found
+
+
+# Drawing ----------------------------------------------------------------------------------
+
+
+@dataclass
+class _Style:
+    style: str
+    heavy_limit: int
+    instance_color: tuple
+    key_color: tuple
+    trajectory_color: tuple
+    raw_color: tuple
+    line_width: float
+    show_trajectory: bool
+    show_keys: bool
+    show_raw: bool
+
+
+def _style(scene: bpy.types.Scene) -> _Style:
+    s = getattr(scene, SCENE_PROP)
+    return _Style(
+        style=s.style,
+        heavy_limit=s.heavy_limit,
+        instance_color=tuple(s.instance_color),
+        key_color=tuple(s.key_color),
+        trajectory_color=tuple(s.trajectory_color),
+        raw_color=tuple(s.raw_color),
+        line_width=s.line_width,
+        show_trajectory=s.show_trajectory,
+        show_keys=s.show_keys,
+        show_raw=s.show_raw,
+    )
+
+
+def parent_space(obj: bpy.types.Object) -> Matrix:
+    """The world matrix of the space `matrix_basis` lives in, at the current frame.
+
+    World space without a parent; `parent.matrix_world @ matrix_parent_inverse` under an
+    object parent; for bone and vertex parents, the evaluated `matrix_world @ matrix_basis^-1`.
+    (Constraints and delta transforms are not drawn.)
+    """
+    parent = obj.parent
+    if parent is None:
+        return Matrix.Identity(4)
+    if obj.parent_type == "OBJECT":
+        return parent.matrix_world @ obj.matrix_parent_inverse
+    return obj.matrix_world @ obj.matrix_basis.inverted_safe()
+
+
+def _geometry_key(obj: bpy.types.Object, style: _Style) -> tuple:
+    data = obj.data
+    counts = (len(data.vertices), len(data.edges)) if obj.type == "MESH" else ()
+    return (
+        obj.type, data.name_full if data is not None else "", counts,
+        _geometry_generation.get(obj.session_uid, 0), style.style, style.heavy_limit,
+    )
+
+
+def _point_shader() -> gpu.types.GPUShader:
+    for name in POINT_SHADERS:
+        try:
+            return gpu.shader.from_builtin(name)
+        except ValueError:  # not a builtin shader of this Blender
+            continue
+    raise ValueError(f"none of the shaders {POINT_SHADERS} is built in")
+
+
+def _build(entry: preview.PreviewEntry, geometry: preview.Geometry, style: _Style) -> dict:
+    """GPU batches for one object: {name: (batch, shader name)}."""
+    b = entry.batches
+    out = {}
+    line_shader = gpu.shader.from_builtin(LINE_SHADER)
+    face_shader = gpu.shader.from_builtin(FACE_SHADER)
+    point_shader = _point_shader()
+    v = len(geometry.points)
+
+    def lines(matrices: np.ndarray):
+        return batch_for_shader(
+            line_shader, "LINES", {"pos": preview.instance_vertices(geometry.points, matrices)},
+            indices=preview.instance_indices(geometry.edges, v, len(matrices)),
+        )
+
+    if style.style == "SOLID" and len(geometry.tris):
+        out["instances_solid"] = (
+            batch_for_shader(
+                face_shader, "TRIS", {"pos": preview.instance_vertices(geometry.points, b.instances)},
+                indices=preview.instance_indices(geometry.tris, v, len(b.instances)),
+            ),
+            FACE_SHADER,
+        )
+    else:
+        out["instances"] = (lines(b.instances), LINE_SHADER)
+    out["keys"] = (lines(b.keys), LINE_SHADER)
+    out["key_points"] = (
+        batch_for_shader(point_shader, "POINTS", {"pos": b.keys[:, :3, 3].astype(np.float32)}),
+        "points",
+    )
+    out["trajectory"] = (
+        batch_for_shader(line_shader, "LINE_STRIP", {"pos": b.trajectory.astype(np.float32)}), LINE_SHADER
+    )
+    if b.raw_instances is not None:
+        out["raw"] = (lines(b.raw_instances), LINE_SHADER)
+        out["raw_trajectory"] = (
+            batch_for_shader(line_shader, "LINE_STRIP", {"pos": b.raw_trajectory.astype(np.float32)}), LINE_SHADER
+        )
+    return out
+
+
+def _batches_for(obj: bpy.types.Object, entry: preview.PreviewEntry, style: _Style) -> dict:
+    key = (entry.digest, _geometry_key(obj, style))
+    cached = _gpu_batches.get(obj.session_uid)
+    if cached is not None and cached[0] == key:
+        return cached[1]
+    heavy = 0 if style.style == "BOX" else style.heavy_limit
+    built = _build(entry, preview.object_geometry(obj, heavy), style)
+    _gpu_batches[obj.session_uid] = (key, built)
+    return built
+
+
+def _draw_one(batches: dict, style: _Style, viewport_size: tuple[float, float]) -> None:
+    line = gpu.shader.from_builtin(LINE_SHADER)
+    face = gpu.shader.from_builtin(FACE_SHADER)
+    point = _point_shader()
+
+    def draw_lines(name: str, color: tuple, width: float) -> None:
+        if name not in batches:
+            return
+        line.bind()
+        line.uniform_float("viewportSize", viewport_size)
+        line.uniform_float("lineWidth", width)
+        line.uniform_float("color", color)
+        batches[name][0].draw(line)
+
+    if "instances_solid" in batches:
+        face.bind()
+        r, g, bl, a = style.instance_color
+        face.uniform_float("color", (r, g, bl, a * SOLID_ALPHA))
+        batches["instances_solid"][0].draw(face)
+    draw_lines("instances", style.instance_color, style.line_width)
+    if style.show_raw:
+        draw_lines("raw", style.raw_color, style.line_width)
+        draw_lines("raw_trajectory", style.raw_color, style.line_width * 1.5)
+    if style.show_trajectory:
+        draw_lines("trajectory", style.trajectory_color, style.line_width * 2.0)
+    if style.show_keys:
+        draw_lines("keys", style.key_color, style.line_width * 2.0)
+        point.bind()
+        point.uniform_float("color", style.key_color)
+        gpu.state.point_size_set(KEY_POINT_SIZE)
+        batches["key_points"][0].draw(point)
+
+
+def draw_previews(
+    scene: bpy.types.Scene, view_layer: bpy.types.ViewLayer, viewport_size: tuple[float, float]
+) -> int:
+    """Draws the preview of every previewed, visible object of `scene` with the current GPU
+    matrices; returns how many objects were drawn."""
+    options = preview_options(scene)
+    style = _style(scene)
+    frame = current_frame(scene)
+    auto = auto_keying(scene)
+    drawn = 0
+    gpu.state.blend_set("ALPHA")
+    gpu.state.depth_test_set("LESS_EQUAL")
+    gpu.state.depth_mask_set(False)
+    try:
+        for obj in enabled_objects(scene):
+            if not obj.visible_get(view_layer=view_layer):
+                continue
+            entry, _ = CACHE.refresh(obj, options, frame, auto)
+            if entry.batches is None:
+                continue
+            batches = _batches_for(obj, entry, style)
+            with gpu.matrix.push_pop():
+                gpu.matrix.multiply_matrix(parent_space(obj))
+                _draw_one(batches, style, viewport_size)
+            drawn += 1
+    finally:
+        gpu.state.point_size_set(1.0)
+        gpu.state.depth_mask_set(True)
+        gpu.state.depth_test_set("NONE")
+        gpu.state.blend_set("NONE")
+    return drawn
+
+
+def _draw_callback() -> None:
+    global _last_draw_error
+    context = bpy.context
+    try:
+        viewport = gpu.state.viewport_get()
+        draw_previews(context.scene, context.view_layer, (float(viewport[2]), float(viewport[3])))
+        _last_draw_error = ""
+    except Exception as err:  # never break the viewport; say it once
+        message = f"ScrewBender preview: {type(err).__name__}: {err}"
+        if message != _last_draw_error:
+            print(message)
+            _last_draw_error = message
+
+
+def gpu_unavailable_reason() -> str:
+    """Why offscreen drawing cannot work here ("" when it can)."""
+    try:
+        offscreen = gpu.types.GPUOffScreen(4, 4)
+    except Exception as err:
+        return f"{type(err).__name__}: {err}"
+    offscreen.free()
+    return ""
+
+
+def render_offscreen(
+    scene: bpy.types.Scene,
+    view_layer: bpy.types.ViewLayer,
+    view_matrix: Matrix,
+    projection_matrix: Matrix,
+    width: int,
+    height: int,
+    background: tuple = (1.0, 1.0, 1.0, 1.0),
+) -> tuple[np.ndarray, int]:
+    """The overlay drawn into a `gpu.types.GPUOffScreen`: (height, width, 4) float32 RGBA,
+    bottom row first, and the number of objects drawn."""
+    offscreen = gpu.types.GPUOffScreen(width, height)
+    try:
+        with offscreen.bind():
+            framebuffer = gpu.state.active_framebuffer_get()
+            framebuffer.clear(color=background, depth=1.0)
+            with gpu.matrix.push_pop(), gpu.matrix.push_pop_projection():
+                gpu.matrix.load_matrix(view_matrix)
+                gpu.matrix.load_projection_matrix(projection_matrix)
+                drawn = draw_previews(scene, view_layer, (float(width), float(height)))
+            buffer = framebuffer.read_color(0, 0, width, height, 4, 0, "FLOAT")
+            buffer.dimensions = width * height * 4
+            pixels = np.array(buffer, dtype=np.float32).reshape(height, width, 4)
+    finally:
+        offscreen.free()
+    return pixels, drawn

@@ -1,0 +1,262 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The live preview's settings, its panel, Apply Preview and Insert Key on Motion.
+
+Scheme, levels, timing, cycle and frame range are Smooth Motion's own panel settings
+(`scene.screwbender`): the preview shows what Smooth Motion would bake, and Apply bakes it
+through the same :func:`bake.smooth`. The preview's display settings live in
+`scene.screwbender_preview`; the per-object switch is `Object.screwbender_preview`.
+"""
+
+from __future__ import annotations
+
+import math
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
+
+from . import bake, insert_key, preview, preview_draw
+from .keys import SmoothError
+
+STYLES = (
+    ("WIRE", "Wireframe", "Each instance drawn as the wireframe of its mesh"),
+    ("SOLID", "Faint Solid", "Each instance drawn as a faint, see-through solid"),
+    ("BOX", "Bounding Box", "Each instance drawn as its bounding box (cheapest)"),
+)
+
+
+def _color(name: str, default: tuple, description: str):
+    return FloatVectorProperty(
+        name=name, subtype="COLOR", size=4, min=0.0, max=1.0, default=default, description=description
+    )
+
+
+def _redraw(self, context) -> None:
+    preview_draw.tag_redraw()
+
+
+class ScrewBenderPreviewSettings(bpy.types.PropertyGroup):
+    """Display settings of the live preview, stored in the scene."""
+
+    instances: IntProperty(
+        name="Instances", default=preview.DEFAULT_INSTANCES, min=1, soft_max=128, max=1024,
+        description="How many copies of the object are drawn, evenly spaced in time along the smoothed motion",
+        update=_redraw,
+    )
+    trajectory_points: IntProperty(
+        name="Path Points", default=preview.DEFAULT_TRAJECTORY_POINTS, min=2, soft_max=2000, max=20000,
+        description="How many points of the origin's trajectory are drawn", update=_redraw,
+    )
+    style: EnumProperty(name="Display", items=STYLES, default="WIRE", description="How each instance is drawn", update=_redraw)
+    heavy_limit: IntProperty(
+        name="Box Above", default=5000, min=0, soft_max=100000,
+        description="Meshes with more vertices than this are drawn as their bounding box", update=_redraw,
+    )
+    show_trajectory: BoolProperty(name="Trajectory", default=True, description="Draw the path of the object's origin", update=_redraw)
+    show_keys: BoolProperty(name="Key Poses", default=True, description="Highlight the key poses", update=_redraw)
+    show_raw: BoolProperty(
+        name="Raw Polyscrew", default=False,
+        description="Also draw the raw polyscrew (one screw per key span, 0 levels, linear timing) for comparison",
+        update=_redraw,
+    )
+    line_width: FloatProperty(name="Line Width", default=1.0, min=0.5, max=10.0, description="Width of the lines, pixels", update=_redraw)
+    instance_color: _color("Instances", (0.15, 0.45, 0.95, 0.6), "Colour of the instances")
+    key_color: _color("Keys", (0.9, 0.15, 0.1, 1.0), "Colour of the key poses")
+    trajectory_color: _color("Trajectory", (1.0, 0.6, 0.1, 1.0), "Colour of the origin's trajectory")
+    raw_color: _color("Raw", (0.4, 0.4, 0.4, 0.6), "Colour of the raw polyscrew")
+
+
+def _toggled(self, context) -> None:
+    preview_draw.sync()
+
+
+def _keyed_selection(context) -> list[bpy.types.Object]:
+    return [obj for obj in context.selected_objects if obj.animation_data is not None]
+
+
+class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
+    """Bake the previewed motion of the objects with the preview on, exactly as shown, through Smooth Motion (the old actions are kept); their preview is turned off"""
+
+    bl_idname = "screwbender.preview_apply"
+    bl_label = "Apply Preview"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode")
+            return False
+        if not preview_draw.enabled_objects(context.scene):
+            cls.poll_message_set("No object has its ScrewBender preview on")
+            return False
+        return True
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        objects = sorted(preview_draw.enabled_objects(context.scene), key=lambda o: o.name)
+        moved = preview_draw.moved_unkeyed(context.scene, objects)
+        if moved:
+            self.report(
+                {"ERROR"},
+                f"{', '.join(moved)}: moved at a key frame but not keyed; the preview shows that pose, "
+                "the keys do not: key it (or undo the move) before applying",
+            )
+            return {"CANCELLED"}
+        try:
+            actions, skipped = bake.smooth(objects, preview_draw.smooth_options(context.scene))
+        except SmoothError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        for message in skipped:
+            self.report({"WARNING" if actions else "ERROR"}, message)
+        if not actions:
+            return {"CANCELLED"}
+        applied = {a.name for a in actions}
+        for obj in objects:
+            adt = obj.animation_data
+            if adt is not None and adt.action is not None and adt.action.name in applied:
+                setattr(obj, preview_draw.OBJECT_PROP, False)
+        preview_draw.sync()
+        self.report({"INFO"}, f"Applied the preview of {len(actions)} object(s): {', '.join(sorted(applied))}")
+        return {"FINISHED"}
+
+
+class SCREWBENDER_OT_insert_key(bpy.types.Operator):
+    """Key, at the current frame, the pose the smoothed motion has there (on every keyed transform channel), to refine the motion locally; reports how much the motion moved"""
+
+    bl_idname = "screwbender.insert_key"
+    bl_label = "Insert Key on Motion"
+    bl_options = {"REGISTER", "UNDO"}
+
+    max_translation: FloatProperty(
+        name="Largest Move", subtype="DISTANCE",
+        description="Largest displacement of an object's origin that the new key caused (output)",
+    )
+    max_angle: FloatProperty(
+        name="Largest Turn", subtype="ANGLE",
+        description="Largest change of orientation that the new key caused (output)",
+    )
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode")
+            return False
+        if not _keyed_selection(context):
+            cls.poll_message_set("Select one or more keyed objects")
+            return False
+        return True
+
+    def draw(self, context: bpy.types.Context) -> None:
+        col = self.layout.column()
+        col.enabled = False
+        col.prop(self, "max_translation")
+        col.prop(self, "max_angle")
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        scene = context.scene
+        frame = scene.frame_current + scene.frame_subframe
+        options = preview_draw.smooth_options(scene)
+        objects = sorted(_keyed_selection(context), key=lambda o: o.name)
+        results = []
+        errors = []
+        for obj in objects:  # every object is read and checked before its keys are written
+            try:
+                results.append((obj, insert_key.insert_key(obj, frame, options)))
+            except SmoothError as err:
+                errors.append(str(err))
+        for message in errors:
+            self.report({"WARNING" if results else "ERROR"}, message)
+        if not results:
+            return {"CANCELLED"}
+        self.max_translation = max(r.max_translation for _, r in results)
+        self.max_angle = max(r.max_angle for _, r in results)
+        for obj, r in results:
+            self.report(
+                {"INFO"},
+                f"{obj.name}: key at frame {frame:g}; the motion moved by at most {r.max_translation:.3g} "
+                f"(frame {r.worst_frame:g}) and turned by at most {math.degrees(r.max_angle):.3g} deg "
+                f"over {len(r.checked_frames)} frames",
+            )
+        scene.frame_set(scene.frame_current, subframe=scene.frame_subframe)  # show the keyed pose
+        return {"FINISHED"}
+
+
+class VIEW3D_PT_screwbender_preview(bpy.types.Panel):
+    """Live preview settings, under the ScrewBender panel of the 3D Viewport."""
+
+    bl_label = "Live Preview"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Animation"
+    bl_parent_id = "VIEW3D_PT_screwbender"
+
+    def draw_header(self, context: bpy.types.Context) -> None:
+        obj = context.active_object
+        if obj is not None:
+            self.layout.prop(obj, preview_draw.OBJECT_PROP, text="")
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        settings = getattr(context.scene, preview_draw.SCENE_PROP)
+        obj = context.active_object
+        if obj is not None:
+            layout.prop(obj, preview_draw.OBJECT_PROP, text=f"Preview {obj.name}")
+            entry = preview_draw.CACHE.entries.get(obj.session_uid)
+            if getattr(obj, preview_draw.OBJECT_PROP) and entry is not None and entry.error:
+                layout.label(text=entry.error, icon="ERROR")
+        layout.label(text="Scheme and levels: as Smooth Motion above", icon="INFO")
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        col = layout.column()
+        col.prop(settings, "instances")
+        col.prop(settings, "style")
+        if settings.style != "BOX":
+            col.prop(settings, "heavy_limit")
+        col.prop(settings, "trajectory_points")
+        col.prop(settings, "line_width")
+        col = layout.column(heading="Show")
+        col.prop(settings, "show_trajectory")
+        col.prop(settings, "show_keys")
+        col.prop(settings, "show_raw")
+        col = layout.column()
+        col.prop(settings, "instance_color")
+        col.prop(settings, "key_color")
+        col.prop(settings, "trajectory_color")
+        if settings.show_raw:
+            col.prop(settings, "raw_color")
+        row = layout.row(align=True)
+        row.operator(SCREWBENDER_OT_preview_apply.bl_idname, icon="CHECKMARK")
+        row.operator(SCREWBENDER_OT_insert_key.bl_idname, icon="KEY_HLT")
+
+
+def menu_func(self, context: bpy.types.Context) -> None:
+    """Object > Animation menu entry."""
+    self.layout.operator(SCREWBENDER_OT_insert_key.bl_idname)
+
+
+classes = (ScrewBenderPreviewSettings, SCREWBENDER_OT_preview_apply, SCREWBENDER_OT_insert_key, VIEW3D_PT_screwbender_preview)
+
+
+def register_properties() -> None:
+    setattr(bpy.types.Scene, preview_draw.SCENE_PROP, PointerProperty(type=ScrewBenderPreviewSettings))
+    setattr(
+        bpy.types.Object,
+        preview_draw.OBJECT_PROP,
+        BoolProperty(
+            name="ScrewBender Preview", default=False, update=_toggled,
+            description="Draw this object's smoothed motion live in the viewport (stroboscopic instances, "
+            "origin trajectory, key poses), recomputed whenever its keys change",
+        ),
+    )
+    bpy.types.VIEW3D_MT_object_animation.append(menu_func)
+    preview_draw.register()
+    try:
+        preview_draw.sync()  # the add-on enabled in a session where objects have the preview on
+    except AttributeError:
+        pass  # bpy.data is restricted while Blender starts up: load_post syncs once the file is loaded
+
+
+def unregister_properties() -> None:
+    preview_draw.unregister()
+    bpy.types.VIEW3D_MT_object_animation.remove(menu_func)
+    delattr(bpy.types.Object, preview_draw.OBJECT_PROP)
+    delattr(bpy.types.Scene, preview_draw.SCENE_PROP)
