@@ -1,39 +1,17 @@
 //! Criterion benchmarks of the core: `s(a, t, b)` (ours and nalgebra's dual-quaternion
-//! ScLERP in the same run) and subdivision (the 100 keys x 6 levels, and the growth
-//! over 10 .. 10,000 keys x 1 .. 8 levels).
+//! ScLERP in the same run) and subdivision (100 keys x 6 levels per scheme, 1,000 keys x 6
+//! levels Jarek). Measured in thread CPU time (groups `s`, `subdivide`; see
+//! `common::CpuTime`) and, for `s`, also in wall-clock time (group `s wall-clock`). The
+//! growth over 10 .. 10,000 keys x 1 .. 8 levels is in `scaling.rs`.
+
+mod common;
 
 use std::hint::black_box;
 
+use common::{keys, CpuTime, Rng};
+use criterion::measurement::{Measurement, WallTime};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use glam::{DQuat, DVec3};
 use polyscrew::{s, subdivide, Pose, Scheme, Screw};
-
-/// A deterministic pseudo-random sequence (xorshift), so runs are comparable.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn pose(&mut self, max_angle: f64) -> Pose {
-        let axis = DVec3::new(self.next() - 0.5, self.next() - 0.5, self.next() - 0.5).normalize();
-        let t = DVec3::new(self.next(), self.next(), self.next()) * 2.0 - 1.0;
-        Pose::from_rotation_translation(DQuat::from_axis_angle(axis, self.next() * max_angle), t)
-    }
-}
-
-/// `n` keys, each a random screw of up to 90 degrees from the previous.
-pub fn keys(n: usize, seed: u64) -> Vec<Pose> {
-    let mut rng = Rng(seed);
-    let mut out = vec![rng.pose(3.0)];
-    for _ in 1..n {
-        let step = rng.pose(std::f64::consts::FRAC_PI_2);
-        out.push(step.mul_pose(out.last().unwrap()));
-    }
-    out
-}
 
 fn to_nalgebra(p: &Pose) -> nalgebra::UnitDualQuaternion<f64> {
     let q = p.rotation;
@@ -43,7 +21,15 @@ fn to_nalgebra(p: &Pose) -> nalgebra::UnitDualQuaternion<f64> {
     nalgebra::UnitDualQuaternion::from_parts(t, r)
 }
 
-fn bench_s(c: &mut Criterion) {
+fn bench_s_cpu(c: &mut Criterion<CpuTime>) {
+    bench_s(c, "s");
+}
+
+fn bench_s_wall(c: &mut Criterion<WallTime>) {
+    bench_s(c, "s wall-clock");
+}
+
+fn bench_s<M: Measurement>(c: &mut Criterion<M>, group: &str) {
     let mut rng = Rng(7);
     let pairs: Vec<(Pose, Pose, f64)> = (0..1024)
         .map(|_| (rng.pose(3.0), rng.pose(3.0), rng.next()))
@@ -52,7 +38,7 @@ fn bench_s(c: &mut Criterion) {
         .iter()
         .map(|(a, b, t)| (to_nalgebra(a), to_nalgebra(b), *t))
         .collect();
-    let mut g = c.benchmark_group("s");
+    let mut g = c.benchmark_group(group);
     g.throughput(Throughput::Elements(pairs.len() as u64));
     g.bench_function("polyscrew s(a, t, b)", |bench| {
         bench.iter(|| {
@@ -83,7 +69,7 @@ fn bench_s(c: &mut Criterion) {
     g.finish();
 }
 
-fn bench_subdivide(c: &mut Criterion) {
+fn bench_subdivide(c: &mut Criterion<CpuTime>) {
     let mut g = c.benchmark_group("subdivide");
     let keys100 = keys(100, 11);
     for scheme in [Scheme::Jarek, Scheme::FourPoint, Scheme::BSpline] {
@@ -101,9 +87,21 @@ fn bench_subdivide(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group! {
-    name = benches;
-    config = Criterion::default().sample_size(30).measurement_time(std::time::Duration::from_secs(3));
-    targets = bench_s, bench_subdivide
+fn config<M: Measurement>(m: M) -> Criterion<M> {
+    Criterion::default()
+        .with_measurement(m)
+        .sample_size(30)
+        .measurement_time(std::time::Duration::from_secs(3))
 }
-criterion_main!(benches);
+
+criterion_group! {
+    name = cpu;
+    config = config(CpuTime);
+    targets = bench_s_cpu, bench_subdivide
+}
+criterion_group! {
+    name = wall;
+    config = config(WallTime);
+    targets = bench_s_wall
+}
+criterion_main!(cpu, wall);

@@ -1,0 +1,149 @@
+#!/usr/bin/env bash
+# Runs every benchmark of issue 7 and writes BENCHMARKS.md (machine, versions, medians,
+# ratios). One command: scripts/bench.sh. Each comparison runs side by side in one process:
+#   - criterion (every rust/polyscrew/benches/*.rs): s(a, t, b) ours vs nalgebra, subdivision
+#     per scheme, growth over 10 .. 10,000 keys x 1 .. 8 levels (core.rs, scaling.rs: thread
+#     CPU time), and the other issues' benches (angular velocity, ...);
+#   - callgrind instruction counts of s (ours vs nalgebra) and of one subdivision;
+#   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
+#   - scripts/bench_bake.py (the add-on's bake vs nla.bake) when it is in this checkout.
+# A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
+# and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt).
+# Env: BENCH_QUICK=1 for a smoke run (short criterion times, small Python runs; the
+#      BENCHMARKS.md it writes says so); BPY=.venv/bpy/5.0 selects the Blender module.
+set -uo pipefail
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
+export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$root/target}
+run="$CARGO_TARGET_DIR/bench"
+rm -rf "$run" "$CARGO_TARGET_DIR/criterion"
+mkdir -p "$run"
+exec > >(tee "$run/log.txt") 2>&1
+start=$(date +%s)
+stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
+load_start=$(cut -d' ' -f1-3 /proc/loadavg)
+date_start=$(date -u '+%Y-%m-%d %H:%M')
+quick=${BENCH_QUICK:-0}
+
+stage "bootstrap"
+scripts/bootstrap.sh || { echo "bench: bootstrap failed"; exit 1; }
+py="$root/.venv/bin/python"
+bpy_dir=${BPY:-$root/.venv/bpy/5.0}
+
+stage "build the polyscrew wheel (release, once)"
+pylib="$run/pylib"
+wheel=""
+if "$root/.venv/bin/maturin" build --release --quiet -o "$run/wheel" 2>&1 | grep -v '^ *Compiling'; then :; fi
+wheel=$(ls "$run"/wheel/polyscrew-*.whl 2>/dev/null | head -1)
+if [ -n "$wheel" ]; then
+  "$py" -m pip --disable-pip-version-check install -q --no-deps --target "$pylib" "$wheel"
+else
+  echo "bench: the wheel did not build; the Python parts will be missing"
+fi
+
+# Every criterion bench of the core crate (core.rs, scaling.rs, and those the other issues add).
+benches=()
+for f in rust/polyscrew/benches/*.rs; do benches+=(--bench "$(basename "$f" .rs)"); done
+stage "criterion: ${benches[*]}"
+crit_args=()
+[ "$quick" = 1 ] && crit_args=(--warm-up-time 0.1 --measurement-time 0.3 --sample-size 10)
+cargo bench -p polyscrew "${benches[@]}" -- "${crit_args[@]}" 2>&1 \
+  | grep --line-buffered -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
+
+stage "callgrind instruction counts"
+if command -v valgrind >/dev/null; then
+  cargo build --profile bench -p polyscrew --example count_s --example count_subdivide 2>&1 | grep -v '^ *Compiling' || true
+  n=100000; [ "$quick" = 1 ] && n=10000
+  echo "$n" > "$run/callgrind-n.txt"
+  cg() { valgrind --tool=callgrind --callgrind-out-file="$1" "${@:2}" 2>&1 | grep -E 'Collected|evaluations|runs of' ; }
+  for which in ours nalgebra; do
+    cg "$run/callgrind-$which-0.out" "$CARGO_TARGET_DIR/release/examples/count_s" "$which" 0
+    cg "$run/callgrind-$which-N.out" "$CARGO_TARGET_DIR/release/examples/count_s" "$which" "$n"
+  done
+  cg "$run/callgrind-subdivide-0.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 0
+  cg "$run/callgrind-subdivide-1.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1
+  # What limits the targets: instructions per output pose across sizes (algorithmic
+  # linearity), simulated branch mispredictions of s (ours vs nalgebra).
+  for kl in "100 6" "10000 6"; do
+    set -- $kl
+    cg "$run/callgrind-subdivide-$1x$2-0.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 0 "$1" "$2"
+    cg "$run/callgrind-subdivide-$1x$2-1.out" "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1 "$1" "$2"
+  done
+  for which in ours nalgebra; do
+    valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$run/branches-$which-0.out" \
+      "$CARGO_TARGET_DIR/release/examples/count_s" "$which" 0 >/dev/null 2>&1
+    valgrind --tool=callgrind --branch-sim=yes --callgrind-out-file="$run/branches-$which-N.out" \
+      "$CARGO_TARGET_DIR/release/examples/count_s" "$which" "$n" >/dev/null 2>&1
+  done
+else
+  echo "not available: valgrind is not installed (apt-get install valgrind)"
+fi
+if [ -x /usr/bin/time ] && [ -x "$CARGO_TARGET_DIR/release/examples/count_subdivide" ]; then
+  # User and system (page-fault) time of the largest subdivision, 10,000 keys x 8 levels.
+  /usr/bin/time -o "$run/time-10000x8.txt" -f "%U %S %R %M" \
+    "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1 10000 8 && cat "$run/time-10000x8.txt"
+fi
+
+pyargs=(); [ "$quick" = 1 ] && pyargs=(--n 2000 --repeat 3)
+stage "Python: batch vs loops (pytransform3d)"
+PYTHONPATH="$pylib" "$py" scripts/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
+  || echo "bench: bench_python.py failed"
+stage "Python inside Blender: batch vs mathutils.Matrix.lerp"
+if [ -d "$bpy_dir" ]; then
+  PYTHONPATH="$pylib:$bpy_dir" "$py" scripts/bench_python.py --blender --out "$run/blender.json" "${pyargs[@]}" \
+    || echo "bench: bench_python.py --blender failed"
+else
+  echo "not available: no Blender module at $bpy_dir"
+fi
+
+stage "bake: ScrewBender vs nla.bake"
+if [ ! -f scripts/bench_bake.py ]; then
+  echo "scripts/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
+elif [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
+  echo "the wheel or the Blender module is missing" | tee "$run/bake.missing"
+elif ! SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1; then
+  echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/bake.missing"
+else
+  bake_args=(); [ "$quick" = 1 ] && bake_args=(--quick)
+  if PYTHONPATH="$bpy_dir" "$py" scripts/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
+    grep -v -e '^Warning' -e '^Read blend' "$run/bake.out" > "$run/bake.txt"; cat "$run/bake.txt"
+  else
+    tail -5 "$run/bake.out"
+    echo "scripts/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
+  fi
+fi
+
+stage "sweep"
+if PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
+  echo "polyscrew.sweep exists, but the sweep comparison (stroboscopic instancing, gpytoolbox, warp) is not in bench.sh yet" | tee "$run/sweep.missing"
+else
+  echo "polyscrew.sweep is not in this build (the sweep branch has not landed); gpytoolbox and warp-lang were therefore not installed" | tee "$run/sweep.missing"
+fi
+
+stage "write BENCHMARKS.md"
+RUN="$run" LOAD_START="$load_start" DATE_START="$date_start" BPY_DIR="$bpy_dir" QUICK="$quick" "$py" - <<'PY'
+import json, os, platform, subprocess
+def out(cmd):
+    try:
+        return subprocess.run(cmd, capture_output=True, text=True, check=True).stdout.strip()
+    except Exception as exc:
+        return f"unknown ({exc.__class__.__name__})"
+cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), "unknown")
+env = {"date": os.environ["DATE_START"] + (" (BENCH_QUICK=1: a smoke run, not the real figures)" if os.environ["QUICK"] == "1" else ""),
+       "cpu": cpu, "nproc": out(["nproc"]),
+       "load_start": os.environ["LOAD_START"], "load_end": " ".join(open("/proc/loadavg").read().split()[:3]),
+       "kernel": platform.release(), "rustc": out(["rustc", "--version"]), "python": platform.python_version(),
+       "valgrind": out(["valgrind", "--version"])}
+import numpy; env["numpy"] = numpy.__version__ + " (1.26 inside Blender)"
+try:
+    import pytransform3d; env["pytransform3d"] = pytransform3d.__version__
+except ImportError:
+    pass
+bpy_json = os.path.join(os.environ["RUN"], "blender.json")
+if os.path.exists(bpy_json):
+    env["bpy"] = json.load(open(bpy_json))["env"].get("bpy", "?")
+json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), indent=1)
+PY
+"$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" --out BENCHMARKS.md
+stage "done"
