@@ -43,7 +43,7 @@ def sweep(obj: bpy.types.Object) -> tuple[bpy.types.Object, float]:
     result = bpy.ops.screwbender.sweep(steps=1, caps=True)
     seconds = time.perf_counter() - start
     if result != {"FINISHED"}:
-        sys.exit(f"50_sweep: Build Swept Region failed on {obj.name}")
+        sys.exit(f"60_sweep: Build Swept Region failed on {obj.name}")
     return bpy.context.view_layer.objects.active, seconds
 
 
@@ -170,13 +170,13 @@ def main() -> None:
         region.data.calc_loop_triangles()
         tris = len(region.data.loop_triangles)
         print(
-            f"50_sweep: {motion}: {body_tris} triangles over {n_frames - 1} screws -> swept region "
+            f"60_sweep: {motion}: {body_tris} triangles over {n_frames - 1} screws -> swept region "
             f"{tris} triangles in {seconds:.3f} s (operator); stroboscopic instances at every "
             f"baked key: {n_frames * body_tris} triangles"
         )
         path = render(source_scene, motion, obj, region, out)
         shutil.copy2(path, images / path.name)
-        print(f"50_sweep: {path} (copied to docs/images/)")
+        print(f"60_sweep: {path} (copied to docs/images/)")
     bpy.ops.wm.save_as_mainfile(filepath=str(out / "demo_sweep.blend"))
 
 

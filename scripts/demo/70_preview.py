@@ -116,7 +116,7 @@ def panel(name: str, scheme: str, levels: int, style: str, raw: bool, degrees) -
     pd.refresh(scene)
     entry = pd.CACHE.entries[obj.session_uid]
     if entry.error:
-        sys.exit(f"50_preview: {entry.error}")
+        sys.exit(f"70_preview: {entry.error}")
     b = entry.batches
     reach = max(obj.dimensions) / 2 + 0.2
     corners = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)]) * reach
@@ -127,7 +127,7 @@ def panel(name: str, scheme: str, levels: int, style: str, raw: bool, degrees) -
     pixels, drawn = pd.render_offscreen(scene, bpy.context.view_layer, view, projection, *PANEL)
     assert drawn == 1
     print(
-        f"50_preview: {name}, {scheme} {levels} levels, {style.lower()}: {len(b.instances)} instances, "
+        f"70_preview: {name}, {scheme} {levels} levels, {style.lower()}: {len(b.instances)} instances, "
         f"{len(b.trajectory)} trajectory points, {len(b.keys)} keys"
     )
     return pixels
@@ -148,7 +148,7 @@ def main() -> None:
     load_scene_builder().build()
     reason = ensure_gpu()
     if reason:
-        print(f"50_preview: skipped, no GPU drawing in this Blender: {reason}")
+        print(f"70_preview: skipped, no GPU drawing in this Blender: {reason}")
         return
     panels = [panel(*spec) for spec in PANELS]
     gap = np.ones((PANEL[1], 6, 4), dtype=np.float32)
@@ -159,7 +159,7 @@ def main() -> None:
     docs = demo_common.ROOT / "docs" / "images"
     docs.mkdir(parents=True, exist_ok=True)
     shutil.copy(path, docs / path.name)
-    print(f"50_preview: {path} ({image.shape[1]}x{image.shape[0]}), copied to {docs / path.name}")
+    print(f"70_preview: {path} ({image.shape[1]}x{image.shape[0]}), copied to {docs / path.name}")
     for obj in bpy.context.scene.objects:
         obj.screwbender_preview = False
 
