@@ -80,8 +80,8 @@ def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options) -> In
     before = keys.read(obj, options.closed)
     frames = check_frames(before, frame)
     try:
-        poses_before, _ = bake.sample_poses(before, frames, options)
-        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options)
+        poses_before, _ = bake.sample_poses(before, frames, options, obj)
+        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options, obj)
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
 
@@ -108,7 +108,7 @@ def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options) -> In
 
     after = keys.read(obj, options.closed)
     try:
-        poses_after, _ = bake.sample_poses(after, frames, options)
+        poses_after, _ = bake.sample_poses(after, frames, options, obj)
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
     translation, angle = pose_change(poses_before, poses_after)

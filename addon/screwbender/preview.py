@@ -117,9 +117,11 @@ def with_scale(poses: np.ndarray, scales: np.ndarray) -> np.ndarray:
     return out
 
 
-def compute(motion: keys.KeyedMotion, options: PreviewOptions) -> PreviewBatches:
+def compute(motion: keys.KeyedMotion, options: PreviewOptions, obj: bpy.types.Object | None = None) -> PreviewBatches:
     """The preview of `motion`: one :func:`bake.sample_poses` call for instances and trajectory.
 
+    `obj` is the object the motion was read from: the Feature Points method needs its mesh and
+    key selection (without it the preview falls back to screw subdivision, as the bake would).
     Raises `ValueError` from polyscrew for motions it refuses.
     """
     start, end = frame_range(motion, options.smooth)
@@ -129,7 +131,7 @@ def compute(motion: keys.KeyedMotion, options: PreviewOptions) -> PreviewBatches
     trajectory_times = _times(start, end, max(2, options.trajectory_points), False)
     times = np.concatenate([instance_times, trajectory_times])
     n = len(instance_times)
-    poses, scales = bake.sample_poses(motion, times, options.smooth)
+    poses, scales = bake.sample_poses(motion, times, options.smooth, obj)
     if scales is None:  # unkeyed scale: the object's own, constant
         scales = np.broadcast_to(motion.scales[0], (len(times), 3))
     matrices = with_scale(poses, scales)
@@ -196,6 +198,7 @@ def key_hash(
             f"|{sum(len(t.strips) for t in adt.nla_tracks)}"
             f"|{sorted((d.data_path, d.array_index) for d in adt.drivers if d.data_path in paths)}".encode()
         )
+    feature_method = options.smooth.method == "FEATURE"
     curves = {}
     at_key = False
     for fc in channels.object_fcurves(obj):
@@ -219,6 +222,14 @@ def key_hash(
                 extra = np.empty(width * count, dtype=dtype)
                 points.foreach_get(attr, extra)
                 digest.update(extra.tobytes())
+        if feature_method and options.smooth.approximate:  # selected keys are approximated
+            flags = np.empty(count, dtype=bool)
+            points.foreach_get("select_control_point", flags)
+            digest.update(flags.tobytes())
+    if feature_method and obj.type == "MESH":  # the feature points are the mesh's inertia points
+        co = np.empty(3 * len(obj.data.vertices), dtype=np.float32)
+        obj.data.vertices.foreach_get("co", co)
+        digest.update(co.tobytes())
     # Unkeyed channels enter the key poses with their current (static) value.
     current = {}
     changed = False
@@ -300,7 +311,7 @@ class PreviewCache:
             motion = keys.read(obj, options.smooth.closed)
             if live is not None:
                 motion = with_live_key(motion, live)
-            entry = PreviewEntry(digest, compute(motion, options))
+            entry = PreviewEntry(digest, compute(motion, options, obj))
         except (SmoothError, ValueError) as err:
             message = str(err)
             entry = PreviewEntry(digest, None, message if message.startswith(obj.name) else f"{obj.name}: {message}")

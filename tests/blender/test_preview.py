@@ -611,6 +611,54 @@ def test_apply_bakes_what_the_preview_shows(pd):
         np.testing.assert_array_equal(co, co_twin)
 
 
+def select_keys(obj, frames) -> None:
+    """Selects the keys at `frames` on every transform curve of `obj`, deselects the others."""
+    for curve in fcurves(obj):
+        for point in curve.keyframe_points:
+            point.select_control_point = any(abs(point.co[0] - f) < 1e-4 for f in frames)
+
+
+def test_feature_points_method_previews_and_applies_the_feature_motion(pd):
+    """With Method = Feature Points the preview shows the feature-point motion (what Apply and
+    Smooth Motion bake), follows the key selection (selected keys approximated) and the mesh."""
+    scene = bpy.context.scene
+    set_smooth(scene, "jarek", 4, "smooth")
+    settings = scene.screwbender
+    settings.method, settings.approximate, settings.stiffness = "FEATURE", True, 0.5
+    scene.screwbender_preview.instances = 13  # frames 1, 6, ..., 61: on the baked frames
+    obj = keyed_object()
+    select_keys(obj, [20.0, 41.0])
+    obj.screwbender_preview = True
+    b = entry_of(pd, obj)
+
+    frames, matrices = baked_matrices(obj)
+    co = np.array([v.co for v in obj.data.vertices], dtype=np.float64)
+    stiffness = np.where(np.isin(frames, [20.0, 41.0]), 0.5, np.inf)
+    expected = polyscrew.sample_feature(
+        matrices, frames, b.instance_times, levels=4, feature_points=polyscrew.inertia_points(co),
+        stiffness=stiffness, timing="smooth",
+    )
+    np.testing.assert_allclose(b.instances, expected, rtol=0, atol=1e-9)
+    screw, _ = reference(obj, b.instance_times, "jarek", 4, "smooth")
+    assert np.abs(b.instances - screw).max() > 1e-3  # not the screw method's motion
+    shown = b.instances.copy()
+
+    select_keys(obj, [20.0, 26.0, 41.0])  # one more approximated key: a new motion
+    changed = entry_of(pd, obj)
+    assert np.abs(changed.instances - shown).max() > 1e-4
+    select_keys(obj, [20.0, 41.0])
+    assert np.array_equal(entry_of(pd, obj).instances, shown)
+    obj.data.vertices[3].co.z = 6.0  # another mesh: other inertia points
+    assert np.abs(entry_of(pd, obj).instances - shown).max() > 1e-6
+    obj.data.vertices[3].co.z = 3.0
+    assert np.array_equal(entry_of(pd, obj).instances, shown)
+
+    assert bpy.ops.screwbender.preview_apply() == {"FINISHED"}
+    frames, baked = baked_matrices(obj)
+    rows = np.searchsorted(frames, b.instance_times)
+    np.testing.assert_allclose(baked[rows], shown, rtol=0, atol=2e-5 * (1 + np.abs(shown).max()))
+
+
 # Insert Key on Motion -------------------------------------------------------------------
 
 
