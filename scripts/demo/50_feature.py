@@ -1,4 +1,4 @@
-"""Demo part: noisy keys smoothed by feature-point motion design (Hofer-Pottmann-Ravani),
+"""Demo part 50: noisy keys smoothed by feature-point motion design (Hofer-Pottmann-Ravani),
 interpolating (every key hit) beside approximating (only the first and last key hit, the
 others, all selected, pulled by the Stiffness spring). Writes out/demo_feature.blend, a stroboscopic
 Workbench render out/demo_feature.png (copied to docs/images/) and the figures of the README

@@ -1,4 +1,4 @@
-"""Demo part 50: the region swept by a smoothed demo motion, built by Build Swept Region.
+"""Demo part 60: the region swept by a smoothed demo motion, built by Build Swept Region.
 
 Opens out/demo.blend (from 20_smooth.py), sweeps the Jarek-smoothed Flyer and SpinBlock with
 the installed extension's `screwbender.sweep` operator (the smoothed motion at its baked

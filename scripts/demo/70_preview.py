@@ -1,4 +1,4 @@
-"""Demo part 50: the live preview overlay, drawn offscreen by the add-on's own draw code.
+"""Demo part 70: the live preview overlay, drawn offscreen by the add-on's own draw code.
 
 Builds the demo scene (10_scene.build), turns the ScrewBender preview on for one object at a
 time and draws the overlay into a `gpu.types.GPUOffScreen` through the add-on's
