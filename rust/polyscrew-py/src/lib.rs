@@ -10,12 +10,12 @@ mod sweep;
 use glam::DVec3;
 use numpy::ndarray::{Array2, Array3, ArrayViewD};
 use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn};
-use pyo3::exceptions::PyValueError;
-use pyo3::prelude::*;
 use polyscrew::{
     rotation_channels as core_rotation_channels, subdivide as core_subdivide, Error, Motion,
     MotionSpec, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
 };
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
 
 /// An array-like argument converted to float64 on the way in.
 pub type FloatArray<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
