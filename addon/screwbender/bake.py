@@ -5,8 +5,9 @@ The pipeline, per object:
 
 1. :func:`keys.read` turns the transform F-curves into key poses (nothing changes).
 2. :func:`sample_channels` samples the subdivided motion at every baked frame: one
-   `polyscrew.sample` call for the rigid poses, one `polyscrew.sample_vectors` call for
-   log-scale, one `polyscrew.rotation_channels` call for the rotation channels.
+   `polyscrew.sample_channels` call for location and rotation channels (Feature Points:
+   `polyscrew.sample_feature` then `polyscrew.rotation_channels`), one
+   `polyscrew.sample_vectors` call for log-scale.
 3. :func:`write` copies the source action, replaces its transform F-curves of this object by
    the dense baked ones (`keyframe_points.add` + `foreach_set`) and assigns the copy; the
    source action keeps a fake user and is recorded on the copy for :func:`revert`.
@@ -100,24 +101,35 @@ def sample_poses(
     and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
     from polyscrew.
 
-    Smooth Motion's bake, the live preview and Insert Key on Motion all sample through here,
-    so they show, key and bake the same motion.
+    The live preview and Insert Key on Motion sample through here; Smooth Motion's bake
+    samples the same motion as channels (:func:`sample_channels`: `polyscrew.sample_channels`
+    is `rotation_channels` of `polyscrew.sample`), so they show, key and bake one motion.
     """
-    spec = dict(
+    if options.method == "FEATURE" and obj is not None:
+        poses = feature.sample_poses(obj, motion, frames, options)
+    else:
+        poses = polyscrew.sample(motion.poses, motion.frames, frames, **_spec(motion, options))
+    return poses, sample_scales(motion, frames, options)
+
+
+def _spec(motion: keys.KeyedMotion, options: Options) -> dict:
+    """The subdivision and timing arguments of `polyscrew.sample` and its siblings."""
+    return dict(
         scheme=options.scheme,
         levels=options.levels,
         closed=motion.closed,
         period=motion.period,
         timing=options.timing,
     )
-    if options.method == "FEATURE" and obj is not None:
-        poses = feature.sample_poses(obj, motion, frames, options)
-    else:
-        poses = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
-    scales = None
-    if motion.scale_keyed:
-        scales = np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
-    return poses, scales
+
+
+def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options) -> np.ndarray | None:
+    """Scales (len(frames), 3) smoothed by the same scheme on log-scale, or None when scale
+    is not keyed."""
+    if not motion.scale_keyed:
+        return None
+    spec = _spec(motion, options)
+    return np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
 
 
 def bake_frames(start: float, end: float, step: float) -> np.ndarray:
@@ -135,13 +147,18 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
     try:
         frames = bake_frames(start, end, options.step)
-        poses, scales = sample_poses(motion, frames, options, obj)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
-        values = {
-            "location": poses[:, :3, 3].copy(),
-            keys.rotation_path(mode): polyscrew.rotation_channels(poses, mode, previous=previous),
-        }
+        if options.method == "FEATURE":
+            poses, scales = sample_poses(motion, frames, options, obj)
+            location = poses[:, :3, 3].copy()
+            rotation = polyscrew.rotation_channels(poses, mode, previous=previous)
+        else:  # one call from keys to channels, no (frames, 4, 4) matrices in between
+            location, rotation = polyscrew.sample_channels(
+                motion.poses, motion.frames, frames, mode, previous, **_spec(motion, options)
+            )
+            scales = sample_scales(motion, frames, options)
+        values = {"location": location, keys.rotation_path(mode): rotation}
         if scales is not None:
             values["scale"] = scales
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range

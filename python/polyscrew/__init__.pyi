@@ -78,6 +78,22 @@ def sample(
     linearly. Open motions hold their end poses outside the keys' range.
     """
 
+def sample_channels(
+    poses: ArrayLike,
+    key_times: ArrayLike,
+    times: ArrayLike,
+    mode: RotationModeName,
+    previous: ArrayLike | None = None,
+    scheme: SchemeName = "jarek",
+    levels: int = 4,
+    closed: bool = False,
+    period: float | None = None,
+    timing: TimingName = "smooth",
+) -> tuple[FloatArray, FloatArray]:
+    """``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
+    ``rotation_channels(sample(...), mode, previous)``, without the (len(times), 4, 4)
+    matrices in between (what a bake writes)."""
+
 def subdivide_vectors(
     values: ArrayLike, scheme: SchemeName = "jarek", levels: int = 4, closed: bool = False
 ) -> FloatArray:

@@ -29,13 +29,15 @@ BAD_POSES = {
 
 
 @pytest.mark.parametrize("name", BAD_POSES)
-@pytest.mark.parametrize("function", ["subdivide", "sample"])
+@pytest.mark.parametrize("function", ["subdivide", "sample", "sample_channels"])
 def test_bad_pose_is_named(name, function):
     edit, message = BAD_POSES[name]
     bad = corrupt(2, edit)
     with pytest.raises(ValueError, match=message):
         if function == "subdivide":
             polyscrew.subdivide(bad)
+        elif function == "sample_channels":
+            polyscrew.sample_channels(bad, [0.0, 1.0, 2.0, 3.0], [0.5], "XYZ")
         else:
             polyscrew.sample(bad, [0.0, 1.0, 2.0, 3.0], [0.5])
 
@@ -98,3 +100,7 @@ def test_other_arguments():
         polyscrew.subdivide_vectors([[0, 0, 0], [np.nan, 0, 0]])
     with pytest.raises(ValueError, match="rotation mode"):
         polyscrew.rotation_channels(np.eye(3)[None], "QUAT")
+    with pytest.raises(ValueError, match="sample_channels: rotation mode"):
+        polyscrew.sample_channels(keys(), [0.0, 1.0, 2.0, 3.0], [0.5], "QUAT")
+    with pytest.raises(ValueError, match="sample_channels: previous: expected 3 entries, got 4"):
+        polyscrew.sample_channels(keys(), [0.0, 1.0, 2.0, 3.0], [0.5], "XYZ", [1.0, 0.0, 0.0, 0.0])

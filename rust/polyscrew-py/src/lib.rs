@@ -334,6 +334,53 @@ fn sample<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// sample_channels(poses, key_times, times, mode, previous=None, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> (ndarray, ndarray)
+///
+/// `sample` as Blender's channels: the locations (M, 3) and the rotation channels of
+/// `rotation_channels(sample(...), mode, previous)`, without building and re-checking the
+/// (M, 4, 4) matrices in between. What a bake writes.
+#[pyfunction]
+#[pyo3(signature = (poses, key_times, times, mode, previous=None, scheme="jarek", levels=4, closed=false, period=None, timing="smooth"))]
+#[allow(clippy::too_many_arguments)]
+#[allow(clippy::type_complexity)]
+fn sample_channels<'py>(
+    py: Python<'py>,
+    poses: FloatArray<'py>,
+    key_times: FloatArray<'py>,
+    times: FloatArray<'py>,
+    mode: &str,
+    previous: Option<FloatArray<'py>>,
+    scheme: &str,
+    levels: i64,
+    closed: bool,
+    period: Option<f64>,
+    timing: &str,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+    const F: &str = "sample_channels";
+    let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
+    let spec = read_spec(F, scheme, levels, closed, period, timing)?;
+    let (keys, single) = read_poses(F, "poses", poses.as_array())?;
+    if single {
+        return Err(shape_err(F, "poses", "(N, 4, 4)", &[4, 4]));
+    }
+    let (key_times, times) = read_times(F, &key_times, &times)?;
+    let previous = previous
+        .map(|p| read_vector(F, "previous", p.as_array()))
+        .transpose()?;
+    let (locations, rotations) = py
+        .detach(|| {
+            let dense = Motion::new(&keys, &key_times, &spec)?.sample(&times)?;
+            let quats: Vec<_> = dense.iter().map(|p| p.rotation).collect();
+            let locations: Vec<_> = dense.iter().map(|p| p.translation).collect();
+            core_rotation_channels(&quats, mode, previous.as_deref())
+                .map(|r| (vec3s_to_array(&locations), r))
+        })
+        .map_err(|e| to_py_err(F, e))?;
+    let rotations =
+        Array2::from_shape_vec((times.len(), mode.width()), rotations).expect("width * n values");
+    Ok((locations.into_pyarray(py), rotations.into_pyarray(py)))
+}
+
 /// subdivide_vectors(values, scheme="jarek", levels=4, closed=False) -> ndarray
 ///
 /// The same schemes applied to plain vectors `values` (N, 3) (the linear masks of
@@ -454,6 +501,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(interpolate, m)?)?;
     m.add_function(wrap_pyfunction!(subdivide, m)?)?;
     m.add_function(wrap_pyfunction!(sample, m)?)?;
+    m.add_function(wrap_pyfunction!(sample_channels, m)?)?;
     m.add_function(wrap_pyfunction!(subdivide_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
