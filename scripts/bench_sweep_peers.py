@@ -3,28 +3,32 @@
 Case: a bumpy torus (48 x 24 quads, 2,304 triangles) along a polyscrew of 25 poses (24 screws:
 a helix of radius 1.2 rising by 1, tumbling by 3 rad about a fixed axis).
 
-Reference: the union of dense stamps, the body placed at `--stamps` poses sampled along the
-24 screws (`polyscrew.interpolate`, the exact screw motion; 3,000 by default). What is
+Reference: the union of dense stamps, the body placed at `--stamps` poses per screw sampled
+along the 24 screws (`polyscrew.interpolate`, the exact screw motion; 125 per screw, 3,001 in
+all, by default). What is
 compared is what can be seen of a solid from outside: orthographic depth images (a software
 z-buffer, tests/python/raster.py, independent of the Rust code) from `--views` directions
 spread evenly over the sphere, every covered pixel taken back to its 3D point. The reference
 surface is the visible surface of the stamps (back faces culled, exact for the closed body);
 each method's mesh is rendered the same way (no culling) and its visible points compared with
 the reference's by the two-sided Hausdorff distance (scipy cKDTree, each way):
-  - method -> reference: the farthest visible point of the method from the reference surface
-    (surface where there is none, or a dent filled);
-  - reference -> method: the farthest reference point from the method's surface (a part of the
-    region missed, or a bulge cut).
+  - method -> reference: how far what is seen of the method lies from the reference surface at
+    worst (a bulge, a dent, or a surface seen through a gap that the reference hides);
+  - reference -> method: how far the reference surface lies from what is seen of the method at
+    worst (a part of the region missed or flattened).
+The larger of the two is the two-sided Hausdorff distance, the "depth error" at which the
+methods are compared.
 Interior triangles (our sweep's excess lies inside the region) are hidden, as in a render.
 The floor of the measure is about one pixel (reported as `pixel`).
 
 Compared, all fed the same screw motion:
   - ours: `polyscrew.sweep(body, 25 poses, steps=8)`, median time of several runs;
   - stroboscopic instancing: k instances per screw (k = 8, 16, 32, ...; 24 k + 1 copies of the
-    body), until its error in both directions is no larger than ours ("at equal depth
-    error"): triangles, and the time to build the instance arrays with numpy;
+    body), until its two-sided error is no larger than ours ("at equal depth error"):
+    triangles, and the time to build the instance arrays with numpy;
   - gpytoolbox `swept_volume` (Sellan, Aigerman, Jacobson 2021) given the dense stamp poses as
-    its transformations, at a couple of grid sizes `eps`;
+    its transformations (it interpolates between them: Catmull-Rom translations, slerped
+    rotations), at a couple of grid sizes `eps`;
   - NVIDIA Warp `warp.geometry.swept_volume_mesh` on the CPU (marching cubes of the minimum,
     over the given poses, of the body's signed distance; winding-number sign; threshold 0).
     Its cost is a brute-force loop over poses at every grid node (time linear in poses x
