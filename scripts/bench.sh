@@ -6,7 +6,10 @@
 #     CPU time), and the other issues' benches (angular velocity, ...);
 #   - callgrind instruction counts of s (ours vs nalgebra) and of one subdivision;
 #   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
-#   - scripts/bench_bake.py (the add-on's bake vs nla.bake) when it is in this checkout.
+#   - scripts/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
+#   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
+#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench-requirements.txt
+#     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv.
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
 # and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt).
 # Env: BENCH_QUICK=1 for a smoke run (short criterion times, small Python runs; the
@@ -30,6 +33,9 @@ stage "bootstrap"
 scripts/bootstrap.sh || { echo "bench: bootstrap failed"; exit 1; }
 py="$root/.venv/bin/python"
 bpy_dir=${BPY:-$root/.venv/bpy/5.0}
+peers_ok=1
+"$py" -m pip --disable-pip-version-check install -q -r scripts/bench-requirements.txt \
+  || { peers_ok=0; echo "bench: scripts/bench-requirements.txt did not install; the sweep comparison will be missing"; }
 
 stage "build the polyscrew wheel (release, once)"
 pylib="$run/pylib"
@@ -97,7 +103,7 @@ else
   echo "not available: no Blender module at $bpy_dir"
 fi
 
-stage "bake: ScrewBender vs nla.bake"
+stage "bake: ScrewBender vs nla.bake vs a keyframe_insert loop"
 if [ ! -f scripts/bench_bake.py ]; then
   echo "scripts/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
 elif [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
@@ -105,7 +111,7 @@ elif [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
 elif ! SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1; then
   echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/bake.missing"
 else
-  bake_args=(); [ "$quick" = 1 ] && bake_args=(--quick)
+  bake_args=(--out "$run/bake.json"); [ "$quick" = 1 ] && bake_args+=(--quick)
   if PYTHONPATH="$bpy_dir" "$py" scripts/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
     grep -v -e '^Warning' -e '^Read blend' "$run/bake.out" > "$run/bake.txt"; cat "$run/bake.txt"
   else
@@ -114,11 +120,17 @@ else
   fi
 fi
 
-stage "sweep"
-if PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
-  echo "polyscrew.sweep exists, but the sweep comparison (stroboscopic instancing, gpytoolbox, warp) is not in bench.sh yet" | tee "$run/sweep.missing"
+stage "sweep: ours vs stroboscopic instancing, gpytoolbox, Warp"
+if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
+  echo "polyscrew.sweep is not in this build" | tee "$run/sweep.missing"
+elif [ "$peers_ok" != 1 ]; then
+  echo "scripts/bench-requirements.txt (gpytoolbox, warp-lang) did not install" | tee "$run/sweep.missing"
 else
-  echo "polyscrew.sweep is not in this build (the sweep branch has not landed); gpytoolbox and warp-lang were therefore not installed" | tee "$run/sweep.missing"
+  sweep_args=(--out "$run/sweep.json"); [ "$quick" = 1 ] && sweep_args+=(--quick)
+  # (Warp's start-up banner filtered out: no CUDA here, the CPU device is used.)
+  PYTHONPATH="$pylib" "$py" scripts/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
+    | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
+  [ -f "$run/sweep.json" ] || echo "scripts/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
 fi
 
 stage "write BENCHMARKS.md"

@@ -116,3 +116,193 @@ def test_bake_ratios_are_read_from_the_best_of_lines(tmp_path):
     name, measured, verdict = rep.targets[-1]
     assert name.startswith("bake") and measured == "322.2x, 18.0x" and verdict == "**missed**"
     assert any("keyframe_insert" in line for line in rep.lines)
+
+
+# --- scripts/bench_sweep_peers.py and the report's new sections (no gpytoolbox, no warp) -----
+
+sweep = load("bench_sweep_peers")
+
+
+def test_loading_the_sweep_bench_imports_neither_peer():
+    import sys
+
+    # CI does not install scripts/bench-requirements.txt: the helpers must not need it.
+    assert "gpytoolbox" not in sys.modules and "warp" not in sys.modules
+
+
+def test_hausdorff_against_brute_force():
+    rng = np.random.default_rng(7)
+    a, b = rng.normal(size=(300, 3)), rng.normal(size=(200, 3)) + 0.3
+    d = np.linalg.norm(a[:, None] - b[None], axis=2)
+    ab, ba = sweep.hausdorff(a, b)
+    assert ab == pytest.approx(d.min(axis=1).max(), abs=1e-12)
+    assert ba == pytest.approx(d.min(axis=0).max(), abs=1e-12)
+    # A prebuilt tree on b gives the same, and a subset is 0 away one way only.
+    from scipy.spatial import cKDTree
+
+    assert sweep.hausdorff(a, b, cKDTree(b)) == (ab, ba)
+    sub_ab, sub_ba = sweep.hausdorff(a[:10], a)
+    assert sub_ab == 0.0 and sub_ba > 0.0
+
+
+def test_hausdorff_of_a_translated_set_is_the_shift():
+    a = np.random.default_rng(1).uniform(size=(50, 3))
+    shift = np.array([0.0, 0.0, 1e-3])
+    ab, ba = sweep.hausdorff(a, a + shift)
+    assert ab <= 1e-3 + 1e-15 and ba <= 1e-3 + 1e-15 and max(ab, ba) > 0.0
+
+
+def test_hausdorff_rejects_an_empty_set():
+    with pytest.raises(ValueError):
+        sweep.hausdorff(np.zeros((0, 3)), np.zeros((1, 3)))
+
+
+@pytest.mark.parametrize("forward", [(0, 0, -1), (0.3, -0.2, -1.0), (1, 1, 1)])
+def test_visible_points_lie_on_the_rendered_plane(forward):
+    import sys
+
+    sys.path.insert(0, str(SCRIPTS.parent / "tests" / "python"))
+    import raster
+
+    # A large tilted square: n . p = 0.2; every visible point must be on it.
+    n = np.array([0.1, 0.2, 1.0])
+    n /= np.linalg.norm(n)
+    u = np.cross(n, [1.0, 0.0, 0.0])
+    u /= np.linalg.norm(u)
+    w = np.cross(n, u)
+    corners = np.array([0.2 * n + 5 * (sx * u + sy * w) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))])
+    tris = np.array([[0, 1, 2], [0, 2, 3]])
+    view = raster.View(forward, (0.1, -0.2, 0.3), 2.0, 64)
+    depth = raster.depth_image(view, corners, tris, cull=False)
+    pts = sweep.visible_points(view, depth)
+    assert len(pts) == np.isfinite(depth).sum() > 1000
+    assert np.abs(pts @ n - 0.2).max() < 1e-12
+    # Back on screen, each point lands on a pixel centre.
+    screen = pts @ view.matrix[:, :3].T + view.matrix[:, 3]
+    assert np.allclose(screen[:, :2] % 1.0, 0.5, atol=1e-9)
+
+
+def test_instance_arrays_place_the_body_at_every_pose():
+    v, t = sweep.bumpy_torus(6, 4)
+    assert len(t) == 48 and len(v) == 24
+    poses = sweep.key_poses(3)
+    iv, it = sweep.instance_arrays(v, t, poses)
+    assert iv.shape == (4 * 24, 3) and it.shape == (4 * 48, 3)
+    k = 2
+    assert np.allclose(iv[k * 24:(k + 1) * 24], v @ poses[k, :3, :3].T + poses[k, :3, 3])
+    assert np.array_equal(it[k * 48:(k + 1) * 48], t + k * 24)
+    # The poses are rigid, and the torus is outward (positive signed volume).
+    r = poses[:, :3, :3]
+    assert np.allclose(np.einsum("kji,kjl->kil", r, r), np.eye(3), atol=1e-12)
+    p = v[t]
+    assert np.einsum("ij,ij->i", p[:, 0], np.cross(p[:, 1], p[:, 2])).sum() > 0
+
+
+def test_first_match_is_at_equal_two_sided_error():
+    rows = [{"per_screw": k, "h_to_ref": a, "h_from_ref": b}
+            for k, a, b in ((8, 0.05, 0.02), (16, 0.011, 0.02), (32, 0.012, 0.009), (64, 0.005, 0.004))]
+    assert sweep.first_match(rows, 0.012)["per_screw"] == 32
+    assert sweep.first_match(rows, 0.05)["per_screw"] == 8
+    assert sweep.first_match(rows, 0.001) is None
+
+
+def test_extrapolation_follows_the_fitted_power_law_and_is_labelled():
+    frames = [1000, 2000, 4000]
+    seconds = [0.5 * (f / 1000) ** 2 for f in frames]
+    value, p = report.extrapolate(frames, seconds, 100_000)
+    assert p == pytest.approx(2.0, abs=1e-12) and value == pytest.approx(5000.0, rel=1e-9)
+    assert report.fmt_seconds(value, extrapolated=True) == "~5000.000 s (extrapolated)"
+    assert report.fmt_seconds(0.0125) == "12.50 ms"
+    with pytest.raises(ValueError):
+        report.extrapolate([1000], [0.5], 4000)
+
+
+BAKE_JSON = {
+    "blender": "5.0.1", "quick": False, "repeat": 3,
+    "cases": [
+        {"objects": 1, "frames": 100000, "ours": 0.2, "nla": 5.0, "loop": 6000.0, "loop_extrapolated": True},
+        {"objects": 100, "frames": 1000, "ours": 0.3, "nla": 3.6, "loop": 60.0, "loop_extrapolated": False},
+    ],
+    "loop_series": [{"objects": 1, "frames": f, "seconds": 0.5 * (f / 1000) ** 2} for f in (1000, 2000, 4000)]
+    + [{"objects": 100, "frames": 1000, "seconds": 60.0}],
+}
+
+
+def test_bake_section_from_json_marks_extrapolations(tmp_path):
+    (tmp_path / "bake.json").write_text(json.dumps(BAKE_JSON))
+    rep = report.Report(tmp_path, {})
+    rep.bake_section()
+    text = "\n".join(rep.lines)
+    row_1 = next(line for line in rep.lines if line.startswith("| 1 object x 100,000 frames"))
+    assert "~6000.000 s (extrapolated)" in row_1 and "~30000x (extrapolated)" in row_1 and "| 25.0x |" in row_1
+    row_100 = next(line for line in rep.lines if line.startswith("| 100 objects x 1,000 frames"))
+    assert "extrapolated" not in row_100 and "| 60.000 s |" in row_100 and "| 200x |" in row_100
+    assert "frames^2.00" in text and "not measurements" in text and "between the two largest" in text
+    assert "not available" not in text
+    assert rep.targets[-1] == ("bake >= 20x nla.bake", "25.0x, 12.0x", "**missed**")
+
+
+SWEEP_JSON = {
+    "quick": False,
+    "case": {"body": "bumpy torus, 48 x 24 quads", "triangles": 2304, "poses": 25, "screws": 24, "motion": "a helix"},
+    "reference": {"stamps": 3001, "per_screw": 125, "views": 12, "res": 1024, "pixel": 0.006, "points": 10, "seconds": 1.0},
+    "versions": {"gpytoolbox": "0.3.8", "warp-lang": "1.19.0"},
+    "rows": [
+        {"method": "ours (polyscrew.sweep)", "note": "8 steps per screw", "seconds": 0.01, "triangles": 94430,
+         "h_to_ref": 0.008, "h_from_ref": 0.014, "ours": True},
+        {"method": "gpytoolbox swept_volume", "note": "eps 0.05", "seconds": 20.0, "triangles": 54048,
+         "h_to_ref": 0.07, "h_from_ref": 0.1, "grid": 0.05},
+        {"method": "Warp swept_volume_mesh (CPU)", "note": "voxel 0.1, 601 poses", "seconds": 64.0, "triangles": 13000,
+         "h_to_ref": 0.12, "h_from_ref": 0.11, "grid": 0.1, "poses": 601},
+    ],
+    "strobe": [
+        {"method": "stroboscopic instancing", "note": "32 per screw", "seconds": 0.2, "triangles": 1771776,
+         "h_to_ref": 0.026, "h_from_ref": 0.013, "per_screw": 32},
+        {"method": "stroboscopic instancing", "note": "64 per screw", "seconds": 0.5, "triangles": 3541248,
+         "h_to_ref": 0.0087, "h_from_ref": 0.009, "per_screw": 64},
+    ],
+    "strobe_match": 64,
+    "warp_extrapolated": {"poses": 3001, "voxel": 0.1, "seconds": 320.0, "exponent": 1.0, "from": []},
+    "notes": ["Warp: kernel compilation took 3 s, not counted"],
+}
+
+
+def test_sweep_section_states_the_method_and_the_match(tmp_path):
+    (tmp_path / "sweep.json").write_text(json.dumps(SWEEP_JSON))
+    rep = report.Report(tmp_path, {})
+    rep.sweep_section()
+    text = "\n".join(rep.lines)
+    assert rep.lines[0] == "## Sweep against peers"
+    assert "Hausdorff" in text and "cKDTree" in text and "3,001 stamps" in text and "depth images" in text
+    assert "| ours (polyscrew.sweep) | 8 steps per screw | 10.00 ms | 94,430 | 0.0080 | 0.0140 |" in text
+    assert "needs 64 copies per screw: 3,541,248 triangles (38x ours)" in text
+    warp_all = next(line for line in rep.lines if "all 3,001 poses" in line)
+    assert "(extrapolated)" in warp_all
+    assert "gpytoolbox 0.3.8" in text and "not available" not in text
+
+
+def test_sweep_section_says_why_it_is_missing(tmp_path):
+    (tmp_path / "sweep.missing").write_text("polyscrew.sweep is not in this build\n")
+    rep = report.Report(tmp_path, {})
+    rep.sweep_section()
+    assert "not available: polyscrew.sweep is not in this build" in rep.lines
+
+
+def test_papers_section_marks_figures_from_other_machines():
+    crit = {
+        "hofer_table1/bunny 6/768 CUI": {"group": "hofer_table1", "function": "bunny 6/768 CUI", "value": None,
+                                         "elements": None, "median_ns": 710e3, "low_ns": 0, "high_ns": 0},
+        "fit_angular_velocity/top_20_keys": {"group": "fit_angular_velocity", "function": "top_20_keys", "value": None,
+                                             "elements": None, "median_ns": 20e6, "low_ns": 0, "high_ns": 0},
+    }
+    rep = report.Report(Path("/nonexistent"), crit)
+    rep.papers_section()
+    text = "\n".join(rep.lines)
+    assert "other machines" in rep.lines[0] and "not measured here" in rep.lines[0]
+    bunny = next(line for line in rep.lines if "bunny" in line)
+    assert "0.71 s" in bunny and "710.00 µs" in bunny and "| 1000x |" in bunny and "Matlab" in bunny
+    teapot = next(line for line in rep.lines if "teapot" in line)
+    assert "not measured in this run" in teapot
+    xie = next(line for line in rep.lines if "Xie" in line)
+    assert "about 2 s" in xie and "20.00 ms" in xie and "| 100x |" in xie
+    assert "for scale" in text
