@@ -12,7 +12,7 @@
 //! angle. With `tau = o1 - R o0` the translation of `M`:
 //!
 //! ```text
-//! rho(t)  = sin(t h) / sin(h)          (= t sinc(t h) / sinc(h), exact at h = 0)
+//! rho(t)  = sin(t h) / sin(h)          (t at h = 0)
 //! A(t)    = rho(t) cos((t - 1) h)
 //! B(t)    = rho(t) sin((t - 1) h)
 //! M^t     : x -> R^t x + A tau + (t - A) (tau . S) S + B (S x tau)
@@ -26,21 +26,10 @@
 
 use glam::{DQuat, DVec3};
 
+use crate::error::{Error, Result};
 use crate::fastmath;
+use crate::lanes::{self, Real, F4, LANES, Q4, V4};
 use crate::pose::Pose;
-
-/// Below this `|x|`, `sin(x) / x` is evaluated by its Taylor series (error below 1e-20).
-const SINC_SERIES_BELOW: f64 = 1e-4;
-
-/// `sin(x) / x` given `sin(x)`, exact to rounding for all `x` including 0.
-#[inline]
-fn sinc_from(x: f64, sin_x: f64) -> f64 {
-    if x.abs() < SINC_SERIES_BELOW {
-        1.0 - x * x / 6.0
-    } else {
-        sin_x / x
-    }
-}
 
 /// The minimal screw carrying pose `a` to pose `b`, ready to be evaluated at any `t`.
 ///
@@ -51,7 +40,8 @@ pub struct Screw {
     base: Pose,
     /// The relative rotation `q = q_b q_a^-1` with `w >= 0`.
     rotation: DQuat,
-    /// Half the rotation angle, `h = atan2(|q.xyz|, q.w)`, in `[0, pi / 2]`.
+    /// Half the rotation angle, `h = atan2(|q.xyz|, q.w)` (by [`fastmath::turn_angle`]), in
+    /// `[0, pi / 2]`.
     half_angle: f64,
     /// `sin(h) = |q.xyz|`, cached.
     sin_half: f64,
@@ -79,7 +69,7 @@ impl Screw {
         }
         let v = q.xyz();
         let sin_h = v.length();
-        let half_angle = fastmath::atan2_first_quadrant(sin_h, q.w);
+        let half_angle = fastmath::turn_angle(q.w, sin_h);
         let tau = b.translation - q * a.translation;
         let (inv_sin_half, axis) = if sin_h > 0.0 {
             let inv = 1.0 / sin_h;
@@ -106,11 +96,13 @@ impl Screw {
         let th = t * h;
         let (sin_th, cos_th) = fastmath::sin_cos(th);
         let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
-        // rho = sin(t h) / sin(h); near h = 0 as t sinc(t h) / sinc(h), exact at h = 0.
-        let rho = if h < SINC_SERIES_BELOW {
-            t * sinc_from(th, sin_th) / (1.0 - h * h / 6.0)
-        } else {
+        // rho = sin(t h) / sin(h), t at h = 0. No series is needed near 0: sin(h) = |q.xyz| is
+        // computed directly and sin(t h) by a kernel of relative accuracy, so the quotient is
+        // accurate to a few ulps however small h is.
+        let rho = if sin_h > 0.0 {
             sin_th * self.inv_sin_half
+        } else {
+            t
         };
         let v = self.rotation.xyz();
         let rotation = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
@@ -354,6 +346,103 @@ pub fn s(a: &Pose, t: f64, b: &Pose) -> Pose {
     Screw::between(a, b).eval(t)
 }
 
+/// `out[i] = s(a[i], t[i], b[i])` for every `i`: the batch form of [`s`], four pairs at a
+/// time side by side (structure of arrays, packed SIMD on baseline x86-64) with selects
+/// instead of branches for the pure translation and the identity, the rest by [`s`].
+///
+/// The same formula and kernels as [`Screw::between`] and [`Screw::eval`]; the results equal
+/// `s`'s to rounding (the products that both rotations of `o_a` share are computed once).
+/// A group of four whose `t h` is NaN or beyond the
+/// fast range reduction (`|t| > 3e5` or so) is done by [`s`] instead.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] unless `t`, `b` and `out` have the length of `a`.
+pub fn s_many(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) -> Result<()> {
+    let n = a.len();
+    for (what, got) in [("t", t.len()), ("b", b.len()), ("out", out.len())] {
+        if got != n {
+            return Err(Error::LengthMismatch {
+                what,
+                expected: n,
+                got,
+            });
+        }
+    }
+    let groups = n / LANES * LANES;
+    for (((a, t), b), out) in a[..groups]
+        .chunks_exact(LANES)
+        .zip(t[..groups].chunks_exact(LANES))
+        .zip(b[..groups].chunks_exact(LANES))
+        .zip(out[..groups].chunks_exact_mut(LANES))
+    {
+        s_lanes(a, t, b, out);
+    }
+    for i in groups..n {
+        out[i] = s(&a[i], t[i], &b[i]);
+    }
+    Ok(())
+}
+
+/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`] then
+/// [`Screw::eval`] with every branch a select.
+#[inline]
+fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
+    let qa = Q4::from_fn(|i| a[i].rotation);
+    let oa = V4::from_fn(|i| a[i].translation);
+    let qb = Q4::from_fn(|i| b[i].rotation);
+    let ob = V4::from_fn(|i| b[i].translation);
+    let t = F4::from_fn(|i| t[i]);
+    // Screw::between, with S = v / sin h (0 for no turn: then rho = t, A = t, B = 0 and the
+    // terms along S vanish, so a pure translation needs no axis of its own).
+    let q = qb.mul(qa.conjugate());
+    let q = q.negate_where(q.w.lt(0.0));
+    let (v, cos_h) = (q.v, q.w);
+    let b2 = v.dot(v);
+    let sin_h = b2.sqrt();
+    let h = fastmath::turn_angle(cos_h, sin_h);
+    let inv = F4::splat(1.0) / sin_h;
+    let turning = inv.finite_positive();
+    let inv = turning.select(inv, F4::splat(0.0));
+    let axis = v.scale(inv);
+    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w); v . o_a and v x o_a serve
+    // M^t o_a below too.
+    let v_dot_o = v.dot(oa);
+    let v_x_o = v.cross(oa);
+    let tau =
+        ob - (oa.scale(cos_h * cos_h - b2) + v.scale(v_dot_o * 2.0) + v_x_o.scale(cos_h * 2.0));
+    // Screw::motion and Screw::eval.
+    let th = t * h;
+    if !th.abs_below(fastmath::FAST_REDUCTION_BELOW).all() {
+        for i in 0..LANES {
+            out[i] = s(&a[i], t.0[i], &b[i]);
+        }
+        return;
+    }
+    let (sin_th, cos_th) = lanes::sin_cos(th);
+    let rho = turning.select(sin_th * inv, t);
+    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
+    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
+    let translation =
+        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
+    // M^t = (rho v, cos(t h)): M^t q_a, and M^t o_a by the formula above with rho v for v.
+    let m = Q4 {
+        v: v.scale(rho),
+        w: cos_th,
+    };
+    let rotation = m.mul(qa);
+    let rho2 = rho * rho;
+    let position = oa.scale(cos_th * cos_th - rho2 * b2)
+        + v.scale(rho2 * v_dot_o * 2.0)
+        + v_x_o.scale(rho * cos_th * 2.0)
+        + translation;
+    for (i, pose) in out.iter_mut().enumerate() {
+        *pose = Pose {
+            rotation: rotation.lane(i),
+            translation: position.lane(i),
+        };
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -494,6 +583,82 @@ mod tests {
             let err = midpoint(&a, &b).max_abs_diff(&s(&a, 0.5, &b));
             assert!(err < 1e-13, "{a:?} {b:?}: error {err:e}");
         }
+    }
+
+    #[test]
+    fn s_many_equals_s() {
+        let mut x = 0.25f64;
+        let mut next = || {
+            x = (x * 3.7 + 0.123).fract();
+            x
+        };
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        let mut t = Vec::new();
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        for i in 0..403 {
+            let pose = |next: &mut dyn FnMut() -> f64| {
+                let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5 + 1e-3).normalize();
+                Pose::from_rotation_translation(
+                    DQuat::from_axis_angle(axis, next() * 2.0 * PI),
+                    DVec3::new(next(), next(), next()) * 4.0 - 2.0,
+                )
+            };
+            let p = pose(&mut next);
+            // Random pairs, and pairs at angle 0, 1e-13, near pi, pure translations, repeats.
+            let q = match i % 8 {
+                0 => exact(axis, DVec3::X, 0.0, 1.5, 1.0, &p),
+                1 => exact(axis, DVec3::Y, 1e-13, 0.3, 1.0, &p),
+                2 => exact(axis, DVec3::Z, PI - 1e-9, -0.7, 1.0, &p),
+                3 => Pose::from_rotation_translation(p.rotation, p.translation + DVec3::X),
+                4 => p,
+                5 => exact(axis, DVec3::ONE, 1e-7, 0.0, 1.0, &p),
+                _ => pose(&mut next),
+            };
+            a.push(p);
+            b.push(q);
+            t.push(match i % 5 {
+                0 => 0.0,
+                1 => 1.0,
+                _ => next() * 3.0 - 1.0,
+            });
+        }
+        // A group beyond the fast range reduction, and one with a NaN t.
+        t[14] = 1e9;
+        t[13] = f64::NAN;
+        let mut out = vec![Pose::IDENTITY; a.len()];
+        s_many(&a, &t, &b, &mut out).unwrap();
+        for i in 0..a.len() {
+            let want = s(&a[i], t[i], &b[i]);
+            if t[i].is_nan() {
+                assert!(
+                    out[i].translation.x.is_nan() || out[i].rotation.w.is_nan(),
+                    "{i}"
+                );
+                continue;
+            }
+            let err = out[i].max_abs_diff(&want);
+            assert!(
+                err < 1e-14,
+                "pair {i}: {:?} {} {:?}: error {err:e}",
+                a[i],
+                t[i],
+                b[i]
+            );
+        }
+        assert!(matches!(
+            s_many(&a, &t[1..], &b, &mut out),
+            Err(Error::LengthMismatch {
+                what: "t",
+                expected: 403,
+                got: 402
+            })
+        ));
+        assert!(matches!(
+            s_many(&a, &t, &b, &mut out[..3]),
+            Err(Error::LengthMismatch { what: "out", .. })
+        ));
+        assert_eq!(s_many(&[], &[], &[], &mut []), Ok(()));
     }
 
     #[test]
