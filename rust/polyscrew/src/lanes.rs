@@ -3,9 +3,10 @@
 //! LLVM compiles to packed SSE2 instructions (two lanes per instruction on baseline x86-64).
 //! Branches become selects: every lane computes every case and a mask picks.
 //!
-//! [`Real`] lets one polynomial kernel serve `f64` and [`F4`] (the same operations in the
-//! same order, so a lane agrees with the scalar to the bit); [`sin_cos`] and
-//! [`atan2_first_quadrant`] are the lane forms of [`crate::fastmath`]'s.
+//! [`Real`] lets one polynomial kernel ([`estrin`]) serve `f64` and [`F4`] (the same
+//! operations in the same order, so a lane agrees with the scalar to the bit):
+//! [`crate::fastmath`]'s sin/cos kernel and `turn_angle` take either; [`sin_cos`] is the lane
+//! form of its range reduction.
 
 use std::f64::consts::FRAC_PI_2;
 use std::ops::{Add, Div, Mul, Neg, Sub};
@@ -38,14 +39,43 @@ impl Real for f64 {
     }
 }
 
-/// `c[0] + x (c[1] + x (... + x c[N - 1]))`, Horner's rule from the inside out.
+/// `c[0] + c[1] x + ... + c[N - 1] x^(N - 1)` by Estrin's scheme: pairs `c[i] + c[i + 1] x`
+/// combined with `x^2`, `x^4`, ..., a dependency chain of `log2 N` steps instead of Horner's
+/// `N - 1` (the kernels sit on the critical path of `s`).
 #[inline(always)]
-pub(crate) fn horner<R: Real, const N: usize>(x: R, c: [f64; N]) -> R {
-    let mut acc = R::splat(c[N - 1]);
-    for &ci in c[..N - 1].iter().rev() {
-        acc = R::splat(ci) + x * acc;
+pub(crate) fn estrin<R: Real, const N: usize>(x: R, c: [f64; N]) -> R {
+    // Level 0: the terms of degree 0 and 1 in x, N / 2 (rounded up) of them.
+    let mut terms: [R; N] = [R::splat(0.0); N];
+    let mut len = 0;
+    let mut i = 0;
+    while i < N {
+        terms[len] = if i + 1 < N {
+            R::splat(c[i]) + R::splat(c[i + 1]) * x
+        } else {
+            R::splat(c[i])
+        };
+        len += 1;
+        i += 2;
     }
-    acc
+    let mut power = x * x;
+    while len > 1 {
+        let mut j = 0;
+        let mut k = 0;
+        while j < len {
+            terms[k] = if j + 1 < len {
+                terms[j] + terms[j + 1] * power
+            } else {
+                terms[j]
+            };
+            k += 1;
+            j += 2;
+        }
+        len = k;
+        if len > 1 {
+            power = power * power;
+        }
+    }
+    terms[0]
 }
 
 /// Four `f64` lanes.
