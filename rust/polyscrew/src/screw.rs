@@ -341,18 +341,55 @@ pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
 
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
+///
+/// [`Screw::between`] then [`Screw::eval`], fused: with `S = v / sin h` (0 when there is no
+/// turn: then `rho = t`, `A = t`, `B = 0` and the terms along `S` vanish, so a pure
+/// translation needs no axis of its own), and the two rotations of `o_a` (by `q` for `tau`,
+/// by `M^t`) sharing `v . o_a` and `v x o_a`. Operation for operation what [`s_many`] does
+/// in each lane.
 #[inline]
 pub fn s(a: &Pose, t: f64, b: &Pose) -> Pose {
-    Screw::between(a, b).eval(t)
+    let mut q = b.rotation * a.rotation.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let (v, cos_h) = (q.xyz(), q.w);
+    let b2 = v.dot(v);
+    let sin_h = b2.sqrt();
+    let h = fastmath::turn_angle(cos_h, sin_h);
+    let inv = 1.0 / sin_h;
+    let turning = inv.is_finite() && inv > 0.0;
+    let inv = if turning { inv } else { 0.0 };
+    let axis = v * inv;
+    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w), as glam's rotation.
+    let oa = a.translation;
+    let v_dot_o = v.dot(oa);
+    let v_x_o = v.cross(oa);
+    let tau =
+        b.translation - (oa * (cos_h * cos_h - b2) + v * (v_dot_o * 2.0) + v_x_o * (cos_h * 2.0));
+    let (sin_th, cos_th) = fastmath::sin_cos(t * h);
+    let rho = if turning { sin_th * inv } else { t };
+    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
+    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
+    let translation = tau * ca + axis * ((t - ca) * tau.dot(axis)) + axis.cross(tau) * cb;
+    let m = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
+    let rho2 = rho * rho;
+    let position = oa * (cos_th * cos_th - rho2 * b2)
+        + v * (rho2 * v_dot_o * 2.0)
+        + v_x_o * (rho * cos_th * 2.0)
+        + translation;
+    Pose {
+        rotation: m * a.rotation,
+        translation: position,
+    }
 }
 
 /// `out[i] = s(a[i], t[i], b[i])` for every `i`: the batch form of [`s`], four pairs at a
 /// time side by side (structure of arrays, packed SIMD on baseline x86-64) with selects
 /// instead of branches for the pure translation and the identity, the rest by [`s`].
 ///
-/// The same formula and kernels as [`Screw::between`] and [`Screw::eval`]; the results equal
-/// `s`'s to rounding (the products that both rotations of `o_a` share are computed once).
-/// A group of four whose `t h` is NaN or beyond the
+/// The same formula and kernels as [`s`], operation for operation, so the results equal
+/// `s`'s to the bit. A group of four whose `t h` is NaN or beyond the
 /// fast range reduction (`|t| > 3e5` or so) is done by [`s`] instead.
 ///
 /// # Errors
@@ -628,6 +665,11 @@ mod tests {
         t[13] = f64::NAN;
         let mut out = vec![Pose::IDENTITY; a.len()];
         s_many(&a, &t, &b, &mut out).unwrap();
+        // The same operations in the same order as s: equal to the bit (the NaN lane aside).
+        let same = (0..a.len())
+            .filter(|&i| out[i] == s(&a[i], t[i], &b[i]))
+            .count();
+        assert_eq!(same, a.len() - 1, "bitwise equal to s except the NaN lane");
         for i in 0..a.len() {
             let want = s(&a[i], t[i], &b[i]);
             if t[i].is_nan() {
