@@ -4,7 +4,8 @@
 #   - criterion (every rust/polyscrew/benches/*.rs): s(a, t, b) ours vs nalgebra, subdivision
 #     per scheme, growth over 10 .. 10,000 keys x 1 .. 8 levels (core.rs, scaling.rs: thread
 #     CPU time), and the other issues' benches (angular velocity, ...);
-#   - callgrind instruction counts of s (ours vs nalgebra) and of one subdivision;
+#   - callgrind instruction counts of s (ours one by one and through s_many, vs nalgebra) and
+#     of one subdivision;
 #   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
 #   - scripts/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
 #   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
@@ -63,7 +64,7 @@ if command -v valgrind >/dev/null; then
   n=100000; [ "$quick" = 1 ] && n=10000
   echo "$n" > "$run/callgrind-n.txt"
   cg() { valgrind --tool=callgrind --callgrind-out-file="$1" "${@:2}" 2>&1 | grep -E 'Collected|evaluations|runs of' ; }
-  for which in ours nalgebra; do
+  for which in ours many nalgebra; do
     cg "$run/callgrind-$which-0.out" "$CARGO_TARGET_DIR/release/examples/count_s" "$which" 0
     cg "$run/callgrind-$which-N.out" "$CARGO_TARGET_DIR/release/examples/count_s" "$which" "$n"
   done

@@ -1,5 +1,5 @@
-//! Criterion benchmarks of the core: `s(a, t, b)` (ours and nalgebra's dual-quaternion
-//! ScLERP in the same run) and subdivision (100 keys x 6 levels per scheme, 1,000 keys x 6
+//! Criterion benchmarks of the core: `s(a, t, b)` (ours one by one and in batches through
+//! `s_many`, and nalgebra's dual-quaternion ScLERP in the same run) and subdivision (100 keys x 6 levels per scheme, 1,000 keys x 6
 //! levels Jarek). Measured in thread CPU time (groups `s`, `subdivide`; see
 //! `common::CpuTime`) and, for `s`, also in wall-clock time (group `s wall-clock`). The
 //! growth over 10 .. 10,000 keys x 1 .. 8 levels is in `scaling.rs`.
@@ -11,7 +11,7 @@ use std::hint::black_box;
 use common::{keys, CpuTime, Rng};
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use polyscrew::{s, subdivide, Pose, Scheme, Screw};
+use polyscrew::{s, s_many, subdivide, Pose, Scheme, Screw};
 
 fn to_nalgebra(p: &Pose) -> nalgebra::UnitDualQuaternion<f64> {
     let q = p.rotation;
@@ -45,6 +45,24 @@ fn bench_s<M: Measurement>(c: &mut Criterion<M>, group: &str) {
             for (a, b, t) in &pairs {
                 black_box(s(black_box(a), *t, black_box(b)));
             }
+        })
+    });
+    g.bench_function("polyscrew s_many (batch of 1024)", |bench| {
+        let (a, t, b): (Vec<Pose>, Vec<f64>, Vec<Pose>) = {
+            let mut a = Vec::new();
+            let mut t = Vec::new();
+            let mut b = Vec::new();
+            for (pa, pb, pt) in &pairs {
+                a.push(*pa);
+                b.push(*pb);
+                t.push(*pt);
+            }
+            (a, t, b)
+        };
+        let mut out = vec![Pose::IDENTITY; pairs.len()];
+        bench.iter(|| {
+            s_many(black_box(&a), black_box(&t), black_box(&b), &mut out).unwrap();
+            black_box(&out);
         })
     });
     g.bench_function("polyscrew Screw::eval (screw reused)", |bench| {

@@ -1,7 +1,8 @@
 //! Runs `s(a, t, b)` (ours or nalgebra's ScLERP) a given number of times, for instruction
 //! counts under `valgrind --tool=callgrind`, which are stable on a shared machine:
 //! `cargo build --release --example count_s && valgrind --tool=callgrind target/release/examples/count_s ours 100000`
-//! (`subdivide N` instead runs N subdivisions of 100 keys by 6 levels with Jarek).
+//! (`many N` evaluates the same N pairs with `s_many` in batches of 1,024; `subdivide N`
+//! instead runs N subdivisions of 100 keys by 6 levels with Jarek).
 use std::hint::black_box;
 
 use glam::{DQuat, DVec3};
@@ -31,6 +32,25 @@ fn main() {
                     black_box(&poses[(i + 1) % 1024]),
                 );
                 acc += p.translation.x;
+            }
+        }
+        "many" => {
+            // The same pairs and t as "ours", through the batch form in batches of 1,024.
+            let b: Vec<Pose> = (0..1024).map(|i| poses[(i + 1) % 1024]).collect();
+            let t = vec![0.37; 1024];
+            let mut out = vec![Pose::IDENTITY; 1024];
+            let mut done = 0;
+            while done < n {
+                let m = (n - done).min(1024);
+                polyscrew::s_many(
+                    black_box(&poses[..m]),
+                    &t[..m],
+                    black_box(&b[..m]),
+                    &mut out[..m],
+                )
+                .expect("equal lengths");
+                acc += out[m / 2].translation.x;
+                done += m;
             }
         }
         "between" => {

@@ -12,7 +12,7 @@
 //! angle. With `tau = o1 - R o0` the translation of `M`:
 //!
 //! ```text
-//! rho(t)  = sin(t h) / sin(h)          (= t sinc(t h) / sinc(h), exact at h = 0)
+//! rho(t)  = sin(t h) / sin(h)          (t at h = 0)
 //! A(t)    = rho(t) cos((t - 1) h)
 //! B(t)    = rho(t) sin((t - 1) h)
 //! M^t     : x -> R^t x + A tau + (t - A) (tau . S) S + B (S x tau)
@@ -26,21 +26,10 @@
 
 use glam::{DQuat, DVec3};
 
+use crate::error::{Error, Result};
 use crate::fastmath;
+use crate::lanes::{self, Real, F4, LANES, Q4, V4};
 use crate::pose::Pose;
-
-/// Below this `|x|`, `sin(x) / x` is evaluated by its Taylor series (error below 1e-20).
-const SINC_SERIES_BELOW: f64 = 1e-4;
-
-/// `sin(x) / x` given `sin(x)`, exact to rounding for all `x` including 0.
-#[inline]
-fn sinc_from(x: f64, sin_x: f64) -> f64 {
-    if x.abs() < SINC_SERIES_BELOW {
-        1.0 - x * x / 6.0
-    } else {
-        sin_x / x
-    }
-}
 
 /// The minimal screw carrying pose `a` to pose `b`, ready to be evaluated at any `t`.
 ///
@@ -51,7 +40,8 @@ pub struct Screw {
     base: Pose,
     /// The relative rotation `q = q_b q_a^-1` with `w >= 0`.
     rotation: DQuat,
-    /// Half the rotation angle, `h = atan2(|q.xyz|, q.w)`, in `[0, pi / 2]`.
+    /// Half the rotation angle, `h = atan2(|q.xyz|, q.w)` (by [`fastmath::turn_angle`]), in
+    /// `[0, pi / 2]`.
     half_angle: f64,
     /// `sin(h) = |q.xyz|`, cached.
     sin_half: f64,
@@ -69,7 +59,7 @@ impl Screw {
     ///
     /// When the relative rotation is exactly a half turn both axis directions are minimal;
     /// the one of the quaternion with `w >= 0` as computed is taken.
-    #[inline]
+    #[inline(always)]
     pub fn between(a: &Pose, b: &Pose) -> Self {
         // A product of unit quaternions is unit to rounding: no normalisation on this path
         // (every division and square root here is on the critical path of `s`).
@@ -79,7 +69,7 @@ impl Screw {
         }
         let v = q.xyz();
         let sin_h = v.length();
-        let half_angle = fastmath::atan2_first_quadrant(sin_h, q.w);
+        let half_angle = fastmath::turn_angle(q.w, sin_h);
         let tau = b.translation - q * a.translation;
         let (inv_sin_half, axis) = if sin_h > 0.0 {
             let inv = 1.0 / sin_h;
@@ -106,11 +96,13 @@ impl Screw {
         let th = t * h;
         let (sin_th, cos_th) = fastmath::sin_cos(th);
         let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
-        // rho = sin(t h) / sin(h); near h = 0 as t sinc(t h) / sinc(h), exact at h = 0.
-        let rho = if h < SINC_SERIES_BELOW {
-            t * sinc_from(th, sin_th) / (1.0 - h * h / 6.0)
-        } else {
+        // rho = sin(t h) / sin(h), t at h = 0. No series is needed near 0: sin(h) = |q.xyz| is
+        // computed directly and sin(t h) by a kernel of relative accuracy, so the quotient is
+        // accurate to a few ulps however small h is.
+        let rho = if sin_h > 0.0 {
             sin_th * self.inv_sin_half
+        } else {
+            t
         };
         let v = self.rotation.xyz();
         let rotation = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
@@ -135,6 +127,91 @@ impl Screw {
             rotation: m.rotation * self.base.rotation,
             translation: m.rotation * self.base.translation + m.translation,
         }
+    }
+
+    /// `[eval(k / 16) for k in ks]`: the screw at several fractions in sixteenths, for the
+    /// fixed fractions of the Split&Tweak rules, without trigonometry.
+    ///
+    /// With `cos h = q.w`, `sin h = |q.xyz|` the half-angle identities
+    /// `cos(x / 2) = sqrt((1 + cos x) / 2)`, `sin(x / 2) = sin x / (2 cos(x / 2))` give `h / 2`,
+    /// `h / 4`, `h / 8` and `h / 16` (exact at `h = 0`, no cancellation up to the half turn),
+    /// and products of these turns give `k h / 16` (`k = 16 j + r`, `|r| <= 8` in binary), one
+    /// or two complex products per fraction. Then, with `theta = k h / 16`, `t = k / 16`,
+    /// `rho = sin(theta) / sin(h)` (`t` at `h = 0`), `A = rho cos(theta - h)`,
+    /// `B = rho sin(theta - h)` as in [`Screw::motion`]:
+    ///
+    /// ```text
+    /// rotation     cos(theta) q_a + sin(theta) (S q_a)
+    /// translation  o_a + A tau + (t - A) (tau . S) S + B (S x tau)
+    ///                  + 2 sin(theta) (cos(theta) (S x o_a) + sin(theta) ((o_a . S) S - o_a))
+    /// ```
+    ///
+    /// the last line being `R^t o_a - o_a` (rotation by `2 theta` about `S`). The vectors are
+    /// computed once per call, so each fraction costs a few dozen multiply-adds. `k = 0` gives
+    /// `a`, `k = 16` gives `b` (to rounding). Meant for `|k| <= 48` (the error grows like
+    /// `|k| / 16` ulps of the turn).
+    #[inline(always)]
+    pub fn eval_sixteenths<const N: usize>(&self, ks: [i32; N]) -> [Pose; N] {
+        // (q.w, |q.xyz|) scaled to unit length: q is a product of unit quaternions, so
+        // |q|^2 = 1 + O(eps) and one Newton step for 1 / |q| is exact to rounding (the turns
+        // below would otherwise carry the excess, doubled at every doubling of the angle).
+        let (w, sin_h) = (self.rotation.w, self.sin_half);
+        let inv_norm = 1.5 - 0.5 * (w * w + sin_h * sin_h);
+        let inv_sin_h = self.inv_sin_half / inv_norm;
+        // turns[j] = (cos, sin) of h / 2^j.
+        let mut turns = [(w * inv_norm, sin_h * inv_norm); 5];
+        for j in 1..turns.len() {
+            let (c, s) = turns[j - 1];
+            let half_c = (0.5 * (1.0 + c)).sqrt();
+            turns[j] = (half_c, s / (2.0 * half_c));
+        }
+        let s = self.axis;
+        let qa = self.base.rotation;
+        let oa = self.base.translation;
+        let tau = self.tau;
+        // (0, S) q_a = (-S . v_a, w_a S + S x v_a).
+        let sv = s.cross(qa.xyz()) + qa.w * s;
+        let s_qa = DQuat::from_xyzw(sv.x, sv.y, sv.z, -s.dot(qa.xyz()));
+        let slide = tau.dot(s) * s;
+        let s_x_tau = s.cross(tau);
+        let s_x_o = s.cross(oa);
+        let o_perp = oa - oa.dot(s) * s;
+        // A macro, not a closure: inlined for certain, so with the caller's constant `k` the
+        // turns fold into one or two complex products each.
+        macro_rules! at {
+            ($k:expr) => {{
+                let k: i32 = $k;
+                let t = f64::from(k) / 16.0;
+                let (cos_th, sin_th) = sixteenth_turn(&turns, k);
+                let (cos_d, sin_d) = sixteenth_turn(&turns, k - 16);
+                let rho = if sin_h > 0.0 { sin_th * inv_sin_h } else { t };
+                let (a, b) = (rho * cos_d, rho * sin_d);
+                let two_sin = 2.0 * sin_th;
+                Pose {
+                    rotation: qa * cos_th + s_qa * sin_th,
+                    translation: oa
+                        + a * tau
+                        + (t - a) * slide
+                        + b * s_x_tau
+                        + (two_sin * cos_th) * s_x_o
+                        - (two_sin * sin_th) * o_perp,
+                }
+            }};
+        }
+        // Unrolled by hand for the same reason (LLVM does not unroll a body this size).
+        let mut out = [self.base; N];
+        macro_rules! unrolled {
+            ($($i:literal)*) => {$(
+                if $i < N {
+                    out[$i] = at!(ks[$i]);
+                }
+            )*};
+        }
+        unrolled!(0 1 2 3 4 5);
+        for i in 6..N {
+            out[i] = at!(ks[i]);
+        }
+        out
     }
 
     /// The start pose `a`.
@@ -185,38 +262,222 @@ impl Screw {
     }
 }
 
+/// `(cos, sin)` of `k h / 16` from `turns[j] = (cos, sin)` of `h / 2^j`, `j = 0..=4`:
+/// `k = 16 j + r` with `-8 <= r < 8`, the turn by `j h` (`|j| <= 2`) times those of the
+/// binary digits of `r` (`|j| > 2`, for `|k| > 40`, by repeated products). Straight-line code: with `k` a constant the branches fold away and
+/// what remains is one to three complex products.
+#[inline(always)]
+fn sixteenth_turn(turns: &[(f64, f64); 5], k: i32) -> (f64, f64) {
+    let mul = |(c1, s1): (f64, f64), (c2, s2): (f64, f64)| (c1 * c2 - s1 * s2, s1 * c2 + c1 * s2);
+    let times = |turn: Option<(f64, f64)>, step: (f64, f64)| match turn {
+        None => step,
+        Some(sofar) => mul(sofar, step),
+    };
+    let whole = (k + 8).div_euclid(16);
+    let r = k - 16 * whole;
+    let (c, s) = turns[0];
+    let (double_c, double_s) = (c * c - s * s, 2.0 * c * s);
+    let mut turn = match whole {
+        0 => None,
+        1 => Some((c, s)),
+        -1 => Some((c, -s)),
+        2 => Some((double_c, double_s)),
+        -2 => Some((double_c, -double_s)),
+        _ => {
+            let step = if whole < 0 { (c, -s) } else { (c, s) };
+            let mut sofar = step;
+            for _ in 1..whole.unsigned_abs() {
+                sofar = mul(sofar, step);
+            }
+            Some(sofar)
+        }
+    };
+    // Bit b of |r| is a turn by h / 2^(4 - b).
+    for bit in 0..4 {
+        if r.unsigned_abs() & (1 << bit) != 0 {
+            let (c, s) = turns[4 - bit];
+            turn = Some(times(turn, if r < 0 { (c, -s) } else { (c, s) }));
+        }
+    }
+    turn.unwrap_or((1.0, 0.0))
+}
+
 /// `s(a, 1/2, b)`, the pose halfway along the minimal screw, without trigonometry.
 ///
-/// With `q = (w, v) = (cos h, sin h S)` the relative rotation (`w >= 0`) and `tau` its
-/// translation, the half-angle identities give
-/// `q^(1/2) = (c, v / (2 c))` with `c = cos(h / 2) = sqrt((1 + w) / 2)`, and the
-/// translation of `M^(1/2)` is `tau / 2 - (v x tau) / (2 (1 + w))` (`A = 1/2`,
-/// `B S = -tan(h / 2) S / 2 = -v / (2 (1 + w))` in [`Screw::motion`]). Exact at `h = 0`,
-/// regular up to the half turn. The outer step of every Split&Tweak rule.
-#[inline]
+/// With `q_a`, `q_b` the rotations on the same side (`q_a . q_b >= 0`), the relative rotation
+/// `q = q_b q_a^-1 = (w, v) = (cos h, sin h S)` and `o_a`, `o_b` the translations:
+///
+/// ```text
+/// rotation     (q_a + q_b) / |q_a + q_b|             (|q_a + q_b|^2 = 2 (1 + w))
+/// translation  (o_a + o_b) / 2 - v x (o_b - o_a) / (2 (1 + w))
+/// ```
+///
+/// The first is the half-way quaternion of the rotation; the second is the midpoint of the
+/// chord of the helix the origin travels, moved out to the helix: in the plane normal to `S`
+/// the arc's midpoint is the chord's midpoint turned by `-90` degrees times
+/// `tan(h / 2) / 2 = |v| / (2 (1 + w))` of the chord. No product of a quaternion and a vector,
+/// exact at `h = 0` (the average), regular up to the half turn (`w = 0`). The outer step of
+/// every Split&Tweak rule.
+#[inline(always)]
 pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
-    let mut q = b.rotation * a.rotation.conjugate();
-    if q.w < 0.0 {
-        q = -q;
+    let qa = a.rotation;
+    let mut qb = b.rotation;
+    if qa.dot(qb) < 0.0 {
+        qb = -qb;
     }
-    let q = q.normalize();
-    let v = q.xyz();
-    let tau = b.translation - q * a.translation;
-    let c = (0.5 * (1.0 + q.w)).sqrt();
-    let half_v = v * (0.5 / c);
-    let rotation = DQuat::from_xyzw(half_v.x, half_v.y, half_v.z, c);
-    let translation = 0.5 * tau - v.cross(tau) * (0.5 / (1.0 + q.w));
+    let sum = qa + qb;
+    let inv_norm = 1.0 / sum.length_squared().sqrt();
+    // The vector part of q_b q_a^-1.
+    let (va, vb) = (qa.xyz(), qb.xyz());
+    let v = qa.w * vb - qb.w * va - vb.cross(va);
+    let chord = b.translation - a.translation;
+    let translation =
+        0.5 * (a.translation + b.translation) - v.cross(chord) * (inv_norm * inv_norm);
     Pose {
-        rotation: (rotation * a.rotation).normalize(),
-        translation: rotation * a.translation + translation,
+        rotation: sum * inv_norm,
+        translation,
     }
 }
 
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
+///
+/// [`Screw::between`] then [`Screw::eval`], fused: with `S = v / sin h` (0 when there is no
+/// turn: then `rho = t`, `A = t`, `B = 0` and the terms along `S` vanish, so a pure
+/// translation needs no axis of its own), and the two rotations of `o_a` (by `q` for `tau`,
+/// by `M^t`) sharing `v . o_a` and `v x o_a`. Operation for operation what [`s_many`] does
+/// in each lane.
 #[inline]
 pub fn s(a: &Pose, t: f64, b: &Pose) -> Pose {
-    Screw::between(a, b).eval(t)
+    let mut q = b.rotation * a.rotation.conjugate();
+    if q.w < 0.0 {
+        q = -q;
+    }
+    let (v, cos_h) = (q.xyz(), q.w);
+    let b2 = v.dot(v);
+    let sin_h = b2.sqrt();
+    let h = fastmath::turn_angle(cos_h, sin_h);
+    let inv = 1.0 / sin_h;
+    let turning = inv.is_finite() && inv > 0.0;
+    let inv = if turning { inv } else { 0.0 };
+    let axis = v * inv;
+    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w), as glam's rotation.
+    let oa = a.translation;
+    let v_dot_o = v.dot(oa);
+    let v_x_o = v.cross(oa);
+    let tau =
+        b.translation - (oa * (cos_h * cos_h - b2) + v * (v_dot_o * 2.0) + v_x_o * (cos_h * 2.0));
+    let (sin_th, cos_th) = fastmath::sin_cos(t * h);
+    let rho = if turning { sin_th * inv } else { t };
+    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
+    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
+    let translation = tau * ca + axis * ((t - ca) * tau.dot(axis)) + axis.cross(tau) * cb;
+    let m = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
+    let rho2 = rho * rho;
+    let position = oa * (cos_th * cos_th - rho2 * b2)
+        + v * (rho2 * v_dot_o * 2.0)
+        + v_x_o * (rho * cos_th * 2.0)
+        + translation;
+    Pose {
+        rotation: m * a.rotation,
+        translation: position,
+    }
+}
+
+/// `out[i] = s(a[i], t[i], b[i])` for every `i`: the batch form of [`s`], four pairs at a
+/// time side by side (structure of arrays, packed SIMD on baseline x86-64) with selects
+/// instead of branches for the pure translation and the identity, the rest by [`s`].
+///
+/// The same formula and kernels as [`s`], operation for operation, so the results equal
+/// `s`'s to the bit. A group of four whose `t h` is NaN or beyond the
+/// fast range reduction (`|t| > 3e5` or so) is done by [`s`] instead.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] unless `t`, `b` and `out` have the length of `a`.
+pub fn s_many(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) -> Result<()> {
+    let n = a.len();
+    for (what, got) in [("t", t.len()), ("b", b.len()), ("out", out.len())] {
+        if got != n {
+            return Err(Error::LengthMismatch {
+                what,
+                expected: n,
+                got,
+            });
+        }
+    }
+    let groups = n / LANES * LANES;
+    for (((a, t), b), out) in a[..groups]
+        .chunks_exact(LANES)
+        .zip(t[..groups].chunks_exact(LANES))
+        .zip(b[..groups].chunks_exact(LANES))
+        .zip(out[..groups].chunks_exact_mut(LANES))
+    {
+        s_lanes(a, t, b, out);
+    }
+    for i in groups..n {
+        out[i] = s(&a[i], t[i], &b[i]);
+    }
+    Ok(())
+}
+
+/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`] then
+/// [`Screw::eval`] with every branch a select.
+#[inline]
+fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
+    let qa = Q4::from_fn(|i| a[i].rotation);
+    let oa = V4::from_fn(|i| a[i].translation);
+    let qb = Q4::from_fn(|i| b[i].rotation);
+    let ob = V4::from_fn(|i| b[i].translation);
+    let t = F4::from_fn(|i| t[i]);
+    // Screw::between, with S = v / sin h (0 for no turn: then rho = t, A = t, B = 0 and the
+    // terms along S vanish, so a pure translation needs no axis of its own).
+    let q = qb.mul(qa.conjugate());
+    let q = q.negate_where(q.w.lt(0.0));
+    let (v, cos_h) = (q.v, q.w);
+    let b2 = v.dot(v);
+    let sin_h = b2.sqrt();
+    let h = fastmath::turn_angle(cos_h, sin_h);
+    let inv = F4::splat(1.0) / sin_h;
+    let turning = inv.finite_positive();
+    let inv = turning.select(inv, F4::splat(0.0));
+    let axis = v.scale(inv);
+    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w); v . o_a and v x o_a serve
+    // M^t o_a below too.
+    let v_dot_o = v.dot(oa);
+    let v_x_o = v.cross(oa);
+    let tau =
+        ob - (oa.scale(cos_h * cos_h - b2) + v.scale(v_dot_o * 2.0) + v_x_o.scale(cos_h * 2.0));
+    // Screw::motion and Screw::eval.
+    let th = t * h;
+    if !th.abs_below(fastmath::FAST_REDUCTION_BELOW).all() {
+        for i in 0..LANES {
+            out[i] = s(&a[i], t.0[i], &b[i]);
+        }
+        return;
+    }
+    let (sin_th, cos_th) = lanes::sin_cos(th);
+    let rho = turning.select(sin_th * inv, t);
+    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
+    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
+    let translation =
+        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
+    // M^t = (rho v, cos(t h)): M^t q_a, and M^t o_a by the formula above with rho v for v.
+    let m = Q4 {
+        v: v.scale(rho),
+        w: cos_th,
+    };
+    let rotation = m.mul(qa);
+    let rho2 = rho * rho;
+    let position = oa.scale(cos_th * cos_th - rho2 * b2)
+        + v.scale(rho2 * v_dot_o * 2.0)
+        + v_x_o.scale(rho * cos_th * 2.0)
+        + translation;
+    for (i, pose) in out.iter_mut().enumerate() {
+        *pose = Pose {
+            rotation: rotation.lane(i),
+            translation: position.lane(i),
+        };
+    }
 }
 
 #[cfg(test)]
@@ -291,6 +552,155 @@ mod tests {
             let err = midpoint(&a, &b).max_abs_diff(&exact(axis, p, angle, 0.7, 0.5, &a));
             assert!(err < 1e-13, "angle {angle:e}: error {err:e}");
         }
+    }
+
+    #[test]
+    fn eval_sixteenths_matches_eval() {
+        let a = Pose::from_rotation_translation(
+            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
+            DVec3::new(1.0, 2.0, -0.5),
+        );
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        let p = DVec3::new(0.5, -0.3, 0.1);
+        let ks = [
+            -34, -18, -17, -16, -14, -2, -1, 0, 1, 2, 4, 7, 8, 12, 14, 16, 17, 18, 30, 33,
+        ];
+        let mut angles = vec![0.0, 1e-300, 1e-13, 1e-9, 1e-6, 1e-4, 1e-3];
+        angles.extend((1..64).map(|i| i as f64 * PI / 64.0));
+        angles.extend([PI - 1e-3, PI - 1e-6, PI - 1e-9, PI - 1e-13, PI]);
+        for angle in angles {
+            for slide in [0.0, 0.7, -2.0] {
+                let b = exact(axis, p, angle, slide, 1.0, &a);
+                let sc = Screw::between(&a, &b);
+                let got = sc.eval_sixteenths(ks);
+                for (k, g) in ks.iter().zip(&got) {
+                    let want = sc.eval(f64::from(*k) / 16.0);
+                    let err = g.max_abs_diff(&want);
+                    assert!(
+                        err < 1e-14,
+                        "angle {angle:e} slide {slide} k {k}: error {err:e}"
+                    );
+                    let norm = (g.rotation.length() - 1.0).abs();
+                    assert!(
+                        norm < 4.0 * f64::EPSILON,
+                        "angle {angle:e} k {k}: |q| - 1 = {norm:e}"
+                    );
+                }
+            }
+        }
+        // A pure translation and the identity.
+        let b =
+            Pose::from_rotation_translation(a.rotation, a.translation + DVec3::new(0.0, 3.0, -4.0));
+        for b in [b, a] {
+            let sc = Screw::between(&a, &b);
+            for (k, g) in ks.iter().zip(sc.eval_sixteenths(ks)) {
+                let err = g.max_abs_diff(&sc.eval(f64::from(*k) / 16.0));
+                assert!(err < 1e-14, "translation, k {k}: error {err:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn midpoint_equals_eval_half_on_random_pairs() {
+        // Pairs of general poses, not only screws from a fixed base.
+        let mut x = 0.5f64;
+        let mut next = || {
+            x = (x * 3.7 + 0.123).fract();
+            x
+        };
+        for _ in 0..2000 {
+            let mut pose = || {
+                let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5 + 1e-3).normalize();
+                Pose::from_rotation_translation(
+                    DQuat::from_axis_angle(axis, next() * 2.0 * PI),
+                    DVec3::new(next(), next(), next()) * 4.0 - 2.0,
+                )
+            };
+            let (a, b) = (pose(), pose());
+            let err = midpoint(&a, &b).max_abs_diff(&s(&a, 0.5, &b));
+            assert!(err < 1e-13, "{a:?} {b:?}: error {err:e}");
+        }
+    }
+
+    #[test]
+    fn s_many_equals_s() {
+        let mut x = 0.25f64;
+        let mut next = || {
+            x = (x * 3.7 + 0.123).fract();
+            x
+        };
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        let mut t = Vec::new();
+        let axis = DVec3::new(0.0, 0.6, 0.8);
+        for i in 0..403 {
+            let pose = |next: &mut dyn FnMut() -> f64| {
+                let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5 + 1e-3).normalize();
+                Pose::from_rotation_translation(
+                    DQuat::from_axis_angle(axis, next() * 2.0 * PI),
+                    DVec3::new(next(), next(), next()) * 4.0 - 2.0,
+                )
+            };
+            let p = pose(&mut next);
+            // Random pairs, and pairs at angle 0, 1e-13, near pi, pure translations, repeats.
+            let q = match i % 8 {
+                0 => exact(axis, DVec3::X, 0.0, 1.5, 1.0, &p),
+                1 => exact(axis, DVec3::Y, 1e-13, 0.3, 1.0, &p),
+                2 => exact(axis, DVec3::Z, PI - 1e-9, -0.7, 1.0, &p),
+                3 => Pose::from_rotation_translation(p.rotation, p.translation + DVec3::X),
+                4 => p,
+                5 => exact(axis, DVec3::ONE, 1e-7, 0.0, 1.0, &p),
+                _ => pose(&mut next),
+            };
+            a.push(p);
+            b.push(q);
+            t.push(match i % 5 {
+                0 => 0.0,
+                1 => 1.0,
+                _ => next() * 3.0 - 1.0,
+            });
+        }
+        // A group beyond the fast range reduction, and one with a NaN t.
+        t[14] = 1e9;
+        t[13] = f64::NAN;
+        let mut out = vec![Pose::IDENTITY; a.len()];
+        s_many(&a, &t, &b, &mut out).unwrap();
+        // The same operations in the same order as s: equal to the bit (the NaN lane aside).
+        let same = (0..a.len())
+            .filter(|&i| out[i] == s(&a[i], t[i], &b[i]))
+            .count();
+        assert_eq!(same, a.len() - 1, "bitwise equal to s except the NaN lane");
+        for i in 0..a.len() {
+            let want = s(&a[i], t[i], &b[i]);
+            if t[i].is_nan() {
+                assert!(
+                    out[i].translation.x.is_nan() || out[i].rotation.w.is_nan(),
+                    "{i}"
+                );
+                continue;
+            }
+            let err = out[i].max_abs_diff(&want);
+            assert!(
+                err < 1e-14,
+                "pair {i}: {:?} {} {:?}: error {err:e}",
+                a[i],
+                t[i],
+                b[i]
+            );
+        }
+        assert!(matches!(
+            s_many(&a, &t[1..], &b, &mut out),
+            Err(Error::LengthMismatch {
+                what: "t",
+                expected: 403,
+                got: 402
+            })
+        ));
+        assert!(matches!(
+            s_many(&a, &t, &b, &mut out[..3]),
+            Err(Error::LengthMismatch { what: "out", .. })
+        ));
+        assert_eq!(s_many(&[], &[], &[], &mut []), Ok(()));
     }
 
     #[test]

@@ -14,8 +14,11 @@
 //!
 //! Every inner `s` is on one edge of the current polyscrew, so each edge's screw is built
 //! once per level and evaluated where the rules need it, using `s(b, t, a) = s(a, 1 - t, b)`
-//! (the minimal screw from `b` to `a` is the inverse of the one from `a` to `b`). Only the
-//! outer `s(., 1/2, .)` needs a new screw per output pose.
+//! (the minimal screw from `b` to `a` is the inverse of the one from `a` to `b`). All the
+//! fractions are sixteenths, so one [`Interpolant::eval_sixteenths`] per edge serves every
+//! rule (for screws: no trigonometry, see [`Screw::eval_sixteenths`]), and the schemes are
+//! tables read by one refinement pass. The outer `s(., 1/2, .)` is
+//! [`Interpolant::midpoint`] (for poses: no screw at all, see [`crate::screw::midpoint`]).
 //!
 //! Open sequences get a phantom pose at each end at every level, by screw extrapolation
 //! `s(P0, -1, P1)` and `s(P[n-1], -1, P[n-2])`; the end poses are kept exactly. Poses sampled
@@ -86,11 +89,17 @@ pub trait Interpolant: Copy {
     fn midpoint(a: &Self, b: &Self) -> Self {
         Self::s(a, 0.5, b)
     }
+    /// `[eval(seg, k / 16) for k in ks]`; implementations may share work between the
+    /// fractions (the subdivision rules evaluate every edge at a few fixed sixteenths).
+    #[inline]
+    fn eval_sixteenths<const N: usize>(seg: &Self::Segment, ks: [i32; N]) -> [Self; N] {
+        ks.map(|k| Self::eval(seg, f64::from(k) / 16.0))
+    }
 }
 
 impl Interpolant for Pose {
     type Segment = Screw;
-    #[inline]
+    #[inline(always)]
     fn segment(a: &Self, b: &Self) -> Screw {
         Screw::between(a, b)
     }
@@ -98,9 +107,13 @@ impl Interpolant for Pose {
     fn eval(seg: &Screw, t: f64) -> Self {
         seg.eval(t)
     }
-    #[inline]
+    #[inline(always)]
     fn midpoint(a: &Self, b: &Self) -> Self {
         crate::screw::midpoint(a, b)
+    }
+    #[inline(always)]
+    fn eval_sixteenths<const N: usize>(seg: &Screw, ks: [i32; N]) -> [Self; N] {
+        seg.eval_sixteenths(ks)
     }
 }
 
@@ -146,6 +159,69 @@ pub fn subdivided_len(n: usize, levels: u32, closed: bool) -> usize {
     }
 }
 
+/// How a scheme's old element is made from the evaluations on its two edges.
+#[derive(Debug, Clone, Copy)]
+enum OldRule {
+    /// Kept (interpolating schemes).
+    Keep,
+    /// `midpoint(ab[incoming], bc[outgoing])` from the evaluations of the edges `a -> b` and
+    /// `b -> c` (indices into [`Rules::sixteenths`]).
+    Tweak { incoming: usize, outgoing: usize },
+}
+
+/// How a scheme's new element between `b` and `c` is made, from edges `a -> b`, `b -> c`,
+/// `c -> d`.
+#[derive(Debug, Clone, Copy)]
+enum NewRule {
+    /// Entry `k` of the edge `b -> c` itself.
+    OnEdge(usize),
+    /// `midpoint(edge_ab[before], edge_cd[after])`.
+    Tweak { before: usize, after: usize },
+}
+
+/// One Split&Tweak scheme as a table: every edge of the current polyscrew is evaluated at
+/// `t = k / 16` for the `k` in `sixteenths` (`s(b, t, a) = s(a, 1 - t, b)` turns every inner
+/// `s` of the rules into one on an edge in its own direction), and the rules pick entries.
+#[derive(Debug, Clone, Copy)]
+struct Rules<const N: usize> {
+    sixteenths: [i32; N],
+    old: OldRule,
+    new: NewRule,
+}
+
+/// Jarek: old `s(s(a, 7/8, b), 1/2, s(b, 1/8, c))`, new `s(s(a, 17/16, b), 1/2, s(c, -1/16, d))`.
+const JAREK: Rules<4> = Rules {
+    sixteenths: [2, 14, 17, -1],
+    old: OldRule::Tweak {
+        incoming: 1,
+        outgoing: 0,
+    },
+    new: NewRule::Tweak {
+        before: 2,
+        after: 3,
+    },
+};
+
+/// 4-point: old kept, new `s(s(a, 9/8, b), 1/2, s(c, -1/8, d))`.
+const FOUR_POINT: Rules<2> = Rules {
+    sixteenths: [18, -2],
+    old: OldRule::Keep,
+    new: NewRule::Tweak {
+        before: 0,
+        after: 1,
+    },
+};
+
+/// B-spline: old `s(s(a, 3/4, b), 1/2, s(b, 1/4, c))`, new `s(b, 1/2, c)`.
+const BSPLINE: Rules<3> = Rules {
+    sixteenths: [4, 12, 8],
+    old: OldRule::Tweak {
+        incoming: 1,
+        outgoing: 0,
+    },
+    new: NewRule::OnEdge(2),
+};
+
 /// Subdivides a closed cycle or an open sequence `levels` times.
 ///
 /// Closed: `n 2^levels` elements, element `i 2^levels` from key `i`. Open:
@@ -160,95 +236,109 @@ pub fn subdivide<T: Interpolant>(
     closed: bool,
 ) -> Result<Vec<T>> {
     check_subdivision(items.len(), levels)?;
-    let mut current = items.to_vec();
-    let mut next = Vec::with_capacity(subdivided_len(items.len(), levels, closed));
-    let mut work = Vec::new();
+    if levels == 0 {
+        return Ok(items.to_vec());
+    }
+    // Two buffers in turn, each allocated once at the size of the last level written to it:
+    // the result (level `levels`) and the one before (level `levels - 1`, or the input).
+    let n = items.len();
+    let last = subdivided_len(n, levels, closed);
+    let before_last = subdivided_len(n, levels - 1, closed);
+    let (cap_current, cap_next) = if levels % 2 == 0 {
+        (last, before_last)
+    } else {
+        (before_last, last)
+    };
+    let mut current = Vec::with_capacity(cap_current);
+    current.extend_from_slice(items);
+    let mut next = Vec::with_capacity(cap_next);
     for _ in 0..levels {
         next.clear();
-        if closed {
-            refine_closed(&current, scheme, &mut next, &mut work);
-        } else {
-            refine_open(&current, scheme, &mut next, &mut work);
+        match scheme {
+            Scheme::Jarek => refine(&current, &JAREK, closed, &mut next),
+            Scheme::FourPoint => refine(&current, &FOUR_POINT, closed, &mut next),
+            Scheme::BSpline => refine(&current, &BSPLINE, closed, &mut next),
         }
         std::mem::swap(&mut current, &mut next);
     }
     Ok(current)
 }
 
-/// One level on a closed cycle: `out` gets `2 n` elements.
-fn refine_closed<T: Interpolant>(
+/// One level: `out` gets `2 n` elements (closed) or `2 n - 1` (open, ends kept exactly).
+///
+/// The edges are evaluated in one pass with a window of three (`a -> b`, `b -> c`,
+/// `c -> d`), each edge's screw built once. Open sequences are extended by a phantom element
+/// at each end on the first and last screw (`s(p0, -1, p1)`, `s(p[n-2], 2, p[n-1])`), so
+/// the phantom edges are those screws shifted by `-1` and `+1`: evaluated at `k - 16` and
+/// `k + 16` sixteenths, with no screw of their own.
+#[inline(always)]
+fn refine<T: Interpolant, const N: usize>(
     p: &[T],
-    scheme: Scheme,
+    rules: &Rules<N>,
+    closed: bool,
     out: &mut Vec<T>,
-    edges: &mut Vec<T::Segment>,
 ) {
     let n = p.len();
-    edges.clear();
-    edges.extend((0..n).map(|i| T::segment(&p[i], &p[(i + 1) % n])));
-    // Edge i runs from p[i] to p[i + 1]; around old i: edge i - 1 (in), edge i (out).
-    for i in 0..n {
-        let e_in = &edges[(i + n - 1) % n];
-        let e = &edges[i];
-        let e_next = &edges[(i + 1) % n];
-        out.push(old_rule(scheme, &p[i], e_in, e));
-        out.push(new_rule(scheme, e_in, e, e_next));
-    }
-}
-
-/// One level on an open sequence: `out` gets `2 n - 1` elements; ends kept exactly.
-fn refine_open<T: Interpolant>(
-    p: &[T],
-    scheme: Scheme,
-    out: &mut Vec<T>,
-    edges: &mut Vec<T::Segment>,
-) {
-    let n = p.len();
-    // Edges of the sequence extended by one phantom pose at each end:
-    // edges[0] = phantom -> p[0], edges[i + 1] = p[i] -> p[i + 1], edges[n] = p[n-1] -> phantom.
-    edges.clear();
-    let first = T::segment(&p[0], &p[1]);
-    let last = T::segment(&p[n - 2], &p[n - 1]);
-    let phantom_start = T::eval(&first, -1.0);
-    let phantom_end = T::eval(&last, 2.0);
-    edges.push(T::segment(&phantom_start, &p[0]));
-    edges.extend((0..n - 1).map(|i| T::segment(&p[i], &p[i + 1])));
-    edges.push(T::segment(&p[n - 1], &phantom_end));
-    out.push(p[0]);
-    for i in 0..n - 1 {
-        if i > 0 {
-            out.push(old_rule(scheme, &p[i], &edges[i], &edges[i + 1]));
+    let ks = rules.sixteenths;
+    let shifted = |by: i32| {
+        let mut ks = ks;
+        for k in &mut ks {
+            *k += by;
         }
-        out.push(new_rule(scheme, &edges[i], &edges[i + 1], &edges[i + 2]));
+        ks
+    };
+    let on = |a: &T, b: &T| T::eval_sixteenths(&T::segment(a, b), ks);
+    if !closed {
+        out.push(p[0]);
     }
-    out.push(p[n - 1]);
-}
-
-/// The tweaked old element `b`, from its incoming edge `a -> b` and outgoing edge `b -> c`.
-#[inline]
-fn old_rule<T: Interpolant>(scheme: Scheme, b: &T, e_in: &T::Segment, e_out: &T::Segment) -> T {
-    match scheme {
-        Scheme::FourPoint => *b,
-        // s(s(b, 1/4, a), 1/2, s(b, 1/4, c)) with s(b, 1/4, a) = s(a, 3/4, b).
-        Scheme::BSpline => T::midpoint(&T::eval(e_in, 0.75), &T::eval(e_out, 0.25)),
-        // s(s(a, 7/8, b), 1/2, s(c, 7/8, b)) with s(c, 7/8, b) = s(b, 1/8, c).
-        Scheme::Jarek => T::midpoint(&T::eval(e_in, 0.875), &T::eval(e_out, 0.125)),
-    }
-}
-
-/// The new element between `b` and `c`, from edges `a -> b`, `b -> c`, `c -> d`.
-#[inline]
-fn new_rule<T: Interpolant>(
-    scheme: Scheme,
-    e_ab: &T::Segment,
-    e_bc: &T::Segment,
-    e_cd: &T::Segment,
-) -> T {
-    // s(s(a, w, b), 1/2, s(d, w, c)) with s(d, w, c) = s(c, 1 - w, d).
-    let tweak = |w: f64| T::midpoint(&T::eval(e_ab, w), &T::eval(e_cd, 1.0 - w));
-    match scheme {
-        Scheme::BSpline => T::eval(e_bc, 0.5),
-        Scheme::FourPoint => tweak(9.0 / 8.0),
-        Scheme::Jarek => tweak(17.0 / 16.0),
+    let mut emit = |b: &T, ab: &[T; N], bc: &[T; N], cd: &[T; N], keep_old: bool| {
+        if keep_old {
+            out.push(match rules.old {
+                OldRule::Keep => *b,
+                OldRule::Tweak { incoming, outgoing } => T::midpoint(&ab[incoming], &bc[outgoing]),
+            });
+        }
+        out.push(match rules.new {
+            NewRule::OnEdge(k) => bc[k],
+            NewRule::Tweak { before, after } => T::midpoint(&ab[before], &cd[after]),
+        });
+    };
+    // A window of three edges in a ring (no copies as it moves): `ring[ia]` is `a -> b`,
+    // `ring[ib]` is `b -> c`, `ring[ic]` gets `c -> d`.
+    let (mut ia, mut ib, mut ic) = (0, 1, 2);
+    if closed {
+        // Edge i runs from p[i] to p[i + 1 mod n]; old i sits between edges i - 1 and i.
+        let last = on(&p[n - 1], &p[0]);
+        let first = on(&p[0], &p[1 % n]);
+        let mut ring = [last, first, first];
+        for i in 0..n {
+            ring[ic] = if i + 2 < n {
+                on(&p[i + 1], &p[i + 2])
+            } else if i + 2 == n {
+                last
+            } else {
+                first
+            };
+            emit(&p[i], &ring[ia], &ring[ib], &ring[ic], true);
+            (ia, ib, ic) = (ib, ic, ia);
+        }
+    } else {
+        // Extended edges: x[0] = phantom -> p[0], x[i + 1] = p[i] -> p[i + 1],
+        // x[n] = p[n - 1] -> phantom; old i sits between x[i] and x[i + 1]. (The first
+        // element, p[0], is already in `out`.)
+        let first = T::segment(&p[0], &p[1]);
+        let x1 = T::eval_sixteenths(&first, ks);
+        let mut ring = [T::eval_sixteenths(&first, shifted(-16)), x1, x1];
+        for i in 0..n - 1 {
+            ring[ic] = if i + 2 < n {
+                on(&p[i + 1], &p[i + 2])
+            } else {
+                T::eval_sixteenths(&T::segment(&p[n - 2], &p[n - 1]), shifted(16))
+            };
+            emit(&p[i], &ring[ia], &ring[ib], &ring[ic], i > 0);
+            (ia, ib, ic) = (ib, ic, ia);
+        }
+        out.push(p[n - 1]);
     }
 }
 
@@ -290,6 +380,82 @@ mod tests {
             let want = linear_reference(&p, scheme);
             for (g, w) in got.iter().zip(&want) {
                 assert!(g.distance(*w) < 1e-14, "{scheme:?}: {g} vs {w}");
+            }
+        }
+    }
+
+    /// One level of the rules in the module docs written directly with `s`, on a closed
+    /// cycle, or on an open sequence extended by its phantoms.
+    fn rules_with_s(p: &[Pose], scheme: Scheme, closed: bool) -> Vec<Pose> {
+        use crate::screw::s;
+        let mut ext = p.to_vec();
+        if !closed {
+            let n = p.len();
+            ext.insert(0, s(&p[0], -1.0, &p[1]));
+            ext.push(s(&p[n - 1], -1.0, &p[n - 2]));
+        }
+        let m = ext.len() as isize;
+        let at = |i: isize| ext[i.rem_euclid(m) as usize];
+        let (range, offset) = if closed { (0..m, 0) } else { (1..m - 1, 1) };
+        let mut out = Vec::new();
+        for i in range {
+            let (a, b, c, d) = (at(i - 1), at(i), at(i + 1), at(i + 2));
+            let old = match scheme {
+                Scheme::FourPoint => b,
+                Scheme::BSpline => s(&s(&b, 0.25, &a), 0.5, &s(&b, 0.25, &c)),
+                Scheme::Jarek => s(&s(&a, 7.0 / 8.0, &b), 0.5, &s(&c, 7.0 / 8.0, &b)),
+            };
+            let new = match scheme {
+                Scheme::BSpline => s(&b, 0.5, &c),
+                Scheme::FourPoint => s(&s(&a, 9.0 / 8.0, &b), 0.5, &s(&d, 9.0 / 8.0, &c)),
+                Scheme::Jarek => s(&s(&a, 17.0 / 16.0, &b), 0.5, &s(&d, 17.0 / 16.0, &c)),
+            };
+            if closed {
+                out.extend([old, new]);
+            } else if i == offset {
+                out.extend([p[0], new]);
+            } else if i == m - 2 {
+                out.push(p[p.len() - 1]);
+            } else {
+                out.extend([old, new]);
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn poses_match_the_rules_written_with_s() {
+        use glam::DQuat;
+        // A tumbling walk with steps up to near a half turn, a pure translation and a repeat.
+        let mut p: Vec<Pose> = (0..9)
+            .map(|i| {
+                let x = i as f64;
+                let axis = DVec3::new(x.sin(), (1.3 * x).cos(), 0.5).normalize();
+                Pose::from_rotation_translation(
+                    DQuat::from_axis_angle(axis, 0.4 * x * x),
+                    DVec3::new(x.cos(), 0.1 * x, -x.sin()),
+                )
+            })
+            .collect();
+        p.push(Pose::from_rotation_translation(
+            p[8].rotation,
+            DVec3::new(2.0, 0.0, 1.0),
+        ));
+        p.push(p[9]);
+        for scheme in [Scheme::FourPoint, Scheme::BSpline, Scheme::Jarek] {
+            for closed in [true, false] {
+                for n in [2, 3, p.len()] {
+                    let got = subdivide(&p[..n], scheme, 1, closed).unwrap();
+                    let want = rules_with_s(&p[..n], scheme, closed);
+                    assert_eq!(got.len(), want.len(), "{scheme:?} closed {closed} n {n}");
+                    for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+                        let err = g.max_abs_diff(w);
+                        assert!(
+                            err < 1e-13,
+                            "{scheme:?} closed {closed} n {n} pose {i}: {err:e}"
+                        );
+                    }
+                }
             }
         }
     }
