@@ -22,29 +22,19 @@ demo_common.blender_with_addon()
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
+import bench_shapes  # noqa: E402  (scripts/, numpy only)
+
 STEPS = 8
 SCREWS = 64
 
 
-def bumpy_torus(n: int = 250, m: int = 200) -> tuple[np.ndarray, np.ndarray]:
-    u = 2 * np.pi * np.arange(n) / n
-    w = 2 * np.pi * np.arange(m) / m
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    s = 0.22 * (1.0 + 0.25 * np.sin(5 * uu) * np.cos(3 * ww))
-    r = 0.6 + s * np.cos(ww)
-    v = np.stack([r * np.cos(uu), r * np.sin(uu), s * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    a, b = i * m + j, ((i + 1) % n) * m + j
-    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
-    return v, np.vstack([np.c_[a, b, c], np.c_[a, c, d]])
 
 
 def main() -> None:
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     swept = __import__("bl_ext.user_default.screwbender.swept", fromlist=["swept"])
     scene = bpy.context.scene
-    v, t = bumpy_torus()
+    v, t = bench_shapes.bumpy_torus(250, 200)
     mesh = swept.mesh_from_arrays("Bumpy", v, t)
     obj = bpy.data.objects.new("Bumpy", mesh)
     scene.collection.objects.link(obj)

@@ -55,6 +55,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_shapes  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 
 #: Instances per screw tried for stroboscopic instancing, in this order (stops at the first match).
@@ -68,17 +71,7 @@ OUR_STEPS = 8
 
 def bumpy_torus(n: int = 48, m: int = 24) -> tuple[np.ndarray, np.ndarray]:
     """The bumpy torus of benches/sweep.rs with `n x m` quads (`2 n m` triangles, outward)."""
-    u = 2 * np.pi * np.arange(n) / n
-    w = 2 * np.pi * np.arange(m) / m
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    s = 0.22 * (1.0 + 0.25 * np.sin(5 * uu) * np.cos(3 * ww))
-    r = 0.6 + s * np.cos(ww)
-    v = np.stack([r * np.cos(uu), r * np.sin(uu), s * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    i, j = i.ravel(), j.ravel()
-    a, b = i * m + j, ((i + 1) % n) * m + j
-    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
-    return v, np.vstack([np.c_[a, b, c], np.c_[a, c, d]]).astype(np.int64)
+    return bench_shapes.bumpy_torus(n, m)
 
 
 def rotation(axis, angle: float) -> np.ndarray:
