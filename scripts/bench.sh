@@ -21,7 +21,7 @@ cd "$root"
 export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$root/target}
 run="$CARGO_TARGET_DIR/bench"
-rm -rf "$run" "$CARGO_TARGET_DIR/criterion"
+rm -rf "$run" "$CARGO_TARGET_DIR/criterion" "$CARGO_TARGET_DIR/criterion-reuse"
 mkdir -p "$run"
 exec > >(tee "$run/log.txt") 2>&1
 start=$(date +%s)
@@ -56,6 +56,15 @@ stage "criterion: ${benches[*]}"
 crit_args=()
 [ "$quick" = 1 ] && crit_args=(--warm-up-time 0.1 --measurement-time 0.3 --sample-size 10)
 cargo bench -p polyscrew "${benches[@]}" -- "${crit_args[@]}" 2>&1 \
+  | grep --line-buffered -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
+
+# The same scaling rows for 1,000 and 10,000 keys with freed memory kept for reuse: glibc
+# otherwise maps every block above 32 MB afresh on each call, and the kernel's page faults
+# on those fresh pages (not the subdivision) bend the growth of the largest outputs.
+stage "criterion: scaling with memory reused (glibc tunables)"
+CRITERION_HOME="$CARGO_TARGET_DIR/criterion-reuse" \
+  GLIBC_TUNABLES=glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967295 \
+  cargo bench -p polyscrew --bench scaling -- "${crit_args[@]}" 'scaling/.*/10{3,4}x' 2>&1 \
   | grep --line-buffered -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
 
 stage "callgrind instruction counts"
@@ -158,5 +167,6 @@ if os.path.exists(bpy_json):
     env["bpy"] = json.load(open(bpy_json))["env"].get("bpy", "?")
 json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), indent=1)
 PY
-"$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" --out BENCHMARKS.md
+"$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
+  --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md
 stage "done"

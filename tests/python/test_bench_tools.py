@@ -306,3 +306,35 @@ def test_papers_section_marks_figures_from_other_machines():
     xie = next(line for line in rep.lines if "Xie" in line)
     assert "about 2 s" in xie and "20.00 ms" in xie and "| 100x |" in xie
     assert "for scale" in text
+
+
+def scaling_records(per_pose_ns, keys=(1_000, 10_000), levels=range(1, 9), schemes=("Jarek", "FourPoint", "BSpline")):
+    """Synthetic criterion records of benches/scaling.rs: time = per_pose_ns(poses) * poses."""
+    out = {}
+    for scheme in schemes:
+        for n in keys:
+            for lv in levels:
+                poses = n << lv
+                out[f"scaling/{scheme}/{n}x{lv}"] = {
+                    "group": "scaling", "function": scheme, "value": f"{n}x{lv}", "elements": poses,
+                    "median_ns": per_pose_ns(poses) * poses, "low_ns": 0, "high_ns": 0}
+    return out
+
+
+def test_linearity_verdict_uses_the_memory_reused_rerun(tmp_path):
+    # Default malloc: 90 ns per pose up to 320,000 poses, 130 ns beyond (fresh pages every call);
+    # memory reused: 90 ns throughout.
+    default = scaling_records(lambda poses: 90.0 if poses <= 320_000 else 130.0)
+    reused = scaling_records(lambda poses: 90.0)
+    rep = report.Report(tmp_path, default, reused)
+    rep.subdivision_section()
+    name, measured, verdict = rep.targets[-1]
+    assert name == "subdivision linear in output size" and verdict == "met"
+    reused_part, default_part = measured.split("; default malloc: ")
+    assert reused_part == "Jarek p = 1.000, FourPoint p = 1.000, BSpline p = 1.000 (outputs >= 10,000, memory reused)"
+    assert float(default_part.split("Jarek p = ")[1].split(",")[0]) > 1.05
+    assert any("memory reused |" in line for line in rep.lines)
+    # Without the rerun the verdict falls back on the default exponent, which is bent here.
+    alone = report.Report(tmp_path, default)
+    alone.subdivision_section()
+    assert alone.targets[-1][2] == "**missed**" and "memory reused" not in alone.targets[-1][1]
