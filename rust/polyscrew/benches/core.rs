@@ -8,18 +8,11 @@ mod common;
 
 use std::hint::black_box;
 
+use common::nalgebra_conv::to_nalgebra;
 use common::{keys, CpuTime, Rng};
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use polyscrew::{s, s_many, subdivide, Pose, Scheme, Screw};
-
-fn to_nalgebra(p: &Pose) -> nalgebra::UnitDualQuaternion<f64> {
-    let q = p.rotation;
-    let r =
-        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z));
-    let t = nalgebra::Translation3::new(p.translation.x, p.translation.y, p.translation.z);
-    nalgebra::UnitDualQuaternion::from_parts(t, r)
-}
 
 fn bench_s_cpu(c: &mut Criterion<CpuTime>) {
     bench_s(c, "s");

@@ -7,22 +7,9 @@ use std::f64::consts::PI;
 use glam::{DQuat, DVec3};
 use polyscrew::{s, Pose};
 
-fn to_nalgebra(p: &Pose) -> nalgebra::UnitDualQuaternion<f64> {
-    let q = p.rotation;
-    let r =
-        nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(q.w, q.x, q.y, q.z));
-    let t = nalgebra::Translation3::new(p.translation.x, p.translation.y, p.translation.z);
-    nalgebra::UnitDualQuaternion::from_parts(t, r)
-}
-
-fn from_nalgebra(d: &nalgebra::UnitDualQuaternion<f64>) -> Pose {
-    let iso = d.to_isometry();
-    let (q, t) = (iso.rotation.quaternion(), iso.translation.vector);
-    Pose {
-        rotation: DQuat::from_xyzw(q.i, q.j, q.k, q.w),
-        translation: DVec3::new(t.x, t.y, t.z),
-    }
-}
+#[path = "../benches/common/nalgebra_conv.rs"]
+mod nalgebra_conv;
+use nalgebra_conv::{from_nalgebra, to_nalgebra};
 
 /// `a` moved by the fraction `u` of the screw about the line through `p` along `axis` by
 /// `angle`, sliding `slide` along it.

@@ -7,6 +7,8 @@
 //! beside it for comparison.
 #![allow(dead_code)]
 
+pub mod nalgebra_conv;
+
 use criterion::measurement::{Measurement, ValueFormatter};
 use criterion::Throughput;
 use glam::{DQuat, DVec3};
