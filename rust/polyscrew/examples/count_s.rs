@@ -62,21 +62,6 @@ fn main() {
                 acc += black_box(sc).angle();
             }
         }
-        "atan" => {
-            for i in 0..n {
-                let p = black_box(&poses[i % 1024]);
-                acc += polyscrew::fastmath::atan2_first_quadrant(
-                    p.rotation.x.abs(),
-                    p.rotation.w.abs(),
-                );
-            }
-        }
-        "stdatan" => {
-            for i in 0..n {
-                let p = black_box(&poses[i % 1024]);
-                acc += p.rotation.x.abs().atan2(p.rotation.w.abs());
-            }
-        }
         "eval" => {
             // The screw built once per pair, evaluated n times (sampling's hot path).
             let screws: Vec<polyscrew::Screw> = (0..1024)

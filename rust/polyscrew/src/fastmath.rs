@@ -1,7 +1,9 @@
 //! The two transcendental functions a screw needs, specialised: `sin` and `cos` of one
-//! argument together, and `atan2` in the first quadrant. std's `sin_cos` evaluates `sin`
-//! and `cos` separately and `atan2` handles every quadrant and special value; these share
-//! one range reduction and skip what cannot happen, which halves the cost of `s(a, t, b)`.
+//! argument together, and the angle of a turn given by its cosine and sine
+//! ([`turn_angle`], in place of `atan2` in the first quadrant). std's `sin_cos` evaluates
+//! `sin` and `cos` separately and `atan2` handles every quadrant and special value; these
+//! share one range reduction and skip what cannot happen, which halves the cost of
+//! `s(a, t, b)`.
 //!
 //! The polynomial kernels are fdlibm's (`k_sin.c`, `k_cos.c`, `s_atan.c`, Sun Microsystems,
 //! 1993), accurate to about 1 ulp on their reduced ranges; the tests compare with std. They
@@ -86,12 +88,6 @@ const AT: [f64; 11] = [
     -3.653_157_274_421_691_552_70e-2,
     1.628_582_011_536_578_236_23e-2,
 ];
-// atan(0.5) and atan(1), in two parts each.
-pub(crate) const ATAN_HALF_HI: f64 = 4.636_476_090_008_060_935_15e-1;
-pub(crate) const ATAN_HALF_LO: f64 = 2.269_877_745_296_168_709_24e-17;
-pub(crate) const ATAN_ONE_HI: f64 = std::f64::consts::FRAC_PI_4;
-pub(crate) const ATAN_ONE_LO: f64 = 3.061_616_997_868_383_017_93e-17;
-pub(crate) const PIO2_ATAN_LO: f64 = 6.123_233_995_736_766_035_87e-17;
 
 /// fdlibm's `x (s1 + s2)`, with `atan(x) = x - x (s1 + s2)` for `|x| < 7/16`; one value or
 /// several lanes.
@@ -102,20 +98,6 @@ pub(crate) fn atan_poly<R: Real>(x: R) -> R {
     let s1 = z * estrin(w, [AT[0], AT[2], AT[4], AT[6], AT[8], AT[10]]);
     let s2 = w * estrin(w, [AT[1], AT[3], AT[5], AT[7], AT[9]]);
     x * (s1 + s2)
-}
-
-/// `atan(x)` for `0 <= x <= 1` (fdlibm's reduction to `|x| < 7/16`).
-#[inline]
-fn atan_unit(x: f64) -> f64 {
-    if x < 0.4375 {
-        x - atan_poly(x)
-    } else if x < 0.6875 {
-        let y = (2.0 * x - 1.0) / (2.0 + x);
-        ATAN_HALF_HI - ((atan_poly(y) - ATAN_HALF_LO) - y)
-    } else {
-        let y = (x - 1.0) / (x + 1.0);
-        ATAN_ONE_HI - ((atan_poly(y) - ATAN_ONE_LO) - y)
-    }
 }
 
 /// The angle `h` in `[0, pi / 2]` of a turn given as `(cos h, sin h)` (`w >= 0`, `s >= 0`,
@@ -138,28 +120,9 @@ pub(crate) fn turn_angle<R: Real>(w: R, s: R) -> R {
     R::splat(4.0) * (x - atan_poly(x))
 }
 
-/// `atan2(y, x)` for `y >= 0`, `x >= 0` (not both zero: that gives 0): an angle in
-/// `[0, pi / 2]`.
-#[inline]
-pub fn atan2_first_quadrant(y: f64, x: f64) -> f64 {
-    debug_assert!(!(y < 0.0 || x < 0.0), "atan2_first_quadrant({y}, {x})");
-    if y <= x {
-        if x == 0.0 {
-            return 0.0;
-        }
-        atan_unit(y / x)
-    } else {
-        (FRAC_PI_2 - atan_unit(x / y)) + PIO2_ATAN_LO
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn ulps(a: f64, b: f64) -> f64 {
-        (a - b).abs() / (f64::EPSILON * b.abs().max(f64::MIN_POSITIVE))
-    }
 
     #[test]
     fn sin_cos_matches_std() {
@@ -193,23 +156,5 @@ mod tests {
         assert!(worst <= 4.0, "worst {worst} ulps");
         assert_eq!(turn_angle(1.0, 0.0), 0.0);
         assert!((turn_angle(0.0, 1.0) - FRAC_PI_2).abs() <= 2.0 * f64::EPSILON);
-    }
-
-    #[test]
-    fn atan2_matches_std() {
-        let mut worst: f64 = 0.0;
-        for i in 0..=200_000 {
-            let a = i as f64 / 200_000.0 * FRAC_PI_2;
-            for scale in [1e-12, 1.0, 3e5] {
-                let (y, x) = (a.sin() * scale, a.cos() * scale);
-                let (y, x) = (y.max(0.0), x.max(0.0));
-                worst = worst.max(ulps(atan2_first_quadrant(y, x), y.atan2(x)));
-            }
-        }
-        assert!(worst <= 2.0, "worst {worst} ulps");
-        assert_eq!(atan2_first_quadrant(0.0, 0.0), 0.0);
-        assert_eq!(atan2_first_quadrant(0.0, 1.0), 0.0);
-        assert!((atan2_first_quadrant(1.0, 0.0) - FRAC_PI_2).abs() < 1e-16);
-        assert!(ulps(atan2_first_quadrant(1e-13, 1.0), 1e-13) < 1.0);
     }
 }

@@ -341,47 +341,9 @@ pub fn midpoint(a: &Pose, b: &Pose) -> Pose {
 
 /// `s(a, t, b)`: the pose a fraction `t` along the minimal screw from `a` to `b`
 /// (ScrewBender section 4; Rossignac-Kim). `t = 0` gives `a`, `t = 1` gives `b`; any real `t`.
-///
-/// [`Screw::between`] then [`Screw::eval`], fused: with `S = v / sin h` (0 when there is no
-/// turn: then `rho = t`, `A = t`, `B = 0` and the terms along `S` vanish, so a pure
-/// translation needs no axis of its own), and the two rotations of `o_a` (by `q` for `tau`,
-/// by `M^t`) sharing `v . o_a` and `v x o_a`. Operation for operation what [`s_many`] does
-/// in each lane.
 #[inline]
 pub fn s(a: &Pose, t: f64, b: &Pose) -> Pose {
-    let mut q = b.rotation * a.rotation.conjugate();
-    if q.w < 0.0 {
-        q = -q;
-    }
-    let (v, cos_h) = (q.xyz(), q.w);
-    let b2 = v.dot(v);
-    let sin_h = b2.sqrt();
-    let h = fastmath::turn_angle(cos_h, sin_h);
-    let inv = 1.0 / sin_h;
-    let turning = inv.is_finite() && inv > 0.0;
-    let inv = if turning { inv } else { 0.0 };
-    let axis = v * inv;
-    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w), as glam's rotation.
-    let oa = a.translation;
-    let v_dot_o = v.dot(oa);
-    let v_x_o = v.cross(oa);
-    let tau =
-        b.translation - (oa * (cos_h * cos_h - b2) + v * (v_dot_o * 2.0) + v_x_o * (cos_h * 2.0));
-    let (sin_th, cos_th) = fastmath::sin_cos(t * h);
-    let rho = if turning { sin_th * inv } else { t };
-    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
-    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
-    let translation = tau * ca + axis * ((t - ca) * tau.dot(axis)) + axis.cross(tau) * cb;
-    let m = DQuat::from_xyzw(v.x * rho, v.y * rho, v.z * rho, cos_th);
-    let rho2 = rho * rho;
-    let position = oa * (cos_th * cos_th - rho2 * b2)
-        + v * (rho2 * v_dot_o * 2.0)
-        + v_x_o * (rho * cos_th * 2.0)
-        + translation;
-    Pose {
-        rotation: m * a.rotation,
-        translation: position,
-    }
+    Screw::between(a, b).eval(t)
 }
 
 /// `out[i] = s(a[i], t[i], b[i])` for every `i`: the batch form of [`s`], four pairs at a
@@ -420,8 +382,8 @@ pub fn s_many(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) -> Result<()>
     Ok(())
 }
 
-/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`] then
-/// [`Screw::eval`] with every branch a select.
+/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`],
+/// [`Screw::motion`] and [`Screw::eval`] operation for operation, every branch a select.
 #[inline]
 fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     let qa = Q4::from_fn(|i| a[i].rotation);
@@ -429,25 +391,23 @@ fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     let qb = Q4::from_fn(|i| b[i].rotation);
     let ob = V4::from_fn(|i| b[i].translation);
     let t = F4::from_fn(|i| t[i]);
-    // Screw::between, with S = v / sin h (0 for no turn: then rho = t, A = t, B = 0 and the
-    // terms along S vanish, so a pure translation needs no axis of its own).
+    // Screw::between.
     let q = qb.mul(qa.conjugate());
     let q = q.negate_where(q.w.lt(0.0));
-    let (v, cos_h) = (q.v, q.w);
-    let b2 = v.dot(v);
-    let sin_h = b2.sqrt();
-    let h = fastmath::turn_angle(cos_h, sin_h);
+    let v = q.v;
+    let sin_h = v.dot(v).sqrt();
+    let h = fastmath::turn_angle(q.w, sin_h);
+    let tau = ob - q.rotate(oa);
     let inv = F4::splat(1.0) / sin_h;
+    // sin h > 0 (sin h = sqrt(|v|^2) is never so small that 1 / sin h overflows).
     let turning = inv.finite_positive();
     let inv = turning.select(inv, F4::splat(0.0));
-    let axis = v.scale(inv);
-    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w); v . o_a and v x o_a serve
-    // M^t o_a below too.
-    let v_dot_o = v.dot(oa);
-    let v_x_o = v.cross(oa);
-    let tau =
-        ob - (oa.scale(cos_h * cos_h - b2) + v.scale(v_dot_o * 2.0) + v_x_o.scale(cos_h * 2.0));
-    // Screw::motion and Screw::eval.
+    let length_recip = F4::splat(1.0) / tau.dot(tau).sqrt();
+    let along_tau = length_recip
+        .finite_positive()
+        .select_v(tau.scale(length_recip), V4::splat(DVec3::Z));
+    let axis = turning.select_v(v.scale(inv), along_tau);
+    // Screw::motion.
     let th = t * h;
     if !th.abs_below(fastmath::FAST_REDUCTION_BELOW).all() {
         for i in 0..LANES {
@@ -457,21 +417,17 @@ fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     }
     let (sin_th, cos_th) = lanes::sin_cos(th);
     let rho = turning.select(sin_th * inv, t);
-    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
-    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
-    let translation =
-        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
-    // M^t = (rho v, cos(t h)): M^t q_a, and M^t o_a by the formula above with rho v for v.
     let m = Q4 {
         v: v.scale(rho),
         w: cos_th,
     };
+    let ca = rho * (cos_th * q.w + sin_th * sin_h);
+    let cb = rho * (sin_th * q.w - cos_th * sin_h);
+    let translation =
+        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
+    // Screw::eval.
     let rotation = m.mul(qa);
-    let rho2 = rho * rho;
-    let position = oa.scale(cos_th * cos_th - rho2 * b2)
-        + v.scale(rho2 * v_dot_o * 2.0)
-        + v_x_o.scale(rho * cos_th * 2.0)
-        + translation;
+    let position = m.rotate(oa) + translation;
     for (i, pose) in out.iter_mut().enumerate() {
         *pose = Pose {
             rotation: rotation.lane(i),
