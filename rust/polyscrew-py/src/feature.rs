@@ -10,11 +10,11 @@ use pyo3::prelude::*;
 
 use polyscrew::{
     feature_motion as core_feature_motion, register as core_register, CurveScheme, FeatureSpec,
-    InertiaFrame, Parametrization, Pose, Stiffness, Timing, MAX_LEVELS,
+    InertiaFrame, Parametrization, Stiffness, Timing, MAX_LEVELS,
 };
 
 use crate::{
-    poses_to_array, read_poses, read_vector, shape_err, to_py_err, vec3s_to_array, FloatArray,
+    poses_to_array, read_keys, read_vector, shape_err, to_py_err, vec3s_to_array, FloatArray,
 };
 
 /// Reads `(K, 3)` points; finiteness is checked by the core, which names the point.
@@ -25,15 +25,6 @@ fn read_points(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResu
     }
     let flat: Vec<f64> = array.iter().copied().collect();
     Ok(flat.chunks_exact(3).map(DVec3::from_slice).collect())
-}
-
-/// Reads `(N, 4, 4)` key poses (a single matrix is refused).
-fn read_keys(function: &str, poses: &FloatArray<'_>) -> PyResult<Vec<Pose>> {
-    let (keys, single) = read_poses(function, "poses", poses.as_array())?;
-    if single {
-        return Err(shape_err(function, "poses", "(N, 4, 4)", &[4, 4]));
-    }
-    Ok(keys)
 }
 
 /// Parses the design options shared by `feature_motion` and `sample_feature`.

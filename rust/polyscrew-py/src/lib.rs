@@ -58,6 +58,15 @@ pub fn read_poses(
     Ok((poses, single))
 }
 
+/// Reads `(N, 4, 4)` key poses (a single matrix is refused).
+pub fn read_keys(function: &str, poses: &FloatArray<'_>) -> PyResult<Vec<Pose>> {
+    let (keys, single) = read_poses(function, "poses", poses.as_array())?;
+    if single {
+        return Err(shape_err(function, "poses", "(N, 4, 4)", &[4, 4]));
+    }
+    Ok(keys)
+}
+
 /// Poses as an `(N, 4, 4)` array in Blender's layout.
 pub fn poses_to_array(poses: &[Pose]) -> Array3<f64> {
     let mut out = Array3::<f64>::zeros((poses.len(), 4, 4));
@@ -271,10 +280,7 @@ fn subdivide<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = "subdivide";
     let spec = read_spec(F, scheme, levels, closed, None, "smooth")?;
-    let (keys, single) = read_poses(F, "poses", poses.as_array())?;
-    if single {
-        return Err(shape_err(F, "poses", "(N, 4, 4)", &[4, 4]));
-    }
+    let keys = read_keys(F, &poses)?;
     let out = py
         .detach(|| {
             core_subdivide(&keys, spec.scheme, spec.levels, spec.closed).map(|d| poses_to_array(&d))
@@ -319,10 +325,7 @@ fn sample<'py>(
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = "sample";
     let spec = read_spec(F, scheme, levels, closed, period, timing)?;
-    let (keys, single) = read_poses(F, "poses", poses.as_array())?;
-    if single {
-        return Err(shape_err(F, "poses", "(N, 4, 4)", &[4, 4]));
-    }
+    let keys = read_keys(F, &poses)?;
     let (key_times, times) = read_times(F, &key_times, &times)?;
     let out = py
         .detach(|| {
@@ -359,10 +362,7 @@ fn sample_channels<'py>(
     const F: &str = "sample_channels";
     let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
     let spec = read_spec(F, scheme, levels, closed, period, timing)?;
-    let (keys, single) = read_poses(F, "poses", poses.as_array())?;
-    if single {
-        return Err(shape_err(F, "poses", "(N, 4, 4)", &[4, 4]));
-    }
+    let keys = read_keys(F, &poses)?;
     let (key_times, times) = read_times(F, &key_times, &times)?;
     let previous = previous
         .map(|p| read_vector(F, "previous", p.as_array()))
