@@ -218,16 +218,6 @@ impl V4 {
         }
     }
 
-    /// `v` in every lane.
-    #[inline(always)]
-    pub(crate) fn splat(v: DVec3) -> Self {
-        V4 {
-            x: F4::splat(v.x),
-            y: F4::splat(v.y),
-            z: F4::splat(v.z),
-        }
-    }
-
     /// Lane `i`.
     #[inline(always)]
     pub(crate) fn lane(&self, i: usize) -> DVec3 {
@@ -331,14 +321,6 @@ impl Q4 {
             v: mask.select_v(n.v, self.v),
             w: mask.select(-self.w, self.w),
         }
-    }
-
-    /// `r` rotated by these (unit) quaternions, with glam's `DQuat * DVec3` order of
-    /// operations: `r (w^2 - |v|^2) + v (2 r . v) + (v x r) (2 w)`.
-    #[inline(always)]
-    pub(crate) fn rotate(self, r: V4) -> V4 {
-        let (w, v) = (self.w, self.v);
-        r.scale(w * w - v.dot(v)) + v.scale(r.dot(v) * 2.0) + v.cross(r).scale(w * 2.0)
     }
 
     /// The Hamilton product `self * o`, with glam's order of operations.

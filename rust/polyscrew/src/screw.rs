@@ -52,6 +52,10 @@ pub struct Screw {
     axis: DVec3,
     /// The translation `tau = o_b - R o_a` of the world motion `M`.
     tau: DVec3,
+    /// `v . o_a` and `v x o_a` (`v = q.xyz`, `o_a` the start's translation): shared by the
+    /// rotation of `o_a` by `q` (for `tau`) and by `M^t` (in [`Screw::eval`]).
+    v_dot_o: f64,
+    v_x_o: DVec3,
 }
 
 impl Screw {
@@ -68,9 +72,14 @@ impl Screw {
             q = -q;
         }
         let v = q.xyz();
-        let sin_h = v.length();
+        let b2 = v.dot(v);
+        let sin_h = b2.sqrt();
         let half_angle = fastmath::turn_angle(q.w, sin_h);
-        let tau = b.translation - q * a.translation;
+        // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w), as glam's `q * o_a`.
+        let oa = a.translation;
+        let (v_dot_o, v_x_o) = (v.dot(oa), v.cross(oa));
+        let tau =
+            b.translation - (oa * (q.w * q.w - b2) + v * (v_dot_o * 2.0) + v_x_o * (q.w * 2.0));
         let (inv_sin_half, axis) = if sin_h > 0.0 {
             let inv = 1.0 / sin_h;
             (inv, v * inv)
@@ -85,6 +94,8 @@ impl Screw {
             inv_sin_half,
             axis,
             tau,
+            v_dot_o,
+            v_x_o,
         }
     }
 
@@ -92,6 +103,16 @@ impl Screw {
     /// `t = 0` is the identity, `t = 1` is `M = b a^-1`.
     #[inline]
     pub fn motion(&self, t: f64) -> Pose {
+        let (rotation, translation, _, _) = self.motion_parts(t);
+        Pose {
+            rotation,
+            translation,
+        }
+    }
+
+    /// `M^t`'s rotation `(rho v, cos(t h))` and translation, with `rho` and `cos(t h)`.
+    #[inline(always)]
+    fn motion_parts(&self, t: f64) -> (DQuat, DVec3, f64, f64) {
         let h = self.half_angle;
         let th = t * h;
         let (sin_th, cos_th) = fastmath::sin_cos(th);
@@ -109,23 +130,30 @@ impl Screw {
         // cos((t-1)h), sin((t-1)h) from the angle-difference identities.
         let a = rho * (cos_th * cos_h + sin_th * sin_h);
         let b = rho * (sin_th * cos_h - cos_th * sin_h);
-        let s = self.axis;
+        // The turn's axis, 0 without a turn (then a = t, b = 0: the terms along it vanish and
+        // a pure translation needs no axis of its own).
+        let s = v * self.inv_sin_half;
         let tau = self.tau;
-        let translation = a * tau + ((t - a) * tau.dot(s)) * s + b * s.cross(tau);
-        Pose {
-            rotation,
-            translation,
-        }
+        let translation = tau * a + s * ((t - a) * tau.dot(s)) + s.cross(tau) * b;
+        (rotation, translation, rho, cos_th)
     }
 
     /// `s(a, t, b) = M^t a`: `t = 0` gives `a`, `t = 1` gives `b` (to rounding), other `t`
-    /// move along or past the screw (ScrewBender section 4, `s(L_a, t, L_b)`).
-    #[inline]
+    /// move along or past the screw (ScrewBender section 4, `s(L_a, t, L_b)`). `M^t o_a` by
+    /// glam's rotation formula with `rho v` for `v`, from the cached `v . o_a`, `v x o_a`.
+    #[inline(always)]
     pub fn eval(&self, t: f64) -> Pose {
-        let m = self.motion(t);
+        let (m, translation, rho, cos_th) = self.motion_parts(t);
+        let v = self.rotation.xyz();
+        let oa = self.base.translation;
+        let rho2 = rho * rho;
+        let position = oa * (cos_th * cos_th - rho2 * v.dot(v))
+            + v * (rho2 * self.v_dot_o * 2.0)
+            + self.v_x_o * (rho * cos_th * 2.0)
+            + translation;
         Pose {
-            rotation: m.rotation * self.base.rotation,
-            translation: m.rotation * self.base.translation + m.translation,
+            rotation: m * self.base.rotation,
+            translation: position,
         }
     }
 
@@ -382,8 +410,8 @@ pub fn s_many(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) -> Result<()>
     Ok(())
 }
 
-/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`],
-/// [`Screw::motion`] and [`Screw::eval`] operation for operation, every branch a select.
+/// [`s`] on four pairs at once (`LANES` of each slice): [`Screw::between`] then
+/// [`Screw::eval`] operation for operation, every branch a select.
 #[inline]
 fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     let qa = Q4::from_fn(|i| a[i].rotation);
@@ -391,23 +419,25 @@ fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     let qb = Q4::from_fn(|i| b[i].rotation);
     let ob = V4::from_fn(|i| b[i].translation);
     let t = F4::from_fn(|i| t[i]);
-    // Screw::between.
+    // Screw::between, with S = v / sin h (0 for no turn: then rho = t, A = t, B = 0 and the
+    // terms along S vanish, so a pure translation needs no axis of its own).
     let q = qb.mul(qa.conjugate());
     let q = q.negate_where(q.w.lt(0.0));
-    let v = q.v;
-    let sin_h = v.dot(v).sqrt();
-    let h = fastmath::turn_angle(q.w, sin_h);
-    let tau = ob - q.rotate(oa);
+    let (v, cos_h) = (q.v, q.w);
+    let b2 = v.dot(v);
+    let sin_h = b2.sqrt();
+    let h = fastmath::turn_angle(cos_h, sin_h);
     let inv = F4::splat(1.0) / sin_h;
-    // sin h > 0 (sin h = sqrt(|v|^2) is never so small that 1 / sin h overflows).
     let turning = inv.finite_positive();
     let inv = turning.select(inv, F4::splat(0.0));
-    let length_recip = F4::splat(1.0) / tau.dot(tau).sqrt();
-    let along_tau = length_recip
-        .finite_positive()
-        .select_v(tau.scale(length_recip), V4::splat(DVec3::Z));
-    let axis = turning.select_v(v.scale(inv), along_tau);
-    // Screw::motion.
+    let axis = v.scale(inv);
+    // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w); v . o_a and v x o_a serve
+    // M^t o_a below too.
+    let v_dot_o = v.dot(oa);
+    let v_x_o = v.cross(oa);
+    let tau =
+        ob - (oa.scale(cos_h * cos_h - b2) + v.scale(v_dot_o * 2.0) + v_x_o.scale(cos_h * 2.0));
+    // Screw::motion and Screw::eval.
     let th = t * h;
     if !th.abs_below(fastmath::FAST_REDUCTION_BELOW).all() {
         for i in 0..LANES {
@@ -417,17 +447,21 @@ fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     }
     let (sin_th, cos_th) = lanes::sin_cos(th);
     let rho = turning.select(sin_th * inv, t);
+    let ca = rho * (cos_th * cos_h + sin_th * sin_h);
+    let cb = rho * (sin_th * cos_h - cos_th * sin_h);
+    let translation =
+        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
+    // M^t = (rho v, cos(t h)): M^t q_a, and M^t o_a by the formula above with rho v for v.
     let m = Q4 {
         v: v.scale(rho),
         w: cos_th,
     };
-    let ca = rho * (cos_th * q.w + sin_th * sin_h);
-    let cb = rho * (sin_th * q.w - cos_th * sin_h);
-    let translation =
-        tau.scale(ca) + axis.scale((t - ca) * tau.dot(axis)) + axis.cross(tau).scale(cb);
-    // Screw::eval.
     let rotation = m.mul(qa);
-    let position = m.rotate(oa) + translation;
+    let rho2 = rho * rho;
+    let position = oa.scale(cos_th * cos_th - rho2 * b2)
+        + v.scale(rho2 * v_dot_o * 2.0)
+        + v_x_o.scale(rho * cos_th * 2.0)
+        + translation;
     for (i, pose) in out.iter_mut().enumerate() {
         *pose = Pose {
             rotation: rotation.lane(i),
