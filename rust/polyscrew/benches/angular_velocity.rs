@@ -5,7 +5,11 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DQuat, DVec3};
-use polyscrew::{fit_angular_velocity, AngularVelocityTarget, FitOptions, SpinningTop};
+use polyscrew::{fit_angular_velocity, AngularVelocityTarget, FitOptions};
+
+#[path = "../tests/fixtures/spinning_top.rs"]
+mod spinning_top;
+use spinning_top::SpinningTop;
 
 /// `n` keys of the precessing top over 4 s, every third and the last constrained, and the
 /// wobbly sketch sampled at 60 Hz.

@@ -6,8 +6,20 @@
 //! times to the motion parameter, and sampling of the subdivided motion at any time.
 //! A second method designs motions from feature points (Hofer-Pottmann-Ravani,
 //! [`feature_motion()`]): curve schemes, including Kobbelt's variational subdivision
-//! ([`variational`]), on the feature points' trajectories, then Horn's registration
-//! ([`registration`]) of the rigid body at every sample.
+//! ([`variational_subdivide`]), on the feature points' trajectories, then Horn's
+//! registration ([`register`]) of the rigid body at every sample.
+//!
+//! The crate is grouped by domain, one module folder each:
+//!
+//! | module | what | source |
+//! | --- | --- | --- |
+//! | [`motion`] | poses, screws, Split&Tweak subdivision, timing, sampling, Blender rotation channels | Rossignac-Kim; Powell-Rossignac (ScrewBender) |
+//! | [`sweep`](mod@sweep) | the region a mesh sweeps along a polyscrew | Rossignac-Kim, "Swept volumes" |
+//! | [`feature`] | feature-point motion design: registration, inertia points, variational subdivision | Hofer-Pottmann-Ravani |
+//! | [`angular_velocity`] | fitting a rotation to a sketched angular velocity | Xie-Xu-Yu-Weng |
+//! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
+//!
+//! What users reach for is re-exported here.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
 //! through [`Error`], never by panicking.
@@ -26,44 +38,32 @@
 #![deny(missing_docs)]
 
 pub mod angular_velocity;
-mod banded;
-pub mod channels;
-pub(crate) mod cyclic_band;
-pub mod eigen;
 pub mod error;
-pub mod fastmath;
-pub mod feature_motion;
-pub mod inertia;
-mod lanes;
-pub mod pose;
-pub mod quat_spline;
-pub mod registration;
-pub mod sample;
-pub mod screw;
-pub mod spinning_top;
-pub mod subdivision;
+pub mod feature;
+pub mod motion;
+pub(crate) mod numeric;
 pub mod sweep;
-pub mod timing;
-pub mod variational;
 
 pub use angular_velocity::{
     fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
-    FitStatus,
+    FitStatus, QuatJet, QuatSpline,
 };
-pub use channels::{rotation_channels, EulerOrder, RotationMode};
 pub use error::{Error, PoseDefect, Result};
-pub use feature_motion::{
+pub use feature::inertia::InertiaFrame;
+pub use feature::motion::{
     feature_motion, feature_motion_timed, sample_feature_motion, CurveScheme, FeatureSpec,
     UNIT_FRAME_POINTS,
 };
-pub use inertia::InertiaFrame;
-pub use pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
-pub use quat_spline::{QuatJet, QuatSpline};
-pub use registration::register;
-pub use sample::{sample, Motion, MotionSpec};
-pub use screw::{midpoint, s, s_many, Screw};
-pub use spinning_top::SpinningTop;
-pub use subdivision::{subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES};
+pub use feature::registration::register;
+pub use feature::variational::{
+    variational_curve, variational_subdivide, Parametrization, Stiffness,
+};
+pub use motion::channels::{rotation_channels, EulerOrder, RotationMode};
+pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
+pub use motion::sample::{sample, Motion, MotionSpec};
+pub use motion::screw::{midpoint, s, s_many, Screw};
+pub use motion::subdivision::{
+    subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES,
+};
+pub use motion::timing::{check_key_times, TimeMap, Timing};
 pub use sweep::{sweep, sweep_mesh, Body, Generator, SweepOptions, SweptMesh};
-pub use timing::{check_key_times, TimeMap, Timing};
-pub use variational::{variational_curve, variational_subdivide, Parametrization, Stiffness};

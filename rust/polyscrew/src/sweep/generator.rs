@@ -32,7 +32,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use super::body::{Body, EdgeKind, NO_FACE};
-use crate::screw::Screw;
+use crate::motion::screw::Screw;
 
 /// Below this fraction of the largest vertex speed, `n . v` counts as zero (the point is
 /// grazing, the face tangent).

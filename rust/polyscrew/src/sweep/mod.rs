@@ -40,8 +40,8 @@ pub use generator::{
 };
 
 use crate::error::{Error, PoseDefect, Result};
-use crate::pose::Pose;
-use crate::screw::Screw;
+use crate::motion::pose::Pose;
+use crate::motion::screw::Screw;
 
 /// Most steps per screw accepted by [`sweep`].
 pub const MAX_STEPS: u32 = 4096;

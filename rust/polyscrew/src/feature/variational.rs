@@ -41,9 +41,9 @@
 
 use glam::DVec3;
 
-use crate::cyclic_band::BandMatrix;
 use crate::error::{Error, Result};
-use crate::subdivision::{check_subdivision, subdivided_len};
+use crate::motion::subdivision::{check_subdivision, subdivided_len};
+use crate::numeric::cyclic_band::BandMatrix;
 
 /// How parameter values are assigned to the input points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -226,7 +226,7 @@ pub struct VariationalLevel {
     stencils: Vec<([usize; 3], [f64; 3])>,
     /// Spring weight of each unknown (0 for new points).
     springs: Vec<f64>,
-    factor: crate::cyclic_band::BandFactor,
+    factor: crate::numeric::cyclic_band::BandFactor,
 }
 
 impl VariationalLevel {

@@ -18,7 +18,7 @@
 //! fractions are sixteenths, so one [`Interpolant::eval_sixteenths`] per edge serves every
 //! rule (for screws: no trigonometry, see [`Screw::eval_sixteenths`]), and the schemes are
 //! tables read by one refinement pass. The outer `s(., 1/2, .)` is
-//! [`Interpolant::midpoint`] (for poses: no screw at all, see [`crate::screw::midpoint`]).
+//! [`Interpolant::midpoint`] (for poses: no screw at all, see [`crate::motion::screw::midpoint`]).
 //!
 //! Open sequences get a phantom pose at each end at every level, by screw extrapolation
 //! `s(P0, -1, P1)` and `s(P[n-1], -1, P[n-2])`; the end poses are kept exactly. Poses sampled
@@ -27,8 +27,8 @@
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::pose::Pose;
-use crate::screw::Screw;
+use crate::motion::pose::Pose;
+use crate::motion::screw::Screw;
 
 /// The largest number of subdivision levels accepted (closed output `n 2^12` poses).
 pub const MAX_LEVELS: u32 = 12;
@@ -109,7 +109,7 @@ impl Interpolant for Pose {
     }
     #[inline(always)]
     fn midpoint(a: &Self, b: &Self) -> Self {
-        crate::screw::midpoint(a, b)
+        crate::motion::screw::midpoint(a, b)
     }
     #[inline(always)]
     fn eval_sixteenths<const N: usize>(seg: &Screw, ks: [i32; N]) -> [Self; N] {
@@ -387,7 +387,7 @@ mod tests {
     /// One level of the rules in the module docs written directly with `s`, on a closed
     /// cycle, or on an open sequence extended by its phantoms.
     fn rules_with_s(p: &[Pose], scheme: Scheme, closed: bool) -> Vec<Pose> {
-        use crate::screw::s;
+        use crate::motion::screw::s;
         let mut ext = p.to_vec();
         if !closed {
             let n = p.len();

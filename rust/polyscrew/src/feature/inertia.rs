@@ -25,8 +25,8 @@
 
 use glam::{DMat3, DVec3};
 
-use crate::eigen::symmetric_eigen;
 use crate::error::{Error, Result};
+use crate::numeric::eigen::symmetric_eigen;
 
 /// A cloud counts as collinear (its rotation about the line undetermined) when the second
 /// largest eigenvalue of its inertia tensor is at most this fraction of the largest.
@@ -148,7 +148,7 @@ impl InertiaFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::registration::register;
+    use crate::feature::registration::register;
     use glam::{DAffine3, DQuat};
 
     fn cloud() -> Vec<DVec3> {

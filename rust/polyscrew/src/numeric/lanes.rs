@@ -3,80 +3,21 @@
 //! LLVM compiles to packed SSE2 instructions (two lanes per instruction on baseline x86-64).
 //! Branches become selects: every lane computes every case and a mask picks.
 //!
-//! [`Real`] lets one polynomial kernel ([`estrin`]) serve `f64` and [`F4`] (the same
-//! operations in the same order, so a lane agrees with the scalar to the bit):
-//! [`crate::fastmath`]'s sin/cos kernel and `turn_angle` take either; [`sin_cos`] is the lane
-//! form of its range reduction.
+//! [`F4`] implements [`fastmath`](crate::numeric::fastmath)'s [`Real`], so one polynomial
+//! kernel serves `f64` and four lanes (the same operations in the same order, so a lane
+//! agrees with the scalar to the bit): the sin/cos kernel and `turn_angle` take either;
+//! [`sin_cos`] is the lane form of its range reduction. This module depends on `fastmath`,
+//! never the other way round.
 
 use std::f64::consts::FRAC_PI_2;
 use std::ops::{Add, Div, Mul, Neg, Sub};
 
 use glam::{DQuat, DVec3};
 
-use crate::fastmath::{kernel, PIO2_HI, PIO2_LO, ROUNDING_SHIFT};
+use crate::numeric::fastmath::{kernel, Real, PIO2_HI, PIO2_LO, ROUNDING_SHIFT};
 
 /// The number of lanes.
 pub(crate) const LANES: usize = 4;
-
-/// A number type the polynomial kernels accept: `f64` or four lanes of it.
-pub(crate) trait Real:
-    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
-{
-    /// `v` in every lane.
-    fn splat(v: f64) -> Self;
-    /// The square root (of every lane).
-    fn sqrt(self) -> Self;
-}
-
-impl Real for f64 {
-    #[inline(always)]
-    fn splat(v: f64) -> Self {
-        v
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        f64::sqrt(self)
-    }
-}
-
-/// `c[0] + c[1] x + ... + c[N - 1] x^(N - 1)` by Estrin's scheme: pairs `c[i] + c[i + 1] x`
-/// combined with `x^2`, `x^4`, ..., a dependency chain of `log2 N` steps instead of Horner's
-/// `N - 1` (the kernels sit on the critical path of `s`).
-#[inline(always)]
-pub(crate) fn estrin<R: Real, const N: usize>(x: R, c: [f64; N]) -> R {
-    // Level 0: the terms of degree 0 and 1 in x, N / 2 (rounded up) of them.
-    let mut terms: [R; N] = [R::splat(0.0); N];
-    let mut len = 0;
-    let mut i = 0;
-    while i < N {
-        terms[len] = if i + 1 < N {
-            R::splat(c[i]) + R::splat(c[i + 1]) * x
-        } else {
-            R::splat(c[i])
-        };
-        len += 1;
-        i += 2;
-    }
-    let mut power = x * x;
-    while len > 1 {
-        let mut j = 0;
-        let mut k = 0;
-        while j < len {
-            terms[k] = if j + 1 < len {
-                terms[j] + terms[j + 1] * power
-            } else {
-                terms[j]
-            };
-            k += 1;
-            j += 2;
-        }
-        len = k;
-        if len > 1 {
-            power = power * power;
-        }
-    }
-    terms[0]
-}
 
 /// Four `f64` lanes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -339,8 +280,8 @@ impl Q4 {
     }
 }
 
-/// `(sin x, cos x)` per lane for `|x| < crate::fastmath::FAST_REDUCTION_BELOW` (the caller
-/// checks), with [`crate::fastmath::sin_cos`]'s reduction and kernel; the quadrant by
+/// `(sin x, cos x)` per lane for `|x| < crate::numeric::fastmath::FAST_REDUCTION_BELOW` (the caller
+/// checks), with [`crate::numeric::fastmath::sin_cos`]'s reduction and kernel; the quadrant by
 /// selects.
 #[inline(always)]
 pub(crate) fn sin_cos(x: F4) -> (F4, F4) {
@@ -359,7 +300,7 @@ pub(crate) fn sin_cos(x: F4) -> (F4, F4) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fastmath;
+    use crate::numeric::fastmath;
 
     #[test]
     fn kernels_agree_with_the_scalar_to_the_bit() {

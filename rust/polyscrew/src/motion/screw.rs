@@ -27,9 +27,10 @@
 use glam::{DQuat, DVec3};
 
 use crate::error::{Error, Result};
-use crate::fastmath;
-use crate::lanes::{self, Real, F4, LANES, Q4, V4};
-use crate::pose::Pose;
+use crate::motion::pose::Pose;
+use crate::numeric::fastmath;
+use crate::numeric::fastmath::Real;
+use crate::numeric::lanes::{self, F4, LANES, Q4, V4};
 
 /// The minimal screw carrying pose `a` to pose `b`, ready to be evaluated at any `t`.
 ///

@@ -3,8 +3,8 @@
 //! them ("between dense poses, the motion is the screw between them").
 
 use crate::error::{Error, Result};
-use crate::subdivision::{subdivide, Interpolant, Scheme};
-use crate::timing::{TimeMap, Timing};
+use crate::motion::subdivision::{subdivide, Interpolant, Scheme};
+use crate::motion::timing::{TimeMap, Timing};
 
 /// Everything that defines a smoothed motion besides its keys.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -82,8 +82,8 @@ impl<T: Interpolant> Motion<T> {
         period: Option<f64>,
         timing: Timing,
     ) -> Result<Self> {
-        crate::subdivision::check_subdivision(key_times.len(), levels)?;
-        let expected = crate::subdivision::subdivided_len(key_times.len(), levels, closed);
+        crate::motion::subdivision::check_subdivision(key_times.len(), levels)?;
+        let expected = crate::motion::subdivision::subdivided_len(key_times.len(), levels, closed);
         if dense.len() != expected {
             return Err(Error::LengthMismatch {
                 what: "dense poses",

@@ -15,8 +15,67 @@
 #![allow(clippy::excessive_precision)]
 
 use std::f64::consts::FRAC_PI_2;
+use std::ops::{Add, Div, Mul, Sub};
 
-use crate::lanes::{estrin, Real};
+/// A number type the polynomial kernels accept: `f64` or four lanes of it.
+pub(crate) trait Real:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    /// `v` in every lane.
+    fn splat(v: f64) -> Self;
+    /// The square root (of every lane).
+    fn sqrt(self) -> Self;
+}
+
+impl Real for f64 {
+    #[inline(always)]
+    fn splat(v: f64) -> Self {
+        v
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        f64::sqrt(self)
+    }
+}
+
+/// `c[0] + c[1] x + ... + c[N - 1] x^(N - 1)` by Estrin's scheme: pairs `c[i] + c[i + 1] x`
+/// combined with `x^2`, `x^4`, ..., a dependency chain of `log2 N` steps instead of Horner's
+/// `N - 1` (the kernels sit on the critical path of `s`).
+#[inline(always)]
+pub(crate) fn estrin<R: Real, const N: usize>(x: R, c: [f64; N]) -> R {
+    // Level 0: the terms of degree 0 and 1 in x, N / 2 (rounded up) of them.
+    let mut terms: [R; N] = [R::splat(0.0); N];
+    let mut len = 0;
+    let mut i = 0;
+    while i < N {
+        terms[len] = if i + 1 < N {
+            R::splat(c[i]) + R::splat(c[i + 1]) * x
+        } else {
+            R::splat(c[i])
+        };
+        len += 1;
+        i += 2;
+    }
+    let mut power = x * x;
+    while len > 1 {
+        let mut j = 0;
+        let mut k = 0;
+        while j < len {
+            terms[k] = if j + 1 < len {
+                terms[j] + terms[j + 1] * power
+            } else {
+                terms[j]
+            };
+            k += 1;
+            j += 2;
+        }
+        len = k;
+        if len > 1 {
+            power = power * power;
+        }
+    }
+    terms[0]
+}
 
 /// `1.5 * 2^52`: adding it rounds an f64 below `2^51` in magnitude to an integer.
 pub(crate) const ROUNDING_SHIFT: f64 = 6_755_399_441_055_744.0;

@@ -27,7 +27,7 @@
 use glam::{DQuat, DVec3, DVec4};
 
 use crate::error::{Error, Result};
-use crate::timing::check_key_times;
+use crate::motion::timing::check_key_times;
 
 /// Keys shorter than this (as 4-vectors) cannot be normalised and are rejected.
 pub const MIN_QUATERNION_LENGTH: f64 = 1e-9;

@@ -51,13 +51,15 @@
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::inertia::InertiaFrame;
-use crate::pose::Pose;
-use crate::registration::{cross_covariance, rotation_from_covariance_warm, IDENTITY4};
-use crate::sample::Motion;
-use crate::subdivision::{check_subdivision, subdivide, Scheme};
-use crate::timing::Timing;
-use crate::variational::{spans_spacing, variational_subdivide, Parametrization, Stiffness};
+use crate::feature::inertia::InertiaFrame;
+use crate::feature::registration::{cross_covariance, rotation_from_covariance_warm, IDENTITY4};
+use crate::feature::variational::{
+    spans_spacing, variational_subdivide, Parametrization, Stiffness,
+};
+use crate::motion::pose::Pose;
+use crate::motion::sample::Motion;
+use crate::motion::subdivision::{check_subdivision, subdivide, Scheme};
+use crate::motion::timing::Timing;
 
 /// The curve scheme run on the feature points' trajectories.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -296,7 +298,7 @@ pub fn feature_motion_timed(
         });
     }
     // Validate the timing before the (costlier) design.
-    crate::timing::TimeMap::new(key_times, spec.closed, period, timing)?;
+    crate::motion::timing::TimeMap::new(key_times, spec.closed, period, timing)?;
     let dense = feature_motion(keys, feature_points, spec)?;
     Motion::from_dense(dense, key_times, spec.levels, spec.closed, period, timing)
 }
@@ -320,8 +322,8 @@ pub fn sample_feature_motion(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::registration::register;
-    use crate::registration::tests::Rng;
+    use crate::feature::registration::register;
+    use crate::feature::registration::tests::Rng;
     use glam::DQuat;
 
     fn keys(n: usize, seed: u64) -> Vec<Pose> {

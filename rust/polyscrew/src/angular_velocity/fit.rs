@@ -30,9 +30,11 @@
 
 use glam::{DQuat, DVec3, DVec4};
 
-use crate::banded::SymBand;
+use crate::angular_velocity::quat_spline::{
+    check_keys, hermite_weights, quat_conj, quat_exp, quat_mul, QuatSpline,
+};
 use crate::error::{Error, Result};
-use crate::quat_spline::{check_keys, hermite_weights, quat_conj, quat_exp, quat_mul, QuatSpline};
+use crate::numeric::banded::SymBand;
 
 /// The paper's weight of the tangential-acceleration term `W_T` (section 2: 0.002; it found
 /// `[0.001, 0.005]` to work well).
@@ -964,7 +966,7 @@ pub fn fit_angular_velocity(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::spinning_top::SpinningTop;
+    use crate::angular_velocity::spinning_top::SpinningTop;
 
     /// The angle of the rotation taking `a` to `b`.
     fn angle(a: DQuat, b: DQuat) -> f64 {

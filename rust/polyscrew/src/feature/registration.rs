@@ -32,9 +32,9 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use crate::eigen::symmetric_eigen_from;
 use crate::error::{Error, Result};
-use crate::pose::Pose;
+use crate::motion::pose::Pose;
+use crate::numeric::eigen::symmetric_eigen_from;
 
 /// The largest eigenvalue of Horn's matrix counts as repeated when the gap to the second is
 /// at most this fraction of the matrix's spectral radius. Jacobi resolves eigenvalues to
