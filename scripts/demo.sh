@@ -6,9 +6,21 @@
 #      bpy wheel and `--out-dir out`:
 #        10_scene.py   the keyed demo scene           -> out/demo_source.blend
 #        20_smooth.py  smoothed with every scheme     -> out/demo.blend
-#        30_render.py  stroboscopic Workbench renders -> out/demo_*.png (+ docs/images/)
+#        30_render.py  stroboscopic Workbench renders -> out/demo_*.png
 #      Other features add their own NN_*.py parts; they run in the same way.
+# Everything is written under out/ (git-ignored): the checkout stays clean.
+#
+#   scripts/demo.sh --update-docs   also copies the renders the README shows (every file of
+#                                   docs/images/) from out/ over docs/images/, for a commit.
 set -euo pipefail
+update_docs=0
+for arg in "$@"; do
+  case "$arg" in
+    --update-docs) update_docs=1 ;;
+    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    *) echo "demo: unknown option $arg (try --help)" >&2; exit 2 ;;
+  esac
+done
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 start=$(date +%s)
@@ -33,5 +45,13 @@ for part in scripts/demo/[0-9][0-9]_*.py; do
     echo "demo: $part failed" >&2; exit 1
   fi
 done
+if [ "$update_docs" = 1 ]; then
+  stage "update docs/images from out/"
+  for image in docs/images/*.png; do
+    name=$(basename "$image")
+    [ -f "out/$name" ] || { echo "demo: out/$name was not rendered; docs/images left as they were" >&2; exit 1; }
+  done
+  for image in docs/images/*.png; do cp "out/$(basename "$image")" "$image"; echo "updated $image"; done
+fi
 stage "demo done"
 ls -1 out/*.blend out/*.png

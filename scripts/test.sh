@@ -16,6 +16,9 @@ py="$root/.venv/bin/python"
 stage "cargo test (workspace)"
 cargo test --workspace --quiet
 
+stage "cargo doc (warnings are errors)"
+RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet -p polyscrew
+
 stage "build the polyscrew wheel (release)"
 rm -rf dist/wheel && mkdir -p dist/wheel
 "$root/.venv/bin/maturin" build --release --quiet -o dist/wheel 2>&1 | grep -v '^ *Compiling' || true

@@ -1,30 +1,38 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """ScrewBender: smooth an object's keyed motion into a coordinate-free screw motion.
 
-Modules: :mod:`channels` (legacy and slotted actions), :mod:`keys` (F-curves -> key poses),
-:mod:`bake` (polyscrew sampling -> new action, revert), :mod:`operators`, :mod:`ui`.
-Live preview: :mod:`preview` (batches, cache), :mod:`preview_draw` (gpu overlay),
-:mod:`insert_key`, :mod:`preview_ui` (settings, panel, Apply Preview, Insert Key on Motion).
+One naming rule: ``<feature>.py`` is the logic of a feature (bpy data in, bpy data out, no
+operator, panel or property group), ``<feature>_ops.py`` its operators, settings, panels and
+menu entries (collect options, call the logic, report), ``<feature>_draw.py`` its viewport
+drawing. The features:
+
+- Smooth Motion and Revert: :mod:`bake` + :mod:`bake_ops`; beneath them :mod:`keys`
+  (F-curves -> key poses), :mod:`channels` (the action APIs of every Blender version) and
+  :mod:`feature` (the Feature Points method).
+- Live preview: :mod:`preview` + :mod:`preview_ops` + :mod:`preview_draw`, with
+  :mod:`insert_key` (Insert Key on Motion).
+- Swept regions and clearance: :mod:`swept` + :mod:`swept_ops`.
+- Angular-velocity editing: :mod:`angvel` + :mod:`angvel_ops`.
 """
 
 from __future__ import annotations
 
 import bpy
 
-from . import angvel, operators, preview_ui, sweep_ops, ui
+from . import angvel_ops, bake_ops, preview_ops, swept_ops
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(
-    operators.classes + ui.classes + angvel.classes + sweep_ops.classes + preview_ui.classes
+    bake_ops.classes + angvel_ops.classes + swept_ops.classes + preview_ops.classes
 )
 
 
 def register() -> None:
     _register_classes()
-    ui.register_properties()
-    preview_ui.register_properties()
+    bake_ops.register_properties()
+    preview_ops.register_properties()
 
 
 def unregister() -> None:
-    preview_ui.unregister_properties()
-    ui.unregister_properties()
+    preview_ops.unregister_properties()
+    bake_ops.unregister_properties()
     _unregister_classes()

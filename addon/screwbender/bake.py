@@ -46,6 +46,13 @@ CLOSED_MODES = (
     ("OFF", "Open", "Treat the keys as an open sequence, ignoring Cycles modifiers"),
 )
 
+#: Which frames get baked keys.
+RANGE_MODES = (
+    ("KEYS", "Keys", "Bake each object from its first to its last key (a cycle: over one period)"),
+    ("SCENE", "Scene", "Bake the scene's frame range"),
+    ("CUSTOM", "Custom", "Bake the frame range given by Start and End"),
+)
+
 #: Custom properties recorded on a smoothed action.
 SOURCE_KEY = "screwbender_source"
 SOURCE_SLOT_KEY = "screwbender_source_slot"
@@ -74,6 +81,29 @@ class Options:
     approximate: bool = False
     #: Feature points: spring stiffness of the approximated keys (smaller is smoother).
     stiffness: float = 1.0
+
+
+def options_from(settings, scene: bpy.types.Scene) -> Options:
+    """The options set on `settings`: Smooth Motion's operator properties, or the panel's
+    scene settings (`scene.screwbender`), which have the same names."""
+    if settings.range_mode == "SCENE":
+        frame_range = (float(scene.frame_start), float(scene.frame_end))
+    elif settings.range_mode == "CUSTOM":
+        frame_range = (settings.frame_start, settings.frame_end)
+    else:
+        frame_range = None
+    return Options(
+        scheme=settings.scheme,
+        levels=settings.levels,
+        timing=settings.timing,
+        closed=settings.closed,
+        frame_range=frame_range,
+        step=settings.step,
+        method=settings.method,
+        parametrization=settings.parametrization,
+        approximate=settings.approximate,
+        stiffness=settings.stiffness,
+    )
 
 
 @dataclass

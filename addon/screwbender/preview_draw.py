@@ -16,7 +16,6 @@ matrix (`matrix_world @ matrix_basis^-1`), so moving a parent does not recompute
 
 from __future__ import annotations
 
-import types
 from dataclasses import dataclass
 
 import bpy
@@ -27,7 +26,6 @@ from gpu_extras.batch import batch_for_shader
 from mathutils import Matrix
 
 from . import bake, preview
-from .operators import SCREWBENDER_OT_smooth
 
 #: The object property that turns an object's preview on.
 OBJECT_PROP = "screwbender_preview"
@@ -62,7 +60,7 @@ _last_draw_error = ""
 def preview_options(scene: bpy.types.Scene) -> preview.PreviewOptions:
     """The preview options of `scene`: Smooth Motion's panel settings (shared) and the
     preview's own display settings."""
-    smooth = SCREWBENDER_OT_smooth.smooth_options(scene.screwbender, types.SimpleNamespace(scene=scene))
+    smooth = bake.options_from(scene.screwbender, scene)
     display = getattr(scene, SCENE_PROP)
     return preview.PreviewOptions(
         smooth=smooth,

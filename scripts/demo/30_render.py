@@ -3,15 +3,14 @@
 For each demo motion, the object is drawn at evenly spaced frames (blue at the start of the
 motion to orange at the end; the key poses in red) once per variant, in panels side by side:
 Blender's own Bezier interpolation of the keys, the raw polyscrew (one screw per key span),
-and the ScrewBender subdivisions. Writes out/demo_<motion>.png and copies them into
-docs/images/ for the README.
+and the ScrewBender subdivisions. Writes out/demo_<motion>.png (`scripts/demo.sh
+--update-docs` copies them to docs/images/ for the README).
 """
 
 from __future__ import annotations
 
 import colorsys
 import math
-import shutil
 import sys
 from pathlib import Path
 
@@ -263,12 +262,9 @@ def main() -> None:
     out = demo_common.out_dir()
     bpy.ops.wm.open_mainfile(filepath=str(out / "demo.blend"))
     source_scene = bpy.context.scene
-    images = demo_common.ROOT / "docs" / "images"
-    images.mkdir(parents=True, exist_ok=True)
     for motion in SHOTS:
         path = render_shot(source_scene, motion, out)
-        shutil.copy2(path, images / path.name)
-        print(f"30_render: {path} (copied to docs/images/)")
+        print(f"30_render: {path}")
 
 
 if __name__ == "__main__":

@@ -12,14 +12,13 @@ key selected to hold, Fit Angular Velocity. Prints the fit figures and writes
 - out/angvel_filmstrip.png: Workbench filmstrip of the top every 6 frames, before (top row)
   and after (bottom row);
 
-and copies them to docs/images/. Run: PYTHONPATH=<pylib>:.venv/bpy/5.0 python scripts/demo/40_angular_velocity.py
+(`scripts/demo.sh --update-docs` copies them to docs/images/). Run: PYTHONPATH=<pylib>:.venv/bpy/5.0 python scripts/demo/40_angular_velocity.py
 """
 
 from __future__ import annotations
 
 import importlib
 import math
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -246,8 +245,6 @@ def main() -> None:
     print(f"  fitted omega direction vs sketch: mean {off.mean():.2f} deg, max {off.max():.2f} deg (sketch loops: {math.degrees(WOBBLE):.0f} deg)")
     print(f"  the top's axis now wobbles up to {max(nutation):.2f} deg away from the keyed precession")
 
-    images = demo_common.ROOT / "docs" / "images"
-    images.mkdir(parents=True, exist_ok=True)
     paths = [out / "angvel_sphere.png", out / "angvel_tip.png", out / "angvel_filmstrip.png"]
     plot_sphere(
         directions, fit_dirs, (target_frames - frames[0]) / FPS, speeds, t_fit, np.linalg.norm(result.omega, axis=1),
@@ -259,8 +256,7 @@ def main() -> None:
     strip = np.arange(0, len(frames), 6)
     render_filmstrip(obj.data, [before[i] for i in strip], [after[i] for i in strip], paths[2])
     for p in paths:
-        shutil.copy2(p, images / p.name)
-        print(f"40_angular_velocity: {p} (copied to docs/images/)")
+        print(f"40_angular_velocity: {p}")
 
 
 if __name__ == "__main__":

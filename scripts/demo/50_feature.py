@@ -1,7 +1,7 @@
 """Demo part 50: noisy keys smoothed by feature-point motion design (Hofer-Pottmann-Ravani),
 interpolating (every key hit) beside approximating (only the first and last key hit, the
 others, all selected, pulled by the Stiffness spring). Writes out/demo_feature.blend, a stroboscopic
-Workbench render out/demo_feature.png (copied to docs/images/) and the figures of the README
+Workbench render out/demo_feature.png and the figures of the README
 in out/demo_feature.txt.
 
 Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/demo/50_feature.py [--out-dir out]
@@ -11,7 +11,6 @@ Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/demo/50_feature.py [--out
 from __future__ import annotations
 
 import math
-import shutil
 import sys
 from pathlib import Path
 
@@ -193,9 +192,6 @@ def main() -> None:
     path = out / "demo_feature.png"
     render.render.filepath = str(path)
     bpy.ops.render.render(write_still=True, scene=render.name)
-    images = demo_common.ROOT / "docs" / "images"
-    images.mkdir(parents=True, exist_ok=True)
-    shutil.copy(path, images / "demo_feature.png")
 
     lines = [
         f"noisy keys: {KEYS}, every {KEY_STEP} frames, jitter {JITTER_LOCATION} (location), "

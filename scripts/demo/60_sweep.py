@@ -5,13 +5,12 @@ the installed extension's `screwbender.sweep` operator (the smoothed motion at i
 keys, 1 step per span: the baked keys are one frame apart), and renders with Workbench, side by side: a few instances of the
 body along the motion over the translucent swept region, and the swept region alone.
 Prints triangles and time, against the triangles of stroboscopic instancing at every baked
-key. Writes out/demo_sweep_<motion>.png and copies them into docs/images/.
+key. Writes out/demo_sweep_<motion>.png.
 """
 
 from __future__ import annotations
 
 import math
-import shutil
 import sys
 import time
 from pathlib import Path
@@ -158,8 +157,6 @@ def main() -> None:
     out = demo_common.out_dir()
     bpy.ops.wm.open_mainfile(filepath=str(out / "demo.blend"))
     source_scene = bpy.context.scene
-    images = demo_common.ROOT / "docs" / "images"
-    images.mkdir(parents=True, exist_ok=True)
     for motion in SHOTS:
         obj = source_scene.objects[f"{motion}.Jarek"]
         region, seconds = sweep(obj)
@@ -175,8 +172,7 @@ def main() -> None:
             f"baked key: {n_frames * body_tris} triangles"
         )
         path = render(source_scene, motion, obj, region, out)
-        shutil.copy2(path, images / path.name)
-        print(f"60_sweep: {path} (copied to docs/images/)")
+        print(f"60_sweep: {path}")
     bpy.ops.wm.save_as_mainfile(filepath=str(out / "demo_sweep.blend"))
 
 

@@ -9,8 +9,7 @@ an orthographic camera fitted to the motion. Three panels side by side:
   2. Flyer, the same motion as faint solid instances;
   3. SpinBlock, a closed cycle of four poses, B-spline 5 levels.
 
-Key poses in red, the origin's trajectory in orange. Writes out/preview_overlay.png and
-copies it to docs/images/. In background mode the `gpu` module refuses to draw until Blender
+Key poses in red, the origin's trajectory in orange. Writes out/preview_overlay.png. In background mode the `gpu` module refuses to draw until Blender
 has a GPU context; a tiny Workbench render creates one (software OpenGL is enough). Where
 even that fails, the script says why and writes no image.
 """
@@ -20,7 +19,6 @@ from __future__ import annotations
 import importlib
 import importlib.util
 import math
-import shutil
 import sys
 from pathlib import Path
 
@@ -156,10 +154,7 @@ def main() -> None:
     image = np.concatenate(sum(([p, gap] for p in panels), [])[:-1], axis=1)
     path = out / "preview_overlay.png"
     save_png(image, path)
-    docs = demo_common.ROOT / "docs" / "images"
-    docs.mkdir(parents=True, exist_ok=True)
-    shutil.copy(path, docs / path.name)
-    print(f"70_preview: {path} ({image.shape[1]}x{image.shape[0]}), copied to {docs / path.name}")
+    print(f"70_preview: {path} ({image.shape[1]}x{image.shape[0]})")
     for obj in bpy.context.scene.objects:
         obj.screwbender_preview = False
 

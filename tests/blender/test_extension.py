@@ -19,7 +19,10 @@ def test_installed_from_zip_and_enabled():
     module = conftest.addon_module()
     installed = Path(module.__file__).resolve()
     assert installed.is_relative_to(conftest.USER_DIR.resolve()), installed
-    for name in ("keys.py", "bake.py", "operators.py", "ui.py", "channels.py", "blender_manifest.toml"):
+    source = conftest.ROOT / "addon" / "screwbender"
+    shipped = sorted(p.name for p in source.iterdir() if p.suffix in (".py", ".toml"))
+    assert len(shipped) >= 15, shipped
+    for name in shipped:
         assert (installed.parent / name).is_file(), name
     # The wheel named in the manifest was unpacked into the extensions' site-packages.
     bundled = list(conftest.USER_DIR.glob("extensions/.local/lib/python*/site-packages/polyscrew/__init__.py"))
