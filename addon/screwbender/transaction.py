@@ -1,0 +1,204 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""All or nothing: what an operator changes in `bpy.data`, undone when it fails halfway.
+
+Blender's undo system records a step only when an operator finishes; an operator that fails
+halfway through writing (a bug, a Blender API that changed, an out-of-memory error) would leave
+half a change in the user's scene: a new action nobody uses, keys inserted on some curves but
+not on others. Every operator that writes runs its writing inside :func:`atomic`::
+
+    with transaction.atomic() as t:
+        action = source.copy()          # new data-blocks are found and removed on failure
+        t.assign_action(obj, action, identifier)  # changes of existing data are journaled
+        t.set(source, "use_fake_user", True)
+
+On an exception the journal is replayed backwards, every data-block created since the start
+(actions, objects, meshes, curves, collections) is removed, and the exception propagates to the
+operator, which reports it and cancels. Nothing here is specific to one operator.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import bpy
+import numpy as np
+
+from . import channels
+
+#: `bpy.data` collections whose new members a failed operator removes, in removal order
+#: (users first: objects before the meshes and curves they use, collections last).
+CREATED_KINDS = ("objects", "meshes", "curves", "actions", "collections")
+
+#: Keyframe properties restored when an F-curve's keys are put back: (name, items per key, dtype).
+KEYFRAME_PROPERTIES = (
+    ("co", 2, np.float32),
+    ("handle_left", 2, np.float32),
+    ("handle_right", 2, np.float32),
+    ("interpolation", 1, np.int32),
+    ("easing", 1, np.int32),
+    ("handle_left_type", 1, np.int32),
+    ("handle_right_type", 1, np.int32),
+    ("type", 1, np.int32),
+    ("back", 1, np.float32),
+    ("amplitude", 1, np.float32),
+    ("period", 1, np.float32),
+    ("select_control_point", 1, bool),
+    ("select_left_handle", 1, bool),
+    ("select_right_handle", 1, bool),
+)
+
+_MISSING = object()
+
+
+def _enum_values(points, name: str) -> np.ndarray:
+    """Enum keyframe properties through `foreach_get` as integers (their RNA values)."""
+    out = np.empty(len(points), dtype=np.int32)
+    points.foreach_get(name, out)
+    return out
+
+
+class Transaction:
+    """The journal of one operator's changes; see the module docstring."""
+
+    def __init__(self) -> None:
+        self._undo: list[Callable[[], None]] = []
+        self._on_commit: list[Callable[[], None]] = []
+        self._existing = {kind: {id_.as_pointer() for id_ in getattr(bpy.data, kind)} for kind in CREATED_KINDS}
+
+    # Journaled changes of existing data ------------------------------------------------------
+
+    def on_rollback(self, undo: Callable[[], None]) -> None:
+        """Registers `undo`, run (newest first) when the transaction fails."""
+        self._undo.append(undo)
+
+    def on_commit(self, action: Callable[[], None]) -> None:
+        """Registers `action`, run when the transaction succeeds (for what cannot be undone,
+        such as removing a data-block: it happens only once everything else has worked)."""
+        self._on_commit.append(action)
+
+    def set(self, target: Any, name: str, value: Any) -> None:
+        """`setattr(target, name, value)`, undone on failure."""
+        old = getattr(target, name)
+        self.on_rollback(lambda: setattr(target, name, old))
+        setattr(target, name, value)
+
+    def set_item(self, target: Any, key: str, value: Any) -> None:
+        """`target[key] = value` (an ID property), undone on failure (removed if it was new)."""
+        old = target.get(key, _MISSING)
+
+        def undo() -> None:
+            if old is _MISSING:
+                if key in target:
+                    del target[key]
+            else:
+                target[key] = old
+
+        self.on_rollback(undo)
+        target[key] = value
+
+    def assign_action(self, obj: bpy.types.Object, action: bpy.types.Action | None, identifier: str = "") -> None:
+        """Makes `action` the active action of `obj` (on slot `identifier`), undone on failure:
+        the old action and slot come back, and animation data created here goes again."""
+        had_adt = obj.animation_data is not None
+        old_action = obj.animation_data.action if had_adt else None
+        old_identifier = channels.slot_identifier(obj) if had_adt else ""
+
+        def undo() -> None:
+            if not had_adt:
+                obj.animation_data_clear()
+            else:
+                channels.assign(obj, old_action, old_identifier)
+
+        self.on_rollback(undo)
+        channels.assign(obj, action, identifier)
+
+    def keep_keys(self, fcurve: bpy.types.FCurve) -> None:
+        """Snapshots every key of `fcurve` (positions, handles, interpolation, easing, types,
+        selection); on failure the curve gets exactly these keys back."""
+        points = fcurve.keyframe_points
+        n = len(points)
+        saved = {}
+        for name, width, dtype in KEYFRAME_PROPERTIES:
+            if dtype is np.int32:
+                saved[name] = _enum_values(points, name)
+            else:
+                values = np.empty(n * width, dtype=dtype)
+                points.foreach_get(name, values)
+                saved[name] = values
+
+        def undo() -> None:
+            points = fcurve.keyframe_points
+            while len(points) > n:
+                points.remove(points[len(points) - 1], fast=True)
+            if len(points) < n:
+                points.add(n - len(points))
+            for name, values in saved.items():
+                points.foreach_set(name, values)
+            fcurve.update()
+
+        self.on_rollback(undo)
+
+    def new_fcurve(self, bag: Any, data_path: str, index: int) -> bpy.types.FCurve:
+        """A new F-curve in `bag` (see :func:`channels.new_fcurve`), removed on failure."""
+        fcurve = channels.new_fcurve(bag, data_path, index)
+        self.on_rollback(lambda: channels.remove_fcurve(bag, data_path, index))
+        return fcurve
+
+    # Outcome ----------------------------------------------------------------------------------
+
+    def rollback(self) -> list[str]:
+        """Undoes everything (journal newest first, then new data-blocks); returns what could
+        not be undone, for the report (empty when everything was put back)."""
+        problems = []
+        for undo in reversed(self._undo):
+            try:
+                undo()
+            except Exception as err:  # keep undoing the rest
+                problems.append(repr(err))
+        self._undo.clear()
+        self._on_commit.clear()
+        for kind in CREATED_KINDS:
+            collection = getattr(bpy.data, kind)
+            for id_ in [i for i in collection if i.as_pointer() not in self._existing[kind]]:
+                try:
+                    collection.remove(id_)
+                except Exception as err:
+                    problems.append(f"{kind}: {err!r}")
+        return problems
+
+    def commit(self) -> None:
+        for action in self._on_commit:
+            action()
+        self._undo.clear()
+        self._on_commit.clear()
+
+
+class RolledBack(RuntimeError):
+    """An operator failed and its changes were undone; the message says why."""
+
+
+@contextlib.contextmanager
+def atomic() -> Iterator[Transaction]:
+    """Runs the body with a :class:`Transaction`; on any exception, rolls everything back and
+    re-raises (as :class:`RolledBack` for unexpected errors, naming the original)."""
+    t = Transaction()
+    try:
+        yield t
+    except BaseException as err:
+        problems = t.rollback()
+        if problems:
+            raise RolledBack(f"{err}; undoing it also failed: {'; '.join(problems)}") from err
+        raise
+    t.commit()
+
+
+def report_failure(operator: bpy.types.Operator, err: BaseException, what: str) -> set[str]:
+    """Reports an unexpected failure of `operator` (after :func:`atomic` undid its changes)
+    and returns `{'CANCELLED'}`; the traceback goes to the console for a bug report."""
+    import traceback
+
+    traceback.print_exception(err)
+    operator.report({"ERROR"}, f"{what} failed ({type(err).__name__}: {err}); nothing was changed")
+    return {"CANCELLED"}
