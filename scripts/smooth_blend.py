@@ -119,9 +119,10 @@ def run(args: argparse.Namespace) -> str:
     )
     try:
         # named objects must all be smoothable (checked before anything changes)
-        actions, skipped = bake.smooth(objects, options, strict=bool(args.objects))
+        result = bake.smooth(objects, options, strict=bool(args.objects))
     except bake.SmoothError as err:
         raise Failure(str(err)) from err
+    actions, skipped = result.actions, result.skipped
     for message in skipped:
         print(f"{PROG}: warning: {message}", file=sys.stderr)
     if not actions:
@@ -130,7 +131,7 @@ def run(args: argparse.Namespace) -> str:
     target = Path(bpy.data.filepath) if args.in_place else args.out.resolve()
     target.parent.mkdir(parents=True, exist_ok=True)
     bpy.ops.wm.save_as_mainfile(filepath=str(target))
-    return f"{PROG}: smoothed {len(actions)} object(s) ({args.scheme}, {args.levels} levels) into {target}"
+    return f"{PROG}: smoothed {len(result.objects)} object(s) ({args.scheme}, {args.levels} levels) into {target}"
 
 
 def main() -> int:

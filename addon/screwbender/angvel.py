@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys
+from . import bake, channels, keys, transaction
 from .keys import SmoothError
 
 #: Custom property (on the sphere helper) whose F-curve is the magnitude sketch, rad/s.
@@ -148,8 +148,9 @@ def sphere_of(obj: bpy.types.Object) -> bpy.types.Object | None:
     return sphere if isinstance(sphere, bpy.types.Object) else None
 
 
-def add_sketch(context: bpy.types.Context, obj: bpy.types.Object) -> bpy.types.Object:
-    """Creates the sphere helper, the direction sketch and the speed curve for `obj`.
+def add_sketch(context: bpy.types.Context, obj: bpy.types.Object, t: transaction.Transaction) -> bpy.types.Object:
+    """Creates the sphere helper, the direction sketch and the speed curve for `obj` (inside
+    the transaction `t`).
 
     The sketch starts as the object's current angular velocity over its keys' range (one
     point and one speed key per frame), so an unedited sketch refits the current motion.
@@ -188,7 +189,7 @@ def add_sketch(context: bpy.types.Context, obj: bpy.types.Object) -> bpy.types.O
     fcurve.update()
     sphere[SKETCH_KEY] = sketch
     sphere[RANGE_KEY] = [start, end]
-    obj[SPHERE_KEY] = sphere
+    t.set_item(obj, SPHERE_KEY, sphere)
     return sphere
 
 
@@ -282,6 +283,7 @@ def selected_keys(obj: bpy.types.Object, motion: keys.KeyedMotion) -> np.ndarray
 def fit(
     context: bpy.types.Context,
     obj: bpy.types.Object,
+    t: transaction.Transaction,
     alpha: float = 0.002,
     delta: float = 0.1,
     max_frames: int = 10,
@@ -290,7 +292,7 @@ def fit(
     """Fits `obj`'s rotation to its sketch and bakes it into a new action; draws the fit.
 
     Everything is computed before anything changes: a refusal (SmoothError, with the
-    polyscrew message) leaves the scene as it was.
+    polyscrew message) leaves the scene as it was; the writing happens inside `t`.
     """
     sphere = sphere_of(obj)
     if sphere is None:
@@ -329,13 +331,17 @@ def fit(
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
     baked = bake.Baked(
-        obj=obj, motion=motion, frames=frames, values={keys.rotation_path(mode): rotation}, cyclic=False
+        objects=[obj], motion=motion, frames=frames, values={keys.rotation_path(mode): rotation}, cyclic=False
     )
-    bake.write(baked)
+    bake.write(baked, t)
     fit_curve = sphere.get(FIT_KEY)
     if not isinstance(fit_curve, bpy.types.Object):
         fit_curve = _curve_object(f"{obj.name}.omega_fit", sphere, FIT_COLOR, context.collection)
-        sphere[FIT_KEY] = fit_curve
+        t.set_item(sphere, FIT_KEY, fit_curve)
+    else:  # the earlier fit's curve gets new data; the old data goes once everything worked
+        old = fit_curve.data
+        t.set(fit_curve, "data", old.copy())
+        t.on_commit(lambda: bpy.data.curves.remove(old) if old.users == 0 else None)
     from_parent = np.linalg.inv(to_parent)
     _set_curve_points(fit_curve, _unit_rows(result.omega @ from_parent.T))
     return result

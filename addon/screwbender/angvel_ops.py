@@ -8,6 +8,7 @@ import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty
 
 from .angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
+from . import transaction
 from .keys import SmoothError
 
 
@@ -31,10 +32,13 @@ class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
         try:
-            sphere = add_sketch(context, obj)
+            with transaction.atomic() as t:
+                sphere = add_sketch(context, obj, t)
         except (SmoothError, ValueError) as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
+        except Exception as err:
+            return transaction.report_failure(self, err, "Add Angular Velocity Sketch")
         self.report({"INFO"}, f"{obj.name}: edit the blue curve on {sphere.name} and its '{SPEED_PROP}' curve")
         return {"FINISHED"}
 
@@ -90,10 +94,13 @@ class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
         try:
-            result = fit(context, obj, self.alpha, self.delta, self.max_frames, self.stroke_timing)
+            with transaction.atomic() as t:
+                result = fit(context, obj, t, self.alpha, self.delta, self.max_frames, self.stroke_timing)
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
+        except Exception as err:
+            return transaction.report_failure(self, err, "Fit Angular Velocity")
         self.report(
             {"INFO"},
             f"{obj.name}: fit error {result.fit_error:.4f} (delta {self.delta:g}), "

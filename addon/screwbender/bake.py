@@ -18,6 +18,7 @@ leaves the scene as it was.
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
@@ -25,7 +26,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, feature, keys
+from . import channels, feature, keys, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -81,6 +82,9 @@ class Options:
     approximate: bool = False
     #: Feature points: spring stiffness of the approximated keys (smaller is smoother).
     stiffness: float = 1.0
+    #: Smooth the current action even when it is a result of Smooth Motion (else such an
+    #: object's original keys are smoothed again, replacing the earlier result).
+    smooth_result: bool = False
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -103,20 +107,40 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
         parametrization=settings.parametrization,
         approximate=settings.approximate,
         stiffness=settings.stiffness,
+        smooth_result=getattr(settings, "smooth_result", False),
     )
 
 
 @dataclass
 class Baked:
-    """Dense channel values for one object, before anything is written."""
+    """Dense channel values for the objects of one action, before anything is written."""
 
-    obj: bpy.types.Object
+    #: The objects animated by the action (several when they share it: linked duplicates).
+    objects: list[bpy.types.Object]
     motion: keys.KeyedMotion
     frames: np.ndarray
-    #: property name -> (len(frames), components) values.
+    #: property name -> (len(frames), components) values; for "scale" only the keyed axes,
+    #: listed in `scale_axes`.
     values: dict[str, np.ndarray]
     #: Whether the baked curves get a Cycles modifier (a closed motion baked over one period).
     cyclic: bool
+    #: The action holding the keys that were smoothed (the original keys).
+    source: bpy.types.Action | None = None
+    #: The action the objects have now (the source, or a result of Smooth Motion replaced by
+    #: this one); the new action is a copy of it, so curves edited since are kept.
+    current: bpy.types.Action | None = None
+    #: The slot of the objects in `current` (4.4+, else "").
+    identifier: str = ""
+
+    @property
+    def obj(self) -> bpy.types.Object:
+        """The first object (the one named in messages)."""
+        return self.objects[0]
+
+    @property
+    def key_count(self) -> int:
+        """Keys the bake writes."""
+        return len(self.frames) * sum(v.shape[1] for v in self.values.values())
 
 
 def sample_poses(
@@ -154,22 +178,53 @@ def _spec(motion: keys.KeyedMotion, options: Options) -> dict:
 
 
 def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options) -> np.ndarray | None:
-    """Scales (len(frames), 3) smoothed by the same scheme on log-scale, or None when scale
-    is not keyed."""
+    """Scales (len(frames), 3), the keyed axes smoothed by the same scheme on log-scale and the
+    unkeyed ones constant (the object's own, possibly negative), or None when no scale axis
+    is keyed."""
     if not motion.scale_keyed:
         return None
-    spec = _spec(motion, options)
-    return np.exp(polyscrew.sample_vectors(np.log(motion.scales), motion.frames, frames, **spec))
+    axes = motion.scale_axes
+    out = np.empty((len(frames), 3))
+    out[:] = motion.scales[0]
+    logs = np.log(motion.scales[:, axes])
+    out[:, axes] = np.exp(polyscrew.sample_vectors(logs, motion.frames, frames, **_spec(motion, options)))
+    return out
+
+
+#: Most keys one Smooth Motion may write (all objects together). Blender keeps about 60 bytes
+#: per key (a BezTriple) plus the undo copy of the action: 20 million keys are about 2.5 GB.
+MAX_KEYS = 20_000_000
 
 
 def bake_frames(start: float, end: float, step: float) -> np.ndarray:
-    """Frames from `start` to `end` (included when on the grid) every `step` frames."""
+    """The baked frames: `start`, every multiple of `step` strictly between, and `end`.
+
+    Keys sit on the scene's frame grid (whole frames for a step of 1, multiples of the step
+    otherwise) and the range's ends, usually the first and last key, are always baked exactly,
+    also when they are subframes (1.5 ... 20.6) or when the step does not divide the range
+    (0.1 over 1..30: 10 * 0.1 is not 1.0 in floating point, so grid frames are `k / 10`).
+    A grid frame closer than :data:`keys.FRAME_TOLERANCE` to an end is that end.
+    """
     if not step > 0.0:
         raise SmoothError(f"step must be positive, got {step:g}")
     if not end > start:
         raise SmoothError(f"frame range {start:g} to {end:g} is empty")
-    count = int(np.floor((end - start) / step + 1e-9)) + 1
-    return start + step * np.arange(count, dtype=np.float64)
+    count = (end - start) / step + 2
+    if count > MAX_KEYS:
+        raise SmoothError(
+            f"frame range {start:g} to {end:g} at step {step:g} is {count:,.0f} frames; the most "
+            f"Smooth Motion bakes is {MAX_KEYS:,} keys: raise Step or shorten the Frame Range"
+        )
+    tol = keys.FRAME_TOLERANCE
+    first, last = int(np.ceil((start + tol) / step)), int(np.floor((end - tol) / step))
+    k = np.arange(first, last + 1, dtype=np.float64)
+    per_frame = 1.0 / step
+    if abs(per_frame - round(per_frame)) < 1e-9:  # 0.1, 0.2, 0.5, 1: grid frames k / n exactly
+        grid = k / round(per_frame)
+    else:
+        grid = k * step
+    grid = grid[(grid > start + tol) & (grid < end - tol)]
+    return np.concatenate(([start], grid, [end]))
 
 
 def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
@@ -190,7 +245,7 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
             scales = sample_scales(motion, frames, options)
         values = {"location": location, keys.rotation_path(mode): rotation}
         if scales is not None:
-            values["scale"] = scales
+            values["scale"] = scales[:, motion.scale_axes]
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{obj.name}: {err}") from err
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
@@ -201,21 +256,25 @@ def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Op
         and options.frame_range is None
         and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
     )
-    return Baked(obj=obj, motion=motion, frames=frames, values=values, cyclic=cyclic)
+    return Baked(objects=[obj], motion=motion, frames=frames, values=values, cyclic=cyclic)
 
 
-def _write_curves(bag, path: str, frames: np.ndarray, values: np.ndarray, cyclic: bool) -> None:
-    """One dense linear F-curve per column of `values`, keyed at `frames`."""
+def _write_curves(
+    bag, path: str, frames: np.ndarray, values: np.ndarray, cyclic: bool, indices: np.ndarray | None = None
+) -> None:
+    """One dense linear F-curve per column of `values` (array index `indices[column]`, by
+    default the column), keyed at `frames`."""
     co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
     co[:, 0] = frames
     # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
     # for an enum property (measured in Blender 4.2 and 5.0).
     linear = (_LINEAR,) * len(frames)
-    for index in range(values.shape[1]):
+    for column in range(values.shape[1]):
+        index = int(indices[column]) if indices is not None else column
         fcurve = channels.new_fcurve(bag, path, index)
         points = fcurve.keyframe_points
         points.add(len(frames))
-        co[:, 1] = values[:, index]
+        co[:, 1] = values[:, column]
         points.foreach_set("co", co.ravel())
         points.foreach_set("interpolation", linear)
         if cyclic:
@@ -223,45 +282,159 @@ def _write_curves(bag, path: str, frames: np.ndarray, values: np.ndarray, cyclic
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
-def write(baked: Baked) -> bpy.types.Action:
-    """Assigns to the object a copy of its action whose transform curves are the baked ones."""
-    obj = baked.obj
-    adt = obj.animation_data
-    source = adt.action
-    identifier = channels.slot_identifier(obj)
-    smoothed = source.copy()
+def write(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
+    """Gives the objects of `baked` a copy of their current action whose transform curves are
+    the baked ones (every other curve as it was); the original keys' action keeps a fake user
+    and is recorded on the copy for :func:`revert`. A result of Smooth Motion that no object
+    uses any more is removed once everything has worked."""
+    source = baked.source if baked.source is not None else baked.obj.animation_data.action
+    current = baked.current if baked.current is not None else source
+    identifier = baked.identifier if baked.current is not None else channels.slot_identifier(baked.obj)
+    smoothed = current.copy()
     smoothed.name = f"{source.name}.smooth"
     smoothed.use_fake_user = False
     slot = smoothed.slots.get(identifier) if channels.is_slotted(smoothed) else None
     bag = channels.ensure_container(smoothed, slot)
-    baked_paths = set(baked.values)
-    # Transform curves of this object that the bake replaces; every other curve stays as copied.
-    replaced = keys.transform_paths(baked.motion.rotation_mode)
-    for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced and fc.data_path in baked_paths]:
+    # Transform curves of these objects that the bake replaces; every other curve stays as copied.
+    replaced = set(baked.values)
+    for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced]:
         bag.fcurves.remove(fcurve)
     for path, values in baked.values.items():
-        _write_curves(bag, path, baked.frames, values, baked.cyclic)
+        indices = np.flatnonzero(baked.motion.scale_axes) if path == "scale" else None
+        _write_curves(bag, path, baked.frames, values, baked.cyclic, indices)
     smoothed[SOURCE_KEY] = source
-    smoothed[SOURCE_SLOT_KEY] = identifier
-    smoothed[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
-    source.use_fake_user = True
-    channels.assign(obj, smoothed, identifier)
+    if current is source:
+        smoothed[SOURCE_SLOT_KEY] = identifier
+        smoothed[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
+    # (re-smoothing: the copy of the earlier result already records the original's slot and flag)
+    t.set(source, "use_fake_user", True)
+    for obj in baked.objects:
+        t.assign_action(obj, smoothed, identifier)
+    if current is not source:
+        name = f"{source.name}.smooth"
+
+        def replace_earlier_result() -> None:
+            if _remove_if_unused(current):
+                smoothed.name = name  # the earlier result's name is free again
+
+        t.on_commit(replace_earlier_result)
     return smoothed
 
 
-def prepare(
-    objects: Iterable[bpy.types.Object], options: Options
-) -> tuple[list[Baked], list[str]]:
-    """Reads and samples every object; returns the bakes and the messages of skipped objects."""
-    bakes: list[Baked] = []
-    skipped: list[str] = []
+def _remove_if_unused(action: bpy.types.Action) -> bool:
+    """Removes `action` when nothing uses it (a replaced result of Smooth Motion); returns
+    whether it did."""
+    if action.users == 0 and not action.use_fake_user:
+        bpy.data.actions.remove(action)
+        return True
+    return False
+
+
+def _read_group(objects: list[bpy.types.Object], options: Options) -> tuple[list[Baked], list, list[str]]:
+    """Reads and samples the objects that share one action (and slot).
+
+    Returns the bakes (one for the whole group when every object has the same key poses, else
+    one per object), the skipped objects with their messages and notes for the report.
+    """
+    first = objects[0]
+    current = first.animation_data.action
+    identifier = channels.slot_identifier(first)
+    source, source_slot = current, identifier
+    original = current.get(SOURCE_KEY)
+    if isinstance(original, bpy.types.Action) and not options.smooth_result:
+        # A result of Smooth Motion: smooth the original keys again with the new options.
+        source, source_slot = original, current.get(SOURCE_SLOT_KEY, "")
+    motions, skipped = [], []
     for obj in objects:
         try:
-            motion = keys.read(obj, options.closed)
-            bakes.append(sample_channels(obj, motion, options))
+            keys.check_editable(obj)
+            read_from = None if source is current else source
+            motions.append((obj, keys.read(obj, options.closed, action=read_from, slot=source_slot)))
         except SmoothError as err:
-            skipped.append(str(err))
-    return bakes, skipped
+            skipped.append((obj, str(err)))
+    if not motions:
+        return [], skipped, []
+    notes = []
+    same = all(_same_motion(motions[0][1], m) for _, m in motions[1:])
+    if same:
+        groups = [[obj for obj, _ in motions]]
+    else:
+        groups = [[obj] for obj, _ in motions]
+        notes.append(
+            f"{', '.join(o.name for o, _ in motions)} share action '{current.name}' but differ in "
+            "unkeyed channels or rotation mode: each got its own smoothed action"
+        )
+    by_object = dict(motions)
+    bakes = []
+    for group in groups:
+        try:
+            baked = sample_channels(group[0], by_object[group[0]], options)
+        except SmoothError as err:
+            skipped += [(obj, str(err)) for obj in group]
+            continue
+        baked.objects = group
+        baked.source, baked.current, baked.identifier = source, current, identifier
+        bakes.append(baked)
+    return bakes, skipped, notes
+
+
+def _same_motion(a: keys.KeyedMotion, b: keys.KeyedMotion) -> bool:
+    return (
+        a.rotation_mode == b.rotation_mode
+        and a.closed == b.closed
+        and np.array_equal(a.frames, b.frames)
+        and np.array_equal(a.poses, b.poses)
+        and np.array_equal(a.scales, b.scales)
+        and np.array_equal(a.scale_axes, b.scale_axes)
+    )
+
+
+def _action_groups(objects: Iterable[bpy.types.Object]) -> tuple[list[list[bpy.types.Object]], list]:
+    """The objects grouped by the action and slot they are animated by (linked duplicates
+    share one), in the objects' order; objects without an action are refused here."""
+    groups: dict[tuple, list[bpy.types.Object]] = {}
+    skipped = []
+    for obj in objects:
+        adt = obj.animation_data
+        if adt is None or adt.action is None:
+            skipped.append((obj, f"{obj.name}: no animation (no active action): skipped"))
+            continue
+        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(obj)), []).append(obj)
+    return list(groups.values()), skipped
+
+
+@dataclass
+class Smoothed:
+    """What Smooth Motion did."""
+
+    #: The new actions.
+    actions: list[bpy.types.Action]
+    #: The objects given a new action.
+    objects: list[bpy.types.Object]
+    #: Messages of the objects skipped (nothing changed on them).
+    skipped: list[str]
+    #: Other things worth telling (shared actions split, results re-smoothed).
+    notes: list[str]
+
+
+def _in_order(objects: list[bpy.types.Object], skipped: list) -> list[str]:
+    """The messages of skipped (object, message) pairs, in the order of `objects`."""
+    order = {obj.as_pointer(): i for i, obj in enumerate(objects)}
+    return [message for obj, message in sorted(skipped, key=lambda pair: order[pair[0].as_pointer()])]
+
+
+def prepare(objects: Iterable[bpy.types.Object], options: Options) -> tuple[list[Baked], list[str], list[str]]:
+    """Reads and samples every object (nothing changes); returns the bakes, the messages of
+    skipped objects and notes."""
+    objects = list(objects)
+    groups, skipped = _action_groups(objects)
+    bakes, notes = [], []
+    for group in groups:
+        done, messages, told = _read_group(group, options)
+        bakes += done
+        skipped += messages
+        notes += told
+    return bakes, _in_order(objects, skipped), notes
 
 
 def smooth(
@@ -269,32 +442,62 @@ def smooth(
     options: Options,
     progress: Callable[[int, int], None] | None = None,
     strict: bool = False,
-) -> tuple[list[bpy.types.Action], list[str]]:
-    """Smooths `objects`; returns the new actions and the messages of skipped objects.
+    t: transaction.Transaction | None = None,
+) -> Smoothed:
+    """Smooths `objects`; objects sharing an action keep sharing one smoothed action.
 
     Objects that cannot be smoothed are skipped and left unchanged; the others get their new
     action (with `strict`, any skipped object raises :class:`SmoothError` listing them all,
-    before anything is changed). `progress(done, total)` is called after each object is
+    before anything is changed). Every object is read and sampled before anything is written,
+    and the writing is all or nothing (inside `t`, or a transaction of its own): a failure
+    halfway leaves `bpy.data` as it was. `progress(done, total)` is called as objects are
     sampled and written.
     """
     objects = list(objects)
-    total = 2 * len(objects)
-    bakes: list[Baked] = []
-    skipped: list[str] = []
-    for i, obj in enumerate(objects):
-        done, messages = prepare([obj], options)
+    groups, skipped = _action_groups(objects)
+    total = len(groups) * 2
+    bakes, notes = [], []
+    for i, group in enumerate(groups):
+        done, messages, told = _read_group(group, options)
         bakes += done
         skipped += messages
+        notes += told
         if progress is not None:
             progress(i + 1, total)
+    skipped = _in_order(objects, skipped)
     if strict and skipped:
         raise SmoothError("; ".join(skipped))
-    actions = []
-    for i, baked in enumerate(bakes):
-        actions.append(write(baked))
-        if progress is not None:
-            progress(len(objects) + i + 1, total)
-    return actions, skipped
+    keys_total = sum(b.key_count for b in bakes)
+    if keys_total > MAX_KEYS:
+        raise SmoothError(
+            f"Smooth Motion would write {keys_total:,} keys ({len(bakes)} action(s)); the most it "
+            f"writes at once is {MAX_KEYS:,}: raise Step, shorten the Frame Range or smooth fewer objects"
+        )
+    resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
+    if resmoothed:
+        notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
+    with contextlib.ExitStack() as stack:
+        if t is None:
+            t = stack.enter_context(transaction.atomic())
+        actions = []
+        for i, baked in enumerate(bakes):
+            actions.append(write(baked, t))
+            if progress is not None:
+                progress(len(groups) + i + 1, total)
+    smoothed_objects = [obj for b in bakes for obj in b.objects]
+    return Smoothed(actions=actions, objects=smoothed_objects, skipped=skipped, notes=notes)
+
+
+def _names(names: list[str], limit: int = 3) -> str:
+    """"A, B, C and 297 more": a readable list of many names."""
+    if len(names) <= limit:
+        return ", ".join(names)
+    return f"{', '.join(names[:limit])} and {len(names) - limit} more"
+
+
+def summary(names: list[str], limit: int = 3) -> str:
+    """The report's list of names: the first `limit` and how many more."""
+    return _names(sorted(names), limit)
 
 
 def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
@@ -306,13 +509,23 @@ def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
     return source if isinstance(source, bpy.types.Action) else None
 
 
-def revert(obj: bpy.types.Object) -> None:
-    """Gives `obj` back the action it had before smoothing; drops the smoothed copy if unused."""
+def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.Object]:
+    """Gives `obj`, and every object sharing its smoothed action, back the action they had
+    before smoothing; drops the smoothed copy once nothing uses it. Returns the objects."""
     source = source_of(obj)
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
     smoothed = obj.animation_data.action
-    channels.assign(obj, source, smoothed.get(SOURCE_SLOT_KEY, ""))
-    source.use_fake_user = bool(smoothed.get(SOURCE_FAKE_USER_KEY, False))
-    if smoothed.users == 0 and not smoothed.use_fake_user:
-        bpy.data.actions.remove(smoothed)
+    identifier = channels.slot_identifier(obj)
+    sharing = [
+        o
+        for o in bpy.data.objects
+        if o.animation_data is not None
+        and o.animation_data.action == smoothed
+        and channels.slot_identifier(o) == identifier
+    ]
+    for other in sharing:
+        t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
+    t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
+    t.on_commit(lambda: _remove_if_unused(smoothed))
+    return sharing

@@ -6,13 +6,35 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, feature
+from . import bake, feature, transaction
 from .keys import SmoothError
 
 
-def _report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str) -> None:
-    for message in skipped:
-        operator.report({level}, message)
+def report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str) -> None:
+    """One line per skipped object for a few, else one line: how many, and the first reasons."""
+    if len(skipped) <= 3:
+        for message in skipped:
+            operator.report({level}, message)
+        return
+    for message in skipped:  # the whole list for the console (a pipeline's log)
+        print(f"ScrewBender: {message}")
+    operator.report(
+        {level}, f"{len(skipped)} objects skipped (the list is in the console): {'; '.join(skipped[:2])}; ..."
+    )
+
+
+def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: str) -> set[str]:
+    """Reports what Smooth Motion did in one readable line (plus skipped objects and notes)."""
+    if not result.actions:
+        report_skipped(operator, result.skipped, "ERROR")
+        return {"CANCELLED"}
+    report_skipped(operator, result.skipped, "WARNING")
+    for note in result.notes:
+        operator.report({"INFO"}, note)
+    objects = [o.name for o in result.objects]
+    shared = f" ({len(result.actions)} new actions)" if len(result.actions) != len(objects) else ""
+    operator.report({"INFO"}, f"{verb} {len(objects)} object(s): {bake.summary(objects)}{shared}")
+    return {"FINISHED"}
 
 
 def draw_method(layout: bpy.types.UILayout, settings) -> None:
@@ -24,6 +46,19 @@ def draw_method(layout: bpy.types.UILayout, settings) -> None:
         row = layout.row()
         row.active = settings.approximate
         row.prop(settings, "stiffness")
+
+
+def draw_options(layout: bpy.types.UILayout, settings) -> None:
+    """Every Smooth Motion option (the operator's redo panel and the sidebar panel)."""
+    draw_method(layout, settings)
+    for name in ("scheme", "levels", "timing", "closed", "range_mode"):
+        layout.prop(settings, name)
+    if settings.range_mode == "CUSTOM":
+        col = layout.column(align=True)
+        col.prop(settings, "frame_start")
+        col.prop(settings, "frame_end")
+    layout.prop(settings, "step")
+    layout.prop(settings, "smooth_result")
 
 
 class SCREWBENDER_OT_smooth(bpy.types.Operator):
@@ -107,7 +142,14 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         min=0.01,
         soft_max=10.0,
         description="Frames between two baked keys: 1 bakes every frame, less bakes subframes "
-        "(for motion blur)",
+        "(for motion blur). Baked keys sit on multiples of the step, plus the first and last frame",
+    )
+    smooth_result: BoolProperty(
+        name="Smooth Result",
+        default=False,
+        description="On an object whose action is already a result of Smooth Motion, smooth that "
+        "result itself (Revert then returns to it). Off: smooth the original keys again with these "
+        "options, replacing the earlier result (one Revert returns to the original)",
     )
 
     @classmethod
@@ -124,14 +166,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        draw_method(layout, self)
-        for name in ("scheme", "levels", "timing", "closed", "range_mode"):
-            layout.prop(self, name)
-        if self.range_mode == "CUSTOM":
-            col = layout.column(align=True)
-            col.prop(self, "frame_start")
-            col.prop(self, "frame_end")
-        layout.prop(self, "step")
+        draw_options(layout, self)
 
     def smooth_options(self, context: bpy.types.Context) -> bake.Options:
         """The add-on's options from this operator's properties."""
@@ -142,21 +177,17 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 2 * len(objects))
         try:
-            actions, skipped = bake.smooth(
-                objects, self.smooth_options(context), lambda done, _total: wm.progress_update(done)
+            result = bake.smooth(
+                objects, self.smooth_options(context), lambda done, total: wm.progress_update(done)
             )
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
+        except Exception as err:  # anything else: bake.smooth has undone its changes
+            return transaction.report_failure(self, err, "Smooth Motion")
         finally:
             wm.progress_end()
-        if not actions:
-            _report_skipped(self, skipped, "ERROR")
-            return {"CANCELLED"}
-        _report_skipped(self, skipped, "WARNING")
-        names = ", ".join(a.name for a in actions)
-        self.report({"INFO"}, f"Smoothed {len(actions)} object(s) into {names}")
-        return {"FINISHED"}
+        return report_smoothed(self, result, "Smoothed")
 
 
 class SCREWBENDER_OT_revert(bpy.types.Operator):
@@ -174,19 +205,25 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
         return True
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        reverted = []
-        for obj in context.selected_objects:
-            if bake.source_of(obj) is not None:
-                bake.revert(obj)
-                reverted.append(obj.name)
-        self.report({"INFO"}, f"Restored the original action of {', '.join(sorted(reverted))}")
+        reverted: dict[str, bpy.types.Object] = {}
+        try:
+            with transaction.atomic() as t:
+                for obj in sorted(context.selected_objects, key=lambda o: o.name):
+                    if obj.name not in reverted and bake.source_of(obj) is not None:
+                        reverted.update((o.name, o) for o in bake.revert(obj, t))
+        except Exception as err:
+            return transaction.report_failure(self, err, "Revert Smoothing")
+        selected = {o.name for o in context.selected_objects}
+        others = sorted(set(reverted) - selected)
+        also = f" (and {bake.summary(others)}, which shared its action)" if others else ""
+        self.report({"INFO"}, f"Restored the original action of {bake.summary(sorted(set(reverted) & selected))}{also}")
         return {"FINISHED"}
-
 
 
 _OPTION_NAMES = (
     "method", "parametrization", "approximate", "stiffness",
     "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
+    "smooth_result",
 )
 
 
@@ -211,6 +248,7 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
     frame_start: _same_property("frame_start")
     frame_end: _same_property("frame_end")
     step: _same_property("step")
+    smooth_result: _same_property("smooth_result")
 
 
 class _SmoothPanel:
@@ -222,14 +260,7 @@ class _SmoothPanel:
         layout = self.layout
         layout.use_property_split = True
         layout.use_property_decorate = False
-        draw_method(layout, settings)
-        for name in ("scheme", "levels", "timing", "closed", "range_mode"):
-            layout.prop(settings, name)
-        if settings.range_mode == "CUSTOM":
-            col = layout.column(align=True)
-            col.prop(settings, "frame_start")
-            col.prop(settings, "frame_end")
-        layout.prop(settings, "step")
+        draw_options(layout, settings)
         op = layout.operator(SCREWBENDER_OT_smooth.bl_idname, icon="IPO_EASE_IN_OUT")
         for name in _OPTION_NAMES:
             setattr(op, name, getattr(settings, name))

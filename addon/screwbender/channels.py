@@ -66,11 +66,31 @@ def object_fcurves(obj: bpy.types.Object) -> list[bpy.types.FCurve]:
     return list(bag.fcurves) if bag is not None else []
 
 
+def action_fcurves(action: bpy.types.Action, identifier: str = "") -> list[bpy.types.FCurve]:
+    """The F-curves of `action` for the slot named `identifier` (4.4+; ignored for legacy
+    actions), empty when it has none."""
+    slot = action.slots.get(identifier) if is_slotted(action) and identifier else None
+    bag = container(action, slot)
+    return list(bag.fcurves) if bag is not None else []
+
+
+def remove_fcurve(bag: Any, data_path: str, index: int) -> None:
+    """Removes the F-curve (`data_path`, `index`) from `bag` when it is there."""
+    fcurve = bag.fcurves.find(data_path, index=index)
+    if fcurve is not None:
+        bag.fcurves.remove(fcurve)
+
+
 def new_fcurve(bag: Any, data_path: str, index: int, group: str = TRANSFORM_GROUP) -> bpy.types.FCurve:
     """Creates an F-curve in `bag` (an action or a channelbag), in F-curve group `group`."""
     if isinstance(bag, bpy.types.Action):
         return bag.fcurves.new(data_path, index=index, action_group=group)
     return bag.fcurves.new(data_path, index=index, group_name=group)
+
+
+def insert_key(fcurve: bpy.types.FCurve, frame: float, value: float) -> None:
+    """Inserts (or replaces) a key of `fcurve` at `frame`, as Blender's keying does."""
+    fcurve.keyframe_points.insert(frame, value)
 
 
 def slot_identifier(obj: bpy.types.Object) -> str:

@@ -98,7 +98,8 @@ def sample_poses(obj: bpy.types.Object, motion: keys.KeyedMotion, frames: np.nda
 
     `options` is a :class:`bake.Options`. Raises ValueError from `polyscrew`.
     """
-    mean_scale = np.exp(np.log(motion.scales).mean(axis=0))
+    # Mean scale over the keys (a static negative scale, a mirrored object, keeps its sign).
+    mean_scale = np.sign(motion.scales[0]) * np.exp(np.log(np.abs(motion.scales)).mean(axis=0))
     return polyscrew.sample_feature(
         motion.poses,
         motion.frames,

@@ -22,7 +22,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys
+from . import bake, channels, keys, transaction
 from .keys import SmoothError
 
 
@@ -72,8 +72,9 @@ def _current_values(obj: bpy.types.Object, curves: dict, path: str, size: int, f
     )
 
 
-def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options) -> InsertResult:
-    """Keys the pose the smoothed motion of `obj` has at `frame` on its transform channels.
+def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options, t: transaction.Transaction) -> InsertResult:
+    """Keys the pose the smoothed motion of `obj` has at `frame` on its transform channels
+    (inside the transaction `t`: the curves get their old keys back if anything fails later).
 
     Raises :class:`SmoothError` (nothing changed) when the keys cannot be smoothed.
     """
@@ -95,16 +96,20 @@ def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options) -> In
         rotation_path: polyscrew.rotation_channels(pose, mode, previous=previous)[0],
     }
     if before.scale_keyed:
-        values["scale"] = scale[0]
+        values["scale"] = scale[0]  # only its keyed axes are keyed again (below)
 
     adt = obj.animation_data
     bag = channels.ensure_container(adt.action, channels.assigned_slot(obj))
     for path, vector in values.items():
         for index, value in enumerate(vector):
+            if path == "scale" and not before.scale_axes[index]:
+                continue  # unkeyed scale stays unkeyed (a mirrored object's static -1 included)
             fcurve = curves.get((path, index))
             if fcurve is None:
-                fcurve = channels.new_fcurve(bag, path, index)
-            fcurve.keyframe_points.insert(frame, float(value))
+                fcurve = t.new_fcurve(bag, path, index)
+            else:
+                t.keep_keys(fcurve)
+            channels.insert_key(fcurve, frame, float(value))
 
     after = keys.read(obj, options.closed)
     try:

@@ -55,10 +55,11 @@ class KeyedMotion:
     frames: np.ndarray
     #: Rigid poses (translation and rotation) at those frames, shape (K, 4, 4).
     poses: np.ndarray
-    #: Scale at those frames, shape (K, 3), all positive.
+    #: Scale at those frames, shape (K, 3): keyed axes positive, an unkeyed axis is the object's
+    #: own (constant) scale, which may be negative (a mirrored object).
     scales: np.ndarray
-    #: Whether any scale channel is keyed (unkeyed scale is left alone).
-    scale_keyed: bool
+    #: Which scale axes are keyed (unkeyed scale is left alone), shape (3,).
+    scale_axes: np.ndarray
     #: The object's rotation mode ("QUATERNION", "AXIS_ANGLE" or an Euler order).
     rotation_mode: str
     #: The rotation channel values at the first key (for sign and Euler continuity).
@@ -69,6 +70,11 @@ class KeyedMotion:
     period: float | None
     #: Whether a Cycles modifier was found on the transform curves.
     cyclic: bool
+
+    @property
+    def scale_keyed(self) -> bool:
+        """Whether any scale channel is keyed."""
+        return bool(self.scale_axes.any())
 
     @property
     def frame_range(self) -> tuple[float, float]:
@@ -181,12 +187,15 @@ def check_editable(obj: bpy.types.Object) -> None:
         raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
 
 
-def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
+def read(obj: bpy.types.Object, closed: str = "AUTO", action: bpy.types.Action | None = None, slot: str = "") -> KeyedMotion:
     """The key poses of `obj`.
 
     `closed` is "AUTO" (closed when a Cycles modifier is on a transform F-curve), "ON" or
     "OFF". For a closed motion whose last key repeats the first pose, that key only closes the
     period: it is dropped from the poses and `period` is its distance from the first key.
+    `action` (with the slot identifier `slot`, 4.4+) reads the keys of another action than the
+    active one, with the object's own values for unkeyed channels (re-smoothing reads the
+    original keys under a smoothed result).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth.
     """
@@ -194,9 +203,10 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
     name = obj.name
     mode = obj.rotation_mode
     paths = transform_paths(mode)
+    source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
     curves = {
         (fc.data_path, fc.array_index): fc
-        for fc in channels.object_fcurves(obj)
+        for fc in source
         if fc.data_path in paths and not fc.mute and len(fc.keyframe_points) > 0
     }
     if not curves:
@@ -226,12 +236,14 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
     for label, values in (("location", location), (paths[1], rotation), ("scale", scale)):
         if not np.all(np.isfinite(values)):
             raise SmoothError(f"{name}: {label} has a non-finite key value: skipped")
-    bad = np.argwhere(scale <= 0.0)
+    scale_axes = np.array([("scale", i) in curves for i in range(3)])
+    bad = np.argwhere((scale <= 0.0) & scale_axes)
     if len(bad):
         k, axis = bad[0]
         raise SmoothError(
             f"{name}: scale {'XYZ'[axis]} is {scale[k, axis]:g} at frame {frames[k]:g}; "
-            "zero or negative scale cannot be smoothed: skipped"
+            "zero or negative scale cannot be smoothed when it is keyed (a static negative scale, "
+            "a mirrored object, can): skipped"
         )
 
     poses = compose(location, rotation_matrices(rotation, mode))
@@ -243,7 +255,7 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
     if is_closed:
         size = 1.0 + float(np.max(np.abs(location)))
         repeats = np.allclose(poses[-1], poses[0], atol=REPEAT_TOLERANCE * size) and np.allclose(
-            np.log(scale[-1]), np.log(scale[0]), atol=REPEAT_TOLERANCE
+            np.log(np.abs(scale[-1])), np.log(np.abs(scale[0])), atol=REPEAT_TOLERANCE
         )
         if repeats:
             if len(frames) < 3:
@@ -253,12 +265,11 @@ def read(obj: bpy.types.Object, closed: str = "AUTO") -> KeyedMotion:
         else:
             # no closing key: the last key returns to the first after the mean key spacing
             period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
-    scale_keyed = any(path == "scale" for path, _ in curves)
     return KeyedMotion(
         frames=frames,
         poses=poses,
         scales=scale,
-        scale_keyed=scale_keyed,
+        scale_axes=scale_axes,
         rotation_mode=mode,
         first_rotation=rotation[0].copy(),
         closed=is_closed,

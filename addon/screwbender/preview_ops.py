@@ -14,7 +14,7 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
 
-from . import bake, insert_key, preview, preview_draw
+from . import bake, bake_ops, insert_key, preview, preview_draw, transaction
 from .keys import SmoothError
 
 STYLES = (
@@ -101,22 +101,18 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
             )
             return {"CANCELLED"}
         try:
-            actions, skipped = bake.smooth(objects, preview_draw.smooth_options(context.scene))
+            with transaction.atomic() as t:
+                result = bake.smooth(objects, preview_draw.smooth_options(context.scene), t=t)
+                for obj in result.objects:
+                    t.set(obj, preview_draw.OBJECT_PROP, False)
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
-        for message in skipped:
-            self.report({"WARNING" if actions else "ERROR"}, message)
-        if not actions:
-            return {"CANCELLED"}
-        applied = {a.name for a in actions}
-        for obj in objects:
-            adt = obj.animation_data
-            if adt is not None and adt.action is not None and adt.action.name in applied:
-                setattr(obj, preview_draw.OBJECT_PROP, False)
-        preview_draw.sync()
-        self.report({"INFO"}, f"Applied the preview of {len(actions)} object(s): {', '.join(sorted(applied))}")
-        return {"FINISHED"}
+        except Exception as err:
+            return transaction.report_failure(self, err, "Apply Preview")
+        finally:
+            preview_draw.sync()
+        return bake_ops.report_smoothed(self, result, "Applied the preview of")
 
 
 class SCREWBENDER_OT_insert_key(bpy.types.Operator):
@@ -158,11 +154,16 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         objects = sorted(_keyed_selection(context), key=lambda o: o.name)
         results = []
         errors = []
-        for obj in objects:  # every object is read and checked before its keys are written
-            try:
-                results.append((obj, insert_key.insert_key(obj, frame, options)))
-            except SmoothError as err:
-                errors.append(str(err))
+        try:
+            with transaction.atomic() as t:
+                for obj in objects:  # an object that cannot be smoothed is skipped unchanged
+                    try:
+                        with transaction.atomic(t) as one:
+                            results.append((obj, insert_key.insert_key(obj, frame, options, one)))
+                    except SmoothError as err:
+                        errors.append(str(err))
+        except Exception as err:  # every key inserted so far is taken back
+            return transaction.report_failure(self, err, "Insert Key on Motion")
         for message in errors:
             self.report({"WARNING" if results else "ERROR"}, message)
         if not results:

@@ -8,7 +8,7 @@ import time
 import bpy
 from bpy.props import BoolProperty, FloatProperty, IntProperty
 
-from . import swept
+from . import swept, transaction
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):
@@ -69,16 +69,20 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         start = time.perf_counter()
         try:
             computed = [swept.compute(o, context, self.steps, self.caps) for o in objects]
-            created = [swept.create_object(s, context, self.closed, self.voxel_size) for s in computed]
+            with transaction.atomic() as t:  # a failure removes every object and mesh made so far
+                created = [swept.create_object(s, context, self.closed, self.voxel_size) for s in computed]
+                t.keep_selection(context.view_layer)
+                for obj in context.selected_objects:
+                    obj.select_set(False)
+                for obj in created:
+                    obj.select_set(True)
+                context.view_layer.objects.active = created[-1]
         except swept.SweepError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
+        except Exception as err:
+            return transaction.report_failure(self, err, "Build Swept Region")
         seconds = time.perf_counter() - start
-        for obj in context.selected_objects:
-            obj.select_set(False)
-        for obj in created:
-            obj.select_set(True)
-        context.view_layer.objects.active = created[-1]
         tris = sum(swept.triangle_count(o.data) for o in created)
         sweep_ms = 1e3 * sum(s.seconds for s in computed)
         self.report(
@@ -115,11 +119,17 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
         except swept.SweepError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
-        swept.select_faces(region, sorted({f for r in results.values() for f in r.faces_a}))
-        for o in others:
-            swept.select_faces(o, results[o.name].faces_b)
-        region["screwbender_clearance"] = {name: r.distance for name, r in results.items()}
-        region["screwbender_intersects"] = [name for name, r in results.items() if r.intersects]
+        try:
+            with transaction.atomic() as t:
+                for o in [region, *others]:
+                    t.keep_face_selection(o.data)
+                swept.select_faces(region, sorted({f for r in results.values() for f in r.faces_a}))
+                for o in others:
+                    swept.select_faces(o, results[o.name].faces_b)
+                t.set_item(region, "screwbender_clearance", {name: r.distance for name, r in results.items()})
+                t.set_item(region, "screwbender_intersects", [name for name, r in results.items() if r.intersects])
+        except Exception as err:
+            return transaction.report_failure(self, err, "Check Clearance")
         for name, r in results.items():
             if r.intersects:
                 self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")

@@ -12,7 +12,7 @@ not on others. Every operator that writes runs its writing inside :func:`atomic`
         t.set(source, "use_fake_user", True)
 
 On an exception the journal is replayed backwards, every data-block created since the start
-(actions, objects, meshes, curves, collections) is removed, and the exception propagates to the
+(objects, meshes, curves, materials, actions, collections) is removed, and the exception propagates to the
 operator, which reports it and cancels. Nothing here is specific to one operator.
 """
 
@@ -29,7 +29,7 @@ from . import channels
 
 #: `bpy.data` collections whose new members a failed operator removes, in removal order
 #: (users first: objects before the meshes and curves they use, collections last).
-CREATED_KINDS = ("objects", "meshes", "curves", "actions", "collections")
+CREATED_KINDS = ("objects", "meshes", "curves", "materials", "actions", "collections")
 
 #: Keyframe properties restored when an F-curve's keys are put back: (name, items per key, dtype).
 KEYFRAME_PROPERTIES = (
@@ -62,7 +62,8 @@ def _enum_values(points, name: str) -> np.ndarray:
 class Transaction:
     """The journal of one operator's changes; see the module docstring."""
 
-    def __init__(self) -> None:
+    def __init__(self, parent: Transaction | None = None) -> None:
+        self._parent = parent
         self._undo: list[Callable[[], None]] = []
         self._on_commit: list[Callable[[], None]] = []
         self._existing = {kind: {id_.as_pointer() for id_ in getattr(bpy.data, kind)} for kind in CREATED_KINDS}
@@ -140,6 +141,31 @@ class Transaction:
 
         self.on_rollback(undo)
 
+    def keep_selection(self, view_layer: bpy.types.ViewLayer) -> None:
+        """Snapshots which objects are selected and which is active; put back on failure."""
+        selected = [o for o in view_layer.objects if o.select_get(view_layer=view_layer)]
+        active = view_layer.objects.active
+
+        def undo() -> None:
+            for o in view_layer.objects:
+                o.select_set(False, view_layer=view_layer)
+            for o in selected:
+                o.select_set(True, view_layer=view_layer)
+            view_layer.objects.active = active
+
+        self.on_rollback(undo)
+
+    def keep_face_selection(self, mesh: bpy.types.Mesh) -> None:
+        """Snapshots the face selection of `mesh`; put back on failure."""
+        mask = np.empty(len(mesh.polygons), dtype=bool)
+        mesh.polygons.foreach_get("select", mask)
+
+        def undo() -> None:
+            mesh.polygons.foreach_set("select", mask)
+            mesh.update()
+
+        self.on_rollback(undo)
+
     def new_fcurve(self, bag: Any, data_path: str, index: int) -> bpy.types.FCurve:
         """A new F-curve in `bag` (see :func:`channels.new_fcurve`), removed on failure."""
         fcurve = channels.new_fcurve(bag, data_path, index)
@@ -169,8 +195,14 @@ class Transaction:
         return problems
 
     def commit(self) -> None:
-        for action in self._on_commit:
-            action()
+        """Ends the transaction: a nested one hands its journal to its parent (which may still
+        fail and undo it); the outermost runs the commit actions."""
+        if self._parent is not None:
+            self._parent._undo += self._undo
+            self._parent._on_commit += self._on_commit
+        else:
+            for action in self._on_commit:
+                action()
         self._undo.clear()
         self._on_commit.clear()
 
@@ -180,10 +212,12 @@ class RolledBack(RuntimeError):
 
 
 @contextlib.contextmanager
-def atomic() -> Iterator[Transaction]:
+def atomic(parent: Transaction | None = None) -> Iterator[Transaction]:
     """Runs the body with a :class:`Transaction`; on any exception, rolls everything back and
-    re-raises (as :class:`RolledBack` for unexpected errors, naming the original)."""
-    t = Transaction()
+    re-raises (as :class:`RolledBack` when the undoing itself had problems). Nested in
+    `parent`, a failure undoes only the body's own changes, and a success leaves them to the
+    parent's outcome: one object can be skipped while the others go on."""
+    t = Transaction(parent)
     try:
         yield t
     except BaseException as err:

@@ -37,6 +37,7 @@ import numpy as np  # noqa: E402
 from mathutils import Matrix, Quaternion, Vector  # noqa: E402
 
 angvel = importlib.import_module("bl_ext.user_default.screwbender.angvel")
+transaction = importlib.import_module("bl_ext.user_default.screwbender.transaction")
 
 FPS = 24
 N_KEYS = 20
@@ -225,7 +226,8 @@ def main() -> None:
     held = key_frames[[i for i in range(N_KEYS) if i % HOLD_EVERY == 0 or i == N_KEYS - 1]]
     select_held_keys(obj, held)
     t0 = time.perf_counter()
-    result = angvel.fit(bpy.context, obj)
+    with transaction.atomic() as t:
+        result = angvel.fit(bpy.context, obj, t)
     elapsed = time.perf_counter() - t0
     after = evaluated(obj, frames)
 

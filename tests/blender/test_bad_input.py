@@ -107,8 +107,8 @@ def test_any_object_type_is_valid_and_bad_ones_are_skipped(sb, kind):
     after = h.snapshot_scene()
     assert after["objects"]["Still"] == before["objects"]["Still"]
     # what was skipped is said (the operator reports it as a warning; the pipeline returns it)
-    actions, skipped = sb.bake.smooth([bad], sb.bake.Options())
-    assert actions == [] and skipped == ["Still: no animation (no active action): skipped"]
+    result = sb.bake.smooth([bad], sb.bake.Options())
+    assert result.actions == [] and result.skipped == ["Still: no animation (no active action): skipped"]
 
 
 def test_poll_explains_itself():

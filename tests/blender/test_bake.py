@@ -36,10 +36,17 @@ def keyed(mode: str, seed: int, name: str = "Body", parent: bool = True):
     return obj
 
 
+def grid(start: float, end: float, step: float) -> np.ndarray:
+    """The frames a bake must have: the ends, and the multiples of `step` strictly between."""
+    multiples = [k * step for k in range(int(np.floor(start / step)) - 1, int(np.ceil(end / step)) + 2)]
+    inner = [f for f in multiples if start + 1e-4 < f < end - 1e-4]
+    return np.array([start, *inner, end])
+
+
 def check_against_sample(sb, obj, motion, scheme, levels, timing, step):
     frames, baked = h.baked_matrices(obj, with_scale=False)
     start, end = motion.frame_range
-    np.testing.assert_allclose(frames, np.arange(start, end + 1e-9, step), atol=1e-4)
+    np.testing.assert_allclose(frames, grid(start, end, step), atol=1e-4)
     spec = dict(scheme=scheme, levels=levels, closed=motion.closed, period=motion.period, timing=timing)
     expected = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
     error = np.abs(baked - expected).max()
@@ -145,5 +152,5 @@ def test_forced_cycle_without_closing_key(sb):
     assert motion.period == pytest.approx(39.0 * 5 / 4)
     assert bpy.ops.screwbender.smooth(closed="ON", levels=4) == {"FINISHED"}
     frames = check_against_sample(sb, obj, motion, "jarek", 4, "smooth", 1.0)
-    assert frames[-1] == 49.0  # every whole frame of the period 1 .. 49.75
+    assert frames[-2] == 49.0 and frames[-1] == 49.75  # every whole frame of the period 1 .. 49.75, and its end
     assert all(len(fc.modifiers) == 0 for fc in h.fcurves(obj))  # no Cycles modifier was there

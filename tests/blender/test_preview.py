@@ -737,7 +737,8 @@ def test_insert_key_four_point_hits_the_key_and_reports_the_change(pd, timing, c
     frame = 30.5
     times = np.union1d(np.arange(1.0, 62.0), [frame])  # the frames the operator checks
     before = motion_from_curves(obj, times, "four_point", 4, timing)
-    result = addon_module("insert_key").insert_key(obj, frame, pd.smooth_options(scene))
+    with addon_module("transaction").atomic() as t:
+        result = addon_module("insert_key").insert_key(obj, frame, pd.smooth_options(scene), t)
     np.testing.assert_array_equal(result.checked_frames, times)
     frames_after, keys_after = baked_matrices(obj)
     new_key = keys_after[list(frames_after).index(frame)]
