@@ -186,8 +186,10 @@ def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options
     axes = motion.scale_axes
     out = np.empty((len(frames), 3))
     out[:] = motion.scales[0]
-    logs = np.log(motion.scales[:, axes])
-    out[:, axes] = np.exp(polyscrew.sample_vectors(logs, motion.frames, frames, **_spec(motion, options)))
+    # (unkeyed axes ride along as constants, |static scale|, and are not used)
+    logs = np.log(np.abs(motion.scales))
+    smoothed = np.exp(polyscrew.sample_vectors(logs, motion.frames, frames, **_spec(motion, options)))
+    out[:, axes] = smoothed[:, axes]
     return out
 
 
@@ -227,9 +229,29 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
     return np.concatenate(([start], grid, [end]))
 
 
-def sample_channels(obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options) -> Baked:
-    """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes)."""
+def channel_count(motion: keys.KeyedMotion) -> int:
+    """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
+    return 3 + (4 if motion.rotation_mode in ("QUATERNION", "AXIS_ANGLE") else 3) + int(motion.scale_axes.sum())
+
+
+def sample_channels(
+    obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options, budget: list[int] | None = None
+) -> Baked:
+    """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes).
+
+    `budget` holds the keys still allowed (all objects of one Smooth Motion together, at most
+    :data:`MAX_KEYS`); a bake that would exceed it is refused before anything is sampled.
+    """
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
+    if budget is not None and end > start and options.step > 0.0:
+        keys_needed = ((end - start) / options.step + 2) * channel_count(motion)
+        if keys_needed > budget[0]:
+            raise SmoothError(
+                f"{obj.name}: baking frames {start:g} to {end:g} every {options.step:g} frames would write "
+                f"{keys_needed:,.0f} keys; one Smooth Motion writes at most {MAX_KEYS:,} "
+                f"({budget[0]:,} left for this object): raise Step, shorten the Frame Range or smooth fewer objects"
+            )
+        budget[0] -= int(keys_needed)
     try:
         frames = bake_frames(start, end, options.step)
         mode = motion.rotation_mode
@@ -330,7 +352,9 @@ def _remove_if_unused(action: bpy.types.Action) -> bool:
     return False
 
 
-def _read_group(objects: list[bpy.types.Object], options: Options) -> tuple[list[Baked], list, list[str]]:
+def _read_group(
+    objects: list[bpy.types.Object], options: Options, budget: list[int]
+) -> tuple[list[Baked], list, list[str]]:
     """Reads and samples the objects that share one action (and slot).
 
     Returns the bakes (one for the whole group when every object has the same key poses, else
@@ -368,7 +392,7 @@ def _read_group(objects: list[bpy.types.Object], options: Options) -> tuple[list
     bakes = []
     for group in groups:
         try:
-            baked = sample_channels(group[0], by_object[group[0]], options)
+            baked = sample_channels(group[0], by_object[group[0]], options, budget)
         except SmoothError as err:
             skipped += [(obj, str(err)) for obj in group]
             continue
@@ -429,8 +453,9 @@ def prepare(objects: Iterable[bpy.types.Object], options: Options) -> tuple[list
     objects = list(objects)
     groups, skipped = _action_groups(objects)
     bakes, notes = [], []
+    budget = [MAX_KEYS]
     for group in groups:
-        done, messages, told = _read_group(group, options)
+        done, messages, told = _read_group(group, options, budget)
         bakes += done
         skipped += messages
         notes += told
@@ -457,8 +482,9 @@ def smooth(
     groups, skipped = _action_groups(objects)
     total = len(groups) * 2
     bakes, notes = [], []
+    budget = [MAX_KEYS]
     for i, group in enumerate(groups):
-        done, messages, told = _read_group(group, options)
+        done, messages, told = _read_group(group, options, budget)
         bakes += done
         skipped += messages
         notes += told
@@ -467,12 +493,6 @@ def smooth(
     skipped = _in_order(objects, skipped)
     if strict and skipped:
         raise SmoothError("; ".join(skipped))
-    keys_total = sum(b.key_count for b in bakes)
-    if keys_total > MAX_KEYS:
-        raise SmoothError(
-            f"Smooth Motion would write {keys_total:,} keys ({len(bakes)} action(s)); the most it "
-            f"writes at once is {MAX_KEYS:,}: raise Step, shorten the Frame Range or smooth fewer objects"
-        )
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")

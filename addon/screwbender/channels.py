@@ -81,6 +81,18 @@ def remove_fcurve(bag: Any, data_path: str, index: int) -> None:
         bag.fcurves.remove(fcurve)
 
 
+def has_group(bag: Any, name: str = TRANSFORM_GROUP) -> bool:
+    """Whether `bag` (an action or a channelbag) has an F-curve group `name`."""
+    return bag.groups.get(name) is not None
+
+
+def remove_group_if_empty(bag: Any, name: str = TRANSFORM_GROUP) -> None:
+    """Removes the F-curve group `name` of `bag` when no F-curve is in it."""
+    group = bag.groups.get(name)
+    if group is not None and not any(fc.group == group for fc in bag.fcurves):
+        bag.groups.remove(group)
+
+
 def new_fcurve(bag: Any, data_path: str, index: int, group: str = TRANSFORM_GROUP) -> bpy.types.FCurve:
     """Creates an F-curve in `bag` (an action or a channelbag), in F-curve group `group`."""
     if isinstance(bag, bpy.types.Action):

@@ -168,8 +168,15 @@ class Transaction:
 
     def new_fcurve(self, bag: Any, data_path: str, index: int) -> bpy.types.FCurve:
         """A new F-curve in `bag` (see :func:`channels.new_fcurve`), removed on failure."""
+        had_group = channels.has_group(bag)
         fcurve = channels.new_fcurve(bag, data_path, index)
-        self.on_rollback(lambda: channels.remove_fcurve(bag, data_path, index))
+
+        def undo() -> None:
+            channels.remove_fcurve(bag, data_path, index)
+            if not had_group:
+                channels.remove_group_if_empty(bag)
+
+        self.on_rollback(undo)
         return fcurve
 
     # Outcome ----------------------------------------------------------------------------------

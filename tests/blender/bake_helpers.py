@@ -259,3 +259,71 @@ def screw_deviation(poses: np.ndarray, radius: float, pitch: float, tilt: np.nda
         thetas = thetas + 2 * np.pi * turns
     ideal = circle_poses(thetas, radius, pitch, tilt)
     return np.abs(poses - ideal).max(axis=(1, 2))
+
+
+def _id_props(id_block) -> dict:
+    """An ID's custom properties, ID pointers by name (comparable across snapshots)."""
+    out = {}
+    for key in id_block.keys():
+        value = id_block[key]
+        if isinstance(value, bpy.types.ID):
+            value = ("ID", value.name)
+        elif hasattr(value, "to_dict"):
+            value = value.to_dict()
+        elif hasattr(value, "to_list"):
+            value = value.to_list()
+        out[key] = value
+    return out
+
+
+def snapshot_data() -> dict:
+    """The names and contents of every action, object, mesh, curve, material and collection,
+    object selection and the active object: what an operator that fails must leave exactly
+    as it was (compare two snapshots with ==)."""
+    scene = bpy.context.scene
+    layer = bpy.context.view_layer
+    scene.frame_set(scene.frame_current)
+
+    def slot(o):
+        adt = o.animation_data
+        s = getattr(adt, "action_slot", None) if adt else None
+        return s.identifier if s is not None else ""
+
+    objects = {}
+    for o in bpy.data.objects:
+        adt = o.animation_data
+        objects[o.name] = {
+            "action": adt.action.name if adt and adt.action else None,
+            "has_animation_data": adt is not None,
+            "slot": slot(o),
+            "matrix_basis": np.array(o.matrix_basis).round(6).tolist(),
+            "data": o.data.name if o.data else None,
+            "parent": o.parent.name if o.parent else None,
+            "selected": o.select_get() if o.name in layer.objects else None,
+            "props": _id_props(o),
+            "preview": bool(getattr(o, "screwbender_preview", False)),
+        }
+    meshes = {}
+    for m in bpy.data.meshes:
+        select = np.empty(len(m.polygons), dtype=bool)
+        m.polygons.foreach_get("select", select)
+        co = np.empty(3 * len(m.vertices), dtype=np.float32)
+        m.vertices.foreach_get("co", co)
+        meshes[m.name] = (len(m.vertices), len(m.polygons), co.tobytes(), select.tobytes(), m.users)
+    curves = {}
+    for c in bpy.data.curves:
+        curves[c.name] = [
+            np.array([tuple(p.co) for p in s.points]).round(6).tolist() for s in c.splines
+        ]
+    return {
+        "objects": objects,
+        "active": layer.objects.active.name if layer.objects.active else None,
+        "actions": {
+            a.name: (a.use_fake_user, a.users, _id_props(a), snapshot_action(a)) for a in bpy.data.actions
+        },
+        "meshes": meshes,
+        "curves": curves,
+        "materials": sorted(m.name for m in bpy.data.materials),
+        "collections": {c.name: sorted(o.name for o in c.objects) for c in bpy.data.collections},
+        "scene_collections": sorted(c.name for c in scene.collection.children),
+    }
