@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, transaction
+from . import bake, channels, keys, owners, transaction
 from .keys import SmoothError
 
 #: Custom property (on the sphere helper) whose F-curve is the magnitude sketch, rad/s.
@@ -331,9 +331,9 @@ def fit(
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
     baked = bake.Baked(
-        objects=[obj], motion=motion, frames=frames, values={keys.rotation_path(mode): rotation}, cyclic=False
+        owner=owners.Owner(obj), motion=motion, frames=frames, values={keys.rotation_path(mode): rotation}, cyclic=False
     )
-    bake.write(baked, t)
+    bake.write_one(baked, t)
     fit_curve = sphere.get(FIT_KEY)
     if not isinstance(fit_curve, bpy.types.Object):
         fit_curve = _curve_object(f"{obj.name}.omega_fit", sphere, FIT_COLOR, context.collection)

@@ -26,7 +26,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, feature, keys, transaction
+from . import channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -113,29 +113,21 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
 
 @dataclass
 class Baked:
-    """Dense channel values for the objects of one action, before anything is written."""
+    """Dense channel values of one owner (an object or a pose bone), before anything is written."""
 
-    #: The objects animated by the action (several when they share it: linked duplicates).
-    objects: list[bpy.types.Object]
+    owner: owners.Owner
     motion: keys.KeyedMotion
     frames: np.ndarray
     #: property name -> (len(frames), components) values; for "scale" only the keyed axes,
-    #: listed in `scale_axes`.
+    #: listed in `motion.scale_axes`.
     values: dict[str, np.ndarray]
     #: Whether the baked curves get a Cycles modifier (a closed motion baked over one period).
     cyclic: bool
-    #: The action holding the keys that were smoothed (the original keys).
-    source: bpy.types.Action | None = None
-    #: The action the objects have now (the source, or a result of Smooth Motion replaced by
-    #: this one); the new action is a copy of it, so curves edited since are kept.
-    current: bpy.types.Action | None = None
-    #: The slot of the objects in `current` (4.4+, else "").
-    identifier: str = ""
 
     @property
     def obj(self) -> bpy.types.Object:
-        """The first object (the one named in messages)."""
-        return self.objects[0]
+        """The owner's object."""
+        return self.owner.obj
 
     @property
     def key_count(self) -> int:
@@ -143,24 +135,50 @@ class Baked:
         return len(self.frames) * sum(v.shape[1] for v in self.values.values())
 
 
+@dataclass
+class ActionBake:
+    """Everything written into one new action: the bakes of every smoothed owner animated by
+    one action (and slot), for every object that action animates."""
+
+    #: The objects animated by the action (several when they share it: linked duplicates).
+    objects: list[bpy.types.Object]
+    #: One bake per smoothed owner (the object itself and/or its bones).
+    parts: list[Baked]
+    #: The action holding the keys that were smoothed (the original keys).
+    source: bpy.types.Action
+    #: The action the objects have now (the source, or a result of Smooth Motion replaced by
+    #: this one); the new action is a copy of it, so curves edited since are kept.
+    current: bpy.types.Action
+    #: The slot of the objects in `current` (4.4+, else "").
+    identifier: str = ""
+
+    @property
+    def obj(self) -> bpy.types.Object:
+        return self.objects[0]
+
+    @property
+    def key_count(self) -> int:
+        return sum(p.key_count for p in self.parts)
+
+
 def sample_poses(
     motion: keys.KeyedMotion,
     frames: np.ndarray,
     options: Options,
-    obj: bpy.types.Object | None = None,
+    owner: owners.Owner | bpy.types.Object | None = None,
 ) -> tuple[np.ndarray, np.ndarray | None]:
     """The smoothed motion at `frames`: rigid poses (len(frames), 4, 4) and, when scale is
     keyed, scales (len(frames), 3) (else None). One `polyscrew.sample` call for the poses
-    (`polyscrew.sample_feature` for the Feature Points method, which needs `obj` for its mesh
-    and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
+    (`polyscrew.sample_feature` for the Feature Points method, which needs the owner for its
+    feature points and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
     from polyscrew.
 
     The live preview and Insert Key on Motion sample through here; Smooth Motion's bake
     samples the same motion as channels (:func:`sample_channels`: `polyscrew.sample_channels`
     is `rotation_channels` of `polyscrew.sample`), so they show, key and bake one motion.
     """
-    if options.method == "FEATURE" and obj is not None:
-        poses = feature.sample_poses(obj, motion, frames, options)
+    if options.method == "FEATURE" and owner is not None:
+        poses = feature.sample_poses(owners.as_owner(owner), motion, frames, options)
     else:
         poses = polyscrew.sample(motion.poses, motion.frames, frames, **_spec(motion, options))
     return poses, sample_scales(motion, frames, options)
@@ -235,21 +253,25 @@ def channel_count(motion: keys.KeyedMotion) -> int:
 
 
 def sample_channels(
-    obj: bpy.types.Object, motion: keys.KeyedMotion, options: Options, budget: list[int] | None = None
+    owner: owners.Owner | bpy.types.Object,
+    motion: keys.KeyedMotion,
+    options: Options,
+    budget: list[int] | None = None,
 ) -> Baked:
-    """Samples the smoothed motion of `obj` at every baked frame (no Blender data changes).
+    """Samples the smoothed motion of `owner` at every baked frame (no Blender data changes).
 
-    `budget` holds the keys still allowed (all objects of one Smooth Motion together, at most
+    `budget` holds the keys still allowed (all owners of one Smooth Motion together, at most
     :data:`MAX_KEYS`); a bake that would exceed it is refused before anything is sampled.
     """
+    owner = owners.as_owner(owner)
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
     if budget is not None and end > start and options.step > 0.0:
         keys_needed = ((end - start) / options.step + 2) * channel_count(motion)
         if keys_needed > budget[0]:
             raise SmoothError(
-                f"{obj.name}: baking frames {start:g} to {end:g} every {options.step:g} frames would write "
+                f"{owner.name}: baking frames {start:g} to {end:g} every {options.step:g} frames would write "
                 f"{keys_needed:,.0f} keys; one Smooth Motion writes at most {MAX_KEYS:,} "
-                f"({budget[0]:,} left for this object): raise Step, shorten the Frame Range or smooth fewer objects"
+                f"({budget[0]:,} left for this one): raise Step, shorten the Frame Range or smooth fewer objects"
             )
         budget[0] -= int(keys_needed)
     try:
@@ -257,7 +279,7 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         if options.method == "FEATURE":
-            poses, scales = sample_poses(motion, frames, options, obj)
+            poses, scales = sample_poses(motion, frames, options, owner)
             location = poses[:, :3, 3].copy()
             rotation = polyscrew.rotation_channels(poses, mode, previous=previous)
         else:  # one call from keys to channels, no (frames, 4, 4) matrices in between
@@ -269,7 +291,7 @@ def sample_channels(
         if scales is not None:
             values["scale"] = scales[:, motion.scale_axes]
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
-        raise SmoothError(f"{obj.name}: {err}") from err
+        raise SmoothError(f"{owner.name}: {err}") from err
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
     # that was cyclic in the source.
     cyclic = (
@@ -278,14 +300,20 @@ def sample_channels(
         and options.frame_range is None
         and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
     )
-    return Baked(objects=[obj], motion=motion, frames=frames, values=values, cyclic=cyclic)
+    return Baked(owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic)
 
 
 def _write_curves(
-    bag, path: str, frames: np.ndarray, values: np.ndarray, cyclic: bool, indices: np.ndarray | None = None
+    bag,
+    path: str,
+    frames: np.ndarray,
+    values: np.ndarray,
+    cyclic: bool,
+    indices: np.ndarray | None = None,
+    group: str = channels.TRANSFORM_GROUP,
 ) -> None:
     """One dense linear F-curve per column of `values` (array index `indices[column]`, by
-    default the column), keyed at `frames`."""
+    default the column), keyed at `frames`, in F-curve group `group`."""
     co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
     co[:, 0] = frames
     # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
@@ -293,7 +321,7 @@ def _write_curves(
     linear = (_LINEAR,) * len(frames)
     for column in range(values.shape[1]):
         index = int(indices[column]) if indices is not None else column
-        fcurve = channels.new_fcurve(bag, path, index)
+        fcurve = channels.new_fcurve(bag, path, index, group)
         points = fcurve.keyframe_points
         points.add(len(frames))
         co[:, 1] = values[:, column]
@@ -304,33 +332,32 @@ def _write_curves(
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
-def write(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
-    """Gives the objects of `baked` a copy of their current action whose transform curves are
-    the baked ones (every other curve as it was); the original keys' action keeps a fake user
-    and is recorded on the copy for :func:`revert`. A result of Smooth Motion that no object
-    uses any more is removed once everything has worked."""
-    source = baked.source if baked.source is not None else baked.obj.animation_data.action
-    current = baked.current if baked.current is not None else source
-    identifier = baked.identifier if baked.current is not None else channels.slot_identifier(baked.obj)
+def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
+    """Gives the objects of `bake` a copy of their current action whose transform curves of
+    the smoothed owners are the baked ones (every other curve as it was); the original keys'
+    action keeps a fake user and is recorded on the copy for :func:`revert`. A result of
+    Smooth Motion that no object uses any more is removed once everything has worked."""
+    source, current, identifier = bake.source, bake.current, bake.identifier
     smoothed = current.copy()
     smoothed.name = f"{source.name}.smooth"
     smoothed.use_fake_user = False
     slot = smoothed.slots.get(identifier) if channels.is_slotted(smoothed) else None
     bag = channels.ensure_container(smoothed, slot)
-    # Transform curves of these objects that the bake replaces; every other curve stays as copied.
-    replaced = set(baked.values)
+    # Transform curves the bake replaces; every other curve stays as copied.
+    replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
     for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced]:
         bag.fcurves.remove(fcurve)
-    for path, values in baked.values.items():
-        indices = np.flatnonzero(baked.motion.scale_axes) if path == "scale" else None
-        _write_curves(bag, path, baked.frames, values, baked.cyclic, indices)
+    for part in bake.parts:
+        for prop, values in part.values.items():
+            indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
+            _write_curves(bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group)
     smoothed[SOURCE_KEY] = source
     if current is source:
         smoothed[SOURCE_SLOT_KEY] = identifier
         smoothed[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
     # (re-smoothing: the copy of the earlier result already records the original's slot and flag)
     t.set(source, "use_fake_user", True)
-    for obj in baked.objects:
+    for obj in bake.objects:
         t.assign_action(obj, smoothed, identifier)
     if current is not source:
         name = f"{source.name}.smooth"
@@ -343,6 +370,13 @@ def write(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
     return smoothed
 
 
+def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
+    """:func:`write` for one owner's bake into a copy of its object's action."""
+    obj = baked.obj
+    action = obj.animation_data.action
+    return write(ActionBake([obj], [baked], action, action, channels.slot_identifier(obj)), t)
+
+
 def _remove_if_unused(action: bpy.types.Action) -> bool:
     """Removes `action` when nothing uses it (a replaced result of Smooth Motion); returns
     whether it did."""
@@ -350,56 +384,6 @@ def _remove_if_unused(action: bpy.types.Action) -> bool:
         bpy.data.actions.remove(action)
         return True
     return False
-
-
-def _read_group(
-    objects: list[bpy.types.Object], options: Options, budget: list[int]
-) -> tuple[list[Baked], list, list[str]]:
-    """Reads and samples the objects that share one action (and slot).
-
-    Returns the bakes (one for the whole group when every object has the same key poses, else
-    one per object), the skipped objects with their messages and notes for the report.
-    """
-    first = objects[0]
-    current = first.animation_data.action
-    identifier = channels.slot_identifier(first)
-    source, source_slot = current, identifier
-    original = current.get(SOURCE_KEY)
-    if isinstance(original, bpy.types.Action) and not options.smooth_result:
-        # A result of Smooth Motion: smooth the original keys again with the new options.
-        source, source_slot = original, current.get(SOURCE_SLOT_KEY, "")
-    motions, skipped = [], []
-    for obj in objects:
-        try:
-            keys.check_editable(obj)
-            read_from = None if source is current else source
-            motions.append((obj, keys.read(obj, options.closed, action=read_from, slot=source_slot)))
-        except SmoothError as err:
-            skipped.append((obj, str(err)))
-    if not motions:
-        return [], skipped, []
-    notes = []
-    same = all(_same_motion(motions[0][1], m) for _, m in motions[1:])
-    if same:
-        groups = [[obj for obj, _ in motions]]
-    else:
-        groups = [[obj] for obj, _ in motions]
-        notes.append(
-            f"{', '.join(o.name for o, _ in motions)} share action '{current.name}' but differ in "
-            "unkeyed channels or rotation mode: each got its own smoothed action"
-        )
-    by_object = dict(motions)
-    bakes = []
-    for group in groups:
-        try:
-            baked = sample_channels(group[0], by_object[group[0]], options, budget)
-        except SmoothError as err:
-            skipped += [(obj, str(err)) for obj in group]
-            continue
-        baked.objects = group
-        baked.source, baked.current, baked.identifier = source, current, identifier
-        bakes.append(baked)
-    return bakes, skipped, notes
 
 
 def _same_motion(a: keys.KeyedMotion, b: keys.KeyedMotion) -> bool:
@@ -413,18 +397,90 @@ def _same_motion(a: keys.KeyedMotion, b: keys.KeyedMotion) -> bool:
     )
 
 
-def _action_groups(objects: Iterable[bpy.types.Object]) -> tuple[list[list[bpy.types.Object]], list]:
-    """The objects grouped by the action and slot they are animated by (linked duplicates
-    share one), in the objects' order; objects without an action are refused here."""
-    groups: dict[tuple, list[bpy.types.Object]] = {}
+@dataclass
+class _Group:
+    """Owners animated by one action and slot: the objects using it, the bones (or "" for
+    the object itself) selected on any of them."""
+
+    objects: list[bpy.types.Object]
+    bones: list[str]
+
+
+def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
+    """The owners grouped by the action and slot that animates them (linked duplicates share
+    one), in the order given; owners without an action are refused here."""
+    groups: dict[tuple, _Group] = {}
     skipped = []
-    for obj in objects:
-        adt = obj.animation_data
+    for item in selection:
+        owner = owners.as_owner(item)
+        adt = owner.obj.animation_data
         if adt is None or adt.action is None:
-            skipped.append((obj, f"{obj.name}: no animation (no active action): skipped"))
+            skipped.append((owner, f"{owner.name}: no animation (no active action): skipped"))
             continue
-        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(obj)), []).append(obj)
+        group = groups.setdefault(
+            (adt.action.as_pointer(), channels.slot_identifier(owner.obj)), _Group([], [])
+        )
+        if owner.obj not in group.objects:
+            group.objects.append(owner.obj)
+        if owner.bone not in group.bones:
+            group.bones.append(owner.bone)
     return list(groups.values()), skipped
+
+
+def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[list[ActionBake], list, list[str]]:
+    """Reads and samples the owners that share one action (and slot).
+
+    Returns the action bakes (one for the whole group when every object has the same key
+    poses for every owner, else one per object), the skipped owners with their messages, and
+    notes for the report.
+    """
+    first = group.objects[0]
+    current = first.animation_data.action
+    identifier = channels.slot_identifier(first)
+    source, source_slot = current, identifier
+    original = current.get(SOURCE_KEY)
+    if isinstance(original, bpy.types.Action) and not options.smooth_result:
+        # A result of Smooth Motion: smooth the original keys again with the new options.
+        source, source_slot = original, current.get(SOURCE_SLOT_KEY, "")
+    read_from = None if source is current else source
+    # motions[bone][object index]
+    motions: dict[str, list[keys.KeyedMotion]] = {}
+    skipped = []
+    for bone in group.bones:
+        row = []
+        for obj in group.objects:
+            owner = owners.Owner(obj, bone)
+            try:
+                row.append(keys.read(owner, options.closed, action=read_from, slot=source_slot))
+            except SmoothError as err:
+                skipped.append((owner, str(err)))
+                break
+        else:
+            motions[bone] = row
+    if not motions:
+        return [], skipped, []
+    notes = []
+    shared = all(_same_motion(row[0], m) for row in motions.values() for m in row[1:])
+    if shared:
+        units = [(group.objects, 0)]
+    else:
+        units = [([obj], i) for i, obj in enumerate(group.objects)]
+        notes.append(
+            f"{', '.join(o.name for o in group.objects)} share action '{current.name}' but differ in "
+            "unkeyed channels or rotation mode: each got its own smoothed action"
+        )
+    bakes = []
+    for objects, column in units:
+        parts = []
+        for bone, row in motions.items():
+            owner = owners.Owner(objects[0], bone)
+            try:
+                parts.append(sample_channels(owner, row[column], options, budget))
+            except SmoothError as err:
+                skipped.append((owner, str(err)))
+        if parts:
+            bakes.append(ActionBake(objects, parts, source, current, identifier))
+    return bakes, skipped, notes
 
 
 @dataclass
@@ -435,23 +491,25 @@ class Smoothed:
     actions: list[bpy.types.Action]
     #: The objects given a new action.
     objects: list[bpy.types.Object]
-    #: Messages of the objects skipped (nothing changed on them).
+    #: The owners smoothed (objects and bones), by name.
+    owners: list[str]
+    #: Messages of what was skipped (nothing changed there).
     skipped: list[str]
     #: Other things worth telling (shared actions split, results re-smoothed).
     notes: list[str]
 
 
-def _in_order(objects: list[bpy.types.Object], skipped: list) -> list[str]:
-    """The messages of skipped (object, message) pairs, in the order of `objects`."""
-    order = {obj.as_pointer(): i for i, obj in enumerate(objects)}
-    return [message for obj, message in sorted(skipped, key=lambda pair: order[pair[0].as_pointer()])]
+def _in_order(selection: list, skipped: list) -> list[str]:
+    """The messages of skipped (owner, message) pairs, in the order of `selection`."""
+    order = {owners.as_owner(item): i for i, item in enumerate(selection)}
+    return [message for owner, message in sorted(skipped, key=lambda pair: order.get(pair[0], len(order)))]
 
 
-def prepare(objects: Iterable[bpy.types.Object], options: Options) -> tuple[list[Baked], list[str], list[str]]:
-    """Reads and samples every object (nothing changes); returns the bakes, the messages of
-    skipped objects and notes."""
-    objects = list(objects)
-    groups, skipped = _action_groups(objects)
+def prepare(selection: Iterable, options: Options) -> tuple[list[ActionBake], list[str], list[str]]:
+    """Reads and samples every owner (objects or :class:`owners.Owner`s; nothing changes);
+    returns the action bakes, the messages of what was skipped, and notes."""
+    selection = list(selection)
+    groups, skipped = _action_groups(selection)
     bakes, notes = [], []
     budget = [MAX_KEYS]
     for group in groups:
@@ -459,27 +517,27 @@ def prepare(objects: Iterable[bpy.types.Object], options: Options) -> tuple[list
         bakes += done
         skipped += messages
         notes += told
-    return bakes, _in_order(objects, skipped), notes
+    return bakes, _in_order(selection, skipped), notes
 
 
 def smooth(
-    objects: Iterable[bpy.types.Object],
+    selection: Iterable,
     options: Options,
     progress: Callable[[int, int], None] | None = None,
     strict: bool = False,
     t: transaction.Transaction | None = None,
 ) -> Smoothed:
-    """Smooths `objects`; objects sharing an action keep sharing one smoothed action.
+    """Smooths the owners in `selection` (objects, or :class:`owners.Owner`s for bones);
+    owners animated by one action get one new action, shared as the old one was.
 
-    Objects that cannot be smoothed are skipped and left unchanged; the others get their new
-    action (with `strict`, any skipped object raises :class:`SmoothError` listing them all,
-    before anything is changed). Every object is read and sampled before anything is written,
-    and the writing is all or nothing (inside `t`, or a transaction of its own): a failure
-    halfway leaves `bpy.data` as it was. `progress(done, total)` is called as objects are
-    sampled and written.
+    Owners that cannot be smoothed are skipped and left unchanged; the others are (with
+    `strict`, anything skipped raises :class:`SmoothError` listing it all, before anything is
+    changed). Everything is read and sampled before anything is written, and the writing is
+    all or nothing (inside `t`, or a transaction of its own): a failure halfway leaves
+    `bpy.data` as it was. `progress(done, total)` is called as actions are sampled and written.
     """
-    objects = list(objects)
-    groups, skipped = _action_groups(objects)
+    selection = list(selection)
+    groups, skipped = _action_groups(selection)
     total = len(groups) * 2
     bakes, notes = [], []
     budget = [MAX_KEYS]
@@ -490,7 +548,7 @@ def smooth(
         notes += told
         if progress is not None:
             progress(i + 1, total)
-    skipped = _in_order(objects, skipped)
+    skipped = _in_order(selection, skipped)
     if strict and skipped:
         raise SmoothError("; ".join(skipped))
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
@@ -500,12 +558,17 @@ def smooth(
         if t is None:
             t = stack.enter_context(transaction.atomic())
         actions = []
-        for i, baked in enumerate(bakes):
-            actions.append(write(baked, t))
+        for i, bake in enumerate(bakes):
+            actions.append(write(bake, t))
             if progress is not None:
                 progress(len(groups) + i + 1, total)
-    smoothed_objects = [obj for b in bakes for obj in b.objects]
-    return Smoothed(actions=actions, objects=smoothed_objects, skipped=skipped, notes=notes)
+    return Smoothed(
+        actions=actions,
+        objects=[obj for b in bakes for obj in b.objects],
+        owners=[p.owner.name for b in bakes for p in b.parts],
+        skipped=skipped,
+        notes=notes,
+    )
 
 
 def _names(names: list[str], limit: int = 3) -> str:
@@ -531,7 +594,8 @@ def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
 
 def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.Object]:
     """Gives `obj`, and every object sharing its smoothed action, back the action they had
-    before smoothing; drops the smoothed copy once nothing uses it. Returns the objects."""
+    before smoothing (bones included: the whole action); drops the smoothed copy once nothing
+    uses it. Returns the objects."""
     source = source_of(obj)
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, keys
+from . import channels, keys, owners
 
 #: Smoothing methods: (identifier, label, description).
 METHODS = (
@@ -50,13 +50,14 @@ PARAMETRIZATIONS = (
 )
 
 
-def selected_keys(obj: bpy.types.Object, frames: np.ndarray) -> np.ndarray:
-    """Per key frame: whether a key is selected there on any transform F-curve of `obj`."""
+def selected_keys(owner: owners.Owner | bpy.types.Object, frames: np.ndarray) -> np.ndarray:
+    """Per key frame: whether a key is selected there on any transform F-curve of `owner`."""
+    owner = owners.as_owner(owner)
     selected = np.zeros(len(frames), dtype=bool)
-    paths = keys.transform_paths(obj.rotation_mode)
-    for fcurve in channels.object_fcurves(obj):
+    paths = keys.transform_paths(owner.rotation_mode)
+    for fcurve in channels.object_fcurves(owner.obj):
         points = fcurve.keyframe_points
-        if fcurve.data_path not in paths or fcurve.mute or len(points) == 0:
+        if owner.prop_of(fcurve.data_path) not in paths or fcurve.mute or len(points) == 0:
             continue
         co = np.empty(2 * len(points), dtype=np.float32)
         points.foreach_get("co", co)
@@ -69,9 +70,28 @@ def selected_keys(obj: bpy.types.Object, frames: np.ndarray) -> np.ndarray:
     return selected
 
 
-def feature_points(obj: bpy.types.Object, scale: np.ndarray) -> np.ndarray | None:
-    """The six inertia points of `obj`'s mesh in the frame of its rigid pose (vertices times
-    `scale`), or None (a unit frame's points) without a mesh or for a degenerate one."""
+#: A bone's feature points are those of a box around it, this wide per unit of bone length.
+BONE_BOX_WIDTH = 0.1
+
+
+def bone_points(length: float) -> np.ndarray:
+    """The eight corners of a box around a bone of `length` in its own space (head at the
+    origin, the bone along +Y): the bone's body for the Feature Points method."""
+    w = BONE_BOX_WIDTH * length
+    return np.array([(x, y, z) for x in (-w, w) for y in (0.0, length) for z in (-w, w)])
+
+
+def feature_points(owner: owners.Owner | bpy.types.Object, scale: np.ndarray) -> np.ndarray | None:
+    """The six inertia points of the owner's body in the frame of its rigid pose: an object's
+    mesh (vertices times `scale`), a bone's box of its length (:func:`bone_points`); None (a
+    unit frame's points) for an object without a mesh or with a degenerate one."""
+    owner = owners.as_owner(owner)
+    if owner.bone:
+        length = owner.obj.data.bones[owner.bone].length
+        if not length > 0.0:
+            return None
+        return polyscrew.inertia_points(bone_points(length) * scale)
+    obj = owner.obj
     if obj.type != "MESH" or len(obj.data.vertices) < 3:
         return None
     co = np.empty(3 * len(obj.data.vertices), dtype=np.float64)
@@ -93,8 +113,10 @@ def key_stiffness(motion: keys.KeyedMotion, selected: np.ndarray, approximate: b
     return lam
 
 
-def sample_poses(obj: bpy.types.Object, motion: keys.KeyedMotion, frames: np.ndarray, options) -> np.ndarray:
-    """The feature-point motion of `obj` at `frames`: (len(frames), 4, 4) rigid poses.
+def sample_poses(
+    owner: owners.Owner | bpy.types.Object, motion: keys.KeyedMotion, frames: np.ndarray, options
+) -> np.ndarray:
+    """The feature-point motion of `owner` at `frames`: (len(frames), 4, 4) rigid poses.
 
     `options` is a :class:`bake.Options`. Raises ValueError from `polyscrew`.
     """
@@ -106,9 +128,9 @@ def sample_poses(obj: bpy.types.Object, motion: keys.KeyedMotion, frames: np.nda
         frames,
         levels=options.levels,
         closed=motion.closed,
-        feature_points=feature_points(obj, mean_scale),
+        feature_points=feature_points(owner, mean_scale),
         parametrization=options.parametrization,
-        stiffness=key_stiffness(motion, selected_keys(obj, motion.frames), options.approximate, options.stiffness),
+        stiffness=key_stiffness(motion, selected_keys(owner, motion.frames), options.approximate, options.stiffness),
         period=motion.period,
         timing=options.timing,
     )

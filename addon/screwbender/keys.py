@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels
+from . import channels, owners
 
 #: Rotation modes and the property holding the rotation in each.
 ROTATION_PATHS = {
@@ -70,6 +70,8 @@ class KeyedMotion:
     period: float | None
     #: Whether a Cycles modifier was found on the transform curves.
     cyclic: bool
+    #: What was read: the object or pose bone.
+    owner: owners.Owner | None = None
 
     @property
     def scale_keyed(self) -> bool:
@@ -165,9 +167,14 @@ def _union(frames: list[np.ndarray]) -> np.ndarray:
     return merged[keep]
 
 
-def check_editable(obj: bpy.types.Object) -> None:
-    """Raises :class:`SmoothError` unless `obj` has an editable action driving its transform."""
-    name = obj.name
+def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
+    """Raises :class:`SmoothError` unless `owner` (an object or a pose bone, see
+    :mod:`owners`) has an editable action driving its transform."""
+    owner = owners.as_owner(owner)
+    obj = owner.obj
+    name = owner.name
+    if not owner.exists():
+        raise SmoothError(f"{name}: no such bone any more: skipped")
     if obj.library is not None or getattr(obj, "override_library", None) is not None:
         raise SmoothError(f"{name}: object is linked from a library and cannot be edited: skipped")
     adt = obj.animation_data
@@ -181,14 +188,19 @@ def check_editable(obj: bpy.types.Object) -> None:
         raise SmoothError(
             f"{name}: has {strips} NLA strip(s); the baked action would not be what the NLA plays: skipped"
         )
-    paths = transform_paths(obj.rotation_mode)
+    paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
     driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
     if driven:
         raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
 
 
-def read(obj: bpy.types.Object, closed: str = "AUTO", action: bpy.types.Action | None = None, slot: str = "") -> KeyedMotion:
-    """The key poses of `obj`.
+def read(
+    owner: owners.Owner | bpy.types.Object,
+    closed: str = "AUTO",
+    action: bpy.types.Action | None = None,
+    slot: str = "",
+) -> KeyedMotion:
+    """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
     `closed` is "AUTO" (closed when a Cycles modifier is on a transform F-curve), "ON" or
     "OFF". For a closed motion whose last key repeats the first pose, that key only closes the
@@ -199,16 +211,18 @@ def read(obj: bpy.types.Object, closed: str = "AUTO", action: bpy.types.Action |
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth.
     """
-    check_editable(obj)
-    name = obj.name
-    mode = obj.rotation_mode
+    owner = owners.as_owner(owner)
+    check_editable(owner)
+    obj, target = owner.obj, owner.target
+    name = owner.name
+    mode = owner.rotation_mode
     paths = transform_paths(mode)
     source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
-    curves = {
-        (fc.data_path, fc.array_index): fc
-        for fc in source
-        if fc.data_path in paths and not fc.mute and len(fc.keyframe_points) > 0
-    }
+    curves = {}
+    for fc in source:
+        prop = owner.prop_of(fc.data_path)
+        if prop in paths and not fc.mute and len(fc.keyframe_points) > 0:
+            curves[prop, fc.array_index] = fc
     if not curves:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
     points = {key: _key_points(fc) for key, fc in curves.items()}
@@ -217,7 +231,7 @@ def read(obj: bpy.types.Object, closed: str = "AUTO", action: bpy.types.Action |
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
 
     def evaluate(path: str, size: int) -> np.ndarray:
-        static = np.array(getattr(obj, path), dtype=np.float64)
+        static = np.array(getattr(target, path), dtype=np.float64)
         out = np.empty((len(frames), size))
         for i in range(size):
             fc = curves.get((path, i))
@@ -275,4 +289,5 @@ def read(obj: bpy.types.Object, closed: str = "AUTO", action: bpy.types.Action |
         closed=is_closed,
         period=period,
         cyclic=cyclic,
+        owner=owner,
     )
