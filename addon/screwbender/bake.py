@@ -249,7 +249,8 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 
 def channel_count(motion: keys.KeyedMotion) -> int:
     """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
-    return 3 + (4 if motion.rotation_mode in ("QUATERNION", "AXIS_ANGLE") else 3) + int(motion.scale_axes.sum())
+    located = 3 if motion.located else 0
+    return located + (4 if motion.rotation_mode in ("QUATERNION", "AXIS_ANGLE") else 3) + int(motion.scale_axes.sum())
 
 
 def sample_channels(
@@ -288,6 +289,8 @@ def sample_channels(
             )
             scales = sample_scales(motion, frames, options)
         values = {"location": location, keys.rotation_path(mode): rotation}
+        if not motion.located:
+            del values["location"]
         if scales is not None:
             values["scale"] = scales[:, motion.scale_axes]
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
@@ -493,6 +496,8 @@ class Smoothed:
     objects: list[bpy.types.Object]
     #: The owners smoothed (objects and bones), by name.
     owners: list[str]
+    #: How many of them are bones.
+    bones: int
     #: Messages of what was skipped (nothing changed there).
     skipped: list[str]
     #: Other things worth telling (shared actions split, results re-smoothed).
@@ -566,6 +571,7 @@ def smooth(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],
         owners=[p.owner.name for b in bakes for p in b.parts],
+        bones=sum(1 for b in bakes for p in b.parts if p.owner.bone),
         skipped=skipped,
         notes=notes,
     )

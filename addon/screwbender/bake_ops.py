@@ -6,7 +6,7 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, feature, transaction
+from . import bake, channels, feature, owners, transaction
 from .keys import SmoothError
 
 
@@ -31,9 +31,15 @@ def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: s
     report_skipped(operator, result.skipped, "WARNING")
     for note in result.notes:
         operator.report({"INFO"}, note)
-    objects = [o.name for o in result.objects]
-    shared = f" ({len(result.actions)} new actions)" if len(result.actions) != len(objects) else ""
-    operator.report({"INFO"}, f"{verb} {len(objects)} object(s): {bake.summary(objects)}{shared}")
+    names = result.owners
+    if result.bones == len(names):
+        what = "bone(s)"
+    elif result.bones:
+        what = "bone(s) and object(s)"
+    else:
+        what = "object(s)"
+    shared = f" ({len(result.actions)} new actions)" if len(result.actions) != len(names) else ""
+    operator.report({"INFO"}, f"{verb} {len(names)} {what}: {bake.summary(names)}{shared}")
     return {"FINISHED"}
 
 
@@ -58,6 +64,7 @@ def draw_options(layout: bpy.types.UILayout, settings) -> None:
         col.prop(settings, "frame_start")
         col.prop(settings, "frame_end")
     layout.prop(settings, "step")
+    layout.prop(settings, "armature")
     layout.prop(settings, "smooth_result")
 
 
@@ -144,6 +151,13 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         description="Frames between two baked keys: 1 bakes every frame, less bakes subframes "
         "(for motion blur). Baked keys sit on multiples of the step, plus the first and last frame",
     )
+    armature: EnumProperty(
+        name="Armatures",
+        items=owners.ARMATURE_MODES,
+        default="BOTH",
+        description="Object Mode, selected armatures: smooth their keyed bones (hidden bones only when "
+        "selected), the armature object's own keys, or both. In Pose Mode the selected bones are smoothed",
+    )
     smooth_result: BoolProperty(
         name="Smooth Result",
         default=False,
@@ -154,8 +168,13 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode == "POSE":
+            if not context.selected_pose_bones:
+                cls.poll_message_set("Select one or more keyed bones")
+                return False
+            return True
         if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode")
+            cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
             return False
         if not context.selected_objects:
             cls.poll_message_set("Select one or more keyed objects")
@@ -173,12 +192,12 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         return bake.options_from(self, context.scene)
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        objects = sorted(context.selected_objects, key=lambda o: o.name)
+        selection = owners.selection(context, self.armature, channels.object_fcurves)
         wm = context.window_manager
-        wm.progress_begin(0, 2 * len(objects))
+        wm.progress_begin(0, 2 * len(selection))
         try:
             result = bake.smooth(
-                objects, self.smooth_options(context), lambda done, total: wm.progress_update(done)
+                selection, self.smooth_options(context), lambda done, total: wm.progress_update(done)
             )
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
@@ -223,7 +242,7 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 _OPTION_NAMES = (
     "method", "parametrization", "approximate", "stiffness",
     "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
-    "smooth_result",
+    "armature", "smooth_result",
 )
 
 
@@ -248,6 +267,7 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
     frame_start: _same_property("frame_start")
     frame_end: _same_property("frame_end")
     step: _same_property("step")
+    armature: _same_property("armature")
     smooth_result: _same_property("smooth_result")
 
 

@@ -72,6 +72,9 @@ class KeyedMotion:
     cyclic: bool
     #: What was read: the object or pose bone.
     owner: owners.Owner | None = None
+    #: Whether the owner's location moves it (not for a bone connected to its parent, whose
+    #: location Blender ignores: its poses have no translation and no location is baked).
+    located: bool = True
 
     @property
     def scale_keyed(self) -> bool:
@@ -218,10 +221,13 @@ def read(
     mode = owner.rotation_mode
     paths = transform_paths(mode)
     source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
+    # A bone connected to its parent ignores its location (Blender's BKE_pchan_to_mat4): its
+    # pose has no translation, and its location curves are not the bake's business.
+    located = not owner.bone or not obj.data.bones[owner.bone].use_connect
     curves = {}
     for fc in source:
         prop = owner.prop_of(fc.data_path)
-        if prop in paths and not fc.mute and len(fc.keyframe_points) > 0:
+        if prop in paths and not fc.mute and len(fc.keyframe_points) > 0 and (located or prop != "location"):
             curves[prop, fc.array_index] = fc
     if not curves:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
@@ -244,7 +250,7 @@ def read(
                 out[:, i] = [fc.evaluate(f) for f in frames]
         return out
 
-    location = evaluate("location", 3)
+    location = evaluate("location", 3) if located else np.zeros((len(frames), 3))
     rotation = evaluate(paths[1], 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)
     scale = evaluate("scale", 3)
     for label, values in (("location", location), (paths[1], rotation), ("scale", scale)):
@@ -290,4 +296,5 @@ def read(
         period=period,
         cyclic=cyclic,
         owner=owner,
+        located=located,
     )

@@ -75,3 +75,96 @@ class Owner:
 def as_owner(thing) -> Owner:
     """An :class:`Owner` from an owner or an object (the object itself)."""
     return thing if isinstance(thing, Owner) else Owner(thing)
+
+
+#: Which owners of a selected armature object Smooth Motion takes, in Object Mode.
+ARMATURE_MODES = (
+    ("BOTH", "Bones and Object", "Smooth the armature object's own keys and those of its keyed bones"),
+    ("BONES", "Bones Only", "Smooth only the keyed bones of selected armatures"),
+    ("OBJECT", "Object Only", "Smooth only the armature object's own keys, not its bones"),
+)
+
+_TRANSFORM_PROPS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
+
+
+def _bone_of(data_path: str) -> tuple[str, str] | None:
+    """(bone name, property) of a pose bone transform data path, else None."""
+    head = 'pose.bones["'
+    if not data_path.startswith(head):
+        return None
+    end = data_path.find('"].', len(head))
+    while end != -1 and data_path[end - 1] == "\\":  # an escaped quote inside the name
+        end = data_path.find('"].', end + 1)
+    if end == -1:
+        return None
+    prop = data_path[end + 3:]
+    if prop not in _TRANSFORM_PROPS:
+        return None
+    name = data_path[len(head):end].replace('\\"', '"').replace("\\\\", "\\")
+    return name, prop
+
+
+def keyed_bones(obj: bpy.types.Object, fcurves) -> list[str]:
+    """The bones of armature `obj` with keyed transform curves among `fcurves`, in the
+    armature's bone order."""
+    if obj.type != "ARMATURE" or obj.pose is None:
+        return []
+    keyed = set()
+    for fc in fcurves:
+        found = _bone_of(fc.data_path)
+        if found is not None and len(fc.keyframe_points):
+            keyed.add(found[0])
+    return [b.name for b in obj.pose.bones if b.name in keyed]
+
+
+def is_hidden(obj: bpy.types.Object, bone: str) -> bool:
+    """Whether a bone is hidden, or in bone collections that are all hidden."""
+    data = obj.data.bones.get(bone)
+    if data is None:
+        return True
+    if data.hide:
+        return True
+    collections = list(getattr(data, "collections", ()))
+    if collections:
+        return not any(getattr(c, "is_visible_effectively", getattr(c, "is_visible", True)) for c in collections)
+    return False
+
+
+def is_selected(obj: bpy.types.Object, bone: str) -> bool:
+    """Whether a bone is selected (the pose bone's flag where Blender has one, else the bone's)."""
+    pose_bone = obj.pose.bones.get(bone)
+    if pose_bone is not None and hasattr(pose_bone, "select"):
+        return bool(pose_bone.select)
+    data = obj.data.bones.get(bone)
+    return bool(data is not None and data.select)
+
+
+def has_own_keys(obj: bpy.types.Object, fcurves) -> bool:
+    """Whether `obj`'s own transform (not its bones') is keyed among `fcurves`."""
+    return any(fc.data_path in _TRANSFORM_PROPS and len(fc.keyframe_points) for fc in fcurves)
+
+
+def selection(context: bpy.types.Context, armature: str = "BOTH", fcurves_of=None) -> list[Owner]:
+    """The owners Smooth Motion works on, as the animator expects.
+
+    Pose Mode: the selected pose bones. Object Mode: each selected object; for an armature,
+    per `armature` ("BOTH", "BONES", "OBJECT", see :data:`ARMATURE_MODES`) its own keys
+    and/or all its keyed bones, leaving hidden bones and bones in hidden bone collections
+    alone unless they are selected. `fcurves_of(obj)` lists an object's F-curves.
+    """
+    if context.mode == "POSE":
+        bones = context.selected_pose_bones or []
+        return sorted((Owner(b.id_data, b.name) for b in bones), key=lambda o: (o.obj.name, o.bone))
+    out = []
+    for obj in sorted(context.selected_objects, key=lambda o: o.name):
+        if obj.type != "ARMATURE" or armature == "OBJECT":
+            out.append(Owner(obj))
+            continue
+        curves = fcurves_of(obj) if fcurves_of is not None else []
+        if armature == "BOTH" and has_own_keys(obj, curves):
+            out.append(Owner(obj))
+        bones = [b for b in keyed_bones(obj, curves) if not is_hidden(obj, b) or is_selected(obj, b)]
+        out += [Owner(obj, b) for b in bones]
+        if not bones and not (armature == "BOTH" and has_own_keys(obj, curves)):
+            out.append(Owner(obj))  # nothing keyed: read it to say so
+    return out
