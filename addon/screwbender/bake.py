@@ -202,13 +202,12 @@ def write(baked: Baked) -> bpy.types.Action:
     smoothed = source.copy()
     smoothed.name = f"{source.name}.smooth"
     smoothed.use_fake_user = False
-    slot = smoothed.slots.get(identifier) if channels.is_slotted(smoothed) else None
-    bag = channels.ensure_container(smoothed, slot)
+    bag = channels.ensure_container(smoothed, channels.find_slot(smoothed, identifier))
     baked_paths = set(baked.values)
     # Transform curves of this object that the bake replaces; every other curve stays as copied.
     replaced = keys.transform_paths(baked.motion.rotation_mode)
-    for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced and fc.data_path in baked_paths]:
-        bag.fcurves.remove(fcurve)
+    for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced and fc.data_path in baked_paths]:
+        channels.remove_fcurve(bag, fcurve)
     for path, values in baked.values.items():
         _write_curves(bag, path, baked.frames, values, baked.cyclic)
     smoothed[SOURCE_KEY] = source
