@@ -48,7 +48,9 @@ HAS_SLOTS: bool = hasattr(bpy.types, "ActionSlot")
 HAS_ACTION_FCURVES: bool = "fcurves" in bpy.types.Action.bl_rna.properties
 #: True when a channelbag's `fcurves.new` takes `group_name` (5.0 and later; 4.4 called the
 #: type ActionChannelBagFCurves).
-NEW_TAKES_GROUP: bool = "group_name" in _new_parameters(("ActionChannelbagFCurves", "ActionChannelBagFCurves"))
+NEW_TAKES_GROUP: bool = "group_name" in _new_parameters(
+    ("ActionChannelbagFCurves", "ActionChannelBagFCurves")
+)
 
 
 def is_slotted(action: bpy.types.Action) -> bool:
