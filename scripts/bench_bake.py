@@ -83,9 +83,7 @@ def run_case(count: int, frames: int) -> tuple[float, float]:
     # Blender's baker on the same (source) actions and frames
     for obj in objects:
         from_action = obj.animation_data.action[bake.SOURCE_KEY]
-        obj.animation_data.action = from_action
-        if hasattr(obj.animation_data, "action_slot") and len(from_action.slots):
-            obj.animation_data.action_slot = from_action.slots[0]
+        bake.channels.assign(obj, from_action, obj.animation_data.action.get(bake.SOURCE_SLOT_KEY, ""))
     select(objects)
     start = time.perf_counter()
     result = bpy.ops.nla.bake(
@@ -131,13 +129,7 @@ def keyframe_insert_loop(count: int, frames: int) -> float:
 
 
 def bake_fcurves(obj):
-    adt = obj.animation_data
-    action = adt.action
-    if hasattr(action, "layers"):
-        from bpy_extras import anim_utils
-
-        return list(anim_utils.action_get_channelbag_for_slot(action, adt.action_slot).fcurves)
-    return list(action.fcurves)
+    return bake.channels.object_fcurves(obj)
 
 
 def main() -> None:

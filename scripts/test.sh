@@ -1,17 +1,40 @@
 #!/usr/bin/env bash
 # The project's one test command: installs what it needs into .venv (scripts/bootstrap.sh),
-# then runs the Rust tests, builds the polyscrew wheel (release, once), runs the Python tests
-# of the module, and the Blender tests headless under every bpy version in .venv/bpy/.
+# then runs the Rust tests, builds the polyscrew wheel (release, once: abi3, for CPython 3.11
+# and later), runs the Python tests of the module, and the Blender tests headless under every
+# Blender version of scripts/blender_matrix.sh (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
+# A version whose CPython or bpy is missing fails the run (it is never skipped).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
+source scripts/blender_matrix.sh
 start=$(date +%s)
-stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
+stage_name="" stage_start=$start timings=()
+stage() { # closes the previous stage (its duration goes to the summary) and opens the next
+  local now; now=$(date +%s)
+  [ -z "$stage_name" ] || timings+=("$(printf '%5d s  %s' $((now - stage_start)) "$stage_name")")
+  stage_name="$*" stage_start=$now
+  echo; echo "=== $* ($((now - start)) s)"
+}
 
 stage "bootstrap"
 scripts/bootstrap.sh
 py="$root/.venv/bin/python"
+missing=()
+for row in "${BLENDER_MATRIX[@]}"; do
+  read -r version cpython _ <<<"$row"
+  if [ ! -x "$(matrix_venv "$cpython")/bin/python" ]; then
+    missing+=("bpy $version: $(missing_cpython "$cpython" "Blender $version"), then run scripts/bootstrap.sh")
+  elif [ ! -f ".venv/bpy/${version%.*}/.stamp-bpy-$version" ]; then
+    missing+=("bpy $version: not installed in .venv/bpy/${version%.*}: run scripts/bootstrap.sh")
+  fi
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  printf 'test: cannot test every Blender version:\n' >&2
+  printf '  %s\n' "${missing[@]}" >&2
+  exit 1
+fi
 
 stage "cargo test (workspace)"
 cargo test --workspace --quiet
@@ -23,7 +46,10 @@ stage "build the polyscrew wheel (release)"
 rm -rf dist/wheel && mkdir -p dist/wheel
 "$root/.venv/bin/maturin" build --release --quiet -o dist/wheel 2>&1 | grep -v '^ *Compiling' || true
 wheel=$(ls dist/wheel/polyscrew-*.whl)
-"$py" -m pip --disable-pip-version-check install -q --force-reinstall --no-deps "$wheel"
+# The one abi3 wheel, into every venv that runs tests (.venv and .venv/py313).
+for env_dir in $(for row in "${BLENDER_MATRIX[@]}"; do read -r _ cpython _ <<<"$row"; matrix_venv "$cpython"; done | sort -u); do
+  "$env_dir/bin/python" -m pip --disable-pip-version-check install -q --force-reinstall --no-deps "$wheel"
+done
 export SCREWBENDER_WHEEL="$wheel"
 if [ -x scripts/build_extension.sh ]; then
   stage "build the extension"
@@ -33,9 +59,14 @@ fi
 stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)'))"
 "$py" -m pytest -q -p no:cacheprovider tests/python
 
-for dir in "$root"/.venv/bpy/*/; do
-  version=$(basename "$dir")
-  stage "pytest tests/blender under bpy $version"
-  PYTHONPATH="$dir" "$py" -m pytest -q -p no:cacheprovider tests/blender
+for row in "${BLENDER_MATRIX[@]}"; do
+  read -r version cpython _ <<<"$row"
+  dir="$root/.venv/bpy/${version%.*}"
+  env_py="$(matrix_venv "$cpython")/bin/python"
+  numpy_version=$(PYTHONPATH="$dir" "$env_py" -c 'import numpy; print(numpy.__version__)')
+  stage "pytest tests/blender under bpy $version (CPython $cpython, numpy $numpy_version)"
+  PYTHONPATH="$dir" "$env_py" -m pytest -q -p no:cacheprovider tests/blender
 done
 stage "all tests passed"
+echo "time per stage:"
+printf '  %s\n' "${timings[@]}"

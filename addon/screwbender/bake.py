@@ -344,12 +344,11 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
     smoothed = current.copy()
     smoothed.name = f"{source.name}.smooth"
     smoothed.use_fake_user = False
-    slot = smoothed.slots.get(identifier) if channels.is_slotted(smoothed) else None
-    bag = channels.ensure_container(smoothed, slot)
+    bag = channels.ensure_container(smoothed, channels.find_slot(smoothed, identifier))
     # Transform curves the bake replaces; every other curve stays as copied.
     replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
-    for fcurve in [fc for fc in bag.fcurves if fc.data_path in replaced]:
-        bag.fcurves.remove(fcurve)
+    for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced]:
+        channels.remove_fcurve(bag, fcurve)
     for part in bake.parts:
         for prop, values in part.values.items():
             indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None

@@ -172,7 +172,7 @@ class Transaction:
         fcurve = channels.new_fcurve(bag, data_path, index)
 
         def undo() -> None:
-            channels.remove_fcurve(bag, data_path, index)
+            channels.remove_fcurve_at(bag, data_path, index)
             if not had_group:
                 channels.remove_group_if_empty(bag)
 

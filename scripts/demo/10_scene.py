@@ -68,15 +68,7 @@ def key(obj: bpy.types.Object, frame: float, location, rotation) -> None:
 
 
 def make_cyclic(obj: bpy.types.Object) -> None:
-    adt = obj.animation_data
-    action = adt.action
-    if hasattr(action, "layers"):
-        from bpy_extras import anim_utils
-
-        curves = anim_utils.action_get_channelbag_for_slot(action, adt.action_slot).fcurves
-    else:
-        curves = action.fcurves
-    for fc in curves:
+    for fc in demo_common.channels().object_fcurves(obj):
         fc.modifiers.new("CYCLES")
 
 

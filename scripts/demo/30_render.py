@@ -74,14 +74,7 @@ def world_matrices(obj: bpy.types.Object, frames: np.ndarray) -> list[Matrix]:
 
 
 def key_frames(obj: bpy.types.Object) -> list[float]:
-    adt = obj.animation_data
-    action = adt.action
-    if hasattr(action, "layers"):
-        from bpy_extras import anim_utils
-
-        curves = anim_utils.action_get_channelbag_for_slot(action, adt.action_slot).fcurves
-    else:
-        curves = action.fcurves
+    curves = demo_common.channels().object_fcurves(obj)
     return sorted({round(k.co[0], 3) for fc in curves for k in fc.keyframe_points})
 
 

@@ -80,3 +80,19 @@ def blender_with_addon():
     if not Path(polyscrew.__file__).resolve().is_relative_to(wheels.resolve()):
         sys.exit(f"demo: polyscrew comes from {polyscrew.__file__}, not from the extension")
     return importlib.import_module("bl_ext.user_default.screwbender.bake")
+
+
+def channels():
+    """The add-on's channels.py (where F-curves live in each Blender's action API), loaded from
+    the source tree for the parts that run without the extension installed. Needs bpy."""
+    module = sys.modules.get("screwbender_channels")
+    if module is None:
+        import importlib.util
+
+        spec = importlib.util.spec_from_file_location(
+            "screwbender_channels", ROOT / "addon" / "screwbender" / "channels.py"
+        )
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[spec.name] = module
+        spec.loader.exec_module(module)
+    return module

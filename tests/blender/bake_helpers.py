@@ -12,6 +12,8 @@ import bpy
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from conftest import addon_module
+
 EULER_ORDERS = ("XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX")
 ROTATION_MODES = ("QUATERNION", "AXIS_ANGLE") + EULER_ORDERS
 ROTATION_PATH = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
@@ -126,16 +128,8 @@ def key_poses(obj, frames: Sequence[float], poses: np.ndarray, scales: np.ndarra
 
 
 def fcurves(obj) -> list[bpy.types.FCurve]:
-    adt = obj.animation_data
-    action = adt.action
-    if hasattr(action, "layers"):
-        for layer in action.layers:
-            for strip in layer.strips:
-                bag = strip.channelbag(adt.action_slot)
-                if bag is not None:
-                    return list(bag.fcurves)
-        return []
-    return list(action.fcurves)
+    """The F-curves of `obj`'s active action and slot (the add-on's channels.py, any version)."""
+    return addon_module("channels").object_fcurves(obj)
 
 
 def curve_points(fcurve) -> np.ndarray:
@@ -179,14 +173,8 @@ def snapshot_action(action) -> dict:
     """Everything about an action's F-curves that smoothing must not change."""
     if action is None:
         return {}
-    bags = []
-    if hasattr(action, "layers"):
-        for layer in action.layers:
-            for strip in layer.strips:
-                for bag in strip.channelbags:
-                    bags.append((bag.slot.identifier, list(bag.fcurves), [g.name for g in bag.groups]))
-    else:
-        bags.append(("", list(action.fcurves), [g.name for g in action.groups]))
+    channels = addon_module("channels")
+    bags = [(slot, channels.fcurves(bag), channels.groups(bag)) for slot, bag in channels.containers(action)]
     out = {"name": action.name, "library": action.library, "bags": []}
     for identifier, curves, groups in bags:
         entry = {"slot": identifier, "groups": groups, "curves": []}

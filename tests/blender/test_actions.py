@@ -109,11 +109,13 @@ def test_undo_restores_the_scene(sb):
     assert bpy.context.preferences.edit.undo_steps > 0
     bpy.ops.ed.undo_push(message="before smoothing")
     before = h.snapshot_scene()
+    slot = sb.channels.slot_identifier(bpy.data.objects["Body"])
     # The second argument asks bpy.ops to push an undo step, as the UI does.
     assert bpy.ops.screwbender.smooth("EXEC_DEFAULT", True, scheme="jarek") == {"FINISHED"}
     assert h.snapshot_scene() != before
     assert bpy.ops.ed.undo() == {"FINISHED"}
     assert h.snapshot_scene() == before
     assert bpy.data.objects["Body"].animation_data.action.name == "BodyAction"
+    assert sb.channels.slot_identifier(bpy.data.objects["Body"]) == slot  # "OBBody" from 4.4 on
     assert bpy.ops.ed.redo() == {"FINISHED"}
     assert bpy.data.objects["Body"].animation_data.action.name == "BodyAction.smooth"

@@ -92,13 +92,10 @@ def test_mirrored_object_is_smoothed(sb):
 
 def test_mirrored_object_with_one_scale_axis_keyed(sb):
     obj = keyed(scale=np.array([[-1, 1, 1], [-1, 2, 1], [-1, 1.5, 1], [-1, 1, 1], [-1, 3, 1]], dtype=float))
-    for fc in [fc for fc in h.fcurves(obj) if fc.data_path == "scale" and fc.array_index != 1]:
-        h.fcurves(obj)  # (keep the list alive while removing)
-        bag = fc.id_data if not hasattr(fc.id_data, "layers") else None
-        addon_module("channels").remove_fcurve(
-            bag if bag is not None else addon_module("channels").container(obj.animation_data.action, obj.animation_data.action_slot),
-            "scale", fc.array_index,
-        )
+    channels = addon_module("channels")
+    bag = channels.container(obj.animation_data.action, channels.assigned_slot(obj))
+    for index in (0, 2):
+        channels.remove_fcurve_at(bag, "scale", index)
     obj.scale = (-1.0, 1.0, 1.0)
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     scale_curves = sorted(fc.array_index for fc in h.fcurves(obj) if fc.data_path == "scale")
