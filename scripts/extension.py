@@ -73,7 +73,17 @@ def blender_tools() -> list[tuple[Path, Path]]:
         return tuple(int(part) for part in tree.name.split(".") if part.isdigit())
 
     trees = [tool.parents[4] for tool in (ROOT / ".venv" / "bpy").glob(f"*/bpy/*/{TOOL_IN_BPY}")]
-    return [(tree / TOOL_IN_BPY, tree / TAGS_IN_BPY) for tree in sorted(trees, key=version_key, reverse=True)]
+    found = []
+    for tree in sorted(trees, key=version_key, reverse=True):
+        tool = tree / TOOL_IN_BPY
+        try:  # a newer Blender's copy may use syntax this Python (3.11, the venv's) lacks
+            compile(tool.read_bytes(), str(tool), "exec")
+        except SyntaxError as error:
+            print(f"extension: skipping Blender {tree.name}'s tool, not Python "
+                  f"{sys.version_info.major}.{sys.version_info.minor} code ({error})", file=sys.stderr)
+            continue
+        found.append((tool, tree / TAGS_IN_BPY))
+    return found
 
 
 @cache
