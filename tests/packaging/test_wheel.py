@@ -90,7 +90,7 @@ def test_linux_wheel_needs_no_glibc_symbol_newer_than_2_28(wheel, tmp_path):
         assert newest <= GLIBC_CEILING, f"{so.name} needs GLIBC_{'.'.join(map(str, newest))}: {sorted(from_elf)}"
 
 
-def test_glibc_reading_sees_a_newer_glibc(tmp_path):
+def test_glibc_readers_are_not_blind():
     """The reader is not blind: this Python interpreter's own libc needs are found, and a
     manylinux_2_35 tag is above the ceiling."""
     assert glibc_of_tag("manylinux_2_35_x86_64") > GLIBC_CEILING
