@@ -1,33 +1,84 @@
 #!/usr/bin/env bash
-# Builds the polyscrew wheel (maturin, release) and the installable ScrewBender extension
-# .zip: dist/screwbender-<version>.zip, with the wheel bundled under wheels/ and listed in
-# the zip's blender_manifest.toml. The wheel is also copied to addon/screwbender/wheels/
-# (git-ignored) so the source folder works as a development extension.
+# Builds the installable ScrewBender extension with Blender's own extension tool: the
+# bl_pkg/cli/blender_ext.py of the bpy wheels in .venv/bpy, which is what
+# `blender --command extension build|validate` runs (plain Python 3.11+, no Blender binary),
+# given Blender's list of valid tags as Blender gives it.
 #
-# Usage: scripts/build_extension.sh            (prints the .zip path last)
-# Env:   PYTHON, MATURIN (default: .venv/bin/python, .venv/bin/maturin, else from PATH);
-#        SCREWBENDER_WHEEL: an already built polyscrew wheel to bundle (skips the maturin build)
+#   scripts/build_extension.sh               this machine's wheel (scripts/build_wheel.sh, or
+#                                            SCREWBENDER_WHEEL: an already built one)
+#                                            -> dist/screwbender-<version>-<platform>.zip
+#   scripts/build_extension.sh --wheels DIR  every polyscrew-*.whl in DIR (the release job: one
+#                                            per platform) -> one zip per platform, split by
+#                                            Blender's `build --split-platforms`
+#   --out DIR                                where the zips go (default dist/; its old
+#                                            screwbender-*.zip are removed)
+#
+# scripts/extension.py writes the copy of addon/screwbender that Blender's tool packages (the
+# version from Cargo.toml, `wheels` and `platforms` from the wheels). Every zip is then
+# validated by the tool of each Blender in .venv/bpy and checked by `extension.py check`
+# (the wheels it lists are the wheels it holds, which Blender's validate does not look at).
+# Prints the zips' paths, this machine's platform's last.
+# Env: PYTHON (default .venv/bin/python), BLENDER_EXT (a blender_ext.py instead of .venv/bpy's)
 set -euo pipefail
-ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
-cd "$ROOT"
+root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
+cd "$root"
+python=${PYTHON:-$root/.venv/bin/python}
+[ -x "$python" ] || python=$(command -v python3)
+ext() { "$python" "$root/scripts/extension.py" "$@"; }
 
-pick() { # first executable of: $1 (env override), $2 (venv path), $3 (name on PATH)
-    if [[ -n "$1" ]]; then echo "$1"; elif [[ -x "$2" ]]; then echo "$2"; else command -v "$3"; fi
-}
-PYTHON="$(pick "${PYTHON:-}" "$ROOT/.venv/bin/python" python3)"
-MATURIN="$(pick "${MATURIN:-}" "$ROOT/.venv/bin/maturin" maturin)"
-
-WHEEL_DIR="$ROOT/dist/wheels"
-mkdir -p "$WHEEL_DIR"
-if [[ -n "${SCREWBENDER_WHEEL:-}" ]]; then
+wheels="" out="$root/dist"
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --wheels) wheels=$(cd "$2" && pwd); shift 2 ;;
+    --out) mkdir -p "$2"; out=$(cd "$2" && pwd); shift 2 ;;
+    *) echo "usage: scripts/build_extension.sh [--wheels DIR] [--out DIR]" >&2; exit 2 ;;
+  esac
+done
+if [ -z "$wheels" ]; then
+  wheels="$root/dist/wheels"
+  mkdir -p "$wheels"
+  if [ -n "${SCREWBENDER_WHEEL:-}" ]; then
+    [ -f "$SCREWBENDER_WHEEL" ] || { echo "build_extension: no wheel $SCREWBENDER_WHEEL" >&2; exit 1; }
     wheel="$(cd "$(dirname "$SCREWBENDER_WHEEL")" && pwd)/$(basename "$SCREWBENDER_WHEEL")"
-    [[ -f "$wheel" ]] || { echo "build_extension: no wheel $SCREWBENDER_WHEEL" >&2; exit 1; }
-    for old in "$WHEEL_DIR"/polyscrew-*.whl; do
-        [[ -e "$old" && "$old" != "$wheel" ]] && rm -f "$old"
-    done
-    [[ "$(dirname "$wheel")" == "$WHEEL_DIR" ]] || cp "$wheel" "$WHEEL_DIR/"
-else
-    rm -f "$WHEEL_DIR"/polyscrew-*.whl
-    "$MATURIN" build --release --quiet -o "$WHEEL_DIR" >&2
+    if [ "$(dirname "$wheel")" != "$wheels" ]; then
+      rm -f "$wheels"/polyscrew-*.whl
+      cp "$wheel" "$wheels/"
+    fi
+  else
+    scripts/build_wheel.sh "$wheels" >&2
+  fi
 fi
-"$PYTHON" "$ROOT/scripts/package_extension.py" --wheels "$WHEEL_DIR" --out "$ROOT/dist"
+
+stage=$(mktemp -d)
+trap 'rm -rf "$stage"' EXIT
+platforms=$(ext stage --wheels "$wheels" --into "$stage/screwbender")
+version=$(ext version)
+tools=$(ext tools)
+read -r build_tool build_tags <<<"$(head -n 1 <<<"$tools")"
+
+rm -f "$out"/screwbender-*.zip
+if [ "$(wc -l <<<"$platforms")" -gt 1 ]; then
+  target=(--output-dir "$out" --split-platforms)
+else
+  target=(--output-filepath "$out/screwbender-$version-${platforms//-/_}.zip")
+fi
+echo "build_extension: Blender's tool ($build_tool) build for $(tr '\n' ' ' <<<"$platforms")" >&2
+"$python" "$build_tool" build --source-dir "$stage/screwbender" --valid-tags "$build_tags" "${target[@]}" </dev/null >&2
+
+zips=("$out"/screwbender-*.zip)
+[ -f "${zips[0]}" ] || { echo "build_extension: Blender's tool wrote no zip to $out" >&2; exit 1; }
+while read -r tool tags; do
+  blender=$(sed -E 's#.*/([^/]+)/scripts/addons_core/bl_pkg/cli/blender_ext.py$#\1#' <<<"$tool")
+  for zip in "${zips[@]}"; do
+    echo -n "build_extension: Blender $blender validate $(basename "$zip"): " >&2
+    "$python" "$tool" validate --valid-tags "$tags" "$zip" </dev/null >&2
+  done
+done <<<"$tools"
+ext check "${zips[@]}" >&2
+
+this="-$(ext platform | tr - _).zip"
+ours=()
+for zip in "${zips[@]}"; do
+  if [[ "$zip" == *"$this" ]]; then ours+=("$zip"); else echo "$zip"; fi
+done
+for zip in "${ours[@]}"; do echo "$zip"; done

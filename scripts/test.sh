@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's one test command: installs what it needs into .venv (scripts/bootstrap.sh),
-# then runs the Rust tests, builds the polyscrew wheel (release, once: abi3, for CPython 3.11
-# and later), runs the Python tests of the module, and the Blender tests headless under every
+# then runs the Rust tests, builds the polyscrew wheel (release, once: abi3 for CPython 3.11
+# and later, manylinux_2_28 on Linux) and the extension zip from it, runs the Python tests of
+# the module, the packaging tests, and the Blender tests headless under every
 # Blender version of scripts/blender_matrix.sh (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
 # A version whose CPython or bpy is missing fails the run (it is never skipped).
 set -euo pipefail
@@ -42,10 +43,9 @@ cargo test --workspace --quiet
 stage "cargo doc (warnings are errors)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet -p polyscrew
 
-stage "build the polyscrew wheel (release)"
+stage "build the polyscrew wheel (release; on Linux manylinux_2_28, zig-linked)"
 rm -rf dist/wheel && mkdir -p dist/wheel
-"$root/.venv/bin/maturin" build --release --quiet -o dist/wheel 2>&1 | grep -v '^ *Compiling' || true
-wheel=$(ls dist/wheel/polyscrew-*.whl)
+wheel=$(scripts/build_wheel.sh dist/wheel | tail -n 1)
 # The one abi3 wheel, into every venv that runs tests (.venv and .venv/py313).
 for env_dir in $(for row in "${BLENDER_MATRIX[@]}"; do read -r _ cpython _ <<<"$row"; matrix_venv "$cpython"; done | sort -u); do
   "$env_dir/bin/python" -m pip --disable-pip-version-check install -q --force-reinstall --no-deps "$wheel"
@@ -58,6 +58,11 @@ fi
 
 stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)'))"
 "$py" -m pytest -q -p no:cacheprovider tests/python
+
+# Packaging: the wheel's tag and GLIBC, Blender's validate on the zips, the multi-platform
+# assembly, the release workflow, `cargo publish --dry-run`, `twine check` (issue 20).
+stage "pytest tests/packaging"
+"$py" -m pytest -q -p no:cacheprovider tests/packaging
 
 for row in "${BLENDER_MATRIX[@]}"; do
   read -r version cpython _ <<<"$row"

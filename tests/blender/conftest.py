@@ -2,16 +2,17 @@
 
 Run inside the bpy wheel (one session per Blender version):
     PYTHONPATH=<pylib>:.venv/bpy/<ver> python -m pytest tests/blender
-The .zip comes from SCREWBENDER_EXTENSION_ZIP (default: the newest dist/screwbender-*.zip,
-built by scripts/build_extension.sh). Blender's user directory is pointed at a temporary
-folder *before* bpy is imported, so nothing of the machine's own Blender set-up is used or
-touched, and the add-on is installed exactly as a user would install it.
+The .zip comes from SCREWBENDER_EXTENSION_ZIP (default: the newest dist/screwbender-*.zip for
+this machine's platform, built by scripts/build_extension.sh). Blender's user directory is
+pointed at a temporary folder *before* bpy is imported, so nothing of the machine's own Blender
+set-up is used or touched, and the add-on is installed exactly as a user would install it.
 """
 
 from __future__ import annotations
 
 import importlib
 import os
+import platform
 import shutil
 import sys
 import tempfile
@@ -29,6 +30,11 @@ def extension_zip() -> Path:
     if env:
         return Path(env)
     found = sorted((ROOT / "dist").glob("screwbender-*.zip"), key=lambda p: p.stat().st_mtime)
+    # One zip per platform (screwbender-<version>-linux_x64.zip, ...): this machine's.
+    system = {"darwin": "macos", "win32": "windows"}.get(sys.platform, sys.platform)
+    machine = platform.machine().lower()
+    machine = {"x86_64": "x64", "amd64": "x64", "aarch64": "arm64"}.get(machine, machine)
+    found = [p for p in found if p.stem.endswith(f"-{system}_{machine}")] or found
     if not found:
         raise pytest.UsageError("no dist/screwbender-*.zip: run scripts/build_extension.sh first")
     return found[-1]
