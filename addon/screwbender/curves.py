@@ -169,56 +169,93 @@ def _cycles(fcurve: bpy.types.FCurve) -> dict | None:
     return None
 
 
-def _codes(fcurve: bpy.types.FCurve, prop: str, raw: np.ndarray) -> tuple[np.ndarray, str | None]:
-    """`raw` Blender enum values of `Keyframe.<prop>` as `polyscrew` codes, and the first
-    identifier `polyscrew` does not know (None when all are known)."""
-    table, identifiers = _table(prop)
-    known = (raw >= 0) & (raw < len(table))
-    codes = np.where(known, table[np.clip(raw, 0, len(table) - 1)], -1)
-    if (codes < 0).any():
-        value = int(raw[np.argmax(codes < 0)])
-        return codes, identifiers.get(value, f"value {value}")
-    return codes, None
+def _codes(prop: str, raw: np.ndarray) -> np.ndarray:
+    """Blender's enum values `raw` of `Keyframe.<prop>` as `polyscrew` codes (-1: unknown)."""
+    table, _ = _table(prop)
+    raw = raw.astype(np.int64)
+    known = raw < len(table)
+    return np.where(known, table[np.where(known, raw, 0)], -1)
+
+
+def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.ndarray, width: int = 1) -> None:
+    """`foreach_get(name)` of the curves `curves` (indices) straight into their part of `out`."""
+    for c in curves:
+        lo, hi = offsets[c], offsets[c + 1]
+        if lo < hi:
+            points[c].foreach_get(name, out[width * lo : width * hi])
 
 
 def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
     """The keys, extrapolation and Cycles modifier of every curve in `fcurves`, packed.
 
-    Raises :class:`UnsupportedCurve` naming every curve that cannot be evaluated as Blender
-    plays it (see :func:`problems`).
+    One `foreach_get` per property and curve, straight into the packed arrays (float32 and,
+    for the enums, unsigned bytes: Blender's own storage, so no conversion): `co`, both
+    handles and `interpolation` always; `easing` only for curves with an easing
+    interpolation, `back` only with BACK, `amplitude` and `period` only with ELASTIC (the
+    others keep Blender's defaults, which nothing reads). Raises :class:`UnsupportedCurve`
+    naming every curve that cannot be evaluated as Blender plays it (see :func:`problems`).
     """
+    fcurves = list(fcurves)
     bad = [(fc, reason) for fc in fcurves for reason in problems(fc)]
-    counts = [len(fc.keyframe_points) for fc in fcurves]
+    points = [fc.keyframe_points for fc in fcurves]
     offsets = np.zeros(len(fcurves) + 1, dtype=np.int64)
-    np.cumsum(counts, out=offsets[1:])
-    k = int(offsets[-1])
-    pairs = {name: np.zeros((k, 2), dtype=np.float32) for name in ("co", "handle_left", "handle_right")}
-    scalars = {name: np.zeros(k, dtype=np.float32) for name in ("back", "amplitude", "period")}
-    enums = {name: np.zeros(k, dtype=np.int64) for name in ("interpolation", "easing")}
-    for c, fc in enumerate(fcurves):
-        lo, hi = int(offsets[c]), int(offsets[c + 1])
-        points = fc.keyframe_points
-        for name, array in pairs.items():
-            flat = np.empty(2 * (hi - lo), dtype=np.float32)
-            points.foreach_get(name, flat)
-            array[lo:hi] = flat.reshape(-1, 2)
-        for name, array in scalars.items():
-            points.foreach_get(name, array[lo:hi])
-        for name, array in enums.items():
-            raw = np.empty(hi - lo, dtype=np.int32)
-            points.foreach_get(name, raw)
-            array[lo:hi], unknown = _codes(fc, name, raw.astype(np.int64))
-            if unknown is not None:
-                bad.append((fc, f"has {name} {unknown!r}, which this polyscrew does not know"))
+    np.cumsum([len(p) for p in points], out=offsets[1:])
+    k, bounds, every = int(offsets[-1]), offsets.tolist(), range(len(fcurves))
+
+    raw = np.zeros(k, dtype=np.uint8)
+    _read(points, bounds, every, "interpolation", raw)
+    interpolation = _codes("interpolation", raw)
+    for i in np.flatnonzero(interpolation < 0):
+        c = int(np.searchsorted(offsets, i, side="right")) - 1
+        name = _table("interpolation")[1].get(int(raw[i]), f"value {int(raw[i])}")
+        bad.append((fcurves[c], f"has interpolation {name!r}, which this polyscrew does not know"))
     if bad:
         raise UnsupportedCurve(bad)
+
+    pairs = {name: np.zeros(2 * k, dtype=np.float32) for name in ("co", "handle_left", "handle_right")}
+    for name, out in pairs.items():
+        _read(points, bounds, every, name, out, width=2)
+
+    # Which curves use the per-key easing parameters at all (one pass over all keys).
+    names = polyscrew.INTERPOLATIONS
+    starts = offsets[:-1][np.diff(offsets) > 0]
+    def curves_with(mask: np.ndarray) -> list[int]:
+        hits = np.zeros(len(fcurves), dtype=bool)
+        if len(starts):
+            hits[np.diff(offsets) > 0] = np.add.reduceat(mask, starts) > 0
+        return np.flatnonzero(hits).tolist()
+
+    easing_codes = np.zeros(k, dtype=np.int64)
+    eased = curves_with(interpolation >= names.index("SINE"))
+    if eased:
+        raw_easing = np.zeros(k, dtype=np.uint8)
+        _read(points, bounds, eased, "easing", raw_easing)
+        easing_codes = _codes("easing", raw_easing)
+        for i in np.flatnonzero(easing_codes < 0):
+            c = int(np.searchsorted(offsets, i, side="right")) - 1
+            name = _table("easing")[1].get(int(raw_easing[i]), f"value {int(raw_easing[i])}")
+            bad.append((fcurves[c], f"has easing {name!r}, which this polyscrew does not know"))
+        if bad:
+            raise UnsupportedCurve(bad)
+    scalars = {
+        "back": np.full(k, 1.70158, dtype=np.float32),
+        "amplitude": np.full(k, 0.8, dtype=np.float32),
+        "period": np.full(k, 4.1, dtype=np.float32),
+    }
+    _read(points, bounds, curves_with(interpolation == names.index("BACK")), "back", scalars["back"])
+    elastic = curves_with(interpolation == names.index("ELASTIC"))
+    _read(points, bounds, elastic, "amplitude", scalars["amplitude"])
+    _read(points, bounds, elastic, "period", scalars["period"])
     return Packed(
         offsets=offsets,
+        co=pairs["co"].reshape(-1, 2),
+        handle_left=pairs["handle_left"].reshape(-1, 2),
+        handle_right=pairs["handle_right"].reshape(-1, 2),
+        interpolation=interpolation,
+        easing=easing_codes,
         extrapolation=[fc.extrapolation for fc in fcurves],
         cycles=[_cycles(fc) for fc in fcurves],
-        **pairs,
         **scalars,
-        **enums,
     )
 
 

@@ -4,7 +4,8 @@
 //!
 //! Outside the keys' range `[x_first, x_last]` the time is folded into it: with
 //! `dx = x_last - x_first` and the side's reference key `ofs` (the first key before, the last
-//! key after), cycle number `n = side (t - ofs) / dx` and `fmod(t - ofs, dx)` give the time in
+//! key after), cycle number `n = side (t - ofs) / dx` (in `double`, from the exact
+//! difference, as Blender's binaries compute it) and `fmodf(t - ofs, dx)` give the time in
 //! the cycle, played backwards in odd cycles for MIRROR. REPEAT_OFFSET adds
 //! `floor((t - ofs) / dx) * dy` before and `ceil((t - ofs) / dx) * dy` after
 //! (`dy = y_last - y_first`) to the value. Beyond `cycles` cycles (0: no limit) the time is
@@ -198,10 +199,13 @@ impl Cycles {
         if cycdx == 0.0 {
             return (time, 0.0);
         }
-        let cycle = side as f32 * (time - ofs) / cycdx;
-        // C's fmod; exact, so float and double agree.
+        // The cycle number is a double, from the unrounded difference (what the 4.2.23 and
+        // 5.0.1 binaries compute: `cvtss2sd`, `subsd`, `divsd`); the phase is `fmodf` of the
+        // float difference. Both matter at whole cycles, where the float quotient rounds to
+        // an integer the double one is not.
+        let cycle = side as f64 * (time as f64 - ofs as f64) / cycdx as f64;
         let cyct = (time - ofs) % cycdx;
-        if cycles != 0 && cycle > cycles as f32 {
+        if cycles != 0 && cycle > cycles as f64 {
             return (time, 0.0);
         }
         let mut offset = 0.0;
@@ -237,9 +241,9 @@ fn interpf(target: f32, origin: f32, fac: f32) -> f32 {
     (fac * target) + (1.0 - fac) * origin
 }
 
-/// C's `int(x)` for a `float` on x86-64 (`cvttss2si`): truncation, and `INT_MIN` where the
+/// C's `int(x)` for a `double` on x86-64 (`cvttsd2si`): truncation, and `INT_MIN` where the
 /// value does not fit (Rust's `as` would saturate instead).
-fn c_int(x: f32) -> i32 {
+fn c_int(x: f64) -> i32 {
     if x.is_nan() || !(-2_147_483_648.0..2_147_483_648.0).contains(&x) {
         i32::MIN
     } else {

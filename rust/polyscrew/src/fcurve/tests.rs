@@ -749,3 +749,29 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn the_cycle_number_is_a_double_from_the_exact_difference() {
+    // Found against Blender 4.2.23 and 5.0.1 (whose fcm_cycles_time computes the cycle number
+    // with cvtss2sd / subsd / divsd): keys at these float32 frames, a time exactly two
+    // cycles after the last key in float32 arithmetic. The float32 quotient is exactly 2.0,
+    // the double one from the unrounded difference 2.00000005: Blender does not cycle with
+    // cycles_after = 2 and plays the curve's own extrapolation.
+    let (x0, x1) = (-9.127_500_534_057_617_f32, 28.307_859_420_776_367_f32);
+    let keys = vec![
+        Key::new(x0, 0.0).with_interpolation(Interpolation::Linear),
+        Key::new(x1, 1000.0).with_interpolation(Interpolation::Linear),
+    ];
+    let plain = FCurve::new(keys.clone(), Extrapolation::Linear, None).unwrap();
+    let mut c = Cycles::new(CycleMode::None, CycleMode::Mirror);
+    c.count_after = 2;
+    let two = FCurve::new(keys.clone(), Extrapolation::Linear, Some(c)).unwrap();
+    let t = 103.178_581_237_792_97;
+    assert_eq!(at(&two, t), at(&plain, t), "no cycling past 2 cycles");
+    assert_eq!(at(&two, t), 3000.0); // Blender's value
+                                     // Unlimited MIRROR, three cycles out: the float32 quotient is 3.0 (even: forwards, ending
+                                     // on the last key), the double one 2.9999999 (odd: backwards, ending on the first key).
+    c.count_after = 0;
+    let free = FCurve::new(keys, Extrapolation::Linear, Some(c)).unwrap();
+    assert_eq!(at(&free, 140.613_937_377_929_7), 0.0); // Blender's value
+}
