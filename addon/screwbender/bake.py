@@ -452,7 +452,9 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
         for obj in group.objects:
             owner = owners.Owner(obj, bone)
             try:
-                row.append(keys.read(owner, options.closed, action=read_from, slot=source_slot))
+                row.append(
+                    keys.read(owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range)
+                )
             except SmoothError as err:
                 skipped.append((owner, str(err)))
                 break
@@ -479,6 +481,9 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
                 parts.append(sample_channels(owner, row[column], options, budget))
             except SmoothError as err:
                 skipped.append((owner, str(err)))
+                continue
+            if row[column].kept:
+                notes.append(f"{owner.name}: kept {'; '.join(row[column].kept)}")
         if parts:
             bakes.append(ActionBake(objects, parts, source, current, identifier))
     return bakes, skipped, notes

@@ -8,8 +8,8 @@ one call for all curves and frames) and read for:
 - **Spins.** A screw between two key poses is the short one (at most half a turn). Where the
   Euler or axis-angle channels turn further within a span (a wheel keyed 0, 360, 720
   degrees), poses taken from Blender's own playback at subframes are added to the keys
-  until every screw span turns less than :data:`WIND_LIMIT`: the motion turns as far and
-  the same way as the channels say. Quaternion keys keep the shortest arc (no sign flips),
+  where they turn more than :data:`WIND_LIMIT`, until every screw span turns at most
+  :data:`WIND_STEP`: the motion turns as far and the same way as the channels say. Quaternion keys keep the shortest arc (no sign flips),
   which is what quaternion users expect.
 - **Holds and pops.** A span where every channel stays still (CONSTANT interpolation, or
   equal keys with flat handles) is held: its frames keep the key pose exactly, the motion is
@@ -37,9 +37,13 @@ import numpy as np
 
 from . import curves
 
-#: The longest turn one screw span may make (radians) before poses from Blender's playback
-#: are added inside it: well below half a turn, where the shortest screw is ambiguous.
-WIND_LIMIT = np.radians(90.0)
+#: A span whose channels turn further than this (radians) along Blender's playback gets poses
+#: from that playback added inside it: the screw between its keys alone, the shortest one,
+#: would turn less (at half a turn and beyond: the other way round).
+WIND_LIMIT = np.radians(150.0)
+
+#: The turn of each screw span a spin is cut into (at most; radians).
+WIND_STEP = np.radians(90.0)
 
 #: Samples of Blender's playback per key span when looking for holds, turns and pace.
 SPAN_SAMPLES = 24
@@ -175,7 +179,7 @@ def analyse_spans(
     added = []
     if source.mode != "QUATERNION":
         for span in np.flatnonzero((turn > WIND_LIMIT) & ~held):
-            pieces = int(np.ceil(turn[span] / WIND_LIMIT))
+            pieces = int(np.ceil(turn[span] / WIND_STEP))
             mask = span_of == span
             cumulative = np.concatenate(([0.0], np.cumsum(steps[mask])))
             where = np.concatenate((sample_frames[mask], [frames[span + 1]]))

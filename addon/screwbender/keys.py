@@ -383,7 +383,8 @@ def read(
             frames, poses, scale, rotation, is_key = frames[:-1], poses[:-1], scale[:-1], rotation[:-1], is_key[:-1]
         else:
             # no closing key: the last key returns to the first after the mean key spacing
-            period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
+            user_keys = int(is_key.sum())
+            period = float(frames[-1] - frames[0]) * user_keys / (user_keys - 1)
             if held is not None:  # the span from the last key back to the first moves
                 held, pops = np.append(held, False), np.append(pops, False)
         if held is not None and held.any():

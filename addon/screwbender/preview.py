@@ -308,7 +308,7 @@ class PreviewCache:
         if entry is not None and entry.digest == digest:
             return entry, False
         try:
-            motion = keys.read(obj, options.smooth.closed)
+            motion = keys.read(obj, options.smooth.closed, extend_to=options.smooth.frame_range)
             if live is not None:
                 motion = with_live_key(motion, live)
             entry = PreviewEntry(digest, compute(motion, options, obj))
