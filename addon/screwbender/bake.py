@@ -73,9 +73,9 @@ _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CO
 class Options:
     """Everything the smoothing needs besides the objects."""
 
-    scheme: str = "jarek"
+    scheme: str = "four_point"
     levels: int = 4
-    timing: str = "smooth"
+    timing: str = "keys"
     closed: str = "AUTO"
     #: Baked frame range; None bakes each object over its keys' range.
     frame_range: tuple[float, float] | None = None

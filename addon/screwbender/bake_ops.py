@@ -112,7 +112,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     scheme: EnumProperty(
         name="Scheme",
         items=bake.SCHEMES,
-        default="jarek",
+        default="four_point",
         description="Subdivision scheme that refines the key poses into the smooth motion",
     )
     levels: IntProperty(
@@ -127,7 +127,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     timing: EnumProperty(
         name="Timing",
         items=bake.TIMINGS,
-        default="smooth",
+        default="keys",
         description="How time runs between keys at uneven frames",
     )
     closed: EnumProperty(

@@ -8,7 +8,8 @@ one call for all curves and frames) and read for:
 - **Spins.** A screw between two key poses is the short one (at most half a turn). Where the
   Euler or axis-angle channels turn further within a span (a wheel keyed 0, 360, 720
   degrees), poses taken from Blender's own playback at subframes are added to the keys
-  where they turn more than :data:`WIND_LIMIT`, until every screw span turns at most
+  where they turn more than :data:`WIND_LIMIT` (and in the neighbouring spans of such a
+  spin that turn more than :data:`WIND_STEP`), until every screw span there turns at most
   :data:`WIND_STEP`: the motion turns as far and the same way as the channels say. Quaternion keys keep the shortest arc (no sign flips),
   which is what quaternion users expect.
 - **Holds and pops.** A span where every channel stays still (CONSTANT interpolation, or
@@ -42,8 +43,10 @@ from . import curves
 #: would turn less (at half a turn and beyond: the other way round).
 WIND_LIMIT = np.radians(150.0)
 
-#: The turn of each screw span a spin is cut into (at most; radians).
-WIND_STEP = np.radians(90.0)
+#: The turn of each screw span a spinning run of spans is cut into (at most; radians): the
+#: spin span and its neighbours turning more than this, so the screw spans of a spin are
+#: short and about equal (approximating schemes then stay within a degree of the keys).
+WIND_STEP = np.radians(45.0)
 
 #: Samples of Blender's playback per key span when looking for holds, turns and pace.
 SPAN_SAMPLES = 24
@@ -178,7 +181,18 @@ def analyse_spans(
     turn = np.bincount(span_of, weights=steps, minlength=spans)
     added = []
     if source.mode != "QUATERNION":
-        for span in np.flatnonzero((turn > WIND_LIMIT) & ~held):
+        spinning = (turn > WIND_LIMIT) & ~held
+        # the runs of spans turning more than WIND_STEP around each spin
+        for span in np.flatnonzero(spinning):
+            left = span
+            while left > 0 and turn[left - 1] > WIND_STEP and not held[left - 1]:
+                left -= 1
+                spinning[left] = True
+            right = span
+            while right < spans - 1 and turn[right + 1] > WIND_STEP and not held[right + 1]:
+                right += 1
+                spinning[right] = True
+        for span in np.flatnonzero(spinning):
             pieces = int(np.ceil(turn[span] / WIND_STEP))
             mask = span_of == span
             cumulative = np.concatenate(([0.0], np.cumsum(steps[mask])))
