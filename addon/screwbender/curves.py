@@ -97,7 +97,7 @@ def problems(fcurve: bpy.types.FCurve) -> list[str]:
     for index, mod in _active_modifiers(fcurve):
         if mod.type == "CYCLES" and index == 0:
             continue
-        kind = mod.type.replace("_", " ").title()
+        kind = bpy.types.FModifier.bl_rna.properties["type"].enum_items[mod.type].name
         where = "" if mod.type != "CYCLES" else " not first in the stack"
         found.append(
             f"has a {kind} modifier {mod.name!r}{where}, which the add-on cannot evaluate "

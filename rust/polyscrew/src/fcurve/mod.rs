@@ -29,10 +29,15 @@
 //!   `evaluate_value_fmodifiers` do.
 //!
 //! Every operation Blender does in `float` is done in `f32` here and every one it does in
-//! `double` in `f64`, in the same order, with the same library functions, so the results are
-//! Blender's `float` values (widened to `f64`), not a more precise curve. The batch is one
-//! pass per curve over the times: `O(K + T log K)` for `K` keys and `T` times, each time found
-//! by Blender's own binary search.
+//! `double` in `f64`, in the same order, with the same C library functions (`log`, `exp`,
+//! `acos`, `cos`, `sinf`, `cosf`, `asinf`, `powf`, `fmodf`), so the results are Blender's
+//! `float` values (widened to `f64`), not a more precise curve: bit-identical to
+//! `FCurve.evaluate` in Blender 4.2.23 and 5.0.1 (`tests/blender/test_curves.py`). Where the
+//! shipped binaries differ from a literal reading of the source, the binaries are followed:
+//! the Cycles modifier's cycle number is a `double` from the unrounded time difference
+//! (found by that test at whole cycles, confirmed in the disassembly of both versions).
+//! The batch is one pass per curve over the times: `O(K + T log K)` for `K` keys and `T`
+//! times, each time found by Blender's own binary search.
 //!
 //! Out of scope (the caller detects them, see the add-on's `curves.py`): every other modifier
 //! (Generator, Built-in Function, Envelope, Noise, Limits, Stepped), drivers, sampled points,
