@@ -29,10 +29,22 @@ from . import channels, keys, owners, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
+#: (The strays are measured by scripts/measure_schemes.py: the demo scene and 20 random keyed
+#: motions spanning about 6 units, at 4 levels.)
 SCHEMES = (
-    ("four_point", "4-Point", "Interpolating: the motion passes through every key pose (C1)"),
-    ("bspline", "B-Spline", "Approximating: the smoothest motion (C2), it cuts inside the key poses"),
-    ("jarek", "Jarek", "Between the two: nearly passes through the keys, smoother than 4-point"),
+    ("four_point", "4-Point", "Interpolating (the default): the motion passes through every key pose exactly (C1)"),
+    (
+        "bspline",
+        "B-Spline",
+        "Approximating: the smoothest motion (C2); it cuts inside the key poses and misses them, "
+        "measured up to 2.1 units and 33 degrees on keys 6 units apart",
+    ),
+    (
+        "jarek",
+        "Jarek",
+        "Between the two: smoother than 4-point (C2 in the limit), it misses the keys by about half "
+        "as much as B-Spline (measured up to 1.2 units and 19 degrees on keys 6 units apart)",
+    ),
 )
 #: Timing of the motion between keys.
 TIMINGS = (
