@@ -203,15 +203,15 @@ def sample_poses(
     (:mod:`sampling`: pieces between holds, timing "keys").
     """
     owner = owners.as_owner(owner) if owner is not None else None
-    poses = sampling.sample(motion, frames, options, owner)
-    return poses, sample_scales(motion, frames, options)
+    sampled = sampling.sample(motion, frames, options, owner)
+    return sampled.poses, sampled.scales
 
 
 def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options) -> np.ndarray | None:
     """Scales (len(frames), 3), the keyed axes smoothed by the same scheme on log-scale and the
     unkeyed ones constant (the object's own, possibly negative), or None when no scale axis
     is keyed."""
-    return sampling.sample_scales(motion, frames, options)
+    return sampling.sample(motion, frames, options).scales
 
 
 #: Most keys one Smooth Motion may write (all objects together). Blender keeps about 60 bytes
@@ -283,8 +283,8 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        location, rotation, constant = sampling.sample(motion, frames, options, owner, channels=True, previous=previous)
-        scales = sample_scales(motion, frames, options)
+        sampled = sampling.sample(motion, frames, options, owner, channels=True, previous=previous)
+        location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
         values = {"location": location, keys.rotation_path(mode): rotation}
         if not motion.located:
             del values["location"]

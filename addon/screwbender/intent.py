@@ -48,8 +48,9 @@ WIND_LIMIT = np.radians(150.0)
 #: short and about equal (approximating schemes then stay within a degree of the keys).
 WIND_STEP = np.radians(45.0)
 
-#: Samples of Blender's playback per key span when looking for holds, turns and pace.
-SPAN_SAMPLES = 24
+#: Samples of Blender's playback per key span when looking for holds and turns (more in a
+#: span whose rotation channels change a lot: one per 10 degrees).
+SPAN_SAMPLES = 8
 
 #: At most this many samples per span for a spinning span (one every 10 degrees of channel
 #: change, at least :data:`SPAN_SAMPLES`).
@@ -204,12 +205,13 @@ def analyse_spans(
 
 
 def pace_fractions(
-    source_poses: np.ndarray, sample_frames: np.ndarray, span_of: np.ndarray, size: float, spans: int
+    source_poses: np.ndarray, span_of: np.ndarray, time_fraction: np.ndarray, size: float, spans: int
 ) -> np.ndarray:
-    """For samples of Blender's playback (poses at `sample_frames`, sorted, each in span
-    `span_of`), the fraction of its span's travel done at each sample (0 at the span's start,
-    1 at its end; a span that does not move stays at 0)."""
-    step = np.zeros(len(sample_frames))
+    """For samples of Blender's playback (poses, sorted by span and time; `span_of` their
+    span, `time_fraction` their place in it), the fraction of its span's travel done at each
+    sample: 0 at the span's start, 1 at its end. Over a span where the playback does not move
+    the fraction of time stands in."""
+    step = np.zeros(len(span_of))
     same = np.concatenate(([False], span_of[1:] == span_of[:-1]))
     step[1:] = travel(source_poses[:-1], source_poses[1:], size)
     step[~same] = 0.0
@@ -218,4 +220,5 @@ def pace_fractions(
     done -= done[np.clip(first, 0, len(done) - 1)][span_of]
     total = np.zeros(spans)
     np.maximum.at(total, span_of, done)
-    return np.where(total[span_of] > 0.0, done / np.where(total[span_of] > 0.0, total[span_of], 1.0), 0.0)
+    moving = total[span_of] > 0.0
+    return np.where(moving, done / np.where(moving, total[span_of], 1.0), time_fraction)

@@ -19,8 +19,9 @@ import polyscrew
 
 from . import feature, intent, keys
 
-#: Points per key span where the travel of the smoothed motion is measured (timing "keys").
-PACE_SAMPLES = 32
+#: Points per key span where the travel of Blender's playback and of the smoothed motion is
+#: measured (timing "keys"; the output frames inside a span are measured too).
+PACE_SAMPLES = 16
 
 
 @dataclass
@@ -123,7 +124,8 @@ def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner
     Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
     travelled the same fraction of the span's travel as Blender's own playback of the curves
     has at that frame (travel: :func:`intent.travel`). Without Blender's curves (a motion
-    read from key values only) the fraction is the fraction of the span's time.
+    read from key values only), or over a span where Blender's playback does not move (the
+    span closing a cycle that has no Cycles modifier), the fraction is the fraction of time.
     """
     k = len(motion.frames)
     f = motion.frames
@@ -135,8 +137,7 @@ def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner
         spans = k - 1
     frames = np.asarray(frames, dtype=np.float64)
     span = np.clip(np.searchsorted(ends, frames, side="right") - 1, 0, spans - 1)
-    width = ends[span + 1] - ends[span]
-    time_fraction = (frames - ends[span]) / width
+    time_fraction = (frames - ends[span]) / (ends[span + 1] - ends[span])
     size = motion.size
     # Blender's playback: per span, PACE_SAMPLES + 1 points from its start to its end, plus
     # the output frames inside it.
@@ -152,47 +153,51 @@ def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner
         poses = keys.compose(
             played["location"], keys.rotation_matrices(played[motion.source.rotation_path], motion.source.mode)
         )
-        done = intent.pace_fractions(poses, sample_frames, sample_span, size, spans)
+        done = intent.pace_fractions(poses, sample_span, sample_fraction, size, spans)
     else:
         done = sample_fraction
-    # The fraction Blender has travelled at each output frame (exact at its own sample).
-    travelled = np.empty(len(frames))
-    for s in np.unique(span):  # a loop over spans, not frames
-        rows = span == s
-        mask = sample_span == s
-        travelled[rows] = np.interp(time_fraction[rows], sample_fraction[mask], done[mask])
-    travelled = np.where(time_fraction <= 0.0, time_fraction, travelled)  # before the first key
-    travelled = np.where(time_fraction >= 1.0, time_fraction, travelled)  # extrapolation
+    # One interpolation for all spans: within span s, the pair (s + time fraction, s + travel
+    # fraction) is increasing, and spans meet at (s + 1, s + 1).
+    travelled = np.interp(span + time_fraction, sample_span + sample_fraction, sample_span + done) - span
+    outside = ~inside
+    travelled[outside] = time_fraction[outside]  # at keys, before the first and after the last
     # The smoothed motion's own travel along each span, at PACE_SAMPLES + 1 parameters.
     u_grid = (np.arange(spans)[:, None] + grid[None, :]).ravel()
     smooth_poses = _sample_at_parameters(motion, u_grid, options, owner).reshape(spans, PACE_SAMPLES + 1, 4, 4)
-    steps = travel(smooth_poses[:, :-1].reshape(-1, 4, 4), smooth_poses[:, 1:].reshape(-1, 4, 4), size)
-    steps = steps.reshape(spans, PACE_SAMPLES)
-    cumulative = np.concatenate([np.zeros((spans, 1)), np.cumsum(steps, axis=1)], axis=1)
+    steps = intent.travel(smooth_poses[:, :-1].reshape(-1, 4, 4), smooth_poses[:, 1:].reshape(-1, 4, 4), size)
+    cumulative = np.concatenate([np.zeros((spans, 1)), np.cumsum(steps.reshape(spans, PACE_SAMPLES), axis=1)], axis=1)
     total = cumulative[:, -1:]
     along = np.where(total > 0.0, cumulative / np.where(total > 0.0, total, 1.0), grid[None, :])
-    u = np.empty(len(frames))
-    for s in np.unique(span):
-        rows = span == s
-        inside_rows = rows & (travelled >= 0.0) & (travelled <= 1.0)
-        u[inside_rows] = s + np.interp(travelled[inside_rows], along[s], grid)
-        outside = rows & ~((travelled >= 0.0) & (travelled <= 1.0))
-        u[outside] = s + travelled[outside]
+    x = (np.arange(spans)[:, None] + along).ravel()
+    y = u_grid
+    u = np.interp(span + travelled, x, y)
+    u[outside] = span[outside] + travelled[outside]
     return u
 
 
-def travel(a: np.ndarray, b: np.ndarray, size: float) -> np.ndarray:
-    return intent.travel(a, b, size)
+@dataclass
+class Sampled:
+    """The smoothed motion at the requested frames."""
+
+    #: Rigid poses (T, 4, 4), or None when channels were asked for.
+    poses: np.ndarray | None
+    #: Location (T, 3) and rotation channels (T, k), when channels were asked for.
+    location: np.ndarray | None
+    rotation: np.ndarray | None
+    #: Scales (T, 3) when scale is keyed (else None).
+    scales: np.ndarray | None
+    #: Per frame: in a held span that pops at its end (its baked keys must be CONSTANT).
+    constant: np.ndarray
 
 
 def sample(
     motion: keys.KeyedMotion, frames: np.ndarray, options, owner=None, channels: bool = False, previous=None
-):
-    """The smoothed motion at `frames` (sorted).
+) -> Sampled:
+    """The smoothed motion at `frames` (sorted), as poses or, with `channels`, as Blender's
+    location and rotation channels (continuous from `previous`); and scales when keyed.
 
-    With `channels`, returns (location (T, 3), rotation channels (T, k), constant (T,) bool:
-    frames of held spans that pop at their end, whose baked keys must be CONSTANT);
-    else rigid poses (T, 4, 4). One polyscrew call per piece (and per hold for channels).
+    One polyscrew call per piece for the motion (and per hold for channels), one for scale;
+    timing "keys" computes each piece's parameters once for both.
     """
     frames = np.asarray(frames, dtype=np.float64)
     mode = motion.rotation_mode
@@ -201,6 +206,9 @@ def sample(
     location = np.empty((n, 3)) if channels else None
     rotation = None
     constant = np.zeros(n, dtype=bool)
+    scaled = motion.scale_keyed
+    logs = np.log(np.abs(motion.scales)) if scaled else None
+    log_scales = np.empty((n, 3)) if scaled else None
     last_rotation = previous
     for seg in segments(motion, frames):
         rows = seg.rows
@@ -211,16 +219,18 @@ def sample(
                 values = polyscrew.rotation_channels(pose, mode, previous=last_rotation)
             else:
                 poses[rows] = pose
+            if scaled:
+                log_scales[rows] = logs[seg.lo]
             if motion.pops is not None and motion.pops[seg.lo]:
                 constant[rows] = True
         else:
-            piece = motion if (seg.lo == 0 and seg.hi == len(motion.frames) - 1) else _sub(motion, seg.lo, seg.hi)
+            whole = seg.lo == 0 and seg.hi == len(motion.frames) - 1
+            piece = motion if whole else _sub(motion, seg.lo, seg.hi)
             t = frames[rows]
             if options.timing == "keys":
-                times, period = _parameter_motion(piece)
-                u = keys_parameters(piece, t, options, owner)
+                key_times, period = _parameter_motion(piece)
+                at = keys_parameters(piece, t, options, owner)
                 spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")
-                key_times, at = times, u
             else:
                 spec = _spec(piece, options)
                 key_times, at = piece.frames, t
@@ -236,42 +246,18 @@ def sample(
                 location[rows] = loc
             else:
                 poses[rows] = polyscrew.sample(piece.poses, key_times, at, **spec)
+            if scaled:
+                log_scales[rows] = polyscrew.sample_vectors(logs[seg.lo : seg.hi + 1], key_times, at, **spec)
         if channels:
             if rotation is None:
                 rotation = np.empty((n, values.shape[1]))
             rotation[rows] = values
             if mode != "AXIS_ANGLE":
                 last_rotation = values[-1]
-    if channels:
-        return location, rotation, constant
-    return poses
-
-
-def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options) -> np.ndarray | None:
-    """Scales (T, 3): keyed axes smoothed on log-scale piece by piece with the same timing,
-    unkeyed axes constant (the owner's own, possibly negative); None when no axis is keyed."""
-    if not motion.scale_keyed:
-        return None
-    frames = np.asarray(frames, dtype=np.float64)
-    axes = motion.scale_axes
-    out = np.empty((len(frames), 3))
-    out[:] = motion.scales[0]
-    logs = np.log(np.abs(motion.scales))
-    smoothed = np.empty((len(frames), 3))
-    for seg in segments(motion, frames):
-        rows = seg.rows
-        if seg.held:
-            smoothed[rows] = logs[seg.lo]
-            continue
-        piece = motion if (seg.lo == 0 and seg.hi == len(motion.frames) - 1) else _sub(motion, seg.lo, seg.hi)
-        if options.timing == "keys":
-            times, period = _parameter_motion(piece)
-            u = keys_parameters(piece, frames[rows], options, None)
-            smoothed[rows] = polyscrew.sample_vectors(
-                logs[seg.lo : seg.hi + 1], times, u, scheme=options.scheme, levels=options.levels,
-                closed=piece.closed, period=period, timing="linear",
-            )
-        else:
-            smoothed[rows] = polyscrew.sample_vectors(logs[seg.lo : seg.hi + 1], piece.frames, frames[rows], **_spec(piece, options))
-    out[:, axes] = np.exp(smoothed[:, axes])
-    return out
+    scales = None
+    if scaled:
+        scales = np.empty((n, 3))
+        scales[:] = motion.scales[0]  # unkeyed axes: the owner's own scale, possibly negative
+        axes = motion.scale_axes
+        scales[:, axes] = np.exp(log_scales[:, axes])
+    return Sampled(poses=poses, location=location, rotation=rotation, scales=scales, constant=constant)
