@@ -193,13 +193,26 @@ class Sampled:
 def sample(
     motion: keys.KeyedMotion, frames: np.ndarray, options, owner=None, channels: bool = False, previous=None
 ) -> Sampled:
-    """The smoothed motion at `frames` (sorted), as poses or, with `channels`, as Blender's
-    location and rotation channels (continuous from `previous`); and scales when keyed.
+    """The smoothed motion at `frames` (any order; channels are continuous in time order from
+    `previous`), as poses or, with `channels`, as Blender's location and rotation channels;
+    and scales when keyed.
 
     One polyscrew call per piece for the motion (and per hold for channels), one for scale;
     timing "keys" computes each piece's parameters once for both.
     """
     frames = np.asarray(frames, dtype=np.float64)
+    if len(frames) > 1 and np.any(np.diff(frames) < 0.0):
+        order = np.argsort(frames, kind="stable")
+        done = sample(motion, frames[order], options, owner, channels, previous)
+        back = np.empty_like(order)
+        back[order] = np.arange(len(order))
+        return Sampled(
+            poses=None if done.poses is None else done.poses[back],
+            location=None if done.location is None else done.location[back],
+            rotation=None if done.rotation is None else done.rotation[back],
+            scales=None if done.scales is None else done.scales[back],
+            constant=done.constant[back],
+        )
     mode = motion.rotation_mode
     n = len(frames)
     poses = np.empty((n, 4, 4)) if not channels else None

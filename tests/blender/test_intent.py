@@ -281,3 +281,45 @@ def test_repeat_with_offset_goes_on(sb, channels, capfd):
     # ... and no spike: within 10 % of the largest elsewhere (the seam is a key of the walk,
     # which bends most at its keys)
     assert second[seams].max() <= 1.1 * elsewhere.max()
+
+
+def test_preview_and_insert_key_follow_spins_and_holds(sb):
+    """The live preview shows, and Insert Key on Motion keys, the motion Smooth Motion bakes:
+    spins turned the whole way, holds still."""
+    from conftest import addon_module
+
+    pd = addon_module("preview_draw")
+    obj = h.new_object("Wheel", "MESH", "XYZ")  # a spin, a hold (21-31), a spin
+    for f, v, x in ((1, 0, 0.0), (21, 360, 1.0), (31, 360, 1.0), (51, 720, 2.0)):
+        obj.rotation_euler, obj.location = (0.0, 0.0, math.radians(v)), (x, 0.0, 0.0)
+        obj.keyframe_insert("rotation_euler", frame=f)
+        obj.keyframe_insert("location", frame=f)
+    h.select_only(obj)
+    scene = bpy.context.scene
+    scene.frame_set(1)  # the object shows its animation, as after keying in the UI
+    scene.screwbender_preview.instances = 51  # one instance per frame 1..51
+    obj.screwbender_preview = True
+    try:
+        pd.refresh(scene)
+        batches = pd.CACHE.entries[obj.session_uid].batches
+    finally:
+        obj.screwbender_preview = False
+        pd.sync()
+    np.testing.assert_allclose(batches.instance_times, np.arange(1.0, 52.0))
+    previewed = batches.instances
+    h.select_only(obj)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    baked = playback(obj, np.arange(1.0, 52.0))
+    off = rotation_angle_between(previewed, baked).max()
+    moved = np.linalg.norm(previewed[:, :3, 3] - baked[:, :3, 3], axis=1).max()
+    assert bpy.ops.screwbender.revert() == {"FINISHED"}
+    # Insert Key on Motion inside the second spin keys the motion's pose, wound as the curve
+    scene.frame_set(41)
+    assert bpy.ops.screwbender.insert_key() == {"FINISHED"}
+    z = [fc for fc in h.fcurves(obj) if fc.data_path == "rotation_euler" and fc.array_index == 2][0]
+    inserted = [kp.co[1] for kp in z.keyframe_points if kp.co[0] == 41][0]
+    print(f"preview against the bake: {off:.4f} deg, {moved:.2e} units; inserted key at frame 41: {math.degrees(inserted):.2f} deg")
+    assert off < 0.05 and moved < 1e-4
+    assert abs(math.degrees(inserted) - 540.0) < 5.0, math.degrees(inserted)  # not 180
+    held = baked[20:31]  # frames 21..31
+    assert np.abs(held - held[0]).max() < 1e-6
