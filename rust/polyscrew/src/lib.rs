@@ -18,6 +18,7 @@
 //! | [`feature`] | feature-point motion design: registration, inertia points, variational subdivision | Hofer-Pottmann-Ravani |
 //! | [`angular_velocity`] | fitting a rotation to a sketched angular velocity | Xie-Xu-Yu-Weng |
 //! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
+//! | [`intent`] | what the animator meant between the keys: Blender's playback of an owner's channels, holds, pops, spins, the pace of timing "Keys" | ScrewBender issue 17 |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
 //! What users reach for is re-exported here.
@@ -42,6 +43,7 @@ pub mod angular_velocity;
 pub mod error;
 pub mod fcurve;
 pub mod feature;
+pub mod intent;
 pub mod motion;
 pub(crate) mod numeric;
 pub mod sweep;
@@ -63,6 +65,10 @@ pub use feature::motion::{
 pub use feature::registration::register;
 pub use feature::variational::{
     variational_curve, variational_subdivide, Parametrization, Stiffness,
+};
+pub use intent::{
+    analyse_spans, keys_parameters, rotation_matrices, rotation_matrix, Channel, KeysTiming,
+    Playback, Spans,
 };
 pub use motion::channels::{rotation_channels, EulerOrder, RotationMode};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};

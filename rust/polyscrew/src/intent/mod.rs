@@ -1,0 +1,46 @@
+//! What the animator meant between the keys, read from Blender's playback of an owner's
+//! transform curves: spins, holds and pops, and the pace of Blender's own interpolation
+//! (timing "Keys"). The numeric part of the add-on's `intent.py` and `sampling.py`, one call
+//! per owner instead of a pipeline of small array operations.
+//!
+//! - [`Playback`]: an owner's transform channels as Blender plays them (location, rotation in
+//!   its [`RotationMode`](crate::RotationMode), scale): its [`FCurve`](crate::FCurve)s
+//!   evaluated exactly as Blender does ([`crate::fcurve`]), the owner's own values for the
+//!   channels without a curve; [`rotation_matrix`] turns rotation channels into matrices with
+//!   Blender's conventions (quaternions and axis-angle axes normalised, zero giving the
+//!   identity; Euler `"XYZ"` meaning `R = Rz Ry Rx`).
+//! - [`analyse_spans`]: per key span, whether it is **held** (every channel still over the
+//!   span, within [`HOLD_TOLERANCE`]), whether the pose **pops** at its end, how far the
+//!   rotation channels **turn** over it (the sum of the rotation angles between
+//!   [`SPAN_SAMPLES`] or more consecutive samples of the playback), and the subframes where
+//!   poses from the playback must be added so that no screw span of a **spin** (a span
+//!   turning more than [`WIND_LIMIT`], and its neighbours turning more than [`WIND_STEP`])
+//!   turns more than [`WIND_STEP`]. A screw between two key poses turns at most half a
+//!   turn; with the added poses the smoothed motion turns as far and the same way as the
+//!   channels. Quaternion channels keep the shortest arc (nothing is added).
+//! - [`keys_parameters`]: timing "Keys". Within each span, the motion parameter of an output
+//!   frame is the one at which the smoothed motion has travelled the same fraction of the
+//!   span as Blender's playback has at that frame. Travel is the root mean square
+//!   displacement of six points at `+-size` along the body's axes ([`travel`]),
+//!   `sqrt(|dt|^2 + size^2 / 3 |dR|_F^2)`, summed over [`PACE_SAMPLES`] steps per span (and
+//!   the output frames inside it) along both motions.
+//!
+//! Every size input can drive is checked in one place ([`limits`]) before it is allocated;
+//! bad input is an [`Error`](crate::Error), never a panic.
+
+pub(crate) mod interp;
+pub mod limits;
+pub mod pace;
+pub mod playback;
+pub mod spans;
+
+#[cfg(test)]
+mod tests;
+
+pub use pace::{
+    keys_parameters, pace_parameters, screw_pace_poses, travel, KeysTiming, PACE_SAMPLES,
+};
+pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
+pub use spans::{
+    analyse_spans, Spans, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
+};

@@ -1,0 +1,304 @@
+//! Timing "Keys": the pace of Blender's own interpolation, kept while the path becomes a
+//! screw path.
+
+use glam::{DMat3, DVec3};
+
+use super::interp::interp;
+use super::limits::check_footprint;
+use super::playback::Playback;
+use crate::error::{Error, Result};
+use crate::motion::pose::Pose;
+use crate::motion::sample::{Motion, MotionSpec};
+use crate::motion::subdivision::Scheme;
+use crate::motion::timing::{check_key_times, Timing};
+
+/// Steps per key span along which the travel of Blender's playback and of the smoothed
+/// motion is measured (the output frames inside a span are measured too).
+pub const PACE_SAMPLES: usize = 16;
+
+/// How far a body moves from `(ta, ra)` to `(tb, rb)` (translation, rotation matrix): the root
+/// mean square displacement of the six points at `+-size` along its axes,
+/// `sqrt(|tb - ta|^2 + size^2 / 3 |Rb - Ra|_F^2)` (the cross terms cancel).
+fn travel_between(ta: DVec3, ra: &DMat3, tb: DVec3, rb: &DMat3, size: f64) -> f64 {
+    let dt = tb - ta;
+    let dr = *rb - *ra;
+    let frobenius =
+        dr.x_axis.length_squared() + dr.y_axis.length_squared() + dr.z_axis.length_squared();
+    (dt.length_squared() + size * size / 3.0 * frobenius).sqrt()
+}
+
+/// How far a body of half-extent `size` moves from pose `a` to pose `b`: the root mean
+/// square displacement of the six points at `+-size` along its axes,
+/// `sqrt(|t_b - t_a|^2 + size^2 / 3 |R_b - R_a|_F^2)`. Zero for equal poses; for a pure
+/// translation its length; for a turn by `angle` about any axis through the origin,
+/// `size sqrt(8 / 3) sin(angle / 2)`.
+pub fn travel(a: &Pose, b: &Pose, size: f64) -> f64 {
+    travel_between(
+        a.translation,
+        &DMat3::from_quat(a.rotation),
+        b.translation,
+        &DMat3::from_quat(b.rotation),
+        size,
+    )
+}
+
+/// The motion parameters `s + j / PACE_SAMPLES` (`j = 0..=PACE_SAMPLES`) of each span `s` in
+/// `0..spans`, span after span: where [`keys_parameters`] measures the smoothed motion.
+///
+/// # Errors
+/// A request over the size limit ([`check_footprint`]).
+pub fn pace_parameters(spans: usize) -> Result<Vec<f64>> {
+    let n = spans.saturating_mul(PACE_SAMPLES + 1);
+    check_footprint(
+        n.saturating_mul(std::mem::size_of::<f64>()),
+        "pace parameters",
+        "pass fewer keys",
+    )?;
+    let grid = |j: usize| j as f64 / PACE_SAMPLES as f64;
+    Ok((0..spans)
+        .flat_map(|s| (0..=PACE_SAMPLES).map(move |j| s as f64 + grid(j)))
+        .collect())
+}
+
+/// The smoothed screw motion of `keys` at [`pace_parameters`]: keys at parameters
+/// `0, 1, ..., K - 1` (a cycle of period `K` when `closed`), subdivided by `scheme` over
+/// `levels` and sampled with linear timing (the parameter is the motion's own).
+///
+/// # Errors
+/// As [`Motion::new`] and [`Motion::sample`], and a request over the size limit.
+pub fn screw_pace_poses(
+    keys: &[Pose],
+    scheme: Scheme,
+    levels: u32,
+    closed: bool,
+) -> Result<Vec<Pose>> {
+    let k = keys.len();
+    let spans = if closed { k } else { k.saturating_sub(1) };
+    let parameters = pace_parameters(spans)?;
+    check_footprint(
+        parameters.len().saturating_mul(std::mem::size_of::<Pose>()),
+        "pace poses",
+        "pass fewer keys",
+    )?;
+    let times: Vec<f64> = (0..k).map(|i| i as f64).collect();
+    let spec = MotionSpec {
+        scheme,
+        levels,
+        closed,
+        period: closed.then_some(k as f64),
+        timing: Timing::Linear,
+    };
+    Motion::new(keys, &times, &spec)?.sample(&parameters)
+}
+
+/// What timing "Keys" needs besides the output frames and the smoothed motion.
+#[derive(Debug, Clone, Copy)]
+pub struct KeysTiming<'a> {
+    /// The key frames, finite and strictly increasing, at least two.
+    pub key_frames: &'a [f64],
+    /// The cycle length in frames of a closed motion (its last span runs from the last key
+    /// to `key_frames[0] + period`); `None` for an open one.
+    pub period: Option<f64>,
+    /// The body's half-extent: how much rotation counts in [`travel`] (positive, finite).
+    pub size: f64,
+    /// Blender's playback of the keys, or `None` (a motion read from key values alone):
+    /// the fraction of the way is then the fraction of time.
+    pub playback: Option<&'a Playback>,
+}
+
+/// Timing "Keys": the motion parameter of each frame of `frames` (key `i` at parameter `i`).
+///
+/// Within span `s` (keys `s`, `s + 1`; for a cycle the last span closes it), a frame at the
+/// fraction `tau` of the span's time gets the parameter `s + v` at which the smoothed motion
+/// has travelled the same fraction of the span's travel as Blender's playback has at that
+/// frame:
+///
+/// - the playback is sampled at [`PACE_SAMPLES`] `+ 1` evenly spaced frames per span and at
+///   every output frame inside a span; `done(tau)` is the travel ([`travel`]) summed along
+///   these samples from the span's start, divided by the span's total (the fraction of time
+///   over a span where the playback does not move, or without playback);
+/// - the smoothed motion `smooth` is given at [`pace_parameters`] (span after span,
+///   `PACE_SAMPLES + 1` poses each, for example [`screw_pace_poses`]); `along(j)` is its
+///   travel summed to pose `j` over the span's total (`j / PACE_SAMPLES` where it does not
+///   move);
+/// - `v` interpolates `(along(j), j / PACE_SAMPLES)` linearly at `done(tau)`.
+///
+/// Frames at keys, before the first key and after the last span keep `s + tau`
+/// (extrapolating linearly). Overshoot (BACK, ELASTIC) counts as travel: the pace follows it
+/// and the parameter stays within the span.
+///
+/// # Errors
+/// [`Error::TooFew`] for fewer than two keys, [`Error::KeyTimes`] for key frames that are
+/// not strictly increasing, [`Error::Period`] for a period not beyond the keys,
+/// [`Error::Invalid`] for a size that is not positive and finite, [`Error::NotFinite`] for
+/// a frame that is not finite, [`Error::LengthMismatch`] when `smooth` does not hold
+/// `PACE_SAMPLES + 1` poses per span, the errors of [`Playback::channels`], and a request
+/// over the size limit ([`check_footprint`]).
+pub fn keys_parameters(
+    timing: &KeysTiming<'_>,
+    frames: &[f64],
+    smooth: &[Pose],
+) -> Result<Vec<f64>> {
+    let key_frames = timing.key_frames;
+    let k = key_frames.len();
+    if k < 2 {
+        return Err(Error::TooFew { got: k, need: 2 });
+    }
+    check_key_times(key_frames)?;
+    let first = key_frames[0];
+    let last = key_frames[k - 1];
+    let mut ends = key_frames.to_vec();
+    if let Some(period) = timing.period {
+        let end = first + period;
+        if !(end.is_finite() && end > last) {
+            return Err(Error::Period {
+                period,
+                span: last - first,
+            });
+        }
+        ends.push(end);
+    }
+    let spans = ends.len() - 1;
+    let size = timing.size;
+    if !(size.is_finite() && size > 0.0) {
+        return Err(Error::Invalid {
+            what: "size",
+            reason: format!("{size} is not a positive finite number"),
+        });
+    }
+    if let Some(index) = frames.iter().position(|f| !f.is_finite()) {
+        return Err(Error::NotFinite {
+            what: "frame",
+            index,
+        });
+    }
+    let per_span = PACE_SAMPLES + 1;
+    let grid_len = spans * per_span;
+    if smooth.len() != grid_len {
+        return Err(Error::LengthMismatch {
+            what: "smooth poses",
+            expected: grid_len,
+            got: smooth.len(),
+        });
+    }
+    let t = frames.len();
+    let samples = grid_len.saturating_add(t);
+    // Per frame: span, fraction, travelled, output; per sample: span, fraction, done, the two
+    // interpolation tables; per grid pose: the two tables; one channel row.
+    let bytes = t
+        .saturating_mul(4 * 8)
+        .saturating_add(samples.saturating_mul(5 * 8))
+        .saturating_add(grid_len.saturating_mul(2 * 8));
+    check_footprint(bytes, "timing Keys", "bake fewer frames")?;
+
+    let span_of = |frame: f64| {
+        ends.partition_point(|&e| e <= frame)
+            .saturating_sub(1)
+            .min(spans - 1)
+    };
+    let located: Vec<(usize, f64)> = frames
+        .iter()
+        .map(|&f| {
+            let s = span_of(f);
+            (s, (f - ends[s]) / (ends[s + 1] - ends[s]))
+        })
+        .collect();
+    let inside = |tau: f64| tau > 0.0 && tau < 1.0;
+    let grid = |j: usize| j as f64 / PACE_SAMPLES as f64;
+
+    // Blender's playback: per span the grid, plus the output frames inside it, in order.
+    let mut sampled: Vec<(usize, f64)> = Vec::with_capacity(samples);
+    sampled.extend((0..spans).flat_map(|s| (0..per_span).map(move |j| (s, grid(j)))));
+    sampled.extend(located.iter().copied().filter(|&(_, tau)| inside(tau)));
+    sampled.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let done = playback_fractions(timing.playback, &ends, &sampled, size)?;
+    let xp: Vec<f64> = sampled.iter().map(|&(s, f)| s as f64 + f).collect();
+    let fp: Vec<f64> = sampled
+        .iter()
+        .zip(&done)
+        .map(|(&(s, _), d)| s as f64 + d)
+        .collect();
+    drop(sampled);
+
+    // The smoothed motion's own travel along each span.
+    let mut x = Vec::with_capacity(grid_len);
+    let mut y = Vec::with_capacity(grid_len);
+    let mut along = Vec::with_capacity(per_span);
+    for s in 0..spans {
+        let poses = &smooth[s * per_span..(s + 1) * per_span];
+        along.clear();
+        along.push(0.0);
+        let mut sum = 0.0;
+        for pair in poses.windows(2) {
+            sum += travel(&pair[0], &pair[1], size);
+            along.push(sum);
+        }
+        for (j, a) in along.iter().enumerate() {
+            x.push(s as f64 + if sum > 0.0 { a / sum } else { grid(j) });
+            y.push(s as f64 + grid(j));
+        }
+    }
+    Ok(located
+        .iter()
+        .map(|&(s, tau)| {
+            let base = s as f64;
+            if inside(tau) {
+                let travelled = interp(base + tau, &xp, &fp) - base;
+                interp(base + travelled, &x, &y)
+            } else {
+                base + tau
+            }
+        })
+        .collect())
+}
+
+/// The fraction of its span's travel along Blender's playback done at each sample
+/// (`(span, fraction of time)`, sorted): 0 at the span's start, 1 at its end; the fraction
+/// of time without playback or over a span where the playback does not move.
+fn playback_fractions(
+    playback: Option<&Playback>,
+    ends: &[f64],
+    sampled: &[(usize, f64)],
+    size: f64,
+) -> Result<Vec<f64>> {
+    let Some(playback) = playback else {
+        return Ok(sampled.iter().map(|&(_, f)| f).collect());
+    };
+    let mut done = Vec::with_capacity(sampled.len());
+    let mut row = Vec::with_capacity(playback.width());
+    let mut previous: Option<(usize, DVec3, DMat3)> = None;
+    let mut start = 0; // the first sample of the current span
+    let mut sum = 0.0;
+    let finish = |done: &mut Vec<f64>, start: usize, sum: f64| {
+        if sum > 0.0 {
+            for d in &mut done[start..] {
+                *d /= sum;
+            }
+        } else {
+            for (d, &(_, f)) in done[start..].iter_mut().zip(&sampled[start..]) {
+                *d = f;
+            }
+        }
+    };
+    for (i, &(s, f)) in sampled.iter().enumerate() {
+        let frame = ends[s] + f * (ends[s + 1] - ends[s]);
+        playback.channels_into(&[frame], &mut row)?;
+        let location = DVec3::new(row[0], row[1], row[2]);
+        let rotation = playback.rotation(&row);
+        match previous {
+            Some((p, ref pl, ref pr)) if p == s => {
+                sum += travel_between(*pl, pr, location, &rotation, size);
+            }
+            Some(_) => {
+                finish(&mut done, start, sum);
+                start = i;
+                sum = 0.0;
+            }
+            None => {}
+        }
+        done.push(sum);
+        previous = Some((s, location, rotation));
+    }
+    finish(&mut done, start, sum);
+    Ok(done)
+}

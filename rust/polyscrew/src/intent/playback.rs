@@ -1,0 +1,327 @@
+//! An owner's transform channels as Blender plays them, and rotation channels as matrices.
+//!
+//! A *channel row* holds an owner's transform at one frame, in Blender's properties: location
+//! `x, y, z`; the rotation in the owner's mode (`rotation_euler` `x, y, z` in radians,
+//! `rotation_quaternion` `w, x, y, z` or `rotation_axis_angle` `angle, x, y, z`); scale
+//! `x, y, z`: `6 + w` numbers, `w` the mode's [`RotationMode::width`].
+
+use glam::{DMat3, DQuat, DVec3};
+
+use super::limits::check_footprint;
+use crate::error::{Error, Result};
+use crate::fcurve::FCurve;
+use crate::motion::channels::RotationMode;
+
+/// One transform channel: a property and an index into it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Channel {
+    /// `location[i]`, `i` in `0..3`.
+    Location(usize),
+    /// The rotation property of the owner's mode, index `i` in `0..width`.
+    Rotation(usize),
+    /// `scale[i]`, `i` in `0..3`.
+    Scale(usize),
+}
+
+impl Channel {
+    /// The channel of Blender's property `property` (`"location"`, `"scale"`, or the rotation
+    /// property of `mode`: `"rotation_euler"`, `"rotation_quaternion"`,
+    /// `"rotation_axis_angle"`) at `index`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for another property (a rotation property of another mode
+    /// included) or an index out of the property's range.
+    pub fn from_property(property: &str, index: usize, mode: RotationMode) -> Result<Self> {
+        let rotation = rotation_property(mode);
+        let (channel, size) = match property {
+            "location" => (Self::Location(index), 3),
+            "scale" => (Self::Scale(index), 3),
+            p if p == rotation => (Self::Rotation(index), mode.width()),
+            _ => {
+                return Err(Error::Invalid {
+                    what: "channels",
+                    reason: format!(
+                        "{property:?} is not location, {rotation} (rotation mode {}) or scale",
+                        mode_name(mode)
+                    ),
+                })
+            }
+        };
+        if index >= size {
+            return Err(Error::Invalid {
+                what: "channels",
+                reason: format!("{property}[{index}]: index out of range 0..{size}"),
+            });
+        }
+        Ok(channel)
+    }
+
+    /// Its place in a channel row of `mode`.
+    pub fn column(self, mode: RotationMode) -> usize {
+        match self {
+            Self::Location(i) => i,
+            Self::Rotation(i) => 3 + i,
+            Self::Scale(i) => 3 + mode.width() + i,
+        }
+    }
+}
+
+/// Blender's rotation property of `mode`.
+pub fn rotation_property(mode: RotationMode) -> &'static str {
+    match mode {
+        RotationMode::Quaternion => "rotation_quaternion",
+        RotationMode::AxisAngle => "rotation_axis_angle",
+        RotationMode::Euler(_) => "rotation_euler",
+    }
+}
+
+fn mode_name(mode: RotationMode) -> &'static str {
+    use crate::motion::channels::EulerOrder::*;
+    match mode {
+        RotationMode::Quaternion => "QUATERNION",
+        RotationMode::AxisAngle => "AXIS_ANGLE",
+        RotationMode::Euler(Xyz) => "XYZ",
+        RotationMode::Euler(Xzy) => "XZY",
+        RotationMode::Euler(Yxz) => "YXZ",
+        RotationMode::Euler(Yzx) => "YZX",
+        RotationMode::Euler(Zxy) => "ZXY",
+        RotationMode::Euler(Zyx) => "ZYX",
+    }
+}
+
+/// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
+/// it:
+///
+/// - quaternion `(w, x, y, z)`, normalised (zero: the identity);
+/// - axis-angle `(angle, x, y, z)`, a rotation by `angle` about the normalised axis
+///   (Rodrigues, `I + sin(a) K + (1 - cos(a)) K^2`; a zero axis: the identity);
+/// - Euler `(x, y, z)` radians, order `"XYZ"` meaning X applied first: `R = Rz Ry Rx`
+///   ([`EulerOrder::to_mat3`](crate::EulerOrder::to_mat3)).
+///
+/// `values` has [`RotationMode::width`] numbers (extra ones are ignored, missing ones read
+/// as 0); they are assumed finite.
+pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let norm = q.length();
+            if norm > 0.0 {
+                DMat3::from_quat(q / norm)
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::AxisAngle => {
+            let axis = DVec3::new(v(1), v(2), v(3));
+            let norm = axis.length();
+            if norm > 0.0 {
+                let k = axis / norm;
+                let (s, c) = v(0).sin_cos();
+                // K v = k x v, as columns of the skew matrix.
+                let skew = DMat3::from_cols(
+                    DVec3::new(0.0, k.z, -k.y),
+                    DVec3::new(-k.z, 0.0, k.x),
+                    DVec3::new(k.y, -k.x, 0.0),
+                );
+                DMat3::IDENTITY + skew * s + (skew * skew) * (1.0 - c)
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::Euler(order) => order.to_mat3(DVec3::new(v(0), v(1), v(2))),
+    }
+}
+
+/// [`rotation_matrix`] of every row of `values` (row-major, `N x width` numbers).
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `values` is not a whole number of rows,
+/// [`Error::NotFinite`] naming the first row holding NaN or infinity, and a request over the
+/// size limit ([`check_footprint`]).
+pub fn rotation_matrices(values: &[f64], mode: RotationMode) -> Result<Vec<DMat3>> {
+    let width = mode.width();
+    if values.len() % width != 0 {
+        return Err(Error::LengthMismatch {
+            what: "rotation values",
+            expected: values.len() / width * width,
+            got: values.len(),
+        });
+    }
+    let n = values.len() / width;
+    check_footprint(
+        n.saturating_mul(std::mem::size_of::<DMat3>()),
+        "rotation matrices",
+        "pass fewer rotations",
+    )?;
+    values
+        .chunks_exact(width)
+        .enumerate()
+        .map(|(index, row)| {
+            if row.iter().all(|x| x.is_finite()) {
+                Ok(rotation_matrix(mode, row))
+            } else {
+                Err(Error::NotFinite {
+                    what: "rotation",
+                    index,
+                })
+            }
+        })
+        .collect()
+}
+
+/// An owner's transform channels as Blender plays them: the keyed channels from their
+/// F-curves (evaluated exactly as Blender's `FCurve.evaluate`), every other channel from the
+/// owner's own value, location zero for an owner Blender does not move by it (a bone
+/// connected to its parent).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Playback {
+    curves: Vec<FCurve>,
+    /// The channel-row column each curve drives.
+    columns: Vec<usize>,
+    /// A channel row of the owner's own values.
+    statics: Vec<f64>,
+    mode: RotationMode,
+    located: bool,
+}
+
+impl Playback {
+    /// The playback of `curves`, curve `c` driving channel `channels[c]`; `statics` is a
+    /// channel row of the owner's own values (used where no curve drives a channel);
+    /// `located` is false for an owner whose location Blender ignores (its location is 0).
+    ///
+    /// # Errors
+    /// [`Error::LengthMismatch`] when `channels` and `curves`, or `statics` and the row
+    /// width `6 + mode.width()`, differ in length; [`Error::Invalid`] when two curves drive
+    /// one channel; [`Error::NotFinite`] for a static value that is not finite.
+    pub fn new(
+        curves: Vec<FCurve>,
+        channels: &[Channel],
+        statics: Vec<f64>,
+        mode: RotationMode,
+        located: bool,
+    ) -> Result<Self> {
+        if channels.len() != curves.len() {
+            return Err(Error::LengthMismatch {
+                what: "channels",
+                expected: curves.len(),
+                got: channels.len(),
+            });
+        }
+        let width = 6 + mode.width();
+        if statics.len() != width {
+            return Err(Error::LengthMismatch {
+                what: "static values",
+                expected: width,
+                got: statics.len(),
+            });
+        }
+        if let Some(index) = statics.iter().position(|v| !v.is_finite()) {
+            return Err(Error::NotFinite {
+                what: "static value",
+                index,
+            });
+        }
+        let columns: Vec<usize> = channels.iter().map(|c| c.column(mode)).collect();
+        for (c, column) in columns.iter().enumerate() {
+            if let Some(first) = columns[..c].iter().position(|o| o == column) {
+                return Err(Error::Invalid {
+                    what: "channels",
+                    reason: format!(
+                        "curves {first} and {c} drive the same channel {:?}",
+                        channels[c]
+                    ),
+                });
+            }
+        }
+        Ok(Self {
+            curves,
+            columns,
+            statics,
+            mode,
+            located,
+        })
+    }
+
+    /// The owner's rotation mode.
+    pub fn mode(&self) -> RotationMode {
+        self.mode
+    }
+
+    /// Numbers per channel row: `6 + mode.width()`.
+    pub fn width(&self) -> usize {
+        self.statics.len()
+    }
+
+    /// Whether location moves the owner.
+    pub fn located(&self) -> bool {
+        self.located
+    }
+
+    /// The curves.
+    pub fn curves(&self) -> &[FCurve] {
+        &self.curves
+    }
+
+    /// The channel rows at `times` (any order, subframes allowed), row-major
+    /// `times.len() x width()`: each keyed channel exactly Blender's value (`float32`,
+    /// widened), the others the owner's own.
+    ///
+    /// # Errors
+    /// [`Error::NotFinite`] for a time that is not finite in `float32`, [`Error::Invalid`]
+    /// for a value that is not finite (as [`crate::evaluate_fcurves`]) and a request over the
+    /// size limit ([`check_footprint`]).
+    pub fn channels(&self, times: &[f64]) -> Result<Vec<f64>> {
+        check_footprint(
+            times
+                .len()
+                .saturating_mul(self.width())
+                .saturating_mul(std::mem::size_of::<f64>()),
+            "channel values",
+            "evaluate fewer frames",
+        )?;
+        let mut out = Vec::new();
+        self.channels_into(times, &mut out)?;
+        Ok(out)
+    }
+
+    /// [`Playback::channels`] into `out` (cleared first): the loops that evaluate span after
+    /// span reuse one buffer. The caller has checked the size.
+    pub(crate) fn channels_into(&self, times: &[f64], out: &mut Vec<f64>) -> Result<()> {
+        let width = self.width();
+        out.clear();
+        out.reserve(times.len() * width);
+        for (index, &t) in times.iter().enumerate() {
+            let t32 = t as f32;
+            if !t32.is_finite() {
+                return Err(Error::NotFinite {
+                    what: "time",
+                    index,
+                });
+            }
+            out.extend_from_slice(&self.statics);
+            let row = &mut out[index * width..];
+            for (c, (curve, &column)) in self.curves.iter().zip(&self.columns).enumerate() {
+                let v = curve.evaluate_f32(t32);
+                if !v.is_finite() {
+                    return Err(Error::Invalid {
+                        what: "value",
+                        reason: format!(
+                            "curve {c} evaluates to {v} at time {index} (frame {t32}), as Blender would"
+                        ),
+                    });
+                }
+                row[column] = v as f64;
+            }
+            if !self.located {
+                row[..3].fill(0.0);
+            }
+        }
+        Ok(())
+    }
+
+    /// The rotation matrix of a channel row (see [`rotation_matrix`]).
+    pub fn rotation(&self, row: &[f64]) -> DMat3 {
+        rotation_matrix(self.mode, row.get(3..).unwrap_or(&[]))
+    }
+}
