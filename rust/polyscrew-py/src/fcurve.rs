@@ -19,49 +19,50 @@ use polyscrew::fcurve::{
 use crate::{read_vector, shape_err, to_py_err, FloatArray};
 
 /// An integer array-like argument converted to int64 on the way in.
-type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+pub(crate) type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
 
 const F: &str = "evaluate_fcurves";
 
 /// Reads `(K, 2)` pairs, flattened.
-fn read_pairs(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+fn read_pairs(f: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 2 {
-        return Err(shape_err(F, what, "(K, 2)", shape));
+        return Err(shape_err(f, what, "(K, 2)", shape));
     }
     Ok(array.iter().copied().collect())
 }
 
 /// Reads a 1-D integer array.
-fn read_ints(what: &str, array: ArrayViewD<'_, i64>) -> PyResult<Vec<i64>> {
+fn read_ints(f: &str, what: &str, array: ArrayViewD<'_, i64>) -> PyResult<Vec<i64>> {
     if array.ndim() != 1 {
-        return Err(shape_err(F, what, "(N,)", array.shape()));
+        return Err(shape_err(f, what, "(N,)", array.shape()));
     }
     Ok(array.iter().copied().collect())
 }
 
 /// A per-key float array, or `k` copies of `default` when it is not given.
 fn read_per_key(
+    f: &str,
     what: &str,
     array: Option<FloatArray<'_>>,
     k: usize,
     default: f32,
 ) -> PyResult<Vec<f64>> {
     match array {
-        Some(a) => read_vector(F, what, a.as_array()),
+        Some(a) => read_vector(f, what, a.as_array()),
         None => Ok(vec![default as f64; k]),
     }
 }
 
 /// One extrapolation name for every curve, or a sequence of `c` names.
-fn read_extrapolation(arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec<Extrapolation>> {
-    let parse = |name: &str| Extrapolation::from_name(name).map_err(|e| to_py_err(F, e));
+fn read_extrapolation(f: &str, arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec<Extrapolation>> {
+    let parse = |name: &str| Extrapolation::from_name(name).map_err(|e| to_py_err(f, e));
     if let Ok(name) = arg.cast::<PyString>() {
         return Ok(vec![parse(name.to_str()?)?; c]);
     }
     let names: Vec<String> = arg.extract().map_err(|_| {
         PyTypeError::new_err(format!(
-            "{F}: extrapolation: expected a name or a sequence of names"
+            "{f}: extrapolation: expected a name or a sequence of names"
         ))
     })?;
     names.iter().map(|n| parse(n)).collect()
@@ -84,8 +85,8 @@ const CYCLES_KEYS: [&str; 11] = [
 
 /// Reads one Cycles settings dict (named as Blender's RNA properties; missing entries take
 /// the defaults of a new modifier).
-fn read_cycles(c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
-    let err = |reason: String| PyValueError::new_err(format!("{F}: cycles[{c}]: {reason}"));
+fn read_cycles(f: &str, c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
+    let err = |reason: String| PyValueError::new_err(format!("{f}: cycles[{c}]: {reason}"));
     for key in dict.keys() {
         let key: String = key.extract()?;
         if !CYCLES_KEYS.contains(&key.as_str()) {
@@ -147,18 +148,22 @@ fn read_cycles(c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
 }
 
 /// `None`, or a sequence of `c` entries each a settings dict or `None`.
-fn read_cycles_list(arg: Option<&Bound<'_, PyAny>>, c: usize) -> PyResult<Vec<Option<Cycles>>> {
+fn read_cycles_list(
+    f: &str,
+    arg: Option<&Bound<'_, PyAny>>,
+    c: usize,
+) -> PyResult<Vec<Option<Cycles>>> {
     let Some(arg) = arg.filter(|a| !a.is_none()) else {
         return Ok(Vec::new());
     };
     let items: Vec<Bound<'_, PyAny>> = arg.extract().map_err(|_| {
         PyTypeError::new_err(format!(
-            "{F}: cycles: expected a sequence of dicts or None, one per curve"
+            "{f}: cycles: expected a sequence of dicts or None, one per curve"
         ))
     })?;
     if items.len() != c {
         return Err(PyValueError::new_err(format!(
-            "{F}: cycles: expected {c} entries (one per curve), got {}",
+            "{f}: cycles: expected {c} entries (one per curve), got {}",
             items.len()
         )));
     }
@@ -170,11 +175,85 @@ fn read_cycles_list(arg: Option<&Bound<'_, PyAny>>, c: usize) -> PyResult<Vec<Op
                 return Ok(None);
             }
             let dict = item.cast::<PyDict>().map_err(|_| {
-                PyTypeError::new_err(format!("{F}: cycles[{i}]: expected a dict or None"))
+                PyTypeError::new_err(format!("{f}: cycles[{i}]: expected a dict or None"))
             })?;
-            read_cycles(i, dict).map(Some)
+            read_cycles(f, i, dict).map(Some)
         })
         .collect()
+}
+
+/// The packed curves' arguments of `evaluate_fcurves`, read and owned: shared with the
+/// functions that take the same curves (`Playback`).
+pub(crate) struct CurveArgs {
+    offsets: Vec<i64>,
+    co: Vec<f64>,
+    handle_left: Vec<f64>,
+    handle_right: Vec<f64>,
+    interpolation: Vec<i64>,
+    easing: Vec<i64>,
+    back: Vec<f64>,
+    amplitude: Vec<f64>,
+    period: Vec<f64>,
+    extrapolation: Vec<Extrapolation>,
+    cycles: Vec<Option<Cycles>>,
+}
+
+impl CurveArgs {
+    /// Reads the arguments (errors name `function` and the argument).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn read<'py>(
+        function: &str,
+        offsets: IntArray<'py>,
+        co: FloatArray<'py>,
+        handle_left: FloatArray<'py>,
+        handle_right: FloatArray<'py>,
+        interpolation: IntArray<'py>,
+        easing: IntArray<'py>,
+        extrapolation: Option<Bound<'py, PyAny>>,
+        back: Option<FloatArray<'py>>,
+        amplitude: Option<FloatArray<'py>>,
+        period: Option<FloatArray<'py>>,
+        cycles: Option<Bound<'py, PyAny>>,
+    ) -> PyResult<Self> {
+        let f = function;
+        let offsets = read_ints(f, "offsets", offsets.as_array())?;
+        let c = offsets.len().saturating_sub(1);
+        let co = read_pairs(f, "co", co.as_array())?;
+        let k = co.len() / 2;
+        Ok(Self {
+            offsets,
+            co,
+            handle_left: read_pairs(f, "handle_left", handle_left.as_array())?,
+            handle_right: read_pairs(f, "handle_right", handle_right.as_array())?,
+            interpolation: read_ints(f, "interpolation", interpolation.as_array())?,
+            easing: read_ints(f, "easing", easing.as_array())?,
+            back: read_per_key(f, "back", back, k, DEFAULT_BACK)?,
+            amplitude: read_per_key(f, "amplitude", amplitude, k, DEFAULT_AMPLITUDE)?,
+            period: read_per_key(f, "period", period, k, DEFAULT_PERIOD)?,
+            extrapolation: match extrapolation.as_ref().filter(|e| !e.is_none()) {
+                Some(e) => read_extrapolation(f, e, c)?,
+                None => vec![Extrapolation::Constant; c],
+            },
+            cycles: read_cycles_list(f, cycles.as_ref(), c)?,
+        })
+    }
+
+    /// The arguments as the core's packed curves.
+    pub(crate) fn packed(&self) -> PackedCurves<'_> {
+        PackedCurves {
+            offsets: &self.offsets,
+            co: &self.co,
+            handle_left: &self.handle_left,
+            handle_right: &self.handle_right,
+            interpolation: &self.interpolation,
+            easing: &self.easing,
+            back: &self.back,
+            amplitude: &self.amplitude,
+            period: &self.period,
+            extrapolation: &self.extrapolation,
+            cycles: &self.cycles,
+        }
+    }
 }
 
 /// evaluate_fcurves(times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation="CONSTANT", back=None, amplitude=None, period=None, cycles=None) -> ndarray
@@ -206,35 +285,22 @@ fn evaluate_fcurves<'py>(
     cycles: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let times = read_vector(F, "times", times.as_array())?;
-    let offsets = read_ints("offsets", offsets.as_array())?;
-    let c = offsets.len().saturating_sub(1);
-    let co = read_pairs("co", co.as_array())?;
-    let k = co.len() / 2;
-    let handle_left = read_pairs("handle_left", handle_left.as_array())?;
-    let handle_right = read_pairs("handle_right", handle_right.as_array())?;
-    let interpolation = read_ints("interpolation", interpolation.as_array())?;
-    let easing = read_ints("easing", easing.as_array())?;
-    let back = read_per_key("back", back, k, DEFAULT_BACK)?;
-    let amplitude = read_per_key("amplitude", amplitude, k, DEFAULT_AMPLITUDE)?;
-    let period = read_per_key("period", period, k, DEFAULT_PERIOD)?;
-    let extrapolation = match extrapolation.as_ref().filter(|e| !e.is_none()) {
-        Some(e) => read_extrapolation(e, c)?,
-        None => vec![Extrapolation::Constant; c],
-    };
-    let cycles = read_cycles_list(cycles.as_ref(), c)?;
-    let packed = PackedCurves {
-        offsets: &offsets,
-        co: &co,
-        handle_left: &handle_left,
-        handle_right: &handle_right,
-        interpolation: &interpolation,
-        easing: &easing,
-        back: &back,
-        amplitude: &amplitude,
-        period: &period,
-        extrapolation: &extrapolation,
-        cycles: &cycles,
-    };
+    let args = CurveArgs::read(
+        F,
+        offsets,
+        co,
+        handle_left,
+        handle_right,
+        interpolation,
+        easing,
+        extrapolation,
+        back,
+        amplitude,
+        period,
+        cycles,
+    )?;
+    let packed = args.packed();
+    let c = packed.len();
     let n = times.len();
     let values = py
         .detach(|| evaluate_packed(&packed, &times))

@@ -6,6 +6,7 @@
 mod angular_velocity;
 mod fcurve;
 mod feature;
+mod intent;
 mod sweep;
 
 use glam::DVec3;
@@ -511,5 +512,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sweep::register(m)?;
     feature::register(m)?;
     fcurve::register(m)?;
+    intent::register(m)?;
     Ok(())
 }
