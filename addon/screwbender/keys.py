@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
+import polyscrew
 
 from . import channels, curves, intent, owners
 
@@ -123,48 +124,12 @@ def rotation_matrices(values: np.ndarray, mode: str) -> np.ndarray:
 
     Follows Blender: quaternions (w, x, y, z) are normalised (zero gives the identity),
     axis-angle is (angle, x, y, z) with the axis normalised (zero gives the identity), and
-    Euler order "XYZ" means X is applied first: `R = Rz Ry Rx`.
+    Euler order "XYZ" means X is applied first: `R = Rz Ry Rx`. One `polyscrew` call
+    (`polyscrew.rotation_matrices`; ValueError for values that are not finite).
     """
-    values = np.asarray(values, dtype=np.float64)
-    n = values.shape[0]
-    if mode == "QUATERNION":
-        norm = np.linalg.norm(values, axis=1)
-        q = np.where(norm[:, None] > 0.0, values / np.where(norm > 0.0, norm, 1.0)[:, None], [1.0, 0.0, 0.0, 0.0])
-        w, x, y, z = q.T
-        return np.stack(
-            [
-                np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], axis=1),
-                np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], axis=1),
-                np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], axis=1),
-            ],
-            axis=1,
-        )
-    if mode == "AXIS_ANGLE":
-        angle = values[:, 0]
-        axis = values[:, 1:4]
-        norm = np.linalg.norm(axis, axis=1)
-        angle = np.where(norm > 0.0, angle, 0.0)
-        axis = np.where(norm[:, None] > 0.0, axis / np.where(norm > 0.0, norm, 1.0)[:, None], [0.0, 0.0, 1.0])
-        k = np.zeros((n, 3, 3))
-        k[:, 0, 1], k[:, 0, 2] = -axis[:, 2], axis[:, 1]
-        k[:, 1, 0], k[:, 1, 2] = axis[:, 2], -axis[:, 0]
-        k[:, 2, 0], k[:, 2, 1] = -axis[:, 1], axis[:, 0]
-        s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-        return np.eye(3) + s * k + (1 - c) * (k @ k)
-    if mode in ROTATION_PATHS:
-        out = np.broadcast_to(np.eye(3), (n, 3, 3)).copy()
-        for axis_name in mode:  # first letter applied first
-            i = "XYZ".index(axis_name)
-            a = values[:, i]
-            s, c = np.sin(a), np.cos(a)
-            r = np.zeros((n, 3, 3))
-            j, k = (i + 1) % 3, (i + 2) % 3
-            r[:, i, i] = 1.0
-            r[:, j, j], r[:, j, k] = c, -s
-            r[:, k, j], r[:, k, k] = s, c
-            out = r @ out
-        return out
-    raise SmoothError(f"unknown rotation mode {mode!r}")
+    if mode not in ROTATION_PATHS:
+        raise SmoothError(f"unknown rotation mode {mode!r}")
+    return polyscrew.rotation_matrices(np.asarray(values, dtype=np.float64), mode)
 
 
 def compose(locations: np.ndarray, rotations: np.ndarray, scales: np.ndarray | None = None) -> np.ndarray:

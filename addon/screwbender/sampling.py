@@ -17,11 +17,12 @@ from dataclasses import dataclass
 import numpy as np
 import polyscrew
 
-from . import feature, intent, keys
+from . import feature, keys
 
-#: Points per key span where the travel of Blender's playback and of the smoothed motion is
-#: measured (timing "keys"; the output frames inside a span are measured too).
-PACE_SAMPLES = 16
+#: Steps per key span along which the travel of Blender's playback and of the smoothed motion
+#: is measured (timing "keys"; the output frames inside a span are measured too): the core's
+#: `polyscrew.PACE_SAMPLES`.
+PACE_SAMPLES = polyscrew.PACE_SAMPLES
 
 
 @dataclass
@@ -107,72 +108,32 @@ def _parameter_motion(motion: keys.KeyedMotion) -> tuple[np.ndarray, float | Non
     return np.arange(k, dtype=np.float64), (float(k) if motion.closed else None)
 
 
-def _sample_at_parameters(motion: keys.KeyedMotion, u: np.ndarray, options, owner) -> np.ndarray:
-    """The smoothed motion of `motion`'s keys at motion parameters `u` (key i at u = i)."""
-    times, period = _parameter_motion(motion)
-    if options.method == "FEATURE" and owner is not None:
-        return feature.sample_poses_at(owner, motion, times, u, options, period)
-    return polyscrew.sample(
-        motion.poses, times, u, scheme=options.scheme, levels=options.levels,
-        closed=motion.closed, period=period, timing="linear",
-    )
-
-
 def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner) -> np.ndarray:
     """Timing "keys": the motion parameter of each frame of `frames`.
 
     Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
     travelled the same fraction of the span's travel as Blender's own playback of the curves
-    has at that frame (travel: :func:`intent.travel`). Without Blender's curves (a motion
-    read from key values only), or over a span where Blender's playback does not move (the
-    span closing a cycle that has no Cycles modifier), the fraction is the fraction of time.
+    has at that frame (travel: `sqrt(|dt|^2 + size^2/3 |dR|_F^2)`, summed along
+    :data:`PACE_SAMPLES` steps per span). Without Blender's curves (a motion read from key
+    values only), or over a span where Blender's playback does not move (the span closing a
+    cycle that has no Cycles modifier), the fraction is the fraction of time.
+
+    One `polyscrew.keys_parameters` call: it samples Blender's playback (the motion's
+    `polyscrew.Playback`) and the smoothed screw motion itself; for the Feature Points
+    method the smoothed motion's poses at `polyscrew.pace_parameters` are sampled here first.
     """
-    k = len(motion.frames)
-    f = motion.frames
-    if motion.closed:
-        ends = np.append(f, f[0] + motion.period)
-        spans = k
-    else:
-        ends = f
-        spans = k - 1
     frames = np.asarray(frames, dtype=np.float64)
-    span = np.clip(np.searchsorted(ends, frames, side="right") - 1, 0, spans - 1)
-    time_fraction = (frames - ends[span]) / (ends[span + 1] - ends[span])
-    size = motion.size
-    # Blender's playback: per span, PACE_SAMPLES + 1 points from its start to its end, plus
-    # the output frames inside it.
-    grid = np.arange(PACE_SAMPLES + 1) / PACE_SAMPLES
-    inside = (time_fraction > 0.0) & (time_fraction < 1.0)
-    sample_span = np.concatenate([np.repeat(np.arange(spans), PACE_SAMPLES + 1), span[inside]])
-    sample_fraction = np.concatenate([np.tile(grid, spans), time_fraction[inside]])
-    order = np.lexsort((sample_fraction, sample_span))
-    sample_span, sample_fraction = sample_span[order], sample_fraction[order]
-    if motion.source is not None:
-        sample_frames = ends[sample_span] + sample_fraction * (ends[sample_span + 1] - ends[sample_span])
-        played = motion.source.channels(sample_frames)
-        poses = keys.compose(
-            played["location"], keys.rotation_matrices(played[motion.source.rotation_path], motion.source.mode)
-        )
-        done = intent.pace_fractions(poses, sample_span, sample_fraction, size, spans)
-    else:
-        done = sample_fraction
-    # One interpolation for all spans: within span s, the pair (s + time fraction, s + travel
-    # fraction) is increasing, and spans meet at (s + 1, s + 1).
-    travelled = np.interp(span + time_fraction, sample_span + sample_fraction, sample_span + done) - span
-    outside = ~inside
-    travelled[outside] = time_fraction[outside]  # at keys, before the first and after the last
-    # The smoothed motion's own travel along each span, at PACE_SAMPLES + 1 parameters.
-    u_grid = (np.arange(spans)[:, None] + grid[None, :]).ravel()
-    smooth_poses = _sample_at_parameters(motion, u_grid, options, owner).reshape(spans, PACE_SAMPLES + 1, 4, 4)
-    steps = intent.travel(smooth_poses[:, :-1].reshape(-1, 4, 4), smooth_poses[:, 1:].reshape(-1, 4, 4), size)
-    cumulative = np.concatenate([np.zeros((spans, 1)), np.cumsum(steps.reshape(spans, PACE_SAMPLES), axis=1)], axis=1)
-    total = cumulative[:, -1:]
-    along = np.where(total > 0.0, cumulative / np.where(total > 0.0, total, 1.0), grid[None, :])
-    x = (np.arange(spans)[:, None] + along).ravel()
-    y = u_grid
-    u = np.interp(span + travelled, x, y)
-    u[outside] = span[outside] + travelled[outside]
-    return u
+    playback = motion.source.playback if motion.source is not None else None
+    common = dict(size=motion.size, closed=motion.closed, period=motion.period, playback=playback)
+    if options.method == "FEATURE" and owner is not None:
+        k = len(motion.frames)
+        u = polyscrew.pace_parameters(k if motion.closed else k - 1)
+        times = np.arange(k, dtype=np.float64)
+        smooth = feature.sample_poses_at(owner, motion, times, u, options, float(k) if motion.closed else None)
+        return polyscrew.keys_parameters(motion.frames, frames, smooth=smooth, **common)
+    return polyscrew.keys_parameters(
+        motion.frames, frames, poses=motion.poses, scheme=options.scheme, levels=options.levels, **common
+    )
 
 
 @dataclass
