@@ -421,3 +421,124 @@ def evaluate_fcurves(
     ``MAX_FCURVE_VALUES`` values, or a value that is not finite (where Blender's would be
     NaN or infinite).
     """
+
+# --- what the animator meant between the keys (polyscrew::intent) ----------------------------
+
+WIND_LIMIT: float
+"""A span whose rotation channels turn further than this (radians, 150 degrees) is a spin."""
+WIND_STEP: float
+"""The most a screw span of a spin turns once poses are added (radians, 45 degrees); the
+neighbouring spans of a spin turning more than this are cut too."""
+SPAN_SAMPLES: int
+"""Samples of the playback per key span in ``analyse_spans`` (8; more for spinning spans)."""
+MAX_SPAN_SAMPLES: int
+"""At most this many samples per span in ``analyse_spans`` (4096; one per 10 degrees)."""
+HOLD_TOLERANCE: float
+"""A channel moving less than this times (its size + 1) over a span is still (1e-6)."""
+PACE_SAMPLES: int
+"""Steps per span along which ``keys_parameters`` measures travel (16)."""
+
+class Playback:
+    """An owner's transform channels as Blender plays them.
+
+    C keyframed curves, packed as ``evaluate_fcurves`` takes them (the same keyword
+    arguments, evaluated exactly as it does), curve ``c`` driving ``channels[c]``, a
+    ``(property, index)`` pair: ``"location"``, ``"scale"`` or the rotation property of
+    ``mode`` (``"rotation_euler"``, ``"rotation_quaternion"``, ``"rotation_axis_angle"``).
+    ``unkeyed``: the owner's own values of all channels, location (3), rotation (3 Euler
+    angles, or 4: quaternion w, x, y, z / axis-angle angle, x, y, z) and scale (3), used where
+    no curve drives a channel. ``located=False``: location is ignored (0), as Blender does
+    for a bone connected to its parent. Raises ValueError for bad curves (as
+    ``evaluate_fcurves``), an unknown property or mode, an index out of range, two curves on
+    one channel, or ``unkeyed`` of the wrong length or not finite.
+    """
+
+    def __init__(
+        self,
+        *,
+        channels: Sequence[tuple[str, int]],
+        unkeyed: ArrayLike,
+        mode: RotationModeName,
+        located: bool = True,
+        offsets: ArrayLike,
+        co: ArrayLike,
+        handle_left: ArrayLike,
+        handle_right: ArrayLike,
+        interpolation: ArrayLike,
+        easing: ArrayLike,
+        extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+        back: ArrayLike | None = None,
+        amplitude: ArrayLike | None = None,
+        period: ArrayLike | None = None,
+        cycles: Sequence[Mapping[str, Any] | None] | None = None,
+    ) -> None: ...
+    def channels(self, frames: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Location (T, 3), rotation (T, 3 or 4) and scale (T, 3) at ``frames`` (T,), any
+        order, subframes allowed: keyed channels exactly Blender's float32 values, the
+        others ``unkeyed``. GIL released."""
+    def __len__(self) -> int:
+        """The number of curves."""
+
+def analyse_spans(
+    playback: Playback, frames: ArrayLike
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:
+    """What each key span of ``frames`` (K,) (strictly increasing, K >= 2) does along the
+    playback: ``(held, pops, turn, inserted)``.
+
+    Each span is sampled at ``SPAN_SAMPLES`` frames from its start (included) to its end
+    (excluded), more where the rotation channels change a lot between its keys (one per 10
+    degrees, at most ``MAX_SPAN_SAMPLES``). ``held`` (K - 1,): no channel of any sample moves
+    from the span's start by more than ``HOLD_TOLERANCE`` (relative to the value + 1);
+    ``pops`` (K - 1,): held, and a channel differs between its keys; ``turn`` (K - 1,):
+    radians the rotation turns through, the sum of the angles between consecutive samples
+    and the span's end. ``inserted`` (M,), ascending: for Euler and axis-angle rotation, the
+    frames where poses of the playback must be added: a span turning more than
+    ``WIND_LIMIT`` (not held), and the runs of its neighbours turning more than
+    ``WIND_STEP``, get ``ceil(turn / WIND_STEP) - 1`` frames where the accumulated turn
+    reaches equal fractions of the span's (linear between samples). GIL released. Raises
+    ValueError for fewer than two frames or frames that do not increase.
+    """
+
+def keys_parameters(
+    key_frames: ArrayLike,
+    frames: ArrayLike,
+    *,
+    size: float,
+    closed: bool = False,
+    period: float | None = None,
+    playback: Playback | None = None,
+    poses: ArrayLike | None = None,
+    scheme: SchemeName = "four_point",
+    levels: int = 4,
+    smooth: ArrayLike | None = None,
+) -> FloatArray:
+    """Timing "Keys": the motion parameter (key i at i) of each of ``frames`` (T,).
+
+    Within span s (keys s, s + 1; for a ``closed`` cycle of ``period`` frames the last span
+    returns to the first key), a frame at the fraction ``tau`` of the span's time gets the
+    parameter at which the smoothed motion has travelled the same fraction of the span as
+    the ``playback`` has at that frame (the fraction of time without ``playback``, or where
+    it does not move). Travel is ``sqrt(|dt|^2 + size^2 / 3 |dR|_F^2)`` (the root mean square
+    displacement of six points at +-``size``), summed over ``PACE_SAMPLES`` steps per span
+    and the output frames inside it; the smoothed motion's travel is measured at
+    ``pace_parameters(spans)`` and inverted linearly. Frames at keys and outside the spans
+    keep ``s + tau``.
+
+    The smoothed motion: the screw motion of the key ``poses`` (K, 4, 4) by ``scheme`` and
+    ``levels`` (keys at parameters 0..K-1, linear timing), or ``smooth``, its poses at
+    ``pace_parameters(spans)`` computed by the caller (feature points). GIL released.
+    Raises ValueError naming the argument: key frames that do not increase, a period not
+    beyond the keys, a size that is not positive, frames not finite, neither or both of
+    ``poses`` and ``smooth``, or ``smooth`` of the wrong length.
+    """
+
+def pace_parameters(spans: int) -> FloatArray:
+    """``s + j / PACE_SAMPLES`` for j in 0..PACE_SAMPLES of each span s in 0..spans, span
+    after span: where ``keys_parameters`` measures the smoothed motion."""
+
+def rotation_matrices(values: ArrayLike, mode: RotationModeName) -> FloatArray:
+    """(N, 3, 3) rotation matrices of (N, k) rotation channel values in Blender's ``mode``:
+    quaternions (w, x, y, z) normalised (zero: identity); axis-angle (angle, x, y, z) about
+    the normalised axis (zero axis: identity); Euler (x, y, z) radians, ``"XYZ"`` meaning X
+    applied first (``R = Rz Ry Rx``). GIL released. Raises ValueError for a wrong shape or a
+    row that is not finite."""

@@ -15,7 +15,7 @@ use polyscrew::intent::{
     screw_pace_poses, Channel, KeysTiming, Playback, HOLD_TOLERANCE, MAX_SPAN_SAMPLES,
     PACE_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
 };
-use polyscrew::{RotationMode, Scheme, MAX_LEVELS};
+use polyscrew::{Error, RotationMode, Scheme, MAX_LEVELS};
 
 use crate::fcurve::{CurveArgs, IntArray};
 use crate::{read_poses, read_vector, shape_err, to_py_err, FloatArray};
@@ -91,8 +91,13 @@ impl PyPlayback {
                 let index = usize::try_from(*index).map_err(|_| {
                     PyValueError::new_err(format!("{F}: channels[{c}]: index {index} is negative"))
                 })?;
-                Channel::from_property(property, index, mode)
-                    .map_err(|e| PyValueError::new_err(format!("{F}: channels[{c}]: {e}")))
+                Channel::from_property(property, index, mode).map_err(|e| {
+                    let reason = match e {
+                        Error::Invalid { reason, .. } => reason,
+                        e => e.to_string(),
+                    };
+                    PyValueError::new_err(format!("{F}: channels[{c}]: {reason}"))
+                })
             })
             .collect::<PyResult<Vec<_>>>()?;
         let unkeyed = read_vector(F, "unkeyed", unkeyed.as_array())?;
