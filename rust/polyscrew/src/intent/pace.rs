@@ -282,7 +282,7 @@ fn playback_fractions(
     };
     for (i, &(s, f)) in sampled.iter().enumerate() {
         let frame = ends[s] + f * (ends[s + 1] - ends[s]);
-        playback.channels_into(&[frame], &mut row)?;
+        playback.pose_channels_into(&[frame], &mut row)?;
         let location = DVec3::new(row[0], row[1], row[2]);
         let rotation = playback.rotation(&row);
         match previous {

@@ -288,6 +288,18 @@ impl Playback {
     /// [`Playback::channels`] into `out` (cleared first): the loops that evaluate span after
     /// span reuse one buffer. The caller has checked the size.
     pub(crate) fn channels_into(&self, times: &[f64], out: &mut Vec<f64>) -> Result<()> {
+        self.rows_into(times, out, self.width())
+    }
+
+    /// [`Playback::channels_into`] for the pose alone: the scale channels keep the owner's
+    /// own values (timing "Keys" measures travel, which scale does not enter).
+    pub(crate) fn pose_channels_into(&self, times: &[f64], out: &mut Vec<f64>) -> Result<()> {
+        self.rows_into(times, out, 3 + self.mode.width())
+    }
+
+    /// The channel rows at `times` into `out`, evaluating only the curves of the first
+    /// `upto` columns.
+    fn rows_into(&self, times: &[f64], out: &mut Vec<f64>, upto: usize) -> Result<()> {
         let width = self.width();
         out.clear();
         out.reserve(times.len() * width);
@@ -302,6 +314,9 @@ impl Playback {
             out.extend_from_slice(&self.statics);
             let row = &mut out[index * width..];
             for (c, (curve, &column)) in self.curves.iter().zip(&self.columns).enumerate() {
+                if column >= upto {
+                    continue;
+                }
                 let v = curve.evaluate_f32(t32);
                 if !v.is_finite() {
                     return Err(Error::Invalid {
