@@ -1,13 +1,17 @@
 """Benchmark: ScrewBender's bake against Blender's own `bpy.ops.nla.bake` and against a
 `keyframe_insert` loop, same objects and frames.
 
-Two cases, both in the same Blender session:
+Three cases, all in the same Blender session:
   1. one object baked over 100,000 frames;
-  2. 100 objects baked over 1,000 frames.
-Each object has location, rotation (XYZ Euler) and scale keys (ten keys at uneven frames),
-so every baker writes the same ten dense F-curves per object, one key per frame.
-ScrewBender's time covers everything the Smooth Motion operator does (reading keys,
-polyscrew sampling, writing the new action); nla.bake's time is the operator call.
+  2. 100 objects baked over 1,000 frames;
+  3. a 100-bone rig (ten chains of ten bones) baked over 1,000 frames, against
+     `nla.bake(bake_types={'POSE'})` of the same bones (Pose Mode, all bones selected).
+Each object and bone has location, rotation (XYZ Euler) and scale keys (ten keys at uneven
+frames), so every baker writes the same nine dense F-curves per object or bone, one key per
+frame. ScrewBender's time covers everything the Smooth Motion operator does (reading keys,
+polyscrew sampling, writing the new action); nla.bake's time is the operator call. The bone
+case runs ours and nla.bake back to back on a fresh rig in each run (after one untimed
+warm-up smoothing), and reports the medians of the runs and their ratio.
 
 The `keyframe_insert` loop is what a script author writes today: for each frame, set the
 scene frame (`scene.frame_set`), set each object's location, rotation and scale from the
@@ -28,7 +32,9 @@ built .zip into a temporary Blender user directory):
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
+import statistics
 import math
 import sys
 import time
@@ -100,6 +106,75 @@ def run_case(count: int, frames: int) -> tuple[float, float]:
     return ours, theirs
 
 
+def keyed_rig(bones: int, frames: int) -> bpy.types.Object:
+    """An armature of `bones` bones in chains of ten (each bone the child of the previous one,
+    not connected: its location counts), every bone keyed like the objects above."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    data = bpy.data.armatures.new("Rig")
+    rig = bpy.data.objects.new("Rig", data)
+    scene.collection.objects.link(rig)
+    select([rig])
+    bpy.ops.object.mode_set(mode="EDIT")
+    previous = None
+    for n in range(bones):
+        chain, link = divmod(n, 10)
+        bone = data.edit_bones.new(f"Bone{n:03d}")
+        bone.head, bone.tail = (chain, 0.0, link), (chain, 0.0, link + 1.0)
+        bone.parent = previous if link else None
+        previous = bone
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for n, pose_bone in enumerate(rig.pose.bones):
+        pose_bone.rotation_mode = "XYZ"
+        for k in range(10):
+            u = (k / 9) ** 1.2  # uneven key spacing
+            frame = 1 + round(u * (frames - 1))
+            pose_bone.location = (0.3 * math.cos(4 * u + n), 0.3 * math.sin(3 * u), 0.2 * u)
+            pose_bone.rotation_euler = (0.5 * math.sin(5 * u), 0.3 * u, 6 * u + n)
+            pose_bone.scale = (1 + 0.3 * math.sin(7 * u), 1.0, 1 + 0.2 * u)
+            for path in ("location", "rotation_euler", "scale"):
+                pose_bone.keyframe_insert(path, frame=frame)
+    scene.frame_start, scene.frame_end = 1, frames
+    return rig
+
+
+def run_bone_case(bones: int, frames: int) -> tuple[float, float]:
+    """One run: ScrewBender's Smooth Motion of every bone (Object Mode, the armature selected,
+    Armatures: Bones Only), then nla.bake POSE of the same bones over the same frames."""
+    rig = keyed_rig(bones, frames)
+    select([rig])
+    owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
+    start = time.perf_counter()
+    selection = owners.selection(bpy.context, "BONES", bake.channels.object_fcurves)
+    result = bake.smooth(selection, bake.Options(scheme="jarek", levels=4))
+    ours = time.perf_counter() - start
+    assert result.bones == bones and not result.skipped, result.skipped
+    keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
+
+    # Blender's baker on the source action, the same bones and frames
+    adt = rig.animation_data
+    bake.channels.assign(rig, adt.action[bake.SOURCE_KEY], adt.action.get(bake.SOURCE_SLOT_KEY, ""))
+    bpy.ops.object.mode_set(mode="POSE")
+    for pose_bone in rig.pose.bones:
+        (pose_bone if hasattr(pose_bone, "select") else pose_bone.bone).select = True
+    start = time.perf_counter()
+    done = bpy.ops.nla.bake(
+        frame_start=1, frame_end=frames, step=1, only_selected=True, visual_keying=False,
+        clear_constraints=False, clear_parents=False, use_current_action=False, bake_types={"POSE"},
+        channel_types={"LOCATION", "ROTATION", "SCALE"},
+    )
+    theirs = time.perf_counter() - start
+    assert done == {"FINISHED"}, done
+    bpy.ops.object.mode_set(mode="OBJECT")
+    their_keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
+    assert keys == their_keys == 9 * bones * frames, (keys, their_keys)
+    print(
+        f"{bones:4d} bones     x {frames:6d} frames: ScrewBender {ours:7.3f} s, nla.bake {theirs:7.3f} s, "
+        f"ratio {theirs / ours:6.1f}x  (keys: {keys} vs {their_keys})"
+    )
+    return ours, theirs
+
+
 def keyframe_insert_loop(count: int, frames: int) -> float:
     """Seconds of the `keyframe_insert` loop over `count` fresh objects and `frames` frames."""
     objects = keyed_objects(count, frames)
@@ -136,8 +211,15 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a tenth of the frames (a smoke run)")
     parser.add_argument("--repeat", type=int, default=3, help="runs per case; the best time of each baker counts")
+    parser.add_argument("--bone-runs", type=int, default=5, help="runs of the bone case (medians count)")
+    parser.add_argument("--only-bones", action="store_true", help="run the bone case only")
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
+    if args.only_bones:
+        result = {"blender": bpy.app.version_string, "quick": args.quick, "bones": bone_case(args)}
+        if args.out:
+            args.out.write_text(json.dumps(result, indent=1))
+        return
     scale = 10 if args.quick else 1
     print(f"Blender {bpy.app.version_string}, bake over every frame, jarek 4 levels")
     result = {"blender": bpy.app.version_string, "quick": args.quick, "repeat": args.repeat,
@@ -172,8 +254,25 @@ def main() -> None:
                   f"{value:.0f} s (extrapolated from {len(one)} sizes, time ~ frames^{p:.2f})")
         print(f"  keyframe_insert loop / ScrewBender: {case['loop'] / case['ours']:.0f}x"
               + (" (extrapolated)" if case["loop_extrapolated"] else ""))
+    result["bones"] = bone_case(args)
     if args.out:
         args.out.write_text(json.dumps(result, indent=1))
+
+
+def bone_case(args) -> dict:
+    """The 100-bone rig x 1,000 frames (--quick: 100 frames): medians of --bone-runs runs."""
+    bones, frames = 100, 1_000 // (10 if args.quick else 1)
+    rig = keyed_rig(3, 20)  # warm-up: the first Smooth Motion of a session imports and allocates
+    select([rig])
+    owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
+    assert bake.smooth(owners.selection(bpy.context, "BONES", bake.channels.object_fcurves), bake.Options()).bones == 3
+    runs = [run_bone_case(bones, frames) for _ in range(args.bone_runs)]
+    ours = statistics.median(r[0] for r in runs)
+    theirs = statistics.median(r[1] for r in runs)
+    print(f"  median of {len(runs)}: ScrewBender {ours:.3f} s, nla.bake {theirs:.3f} s, ratio {theirs / ours:.1f}x "
+          f"(per run {', '.join(f'{t / o:.1f}x' for o, t in runs)})")
+    return {"bones": bones, "frames": frames, "ours_runs": [r[0] for r in runs], "nla_runs": [r[1] for r in runs],
+            "ours": ours, "nla": theirs}
 
 
 if __name__ == "__main__":

@@ -202,6 +202,7 @@ def read(
     closed: str = "AUTO",
     action: bpy.types.Action | None = None,
     slot: str = "",
+    fcurves: list | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -210,7 +211,9 @@ def read(
     period: it is dropped from the poses and `period` is its distance from the first key.
     `action` (with the slot identifier `slot`, 4.4+) reads the keys of another action than the
     active one, with the object's own values for unkeyed channels (re-smoothing reads the
-    original keys under a smoothed result).
+    original keys under a smoothed result). `fcurves`, when given, are the F-curves to read
+    from instead (the caller's grouping by owner, :func:`owners.curves_by_owner`: many bones
+    of one action are then read without scanning all its curves for each bone).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth.
     """
@@ -220,7 +223,10 @@ def read(
     name = owner.name
     mode = owner.rotation_mode
     paths = transform_paths(mode)
-    source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
+    if fcurves is not None:
+        source = fcurves
+    else:
+        source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
     # A bone connected to its parent ignores its location (Blender's BKE_pchan_to_mat4): its
     # pose has no translation, and its location curves are not the bake's business.
     located = not owner.bone or not obj.data.bones[owner.bone].use_connect

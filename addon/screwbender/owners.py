@@ -117,6 +117,22 @@ def keyed_bones(obj: bpy.types.Object, fcurves) -> list[str]:
     return [b.name for b in obj.pose.bones if b.name in keyed]
 
 
+def curves_by_owner(fcurves) -> dict[str, list]:
+    """The transform F-curves among `fcurves` grouped by owner: bone name -> that bone's
+    location, rotation and scale curves, "" -> the object's own. One pass over the curves,
+    so that reading many bones of one action does not scan every curve once per bone."""
+    out: dict[str, list] = {}
+    for fc in fcurves:
+        path = fc.data_path
+        if path in _TRANSFORM_PROPS:
+            out.setdefault("", []).append(fc)
+            continue
+        found = _bone_of(path)
+        if found is not None:
+            out.setdefault(found[0], []).append(fc)
+    return out
+
+
 def is_hidden(obj: bpy.types.Object, bone: str) -> bool:
     """Whether a bone is hidden, or in bone collections that are all hidden."""
     data = obj.data.bones.get(bone)
@@ -157,14 +173,24 @@ def selection(context: bpy.types.Context, armature: str = "BOTH", fcurves_of=Non
         return sorted((Owner(b.id_data, b.name) for b in bones), key=lambda o: (o.obj.name, o.bone))
     out = []
     for obj in sorted(context.selected_objects, key=lambda o: o.name):
-        if obj.type != "ARMATURE" or armature == "OBJECT":
-            out.append(Owner(obj))
-            continue
-        curves = fcurves_of(obj) if fcurves_of is not None else []
-        if armature == "BOTH" and has_own_keys(obj, curves):
-            out.append(Owner(obj))
-        bones = [b for b in keyed_bones(obj, curves) if not is_hidden(obj, b) or is_selected(obj, b)]
-        out += [Owner(obj, b) for b in bones]
-        if not bones and not (armature == "BOTH" and has_own_keys(obj, curves)):
-            out.append(Owner(obj))  # nothing keyed: read it to say so
+        curves = fcurves_of(obj) if fcurves_of is not None and obj.type == "ARMATURE" else []
+        out += of_object(obj, armature, curves)
+    return out
+
+
+def of_object(obj: bpy.types.Object, armature: str = "BOTH", fcurves=()) -> list[Owner]:
+    """The owners of one object that Smooth Motion takes in Object Mode: the object itself;
+    for an armature, per `armature` (:data:`ARMATURE_MODES`), its own keys and/or its keyed
+    bones among `fcurves` (its F-curves), hidden bones and bones in hidden collections only
+    when selected; the armature itself when nothing is keyed (reading it says so)."""
+    if obj.type != "ARMATURE" or armature == "OBJECT":
+        return [Owner(obj)]
+    out = []
+    own = armature == "BOTH" and has_own_keys(obj, fcurves)
+    if own:
+        out.append(Owner(obj))
+    bones = [b for b in keyed_bones(obj, fcurves) if not is_hidden(obj, b) or is_selected(obj, b)]
+    out += [Owner(obj, b) for b in bones]
+    if not bones and not own:
+        out.append(Owner(obj))  # nothing keyed: read it to say so
     return out
