@@ -394,24 +394,29 @@ def test_insert_key_on_a_bone_with_the_raw_polyscrew_keeps_the_motion(pd, mode, 
         for c in bag["curves"]:
             if 'pose.bones["Upper"]' in c["path"][0] or not c["path"][0].startswith("pose") or "Fore\"].location" in c["path"][0]:
                 assert new[c["path"]] == c, c["path"]
-    # every new key went into the bone's own F-curve group
-    for fc in h.fcurves(rig):
-        if fc.data_path.startswith('pose.bones["Hand"]'):
-            assert fc.group is not None and fc.group.name == "Hand"
 
 
 def test_insert_key_in_object_mode_keys_the_armatures_bones(pd, capfd):
     scene = bpy.context.scene
     set_smooth(scene, "four_point", 4, armature="BONES")
     rig = keyed_rig()
+    channels = addon_module("channels")
+    bag = channels.container(rig.animation_data.action, channels.assigned_slot(rig))
+    for fc in [fc for fc in h.fcurves(rig) if fc.data_path == 'pose.bones["Upper"].location']:
+        channels.remove_fcurve(bag, fc)  # Upper keyed on its rotation only
     h.select_only(rig)
     scene.frame_set(25)
     counts = {b: len(next(fc for fc in h.fcurves(rig) if fc.data_path == f'pose.bones["{b}"].rotation_euler').keyframe_points) for b in CHAIN}
     reported = run_insert_key(capfd)
     assert sorted(name for name, *_ in reported) == [f"Rig: {b}" for b in sorted(CHAIN)]
     for bone in CHAIN:
-        frames, matrices = bone_key_matrices(rig, bone)
+        frames, _ = h.channel(rig, f'pose.bones["{bone}"].rotation_euler', 3)
         assert len(frames) == counts[bone] + 1 and 25.0 in frames
+    # Upper's location, unkeyed but not ignored (Upper is not connected), is keyed now, in the
+    # F-curve group named after the bone, as Blender keys bones
+    upper = [fc for fc in h.fcurves(rig) if fc.data_path == 'pose.bones["Upper"].location']
+    assert sorted(fc.array_index for fc in upper) == [0, 1, 2]
+    assert all(len(fc.keyframe_points) == 1 and fc.group is not None and fc.group.name == "Upper" for fc in upper)
     own = [fc for fc in h.fcurves(rig) if fc.data_path == "location"]
     assert all(len(fc.keyframe_points) == len(FRAMES) for fc in own)  # Bones Only
     # 4-point moves a little near the new key; the connected Fore has no translation to move
