@@ -34,8 +34,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
-import statistics
 import math
+import os
+import statistics
 import sys
 import time
 from pathlib import Path
@@ -138,16 +139,18 @@ def keyed_rig(bones: int, frames: int) -> bpy.types.Object:
     return rig
 
 
-def run_bone_case(bones: int, frames: int) -> tuple[float, float]:
+def run_bone_case(bones: int, frames: int) -> tuple[float, float, float, float]:
     """One run: ScrewBender's Smooth Motion of every bone (Object Mode, the armature selected,
-    Armatures: Bones Only), then nla.bake POSE of the same bones over the same frames."""
+    Armatures: Bones Only), then nla.bake POSE of the same bones over the same frames.
+    Returns wall-clock seconds (ours, nla.bake) and the process's CPU seconds (ours, nla.bake:
+    every thread of the process, so Blender's threaded depsgraph evaluation counts)."""
     rig = keyed_rig(bones, frames)
     select([rig])
     owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     selection = owners.selection(bpy.context, "BONES", bake.channels.object_fcurves)
     result = bake.smooth(selection, bake.Options(scheme="jarek", levels=4))
-    ours = time.perf_counter() - start
+    ours, ours_cpu = time.perf_counter() - start, time.process_time() - cpu
     assert result.bones == bones and not result.skipped, result.skipped
     keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
 
@@ -157,22 +160,23 @@ def run_bone_case(bones: int, frames: int) -> tuple[float, float]:
     bpy.ops.object.mode_set(mode="POSE")
     for pose_bone in rig.pose.bones:
         (pose_bone if hasattr(pose_bone, "select") else pose_bone.bone).select = True
-    start = time.perf_counter()
+    start, cpu = time.perf_counter(), time.process_time()
     done = bpy.ops.nla.bake(
         frame_start=1, frame_end=frames, step=1, only_selected=True, visual_keying=False,
         clear_constraints=False, clear_parents=False, use_current_action=False, bake_types={"POSE"},
         channel_types={"LOCATION", "ROTATION", "SCALE"},
     )
-    theirs = time.perf_counter() - start
+    theirs, theirs_cpu = time.perf_counter() - start, time.process_time() - cpu
     assert done == {"FINISHED"}, done
     bpy.ops.object.mode_set(mode="OBJECT")
     their_keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
     assert keys == their_keys == 9 * bones * frames, (keys, their_keys)
     print(
         f"{bones:4d} bones     x {frames:6d} frames: ScrewBender {ours:7.3f} s, nla.bake {theirs:7.3f} s, "
-        f"ratio {theirs / ours:6.1f}x  (keys: {keys} vs {their_keys})"
+        f"ratio {theirs / ours:6.1f}x; CPU {ours_cpu:6.3f} s vs {theirs_cpu:6.3f} s, {theirs_cpu / ours_cpu:5.1f}x  "
+        f"(keys: {keys} vs {their_keys})"
     )
-    return ours, theirs
+    return ours, theirs, ours_cpu, theirs_cpu
 
 
 def keyframe_insert_loop(count: int, frames: int) -> float:
@@ -267,12 +271,17 @@ def bone_case(args) -> dict:
     owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
     assert bake.smooth(owners.selection(bpy.context, "BONES", bake.channels.object_fcurves), bake.Options()).bones == 3
     runs = [run_bone_case(bones, frames) for _ in range(args.bone_runs)]
-    ours = statistics.median(r[0] for r in runs)
-    theirs = statistics.median(r[1] for r in runs)
+    ours, theirs, ours_cpu, theirs_cpu = (statistics.median(r[i] for r in runs) for i in range(4))
     print(f"  median of {len(runs)}: ScrewBender {ours:.3f} s, nla.bake {theirs:.3f} s, ratio {theirs / ours:.1f}x "
-          f"(per run {', '.join(f'{t / o:.1f}x' for o, t in runs)})")
-    return {"bones": bones, "frames": frames, "ours_runs": [r[0] for r in runs], "nla_runs": [r[1] for r in runs],
-            "ours": ours, "nla": theirs}
+          f"(per run {', '.join(f'{r[1] / r[0]:.1f}x' for r in runs)}); CPU time {ours_cpu:.3f} s vs "
+          f"{theirs_cpu:.3f} s, ratio {theirs_cpu / ours_cpu:.1f}x")
+    if hasattr(os, "getloadavg"):
+        print(f"  machine: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.1f}")
+    return {"bones": bones, "frames": frames, "runs": len(runs),
+            "ours_runs": [r[0] for r in runs], "nla_runs": [r[1] for r in runs],
+            "ours_cpu_runs": [r[2] for r in runs], "nla_cpu_runs": [r[3] for r in runs],
+            "ours": ours, "nla": theirs, "ours_cpu": ours_cpu, "nla_cpu": theirs_cpu,
+            "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None}
 
 
 if __name__ == "__main__":

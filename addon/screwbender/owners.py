@@ -12,6 +12,7 @@ for a bone (`PoseBone.matrix_basis`).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import bpy
@@ -37,9 +38,10 @@ class Owner:
         """What holds the transform properties: the object or the pose bone."""
         return self.obj.pose.bones[self.bone] if self.bone else self.obj
 
-    @property
+    @functools.cached_property
     def prefix(self) -> str:
-        """The data-path prefix of the owner's F-curves in the object's action."""
+        """The data-path prefix of the owner's F-curves in the object's action (computed once:
+        reading and baking a bone asks for it for every curve)."""
         return f'pose.bones["{_quoted(self.bone)}"].' if self.bone else ""
 
     @property
