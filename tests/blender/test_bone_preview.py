@@ -263,7 +263,7 @@ def test_rotating_a_bone_at_a_key_frame_previews_the_moved_key(pd):
     expected = polyscrew.sample(key_matrices, frames, live.instance_times, scheme="four_point", levels=3)
     np.testing.assert_allclose(live.instances, expected, atol=1e-9)
     assert np.abs(live.instances - original).max() > 0.1
-    with pytest.raises(RuntimeError, match="Rig: Fore: .*|moved at a key frame but not keyed"):
+    with pytest.raises(RuntimeError, match="Rig: Fore: moved at a key frame but not keyed"):
         bpy.ops.screwbender.preview_apply()
 
 

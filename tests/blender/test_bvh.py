@@ -16,13 +16,11 @@ to one unit in the last place.
 
 from __future__ import annotations
 
-import math
 import re
 
 import bpy
 import numpy as np
 import polyscrew
-import pytest
 from conftest import addon_module
 
 import bake_helpers as h
