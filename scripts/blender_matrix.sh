@@ -10,6 +10,23 @@ BLENDER_MATRIX=(
   "5.2.3 3.13 numpy>=2.5,<2.6"
 )
 
+# BLENDER_VERSIONS (e.g. "4.2 5.0", or full versions): only these rows, for a machine that
+# cannot run the others (the release workflow's Intel Mac has no bpy 5.x). Unset: all.
+if [ -n "${BLENDER_VERSIONS:-}" ]; then
+  _selected=()
+  for _row in "${BLENDER_MATRIX[@]}"; do
+    read -r _version _ _ <<<"$_row"
+    for _want in $BLENDER_VERSIONS; do
+      if [ "$_version" = "$_want" ] || [ "${_version%.*}" = "$_want" ]; then _selected+=("$_row"); fi
+    done
+  done
+  if [ ${#_selected[@]} -eq 0 ]; then
+    echo "BLENDER_VERSIONS=$BLENDER_VERSIONS names no version of scripts/blender_matrix.sh" >&2
+    exit 1
+  fi
+  BLENDER_MATRIX=("${_selected[@]}")
+fi
+
 # The venv whose interpreter runs the tests of CPython $1: .venv for 3.11 (the project's own,
 # with the build and test requirements), .venv/py<XY> for any other (pytest, numpy, scipy).
 matrix_venv() {

@@ -29,8 +29,13 @@ def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: s
         report_skipped(operator, result.skipped, "ERROR")
         return {"CANCELLED"}
     report_skipped(operator, result.skipped, "WARNING")
-    for note in result.notes:
-        operator.report({"INFO"}, note)
+    if len(result.notes) <= 3:
+        for note in result.notes:
+            operator.report({"INFO"}, note)
+    else:  # many owners: one line, the list in the console
+        for note in result.notes:
+            print(f"ScrewBender: {note}")
+        operator.report({"INFO"}, f"{'; '.join(result.notes[:2])}; and {len(result.notes) - 2} more notes (in the console)")
     names = result.owners
     if result.bones == len(names):
         what = "bone(s)"
@@ -107,7 +112,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     scheme: EnumProperty(
         name="Scheme",
         items=bake.SCHEMES,
-        default="jarek",
+        default="four_point",
         description="Subdivision scheme that refines the key poses into the smooth motion",
     )
     levels: IntProperty(
@@ -122,7 +127,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     timing: EnumProperty(
         name="Timing",
         items=bake.TIMINGS,
-        default="smooth",
+        default="keys",
         description="How time runs between keys at uneven frames",
     )
     closed: EnumProperty(

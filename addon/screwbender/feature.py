@@ -113,6 +113,36 @@ def key_stiffness(motion: keys.KeyedMotion, selected: np.ndarray, approximate: b
     return lam
 
 
+def sample_poses_at(
+    owner: owners.Owner | bpy.types.Object,
+    motion: keys.KeyedMotion,
+    key_times: np.ndarray,
+    times: np.ndarray,
+    options,
+    period: float | None = None,
+    timing: str = "linear",
+) -> np.ndarray:
+    """The feature-point motion of `owner`'s keys (`motion`) at `times`, the keys placed at
+    `key_times` (their frames, or their parameters 0..K-1 with linear timing): (len(times), 4, 4).
+
+    `options` is a :class:`bake.Options`. Raises ValueError from `polyscrew`.
+    """
+    # Mean scale over the keys (a static negative scale, a mirrored object, keeps its sign).
+    mean_scale = np.sign(motion.scales[0]) * np.exp(np.log(np.abs(motion.scales)).mean(axis=0))
+    return polyscrew.sample_feature(
+        motion.poses,
+        key_times,
+        times,
+        levels=options.levels,
+        closed=motion.closed,
+        feature_points=feature_points(owner, mean_scale),
+        parametrization=options.parametrization,
+        stiffness=key_stiffness(motion, selected_keys(owner, motion.frames), options.approximate, options.stiffness),
+        period=period,
+        timing=timing,
+    )
+
+
 def sample_poses(
     owner: owners.Owner | bpy.types.Object, motion: keys.KeyedMotion, frames: np.ndarray, options
 ) -> np.ndarray:

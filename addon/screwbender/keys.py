@@ -13,12 +13,12 @@ meant for the animator.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
 
-from . import channels, owners
+from . import channels, curves, intent, owners
 
 #: Rotation modes and the property holding the rotation in each.
 ROTATION_PATHS = {
@@ -75,6 +75,23 @@ class KeyedMotion:
     #: Whether the owner's location moves it (not for a bone connected to its parent, whose
     #: location Blender ignores: its poses have no translation and no location is baked).
     located: bool = True
+    #: The owner's curves as Blender plays them (None when they hold something the add-on
+    #: cannot evaluate: the motion is then made of the key values alone).
+    source: intent.Source | None = None
+    #: Per key span: held (the pose stays still over it), and popping at its end.
+    held: np.ndarray | None = None
+    pops: np.ndarray | None = None
+    #: Per key: an animator's key (False: a pose taken from Blender's playback inside a spin).
+    is_key: np.ndarray | None = None
+    #: The frames baked by default, when they are not the keys' range (an extended cycle).
+    bake_range: tuple[float, float] | None = None
+    #: Cycles modifier modes (before, after) per (property, index), for the baked curves of a
+    #: cycle baked over one period.
+    cycle_modes: dict | None = None
+    #: The body's size (travel of rotations, timing "keys"): half its largest dimension.
+    size: float = 1.0
+    #: What was found and kept, for the report ("2 holds", "a spin", ...).
+    kept: list[str] = field(default_factory=list)
 
     @property
     def scale_keyed(self) -> bool:
@@ -83,7 +100,10 @@ class KeyedMotion:
 
     @property
     def frame_range(self) -> tuple[float, float]:
-        """First and last key frame, including the key closing a cycle."""
+        """First and last key frame, including the key closing a cycle (an extended cycle: the
+        keys' own period)."""
+        if self.bake_range is not None:
+            return self.bake_range
         end = self.frames[0] + self.period if self.period is not None else self.frames[-1]
         return float(self.frames[0]), float(end)
 
@@ -202,6 +222,7 @@ def read(
     closed: str = "AUTO",
     action: bpy.types.Action | None = None,
     slot: str = "",
+    extend_to: tuple[float, float] | None = None,
     fcurves: list | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
@@ -211,9 +232,12 @@ def read(
     period: it is dropped from the poses and `period` is its distance from the first key.
     `action` (with the slot identifier `slot`, 4.4+) reads the keys of another action than the
     active one, with the object's own values for unkeyed channels (re-smoothing reads the
-    original keys under a smoothed result). `fcurves`, when given, are the F-curves to read
-    from instead (the caller's grouping by owner, :func:`owners.curves_by_owner`: many bones
-    of one action are then read without scanning all its curves for each bone).
+    original keys under a smoothed result). `extend_to` is the frame range to be covered
+    when a Cycles modifier plays the keys on (Repeat with Offset, Mirror): the keys are
+    extended by Blender's playback over it, plus :data:`intent.EXTRA_CYCLES` on each side.
+    `fcurves`, when given, are the F-curves to read from instead (the caller's grouping by
+    owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
+    scanning all its curves for each bone).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth.
     """
@@ -224,45 +248,62 @@ def read(
     mode = owner.rotation_mode
     paths = transform_paths(mode)
     if fcurves is not None:
-        source = fcurves
+        listed = fcurves
     else:
-        source = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
+        listed = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
     # A bone connected to its parent ignores its location (Blender's BKE_pchan_to_mat4): its
     # pose has no translation, and its location curves are not the bake's business.
     located = not owner.bone or not obj.data.bones[owner.bone].use_connect
-    curves = {}
-    for fc in source:
+    found = {}
+    for fc in listed:
         prop = owner.prop_of(fc.data_path)
         if prop in paths and not fc.mute and len(fc.keyframe_points) > 0 and (located or prop != "location"):
-            curves[prop, fc.array_index] = fc
-    if not curves:
+            found[prop, fc.array_index] = fc
+    if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    points = {key: _key_points(fc) for key, fc in curves.items()}
+    points = {key: _key_points(fc) for key, fc in found.items()}
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
 
+    statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
+    columns = list(found)
+    notes = []
+    try:
+        packed = curves.read([found[c] for c in columns])
+        source = intent.Source(
+            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located,
+            cycles_after=[(c or {}).get("mode_after", "") for c in packed.cycles],
+            cycles_before=[(c or {}).get("mode_before", "") for c in packed.cycles],
+        )
+    except curves.UnsupportedCurve as err:
+        source = None
+        notes.append(f"{err}: smoothed from the key values alone (spins, holds and easing not read)")
+
     def evaluate(path: str, size: int) -> np.ndarray:
-        static = np.array(getattr(target, path), dtype=np.float64)
+        """The channels at the key frames (source-less: a loop over keys, not frames)."""
         out = np.empty((len(frames), size))
         for i in range(size):
-            fc = curves.get((path, i))
+            fc = found.get((path, i))
             if fc is None:
-                out[:, i] = static[i]
+                out[:, i] = statics[path][i]
             elif len(fc.modifiers) == 0 and np.array_equal(points[path, i][:, 0], frames):
                 out[:, i] = points[path, i][:, 1]  # keyed on every key frame: its key values
             else:
-                # A loop over keys (not frames): the curve evaluated at the other curves' keys.
                 out[:, i] = [fc.evaluate(f) for f in frames]
         return out
 
-    location = evaluate("location", 3) if located else np.zeros((len(frames), 3))
-    rotation = evaluate(paths[1], 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)
-    scale = evaluate("scale", 3)
+    if source is not None:
+        at_keys = source.channels(frames)
+        location, rotation, scale = at_keys["location"], at_keys[paths[1]], at_keys["scale"]
+    else:
+        location = evaluate("location", 3) if located else np.zeros((len(frames), 3))
+        rotation = evaluate(paths[1], 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)
+        scale = evaluate("scale", 3)
     for label, values in (("location", location), (paths[1], rotation), ("scale", scale)):
         if not np.all(np.isfinite(values)):
             raise SmoothError(f"{name}: {label} has a non-finite key value: skipped")
-    scale_axes = np.array([("scale", i) in curves for i in range(3)])
+    scale_axes = np.array([("scale", i) in found for i in range(3)])
     bad = np.argwhere((scale <= 0.0) & scale_axes)
     if len(bad):
         k, axis = bad[0]
@@ -273,10 +314,69 @@ def read(
         )
 
     poses = compose(location, rotation_matrices(rotation, mode))
-    cyclic = any(
-        m.type == "CYCLES" and not m.mute for fc in curves.values() for m in fc.modifiers
+    modes = {}  # (property, index) -> Cycles modifier (mode_before, mode_after)
+    for key, fc in found.items():
+        for modifier in fc.modifiers:
+            if modifier.type == "CYCLES" and not modifier.mute:
+                modes[key] = (modifier.mode_before, modifier.mode_after)
+                break
+    cyclic = bool(modes)
+    extended = (
+        source is not None
+        and closed == "AUTO"
+        and any(mode_ in intent.EXTENDED_CYCLES for pair in modes.values() for mode_ in pair)
     )
-    is_closed = cyclic if closed == "AUTO" else closed == "ON"
+    is_closed = (cyclic and not extended) if closed == "AUTO" else closed == "ON"
+    kept = list(notes)
+    bake_range = None
+    if extended:
+        # Blender plays the keys on, shifted (offset) or mirrored, beyond their range: take
+        # that playback over neighbouring cycles as keys of an open motion.
+        first, last = float(frames[0]), float(frames[-1])
+        cycle = last - first
+        before, after = intent.EXTRA_CYCLES, intent.EXTRA_CYCLES
+        if extend_to is not None:
+            before += max(0, int(np.ceil((first - extend_to[0]) / cycle)))
+            after += max(0, int(np.ceil((extend_to[1] - last) / cycle)))
+        if before + after > intent.MAX_CYCLES:
+            raise SmoothError(
+                f"{name}: the frame range spans {before + after} cycles of its Cycles modifier; "
+                f"at most {intent.MAX_CYCLES} are baked: shorten the Frame Range: skipped"
+            )
+        frames = np.concatenate(
+            [frames[:-1] + c * cycle for c in range(-before, after + 1)] + [frames[-1:] + after * cycle]
+        )
+        played = source.channels(frames)
+        location, rotation, scale = played["location"], played[paths[1]], played["scale"]
+        poses = compose(location, rotation_matrices(rotation, mode))
+        bake_range = (first, last)
+        kept.append(f"the Cycles modifier's {_cycle_words(modes)} (the motion goes on beyond the keys)")
+
+    held = pops = None
+    is_key = np.ones(len(frames), dtype=bool)
+    if source is not None:
+        held, pops, turn, inserted = intent.analyse_spans(source, frames, rotation_matrices, compose)
+        if len(inserted):
+            spins = int(np.sum((turn > intent.WIND_LIMIT) & ~held))
+            played = source.channels(inserted)
+            order = np.argsort(np.concatenate([frames, inserted]), kind="stable")
+            parent = np.clip(np.searchsorted(frames, np.concatenate([frames, inserted])[order][:-1], side="right") - 1, 0, len(frames) - 2)
+            frames = np.concatenate([frames, inserted])[order]
+            location = np.concatenate([location, played["location"]])[order]
+            rotation = np.concatenate([rotation, played[paths[1]]])[order]
+            scale = np.concatenate([scale, played["scale"]])[order]
+            is_key = np.concatenate([is_key, np.zeros(len(inserted), dtype=bool)])[order]
+            poses = compose(location, rotation_matrices(rotation, mode))
+            held, pops = held[parent], pops[parent]
+            kept.append(f"{spins} spin(s) over half a turn or more ({len(inserted)} poses from Blender's playback added)")
+        if held.any():
+            popping = int(pops.sum())
+            kept.append(f"{int(held.sum())} hold(s)" + (f", {popping} with a pop" if popping else ""))
+        if scale_axes.any():
+            bad = np.argwhere((scale <= 0.0) & scale_axes)
+            if len(bad):
+                raise SmoothError(f"{name}: keyed scale reaches {scale[tuple(bad[0])]:g} between keys: skipped")
+
     period = None
     if is_closed:
         size = 1.0 + float(np.max(np.abs(location)))
@@ -287,20 +387,65 @@ def read(
             if len(frames) < 3:
                 raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
             period = float(frames[-1] - frames[0])
-            frames, poses, scale, rotation = frames[:-1], poses[:-1], scale[:-1], rotation[:-1]
+            frames, poses, scale, rotation, is_key = frames[:-1], poses[:-1], scale[:-1], rotation[:-1], is_key[:-1]
         else:
             # no closing key: the last key returns to the first after the mean key spacing
-            period = float(frames[-1] - frames[0]) * len(frames) / (len(frames) - 1)
+            user_keys = int(is_key.sum())
+            period = float(frames[-1] - frames[0]) * user_keys / (user_keys - 1)
+            if held is not None:  # the span from the last key back to the first moves
+                held, pops = np.append(held, False), np.append(pops, False)
+        if held is not None and held.any():
+            # A cycle with holds: cut at them, as an open motion over neighbouring periods.
+            first = float(frames[0])
+            reps = intent.EXTRA_CYCLES
+            shifts = [c * period for c in range(-reps, reps + 1)]
+            count = len(frames)
+            frames = np.concatenate([frames + d for d in shifts] + [frames[:1] + (reps + 1) * period])
+            poses = np.concatenate([poses] * len(shifts) + [poses[:1]])
+            scale = np.concatenate([scale] * len(shifts) + [scale[:1]])
+            is_key = np.concatenate([is_key] * len(shifts) + [is_key[:1]])
+            held, pops = np.tile(held, len(shifts)), np.tile(pops, len(shifts))
+            rotation = rotation[np.arange(len(frames)) % count]
+            bake_range = (first, first + period)
+            modes = {key: ("REPEAT", "REPEAT") for key in found} if cyclic else {}
+            is_closed, period = False, None
+    start_index = 0
+    if bake_range is not None:
+        start_index = int(np.argmin(np.abs(frames - bake_range[0])))
     return KeyedMotion(
         frames=frames,
         poses=poses,
         scales=scale,
         scale_axes=scale_axes,
         rotation_mode=mode,
-        first_rotation=rotation[0].copy(),
+        first_rotation=rotation[start_index].copy(),
         closed=is_closed,
         period=period,
         cyclic=cyclic,
         owner=owner,
         located=located,
+        source=source,
+        held=held,
+        pops=pops,
+        is_key=is_key,
+        bake_range=bake_range,
+        cycle_modes=modes if bake_range is not None else None,
+        size=body_size(owner),
+        kept=kept,
     )
+
+
+def _cycle_words(modes: dict) -> str:
+    names = sorted({m for pair in modes.values() for m in pair if m in intent.EXTENDED_CYCLES})
+    return " and ".join(n.replace("_", " ").title().replace("Offset", "with Offset") for n in names)
+
+
+def body_size(owner: owners.Owner) -> float:
+    """Half the largest dimension of the owner's body: an object's bounding box (scaled), a
+    bone's length; 1 for a body without extent."""
+    if owner.bone:
+        length = owner.obj.data.bones[owner.bone].length
+        return 0.5 * length if length > 0.0 else 1.0
+    obj = owner.obj
+    extent = float(max(obj.dimensions)) if obj.type != "EMPTY" else float(getattr(obj, "empty_display_size", 1.0)) * 2.0
+    return 0.5 * extent if extent > 0.0 else 1.0

@@ -347,3 +347,77 @@ def sample_feature(
     Key i sits at ``key_times[i]`` (finite, strictly increasing); ``period`` and ``timing``
     as in ``sample``; between dense poses the motion is the screw joining them.
     """
+
+# --- Blender's F-curve evaluation, issue 17 --------------------------------------------------
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+InterpolationName = Literal[
+    "CONSTANT", "LINEAR", "BEZIER", "SINE", "QUAD", "CUBIC", "QUART", "QUINT", "EXPO", "CIRC",
+    "BACK", "BOUNCE", "ELASTIC",
+]
+EasingName = Literal["AUTO", "EASE_IN", "EASE_OUT", "EASE_IN_OUT"]
+ExtrapolationName = Literal["CONSTANT", "LINEAR"]
+CycleModeName = Literal["NONE", "REPEAT", "REPEAT_OFFSET", "MIRROR"]
+
+INTERPOLATIONS: tuple[InterpolationName, ...]
+"""Blender's ``Keyframe.interpolation`` identifiers; a key's code is its index here."""
+EASINGS: tuple[EasingName, ...]
+"""Blender's ``Keyframe.easing`` identifiers; a key's code is its index here."""
+EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
+"""Blender's ``FCurve.extrapolation`` identifiers."""
+CYCLE_MODES: tuple[CycleModeName, ...]
+"""Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
+MAX_FCURVE_KEYS: int
+"""The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
+MAX_FCURVE_VALUES: int
+"""The most values (curves x times) one ``evaluate_fcurves`` call returns (2**27)."""
+
+def evaluate_fcurves(
+    times: ArrayLike,
+    *,
+    offsets: ArrayLike,
+    co: ArrayLike,
+    handle_left: ArrayLike,
+    handle_right: ArrayLike,
+    interpolation: ArrayLike,
+    easing: ArrayLike,
+    extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+    back: ArrayLike | None = None,
+    amplitude: ArrayLike | None = None,
+    period: ArrayLike | None = None,
+    cycles: Sequence[Mapping[str, Any] | None] | None = None,
+) -> FloatArray:
+    """C keyframed F-curves at T ``times`` as Blender evaluates them: (C, T) float64.
+
+    Each value is exactly Blender's ``FCurve.evaluate(time)`` (4.2 and later): every step
+    is done in float32 (and float64 where Blender uses double) in Blender's order, so the
+    result is Blender's float32 value, widened. Times may be in any order and are rounded to
+    float32, as Blender's frame is.
+
+    Keys are packed one curve after the other (K keys in all); curve ``c`` owns keys
+    ``offsets[c]:offsets[c + 1]`` (``offsets`` (C + 1,), from 0 to K, non-decreasing; every
+    curve needs a key):
+
+    - ``co``, ``handle_left``, ``handle_right``: (K, 2) ``(frame, value)``; frames of a
+      curve's keys must not decrease;
+    - ``interpolation``: (K,) integer codes, indices into ``INTERPOLATIONS`` (the segment
+      from each key to the next); ``easing``: (K,) indices into ``EASINGS`` (AUTO is
+      ease-out for BACK, BOUNCE, ELASTIC and ease-in for the others, as in Blender);
+    - ``back``, ``amplitude``, ``period``: (K,), default Blender's 1.70158, 0.8, 4.1.
+
+    ``extrapolation``: one name of ``EXTRAPOLATIONS`` for every curve or one per curve
+    (default ``"CONSTANT"``). ``cycles``: None, or C entries, each None (no modifier) or a
+    dict of the Cycles modifier's RNA properties: ``mode_before``, ``mode_after`` (names
+    of ``CYCLE_MODES``, default ``"REPEAT"``), ``cycles_before``, ``cycles_after`` (0:
+    unlimited), ``use_restricted_range`` with ``frame_start``, ``frame_end``, ``blend_in``,
+    ``blend_out``, ``use_influence`` with ``influence``. Other modifiers, drivers and muted
+    curves are not evaluated (the add-on's ``curves.py`` refuses them).
+
+    The GIL is released. Raises ValueError naming the argument, curve and key: wrong shapes
+    or lengths, bad offsets, codes or names, numbers not finite in float32, keys out of
+    time order, a curve without keys, more than ``MAX_FCURVE_KEYS`` keys or
+    ``MAX_FCURVE_VALUES`` values, or a value that is not finite (where Blender's would be
+    NaN or infinite).
+    """

@@ -66,7 +66,7 @@ def test_baked_channels_reproduce_sample(sb, mode, scheme):
     obj = keyed(mode, seed=len(mode) + len(scheme))
     motion = sb.keys.read(obj)
     source = obj.animation_data.action
-    assert bpy.ops.screwbender.smooth(scheme=scheme, levels=5) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(scheme=scheme, levels=5, timing="smooth") == {"FINISHED"}
     assert obj.animation_data.action != source
     check_against_sample(sb, obj, motion, scheme, 5, "smooth", 1.0)
 
@@ -83,7 +83,7 @@ def test_evaluated_motion_follows_the_bake(sb):
     """Blender evaluating the new action gives the sampled poses (scale included)."""
     obj = keyed("ZXY", seed=5)
     motion = sb.keys.read(obj)
-    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(scheme="jarek", timing="smooth") == {"FINISHED"}
     frames = np.arange(1.0, 41.0)
     basis = h.evaluated_basis(obj, frames)
     poses = polyscrew.sample(motion.poses, motion.frames, frames)
@@ -95,7 +95,7 @@ def test_evaluated_motion_follows_the_bake(sb):
 def test_custom_and_scene_frame_ranges(sb, factory_scene):
     obj = keyed("XYZ", seed=2)
     motion = sb.keys.read(obj)
-    assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=-5, frame_end=50) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=-5, frame_end=50, scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     np.testing.assert_allclose(frames, np.arange(-5, 51))
     expected = polyscrew.sample(motion.poses, motion.frames, frames)
@@ -106,7 +106,7 @@ def test_custom_and_scene_frame_ranges(sb, factory_scene):
 
     bpy.ops.screwbender.revert()
     factory_scene.frame_start, factory_scene.frame_end = 3, 12
-    assert bpy.ops.screwbender.smooth(range_mode="SCENE") == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(range_mode="SCENE", scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, _ = h.baked_matrices(obj)
     np.testing.assert_allclose(frames, np.arange(3, 13))
 
@@ -122,7 +122,7 @@ def test_cyclic_motion_bakes_one_period_with_cycles_modifier(sb):
         fc.modifiers.new("CYCLES")
     motion = sb.keys.read(obj)
     assert motion.closed and motion.period == 30
-    assert bpy.ops.screwbender.smooth(scheme="bspline") == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(scheme="bspline", timing="smooth") == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     np.testing.assert_allclose(frames, np.arange(1, 32))
     expected = polyscrew.sample(motion.poses, motion.frames, frames, scheme="bspline", closed=True, period=30.0)
@@ -139,7 +139,7 @@ def test_several_objects_in_one_run(sb):
     motions = [sb.keys.read(obj) for obj in objects]
     sources = [obj.animation_data.action for obj in objects]
     h.select_only(*objects)
-    assert bpy.ops.screwbender.smooth(levels=3) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(levels=3, scheme="jarek", timing="smooth") == {"FINISHED"}
     for obj, motion, source in zip(objects, motions, sources):
         assert obj.animation_data.action != source
         check_against_sample(sb, obj, motion, "jarek", 3, "smooth", 1.0)
@@ -150,7 +150,7 @@ def test_forced_cycle_without_closing_key(sb):
     obj = keyed("YXZ", seed=9, parent=False)
     motion = sb.keys.read(obj, closed="ON")
     assert motion.period == pytest.approx(39.0 * 5 / 4)
-    assert bpy.ops.screwbender.smooth(closed="ON", levels=4) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(closed="ON", levels=4, scheme="jarek", timing="smooth") == {"FINISHED"}
     frames = check_against_sample(sb, obj, motion, "jarek", 4, "smooth", 1.0)
     assert frames[-2] == 49.0 and frames[-1] == 49.75  # every whole frame of the period 1 .. 49.75, and its end
     assert all(len(fc.modifiers) == 0 for fc in h.fcurves(obj))  # no Cycles modifier was there

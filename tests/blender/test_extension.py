@@ -34,7 +34,9 @@ def test_operators_panels_and_settings_registered():
     assert bpy.ops.screwbender.revert.get_rna_type().name == "Revert Smoothing"
     assert hasattr(bpy.types, "VIEW3D_PT_screwbender")
     assert hasattr(bpy.types, "GRAPH_PT_screwbender")
-    assert bpy.context.scene.screwbender.scheme == "jarek"
+    # the defaults hit every key (4-point) at the pace of Blender's own curves (issue 17)
+    assert bpy.context.scene.screwbender.scheme == "four_point"
+    assert bpy.context.scene.screwbender.timing == "keys"
     rna = bpy.ops.screwbender.smooth.get_rna_type()
     for name in ("scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step"):
         assert rna.properties[name].description, f"option {name} has no tooltip"

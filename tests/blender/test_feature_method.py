@@ -53,7 +53,7 @@ def select_keys(obj, frames):
 def test_baked_channels_are_sample_feature(sb, parametrization, kind):
     obj = keyed(seed=3, kind=kind)
     motion = sb.keys.read(obj)
-    assert bpy.ops.screwbender.smooth(method="FEATURE", parametrization=parametrization, levels=4) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(method="FEATURE", parametrization=parametrization, levels=4, scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     expected = polyscrew.sample_feature(
         motion.poses, motion.frames, frames, levels=4, closed=motion.closed, period=motion.period,
@@ -73,7 +73,7 @@ def test_selected_keys_approximated_others_hit(sb):
     # Freshly inserted keys are all selected: by default every inner key is approximated.
     assert all(p.select_control_point for fc in h.fcurves(obj) for p in fc.keyframe_points)
     select_keys(obj, [f for i, f in enumerate(FRAMES) if i != 3])
-    assert bpy.ops.screwbender.smooth(method="FEATURE", approximate=True, stiffness=0.5, levels=4) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(method="FEATURE", approximate=True, stiffness=0.5, levels=4, scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     at_keys = np.searchsorted(frames, motion.frames)
     miss = np.abs(baked[at_keys] - motion.poses).max(axis=(1, 2))
@@ -90,7 +90,7 @@ def test_selected_keys_approximated_others_hit(sb):
     assert np.abs(baked - expected).max() < SAMPLE_TOLERANCE
     # Smoother than hitting every key: the location's second differences are smaller.
     assert bpy.ops.screwbender.revert() == {"FINISHED"}
-    assert bpy.ops.screwbender.smooth(method="FEATURE", levels=4) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(method="FEATURE", levels=4, scheme="jarek", timing="smooth") == {"FINISHED"}
     exact = h.baked_matrices(obj)[1]
 
     def roughness(m):
@@ -111,7 +111,7 @@ def test_options_registered_with_tooltips(sb):
 def test_default_method_unchanged(sb):
     obj = keyed(seed=5)
     motion = sb.keys.read(obj)
-    assert bpy.ops.screwbender.smooth(levels=4) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(levels=4, scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, baked = h.baked_matrices(obj)
     expected = polyscrew.sample(motion.poses, motion.frames, frames, scheme="jarek", levels=4)
     assert np.abs(baked - expected).max() < SAMPLE_TOLERANCE

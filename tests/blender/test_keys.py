@@ -41,9 +41,11 @@ def test_key_poses_equal_matrix_basis(sb, mode):
     h.key_poses(obj, FRAMES, poses, scales)
     motion = sb.keys.read(obj)
 
-    np.testing.assert_allclose(motion.frames, FRAMES)
+    # the animator's keys, and poses of Blender's playback added inside spans turning over
+    # 150 degrees (random keys do): every one equals matrix_basis at its frame
+    np.testing.assert_allclose(motion.frames[motion.is_key], FRAMES)
     assert motion.rotation_mode == mode and motion.scale_keyed and not motion.closed
-    basis = h.evaluated_basis(obj, FRAMES)
+    basis = h.evaluated_basis(obj, motion.frames)
     read = h.compose(motion.poses[:, :3, 3], motion.poses[:, :3, :3], motion.scales)
     error = np.abs(read - basis).max()
     print(f"{bpy.app.version_string} {mode}: max |read - matrix_basis| = {error:.2e}")
@@ -105,4 +107,5 @@ def test_cycle_without_repeated_pose_keeps_every_key(sb):
     motion = sb.keys.read(obj, closed="ON")
     assert motion.closed and not motion.cyclic
     assert motion.period == pytest.approx(24.0)  # closed after the mean key spacing (6)
-    assert len(motion.frames) == 4 and motion.frame_range == (1.0, 25.0)
+    assert motion.is_key.sum() == 4 and motion.frame_range == (1.0, 25.0)
+    np.testing.assert_array_equal(motion.frames[motion.is_key], [1, 6, 15, 19])

@@ -77,7 +77,7 @@ def test_mirrored_object_is_smoothed(sb):
     obj = keyed(mode="QUATERNION")
     obj.scale = (-1.0, 1.0, 1.0)  # mirrored, scale not keyed
     motion = sb.keys.read(obj)
-    assert bpy.ops.screwbender.smooth(scheme="four_point") == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(scheme="four_point", timing="smooth") == {"FINISHED"}
     paths = {fc.data_path for fc in h.fcurves(obj)}
     assert "scale" not in paths  # unkeyed scale stays unkeyed
     assert tuple(obj.scale) == (-1.0, 1.0, 1.0)
@@ -157,12 +157,12 @@ def test_smoothing_a_result_again_smooths_the_original_keys(sb):
     assert bpy.ops.screwbender.smooth(scheme="bspline") == {"FINISHED"}
     first = obj.animation_data.action
     first["note"] = "edited after smoothing"  # the animator's own data on the result survives
-    assert bpy.ops.screwbender.smooth(scheme="four_point", levels=3) == {"FINISHED"}
+    assert bpy.ops.screwbender.smooth(scheme="four_point", levels=3, timing="smooth") == {"FINISHED"}
     second = obj.animation_data.action
     assert second.name == f"{original.name}.smooth" and second.get("note") == "edited after smoothing"
     assert [a.name for a in bpy.data.actions] == sorted([original.name, second.name])
     frames, baked = h.baked_matrices(obj)
-    expected = polyscrew.sample(motion.poses, motion.frames, frames, scheme="four_point", levels=3)
+    expected = polyscrew.sample(motion.poses, motion.frames, frames, scheme="four_point", levels=3, timing="smooth")
     assert np.abs(baked - expected).max() < 1e-5  # the original keys, not the B-spline result
     assert bpy.ops.screwbender.revert() == {"FINISHED"}
     assert obj.animation_data.action == original

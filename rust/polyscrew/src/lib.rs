@@ -17,6 +17,7 @@
 //! | [`sweep`](mod@sweep) | the region a mesh sweeps along a polyscrew | Rossignac-Kim, "Swept volumes" |
 //! | [`feature`] | feature-point motion design: registration, inertia points, variational subdivision | Hofer-Pottmann-Ravani |
 //! | [`angular_velocity`] | fitting a rotation to a sketched angular velocity | Xie-Xu-Yu-Weng |
+//! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
 //! What users reach for is re-exported here.
@@ -39,6 +40,7 @@
 
 pub mod angular_velocity;
 pub mod error;
+pub mod fcurve;
 pub mod feature;
 pub mod motion;
 pub(crate) mod numeric;
@@ -49,6 +51,10 @@ pub use angular_velocity::{
     FitStatus, QuatJet, QuatSpline,
 };
 pub use error::{Error, PoseDefect, Result};
+pub use fcurve::{
+    evaluate_fcurves, CycleMode, Cycles, Easing, Extrapolation, FCurve, Interpolation, Key,
+    PackedCurves,
+};
 pub use feature::inertia::InertiaFrame;
 pub use feature::motion::{
     feature_motion, feature_motion_timed, sample_feature_motion, CurveScheme, FeatureSpec,

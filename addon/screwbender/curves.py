@@ -1,0 +1,276 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""What an animator's F-curves do between their keys, at any frames, in one `polyscrew` call.
+
+Blender's own `FCurve.evaluate(frame)` costs a Python call per curve and frame; this module
+reads the keys of many curves at once (`keyframe_points.foreach_get`, one call per property
+and curve, no loop over keys) and evaluates them at every frame with
+`polyscrew.evaluate_fcurves`, which mirrors Blender's evaluation operation by operation
+(float32, the same key search, handle correction, cubic solver and easing formulas), so the
+values are Blender's own: CONSTANT holds, LINEAR, BEZIER with any handles, the eleven easings
+with their AUTO defaults and `back` / `amplitude` / `period`, CONSTANT and LINEAR
+extrapolation, and a Cycles modifier (every mode before and after, cycle counts, restricted
+frame range, influence).
+
+What it cannot evaluate is refused, never approximated: :func:`problems` lists why a curve is
+out of scope (another active modifier, named with its type and name: Generator, Built-in
+Function, Envelope, Noise, Limits, Stepped; a muted curve or muted group, which Blender does
+not play; a driver; baked sample points; no keys; an interpolation this `polyscrew` does not
+know), and :func:`read` / :func:`evaluate` raise :class:`UnsupportedCurve` naming every such
+curve and reason. Muted modifiers are ignored, as Blender ignores them. The caller decides
+what to do (report it to the animator, or fall back to key values only for that object).
+
+Enumerations are passed to `polyscrew` by name: Blender's RNA identifiers, mapped through
+tables read from RNA (`bl_rna.properties[...].enum_items`), never Blender's internal values.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+import polyscrew
+
+
+class UnsupportedCurve(ValueError):
+    """F-curves `polyscrew` cannot evaluate as Blender does.
+
+    The message names each curve (`data_path[index]`) and the reason; :attr:`problems` holds
+    `(fcurve, reason)` pairs for callers that handle them one by one.
+    """
+
+    def __init__(self, problems: list[tuple[bpy.types.FCurve, str]]):
+        self.problems = problems
+        lines = [f"{curve_name(fc)}: {reason}" for fc, reason in problems]
+        super().__init__("cannot evaluate these F-curves as Blender does: " + "; ".join(lines))
+
+
+def curve_name(fcurve: bpy.types.FCurve) -> str:
+    """`data_path[array_index]`, how the messages name a curve."""
+    return f"{fcurve.data_path}[{fcurve.array_index}]"
+
+
+def _code_table(struct: type, prop: str, names: Sequence[str]) -> tuple[np.ndarray, dict[int, str]]:
+    """Blender's internal enum values of `struct.prop` -> codes of `polyscrew` (index in
+    `names`), -1 for an identifier `polyscrew` does not know; and value -> identifier."""
+    items = struct.bl_rna.properties[prop].enum_items
+    table = np.full(max(item.value for item in items) + 1, -1, dtype=np.int64)
+    identifiers = {}
+    for item in items:
+        identifiers[item.value] = item.identifier
+        if item.identifier in names:
+            table[item.value] = names.index(item.identifier)
+    return table, identifiers
+
+
+_TABLES: dict[str, tuple[np.ndarray, dict[int, str]]] = {}
+
+
+def _table(prop: str) -> tuple[np.ndarray, dict[int, str]]:
+    """The code table of `Keyframe.<prop>` ("interpolation" or "easing"), built once."""
+    if prop not in _TABLES:
+        names = polyscrew.INTERPOLATIONS if prop == "interpolation" else polyscrew.EASINGS
+        _TABLES[prop] = _code_table(bpy.types.Keyframe, prop, names)
+    return _TABLES[prop]
+
+
+def _active_modifiers(fcurve: bpy.types.FCurve) -> list[tuple[int, bpy.types.FModifier]]:
+    """The modifiers Blender evaluates (not muted), with their place in the stack."""
+    return [(i, m) for i, m in enumerate(fcurve.modifiers) if not m.mute]
+
+
+def problems(fcurve: bpy.types.FCurve) -> list[str]:
+    """Why `fcurve` cannot be evaluated here as Blender plays it (empty when it can)."""
+    found = []
+    if getattr(fcurve, "driver", None) is not None:
+        found.append("is a driver (its input is not time)")
+    if fcurve.mute:
+        found.append("is muted (Blender does not play it)")
+    group = fcurve.group
+    if group is not None and getattr(group, "mute", False):
+        found.append(f"its group {group.name!r} is muted (Blender does not play it)")
+    if len(fcurve.sampled_points):
+        found.append("holds baked sample points, not keyframes")
+    if not len(fcurve.keyframe_points):
+        found.append("has no keyframes")
+    for index, mod in _active_modifiers(fcurve):
+        if mod.type == "CYCLES" and index == 0:
+            continue
+        kind = bpy.types.FModifier.bl_rna.properties["type"].enum_items[mod.type].name
+        where = "" if mod.type != "CYCLES" else " not first in the stack"
+        found.append(
+            f"has a {kind} modifier {mod.name!r}{where}, which the add-on cannot evaluate "
+            "(mute, remove or apply it)"
+        )
+    return found
+
+
+@dataclass
+class Packed:
+    """The keys of several F-curves as `polyscrew.evaluate_fcurves` takes them."""
+
+    #: (C + 1,) int64: curve c owns keys offsets[c]:offsets[c + 1].
+    offsets: np.ndarray
+    #: (K, 2) float32 each: key, left handle, right handle (frame, value).
+    co: np.ndarray
+    handle_left: np.ndarray
+    handle_right: np.ndarray
+    #: (K,) int64: codes into polyscrew.INTERPOLATIONS and polyscrew.EASINGS.
+    interpolation: np.ndarray
+    easing: np.ndarray
+    #: (K,) float32: BACK overshoot, ELASTIC amplitude and period.
+    back: np.ndarray
+    amplitude: np.ndarray
+    period: np.ndarray
+    #: C names: "CONSTANT" or "LINEAR".
+    extrapolation: list[str]
+    #: C entries: None or the Cycles modifier's RNA properties.
+    cycles: list[dict | None] = field(default_factory=list)
+
+    def arguments(self) -> dict:
+        """The keyword arguments of `polyscrew.evaluate_fcurves` (all but the times)."""
+        return {
+            "offsets": self.offsets,
+            "co": self.co,
+            "handle_left": self.handle_left,
+            "handle_right": self.handle_right,
+            "interpolation": self.interpolation,
+            "easing": self.easing,
+            "back": self.back,
+            "amplitude": self.amplitude,
+            "period": self.period,
+            "extrapolation": self.extrapolation,
+            "cycles": self.cycles if any(c is not None for c in self.cycles) else None,
+        }
+
+
+#: The RNA properties of a Cycles modifier passed on (see `polyscrew.evaluate_fcurves`).
+CYCLES_PROPERTIES = (
+    "mode_before",
+    "mode_after",
+    "cycles_before",
+    "cycles_after",
+    "use_restricted_range",
+    "frame_start",
+    "frame_end",
+    "blend_in",
+    "blend_out",
+    "use_influence",
+    "influence",
+)
+
+
+def _cycles(fcurve: bpy.types.FCurve) -> dict | None:
+    """The settings of `fcurve`'s active Cycles modifier (None when it has none)."""
+    for index, mod in _active_modifiers(fcurve):
+        if index == 0 and mod.type == "CYCLES":
+            return {name: getattr(mod, name) for name in CYCLES_PROPERTIES}
+    return None
+
+
+def _codes(prop: str, raw: np.ndarray) -> np.ndarray:
+    """Blender's enum values `raw` of `Keyframe.<prop>` as `polyscrew` codes (-1: unknown)."""
+    table, _ = _table(prop)
+    raw = raw.astype(np.int64)
+    known = raw < len(table)
+    return np.where(known, table[np.where(known, raw, 0)], -1)
+
+
+def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.ndarray, width: int = 1) -> None:
+    """`foreach_get(name)` of the curves `curves` (indices) straight into their part of `out`."""
+    for c in curves:
+        lo, hi = offsets[c], offsets[c + 1]
+        if lo < hi:
+            points[c].foreach_get(name, out[width * lo : width * hi])
+
+
+def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
+    """The keys, extrapolation and Cycles modifier of every curve in `fcurves`, packed.
+
+    One `foreach_get` per property and curve, straight into the packed arrays (float32 and,
+    for the enums, unsigned bytes: Blender's own storage, so no conversion): `co`, both
+    handles and `interpolation` always; `easing` only for curves with an easing
+    interpolation, `back` only with BACK, `amplitude` and `period` only with ELASTIC (the
+    others keep Blender's defaults, which nothing reads). Raises :class:`UnsupportedCurve`
+    naming every curve that cannot be evaluated as Blender plays it (see :func:`problems`).
+    """
+    fcurves = list(fcurves)
+    bad = [(fc, reason) for fc in fcurves for reason in problems(fc)]
+    points = [fc.keyframe_points for fc in fcurves]
+    offsets = np.zeros(len(fcurves) + 1, dtype=np.int64)
+    np.cumsum([len(p) for p in points], out=offsets[1:])
+    k, bounds, every = int(offsets[-1]), offsets.tolist(), range(len(fcurves))
+
+    raw = np.zeros(k, dtype=np.uint8)
+    _read(points, bounds, every, "interpolation", raw)
+    interpolation = _codes("interpolation", raw)
+    for i in np.flatnonzero(interpolation < 0):
+        c = int(np.searchsorted(offsets, i, side="right")) - 1
+        name = _table("interpolation")[1].get(int(raw[i]), f"value {int(raw[i])}")
+        bad.append((fcurves[c], f"has interpolation {name!r}, which this polyscrew does not know"))
+    if bad:
+        raise UnsupportedCurve(bad)
+
+    pairs = {name: np.zeros(2 * k, dtype=np.float32) for name in ("co", "handle_left", "handle_right")}
+    for name, out in pairs.items():
+        _read(points, bounds, every, name, out, width=2)
+
+    # Which curves use the per-key easing parameters at all (one pass over all keys).
+    names = polyscrew.INTERPOLATIONS
+    starts = offsets[:-1][np.diff(offsets) > 0]
+    def curves_with(mask: np.ndarray) -> list[int]:
+        hits = np.zeros(len(fcurves), dtype=bool)
+        if len(starts):
+            hits[np.diff(offsets) > 0] = np.add.reduceat(mask, starts) > 0
+        return np.flatnonzero(hits).tolist()
+
+    easing_codes = np.zeros(k, dtype=np.int64)
+    eased = curves_with(interpolation >= names.index("SINE"))
+    if eased:
+        raw_easing = np.zeros(k, dtype=np.uint8)
+        _read(points, bounds, eased, "easing", raw_easing)
+        easing_codes = _codes("easing", raw_easing)
+        for i in np.flatnonzero(easing_codes < 0):
+            c = int(np.searchsorted(offsets, i, side="right")) - 1
+            name = _table("easing")[1].get(int(raw_easing[i]), f"value {int(raw_easing[i])}")
+            bad.append((fcurves[c], f"has easing {name!r}, which this polyscrew does not know"))
+        if bad:
+            raise UnsupportedCurve(bad)
+    scalars = {
+        "back": np.full(k, 1.70158, dtype=np.float32),
+        "amplitude": np.full(k, 0.8, dtype=np.float32),
+        "period": np.full(k, 4.1, dtype=np.float32),
+    }
+    _read(points, bounds, curves_with(interpolation == names.index("BACK")), "back", scalars["back"])
+    elastic = curves_with(interpolation == names.index("ELASTIC"))
+    _read(points, bounds, elastic, "amplitude", scalars["amplitude"])
+    _read(points, bounds, elastic, "period", scalars["period"])
+    return Packed(
+        offsets=offsets,
+        co=pairs["co"].reshape(-1, 2),
+        handle_left=pairs["handle_left"].reshape(-1, 2),
+        handle_right=pairs["handle_right"].reshape(-1, 2),
+        interpolation=interpolation,
+        easing=easing_codes,
+        extrapolation=[fc.extrapolation for fc in fcurves],
+        cycles=[_cycles(fc) for fc in fcurves],
+        **scalars,
+    )
+
+
+def evaluate_packed(packed: Packed, frames: np.ndarray) -> np.ndarray:
+    """The packed curves at `frames` (any order, subframes allowed): (C, len(frames))."""
+    times = np.ascontiguousarray(frames, dtype=np.float64).reshape(-1)
+    return polyscrew.evaluate_fcurves(times, **packed.arguments())
+
+
+def evaluate(fcurves: Sequence[bpy.types.FCurve], frames: np.ndarray) -> np.ndarray:
+    """Every curve of `fcurves` at every frame of `frames`, as Blender plays them:
+    float64 array (len(fcurves), len(frames)), equal to `fcurve.evaluate(frame)` (Blender's
+    float32 values). One `polyscrew` call.
+
+    Raises :class:`UnsupportedCurve` (a ValueError) naming every curve it cannot evaluate
+    and why, before evaluating anything.
+    """
+    return evaluate_packed(read(fcurves), frames)

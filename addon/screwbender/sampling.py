@@ -1,0 +1,276 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""The smoothed motion of an owner at any frames: what Smooth Motion bakes, the preview draws
+and Insert Key on Motion keys.
+
+The key poses (:func:`keys.read`) are cut at held spans (:mod:`intent`) into pieces; each
+piece is one `polyscrew` call (screw subdivision or feature points) for all its frames, held
+frames keep their key pose. Timing "smooth" and "linear" map frames to the motion with
+polyscrew's own time maps; timing "keys" gives each frame the parameter at which the smoothed
+piece has travelled the same fraction of the span as Blender's playback has
+(:func:`keys_parameters`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import polyscrew
+
+from . import feature, intent, keys
+
+#: Points per key span where the travel of Blender's playback and of the smoothed motion is
+#: measured (timing "keys"; the output frames inside a span are measured too).
+PACE_SAMPLES = 16
+
+
+@dataclass
+class Segment:
+    """Consecutive output frames sampled the same way: a piece of keys `lo..hi` smoothed
+    together, or the hold of key `lo` (`hi == lo`)."""
+
+    lo: int
+    hi: int
+    #: Indices into the output frames (consecutive).
+    rows: np.ndarray
+
+    @property
+    def held(self) -> bool:
+        return self.hi == self.lo
+
+
+def segments(motion: keys.KeyedMotion, frames: np.ndarray) -> list[Segment]:
+    """The output `frames` (sorted) split into pieces and holds, in order.
+
+    A frame belongs to the span starting at the last key at or before it (frames before the
+    first key to the first span, after the last key to the last one); a span's frames are
+    held when the span is. Pieces are the maximal runs of spans that are not held.
+    """
+    k = len(motion.frames)
+    held = motion.held if motion.held is not None else np.zeros(max(k - 1, 0), dtype=bool)
+    if k < 2 or motion.closed or not held.any():
+        return [Segment(0, k - 1, np.arange(len(frames)))]
+    span = np.clip(np.searchsorted(motion.frames, frames, side="right") - 1, 0, k - 2)
+    # piece id per span: runs of non-held spans share one; each held span is its own
+    piece_start = np.empty(k - 1, dtype=int)
+    start = 0
+    for i in range(k - 1):
+        if held[i] or (i > 0 and held[i - 1]):
+            start = i
+        piece_start[i] = start
+    out: list[Segment] = []
+    boundaries = np.flatnonzero(np.diff(piece_start[span])) + 1
+    for rows in np.split(np.arange(len(frames)), boundaries):
+        if not len(rows):
+            continue
+        first_span = int(span[rows[0]])
+        if held[first_span]:
+            out.append(Segment(first_span, first_span, rows))
+            continue
+        lo = int(piece_start[first_span])
+        hi = lo
+        while hi < k - 1 and not held[hi]:
+            hi += 1
+        out.append(Segment(lo, hi, rows))
+    return out
+
+
+def _sub(motion: keys.KeyedMotion, lo: int, hi: int) -> keys.KeyedMotion:
+    """The keys `lo..hi` of an open motion, as a motion of their own."""
+    import dataclasses
+
+    return dataclasses.replace(
+        motion,
+        frames=motion.frames[lo : hi + 1],
+        poses=motion.poses[lo : hi + 1],
+        scales=motion.scales[lo : hi + 1],
+        held=None,
+        closed=False,
+        period=None,
+    )
+
+
+def _spec(motion: keys.KeyedMotion, options, timing: str | None = None) -> dict:
+    return dict(
+        scheme=options.scheme,
+        levels=options.levels,
+        closed=motion.closed,
+        period=motion.period,
+        timing=timing or options.timing,
+    )
+
+
+def _parameter_motion(motion: keys.KeyedMotion) -> tuple[np.ndarray, float | None]:
+    """Key times `0, 1, ..., K-1` (and period K for a cycle): with linear timing, the motion
+    of these keys at time u is the motion at parameter u."""
+    k = len(motion.frames)
+    return np.arange(k, dtype=np.float64), (float(k) if motion.closed else None)
+
+
+def _sample_at_parameters(motion: keys.KeyedMotion, u: np.ndarray, options, owner) -> np.ndarray:
+    """The smoothed motion of `motion`'s keys at motion parameters `u` (key i at u = i)."""
+    times, period = _parameter_motion(motion)
+    if options.method == "FEATURE" and owner is not None:
+        return feature.sample_poses_at(owner, motion, times, u, options, period)
+    return polyscrew.sample(
+        motion.poses, times, u, scheme=options.scheme, levels=options.levels,
+        closed=motion.closed, period=period, timing="linear",
+    )
+
+
+def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner) -> np.ndarray:
+    """Timing "keys": the motion parameter of each frame of `frames`.
+
+    Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
+    travelled the same fraction of the span's travel as Blender's own playback of the curves
+    has at that frame (travel: :func:`intent.travel`). Without Blender's curves (a motion
+    read from key values only), or over a span where Blender's playback does not move (the
+    span closing a cycle that has no Cycles modifier), the fraction is the fraction of time.
+    """
+    k = len(motion.frames)
+    f = motion.frames
+    if motion.closed:
+        ends = np.append(f, f[0] + motion.period)
+        spans = k
+    else:
+        ends = f
+        spans = k - 1
+    frames = np.asarray(frames, dtype=np.float64)
+    span = np.clip(np.searchsorted(ends, frames, side="right") - 1, 0, spans - 1)
+    time_fraction = (frames - ends[span]) / (ends[span + 1] - ends[span])
+    size = motion.size
+    # Blender's playback: per span, PACE_SAMPLES + 1 points from its start to its end, plus
+    # the output frames inside it.
+    grid = np.arange(PACE_SAMPLES + 1) / PACE_SAMPLES
+    inside = (time_fraction > 0.0) & (time_fraction < 1.0)
+    sample_span = np.concatenate([np.repeat(np.arange(spans), PACE_SAMPLES + 1), span[inside]])
+    sample_fraction = np.concatenate([np.tile(grid, spans), time_fraction[inside]])
+    order = np.lexsort((sample_fraction, sample_span))
+    sample_span, sample_fraction = sample_span[order], sample_fraction[order]
+    if motion.source is not None:
+        sample_frames = ends[sample_span] + sample_fraction * (ends[sample_span + 1] - ends[sample_span])
+        played = motion.source.channels(sample_frames)
+        poses = keys.compose(
+            played["location"], keys.rotation_matrices(played[motion.source.rotation_path], motion.source.mode)
+        )
+        done = intent.pace_fractions(poses, sample_span, sample_fraction, size, spans)
+    else:
+        done = sample_fraction
+    # One interpolation for all spans: within span s, the pair (s + time fraction, s + travel
+    # fraction) is increasing, and spans meet at (s + 1, s + 1).
+    travelled = np.interp(span + time_fraction, sample_span + sample_fraction, sample_span + done) - span
+    outside = ~inside
+    travelled[outside] = time_fraction[outside]  # at keys, before the first and after the last
+    # The smoothed motion's own travel along each span, at PACE_SAMPLES + 1 parameters.
+    u_grid = (np.arange(spans)[:, None] + grid[None, :]).ravel()
+    smooth_poses = _sample_at_parameters(motion, u_grid, options, owner).reshape(spans, PACE_SAMPLES + 1, 4, 4)
+    steps = intent.travel(smooth_poses[:, :-1].reshape(-1, 4, 4), smooth_poses[:, 1:].reshape(-1, 4, 4), size)
+    cumulative = np.concatenate([np.zeros((spans, 1)), np.cumsum(steps.reshape(spans, PACE_SAMPLES), axis=1)], axis=1)
+    total = cumulative[:, -1:]
+    along = np.where(total > 0.0, cumulative / np.where(total > 0.0, total, 1.0), grid[None, :])
+    x = (np.arange(spans)[:, None] + along).ravel()
+    y = u_grid
+    u = np.interp(span + travelled, x, y)
+    u[outside] = span[outside] + travelled[outside]
+    return u
+
+
+@dataclass
+class Sampled:
+    """The smoothed motion at the requested frames."""
+
+    #: Rigid poses (T, 4, 4), or None when channels were asked for.
+    poses: np.ndarray | None
+    #: Location (T, 3) and rotation channels (T, k), when channels were asked for.
+    location: np.ndarray | None
+    rotation: np.ndarray | None
+    #: Scales (T, 3) when scale is keyed (else None).
+    scales: np.ndarray | None
+    #: Per frame: in a held span that pops at its end (its baked keys must be CONSTANT).
+    constant: np.ndarray
+
+
+def sample(
+    motion: keys.KeyedMotion, frames: np.ndarray, options, owner=None, channels: bool = False, previous=None
+) -> Sampled:
+    """The smoothed motion at `frames` (any order; channels are continuous in time order from
+    `previous`), as poses or, with `channels`, as Blender's location and rotation channels;
+    and scales when keyed.
+
+    One polyscrew call per piece for the motion (and per hold for channels), one for scale;
+    timing "keys" computes each piece's parameters once for both.
+    """
+    frames = np.asarray(frames, dtype=np.float64)
+    if len(frames) > 1 and np.any(np.diff(frames) < 0.0):
+        order = np.argsort(frames, kind="stable")
+        done = sample(motion, frames[order], options, owner, channels, previous)
+        back = np.empty_like(order)
+        back[order] = np.arange(len(order))
+        return Sampled(
+            poses=None if done.poses is None else done.poses[back],
+            location=None if done.location is None else done.location[back],
+            rotation=None if done.rotation is None else done.rotation[back],
+            scales=None if done.scales is None else done.scales[back],
+            constant=done.constant[back],
+        )
+    mode = motion.rotation_mode
+    n = len(frames)
+    poses = np.empty((n, 4, 4)) if not channels else None
+    location = np.empty((n, 3)) if channels else None
+    rotation = None
+    constant = np.zeros(n, dtype=bool)
+    scaled = motion.scale_keyed
+    logs = np.log(np.abs(motion.scales)) if scaled else None
+    log_scales = np.empty((n, 3)) if scaled else None
+    last_rotation = previous
+    for seg in segments(motion, frames):
+        rows = seg.rows
+        if seg.held:
+            pose = np.repeat(motion.poses[seg.lo][None], len(rows), axis=0)
+            if channels:
+                location[rows] = pose[:, :3, 3]
+                values = polyscrew.rotation_channels(pose, mode, previous=last_rotation)
+            else:
+                poses[rows] = pose
+            if scaled:
+                log_scales[rows] = logs[seg.lo]
+            if motion.pops is not None and motion.pops[seg.lo]:
+                constant[rows] = True
+        else:
+            whole = seg.lo == 0 and seg.hi == len(motion.frames) - 1
+            piece = motion if whole else _sub(motion, seg.lo, seg.hi)
+            t = frames[rows]
+            if options.timing == "keys":
+                key_times, period = _parameter_motion(piece)
+                at = keys_parameters(piece, t, options, owner)
+                spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")
+            else:
+                spec = _spec(piece, options)
+                key_times, at = piece.frames, t
+            if options.method == "FEATURE" and owner is not None:
+                piece_poses = feature.sample_poses_at(owner, piece, key_times, at, options, spec["period"], spec["timing"])
+                if channels:
+                    location[rows] = piece_poses[:, :3, 3]
+                    values = polyscrew.rotation_channels(piece_poses, mode, previous=last_rotation)
+                else:
+                    poses[rows] = piece_poses
+            elif channels:
+                loc, values = polyscrew.sample_channels(piece.poses, key_times, at, mode, last_rotation, **spec)
+                location[rows] = loc
+            else:
+                poses[rows] = polyscrew.sample(piece.poses, key_times, at, **spec)
+            if scaled:
+                log_scales[rows] = polyscrew.sample_vectors(logs[seg.lo : seg.hi + 1], key_times, at, **spec)
+        if channels:
+            if rotation is None:
+                rotation = np.empty((n, values.shape[1]))
+            rotation[rows] = values
+            if mode != "AXIS_ANGLE":
+                last_rotation = values[-1]
+    scales = None
+    if scaled:
+        scales = np.empty((n, 3))
+        scales[:] = motion.scales[0]  # unkeyed axes: the owner's own scale, possibly negative
+        axes = motion.scale_axes
+        scales[:, axes] = np.exp(log_scales[:, axes])
+    return Sampled(poses=poses, location=location, rotation=rotation, scales=scales, constant=constant)

@@ -1,0 +1,258 @@
+//! Binding of Blender's F-curve evaluation (`polyscrew::fcurve`): conversion only.
+//!
+//! Enumerations cross the boundary by name: per-curve settings as the RNA identifiers
+//! (`"LINEAR"`, `"REPEAT_OFFSET"`), per-key ones as integer codes that index the name tuples
+//! the module exports (`INTERPOLATIONS`, `EASINGS`), so that a whole array of keys is one
+//! integer array and its meaning is still fixed by names, never by Blender's internal values.
+
+use numpy::ndarray::{Array2, ArrayViewD};
+use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLikeDyn};
+use pyo3::exceptions::{PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyString, PyTuple};
+
+use polyscrew::fcurve::{
+    evaluate_packed, key::DEFAULT_AMPLITUDE, key::DEFAULT_BACK, key::DEFAULT_PERIOD, CycleMode,
+    Cycles, Easing, Extrapolation, FrameRange, Interpolation, PackedCurves, MAX_KEYS, MAX_VALUES,
+};
+
+use crate::{read_vector, shape_err, to_py_err, FloatArray};
+
+/// An integer array-like argument converted to int64 on the way in.
+type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+
+const F: &str = "evaluate_fcurves";
+
+/// Reads `(K, 2)` pairs, flattened.
+fn read_pairs(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+    let shape = array.shape();
+    if shape.len() != 2 || shape[1] != 2 {
+        return Err(shape_err(F, what, "(K, 2)", shape));
+    }
+    Ok(array.iter().copied().collect())
+}
+
+/// Reads a 1-D integer array.
+fn read_ints(what: &str, array: ArrayViewD<'_, i64>) -> PyResult<Vec<i64>> {
+    if array.ndim() != 1 {
+        return Err(shape_err(F, what, "(N,)", array.shape()));
+    }
+    Ok(array.iter().copied().collect())
+}
+
+/// A per-key float array, or `k` copies of `default` when it is not given.
+fn read_per_key(
+    what: &str,
+    array: Option<FloatArray<'_>>,
+    k: usize,
+    default: f32,
+) -> PyResult<Vec<f64>> {
+    match array {
+        Some(a) => read_vector(F, what, a.as_array()),
+        None => Ok(vec![default as f64; k]),
+    }
+}
+
+/// One extrapolation name for every curve, or a sequence of `c` names.
+fn read_extrapolation(arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec<Extrapolation>> {
+    let parse = |name: &str| Extrapolation::from_name(name).map_err(|e| to_py_err(F, e));
+    if let Ok(name) = arg.cast::<PyString>() {
+        return Ok(vec![parse(name.to_str()?)?; c]);
+    }
+    let names: Vec<String> = arg.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{F}: extrapolation: expected a name or a sequence of names"
+        ))
+    })?;
+    names.iter().map(|n| parse(n)).collect()
+}
+
+/// The keys a Cycles settings dict may hold: the RNA property names of `FModifierCycles`.
+const CYCLES_KEYS: [&str; 11] = [
+    "mode_before",
+    "mode_after",
+    "cycles_before",
+    "cycles_after",
+    "use_restricted_range",
+    "frame_start",
+    "frame_end",
+    "blend_in",
+    "blend_out",
+    "use_influence",
+    "influence",
+];
+
+/// Reads one Cycles settings dict (named as Blender's RNA properties; missing entries take
+/// the defaults of a new modifier).
+fn read_cycles(c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
+    let err = |reason: String| PyValueError::new_err(format!("{F}: cycles[{c}]: {reason}"));
+    for key in dict.keys() {
+        let key: String = key.extract()?;
+        if !CYCLES_KEYS.contains(&key.as_str()) {
+            return Err(err(format!(
+                "unknown setting {key:?} (expected some of {})",
+                CYCLES_KEYS.join(", ")
+            )));
+        }
+    }
+    fn get<'py, T: FromPyObjectOwned<'py>>(
+        dict: &Bound<'py, PyDict>,
+        key: &str,
+        default: T,
+        err: &dyn Fn(String) -> PyErr,
+    ) -> PyResult<T> {
+        match dict.get_item(key)? {
+            Some(v) => v
+                .extract::<T>()
+                .map_err(|e| err(format!("{key}: {}", Into::<PyErr>::into(e)))),
+            None => Ok(default),
+        }
+    }
+    let mode = |key: &str| -> PyResult<CycleMode> {
+        let name: String = get(dict, key, "REPEAT".to_string(), &err)?;
+        CycleMode::from_name(&name).map_err(|e| err(format!("{key}: {e}")))
+    };
+    let count = |key: &str| -> PyResult<i32> {
+        let n: i64 = get(dict, key, 0, &err)?;
+        i32::try_from(n).map_err(|_| err(format!("{key}: {n} is out of range")))
+    };
+    let num = |key: &str, default: f32| -> PyResult<f32> {
+        Ok(get(dict, key, default as f64, &err)? as f32)
+    };
+    let range = if get(dict, "use_restricted_range", false, &err)? {
+        Some(FrameRange {
+            start: num("frame_start", 0.0)?,
+            end: num("frame_end", 0.0)?,
+            blend_in: num("blend_in", 0.0)?,
+            blend_out: num("blend_out", 0.0)?,
+        })
+    } else {
+        None
+    };
+    let influence = if get(dict, "use_influence", false, &err)? {
+        Some(num("influence", 1.0)?)
+    } else {
+        None
+    };
+    let cycles = Cycles {
+        before: mode("mode_before")?,
+        after: mode("mode_after")?,
+        count_before: count("cycles_before")?,
+        count_after: count("cycles_after")?,
+        range,
+        influence,
+    };
+    cycles.validate().map_err(|e| err(e.to_string()))?;
+    Ok(cycles)
+}
+
+/// `None`, or a sequence of `c` entries each a settings dict or `None`.
+fn read_cycles_list(arg: Option<&Bound<'_, PyAny>>, c: usize) -> PyResult<Vec<Option<Cycles>>> {
+    let Some(arg) = arg.filter(|a| !a.is_none()) else {
+        return Ok(Vec::new());
+    };
+    let items: Vec<Bound<'_, PyAny>> = arg.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{F}: cycles: expected a sequence of dicts or None, one per curve"
+        ))
+    })?;
+    if items.len() != c {
+        return Err(PyValueError::new_err(format!(
+            "{F}: cycles: expected {c} entries (one per curve), got {}",
+            items.len()
+        )));
+    }
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| {
+            if item.is_none() {
+                return Ok(None);
+            }
+            let dict = item.cast::<PyDict>().map_err(|_| {
+                PyTypeError::new_err(format!("{F}: cycles[{i}]: expected a dict or None"))
+            })?;
+            read_cycles(i, dict).map(Some)
+        })
+        .collect()
+}
+
+/// evaluate_fcurves(times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation="CONSTANT", back=None, amplitude=None, period=None, cycles=None) -> ndarray
+///
+/// Blender's F-curve evaluation of C curves at T times in one call: `(C, T)` float64, each
+/// value exactly Blender's `FCurve.evaluate(time)` (float32 arithmetic mirrored). Curve `c`
+/// owns keys `offsets[c]:offsets[c + 1]` of the packed per-key arrays (`co`, `handle_left`,
+/// `handle_right` (K, 2); `interpolation`, `easing` (K,) integer codes indexing
+/// `INTERPOLATIONS` and `EASINGS`; `back`, `amplitude`, `period` (K,), default Blender's
+/// defaults). `extrapolation`: one of `EXTRAPOLATIONS` for all curves or one per curve.
+/// `cycles`: None, or one entry per curve, None or a dict of the Cycles modifier's RNA
+/// properties. GIL released. Raises ValueError naming the argument, curve and key.
+#[pyfunction]
+#[pyo3(signature = (times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None))]
+#[allow(clippy::too_many_arguments)]
+fn evaluate_fcurves<'py>(
+    py: Python<'py>,
+    times: FloatArray<'py>,
+    offsets: IntArray<'py>,
+    co: FloatArray<'py>,
+    handle_left: FloatArray<'py>,
+    handle_right: FloatArray<'py>,
+    interpolation: IntArray<'py>,
+    easing: IntArray<'py>,
+    extrapolation: Option<Bound<'py, PyAny>>,
+    back: Option<FloatArray<'py>>,
+    amplitude: Option<FloatArray<'py>>,
+    period: Option<FloatArray<'py>>,
+    cycles: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let times = read_vector(F, "times", times.as_array())?;
+    let offsets = read_ints("offsets", offsets.as_array())?;
+    let c = offsets.len().saturating_sub(1);
+    let co = read_pairs("co", co.as_array())?;
+    let k = co.len() / 2;
+    let handle_left = read_pairs("handle_left", handle_left.as_array())?;
+    let handle_right = read_pairs("handle_right", handle_right.as_array())?;
+    let interpolation = read_ints("interpolation", interpolation.as_array())?;
+    let easing = read_ints("easing", easing.as_array())?;
+    let back = read_per_key("back", back, k, DEFAULT_BACK)?;
+    let amplitude = read_per_key("amplitude", amplitude, k, DEFAULT_AMPLITUDE)?;
+    let period = read_per_key("period", period, k, DEFAULT_PERIOD)?;
+    let extrapolation = match extrapolation.as_ref().filter(|e| !e.is_none()) {
+        Some(e) => read_extrapolation(e, c)?,
+        None => vec![Extrapolation::Constant; c],
+    };
+    let cycles = read_cycles_list(cycles.as_ref(), c)?;
+    let packed = PackedCurves {
+        offsets: &offsets,
+        co: &co,
+        handle_left: &handle_left,
+        handle_right: &handle_right,
+        interpolation: &interpolation,
+        easing: &easing,
+        back: &back,
+        amplitude: &amplitude,
+        period: &period,
+        extrapolation: &extrapolation,
+        cycles: &cycles,
+    };
+    let n = times.len();
+    let values = py
+        .detach(|| evaluate_packed(&packed, &times))
+        .map_err(|e| to_py_err(F, e))?;
+    let out = Array2::from_shape_vec((c, n), values)
+        .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+    Ok(out.into_pyarray(py))
+}
+
+/// Adds `evaluate_fcurves` and its name tables to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(evaluate_fcurves, m)?)?;
+    let py = m.py();
+    m.add("INTERPOLATIONS", PyTuple::new(py, Interpolation::NAMES)?)?;
+    m.add("EASINGS", PyTuple::new(py, Easing::NAMES)?)?;
+    m.add("EXTRAPOLATIONS", PyTuple::new(py, Extrapolation::NAMES)?)?;
+    m.add("CYCLE_MODES", PyTuple::new(py, CycleMode::NAMES)?)?;
+    m.add("MAX_FCURVE_KEYS", MAX_KEYS)?;
+    m.add("MAX_FCURVE_VALUES", MAX_VALUES)?;
+    Ok(())
+}
