@@ -66,9 +66,15 @@ def key_bone(obj, bone: str, frames, poses, mode: str = "XYZ", scales=None) -> N
             pb.keyframe_insert("scale", frame=frame)
 
 
-def random_poses(n: int, seed: int, reach: float = 0.5) -> np.ndarray:
+def random_poses(n: int, seed: int, reach: float = 0.5, gentle: bool = False) -> np.ndarray:
+    """`n` random poses (a random walk of rotations); `gentle`: rotations of about 50 degrees
+    about axes near one direction, so that no rotation channel (axis-angle included) turns by
+    half a turn between keys, which Smooth Motion would keep as a spin."""
     rng = np.random.default_rng(seed)
-    rot = Rotation.from_rotvec(np.cumsum(rng.normal(0, 0.5, (n, 3)), axis=0))
+    if gentle:
+        rot = Rotation.from_rotvec([0.7, 0.4, 0.3] + rng.normal(0, 0.15, (n, 3)))
+    else:
+        rot = Rotation.from_rotvec(np.cumsum(rng.normal(0, 0.5, (n, 3)), axis=0))
     return h.rigid(rng.uniform(-reach, reach, (n, 3)), rot.as_matrix())
 
 
