@@ -442,27 +442,33 @@ class Report:
         self.bones_table(data, json.loads(js.read_text()).get("blender", "?"))
 
     def bones_table(self, data: dict, blender: str) -> None:
-        """The bone case: medians of wall-clock and CPU time, ours and nla.bake, and their ratios."""
-        runs = data["runs"]
+        """The bone case: medians of wall-clock and CPU time, ours (per timing) and nla.bake,
+        and their ratios."""
+        runs, m = data["runs"], data["median"]
         self.w(f"`scripts/bench_bake.py`, Blender {blender}: a rig of {data['bones']} bones (ten chains of ten, not "
                "connected), every bone keyed on location, XYZ Euler rotation and scale at ten uneven frames. "
                "ScrewBender: Smooth Motion of all its bones (Object Mode, the armature selected, Armatures: Bones "
-               "Only: the selection, reading, sampling and the new action); nla.bake: "
+               "Only: the selection, reading, sampling and the new action), Jarek 4 levels; nla.bake: "
                "`bpy.ops.nla.bake(bake_types={'POSE'})` of the same bones (Pose Mode, all selected; location, "
-               f"rotation, scale) over the same {data['frames']:,} frames. Both write "
-               f"{9 * data['bones'] * data['frames']:,} keys. Ours and nla.bake run back to back in one process on "
-               f"a fresh rig in each of {runs} runs, after one untimed warm-up; medians of the runs. CPU time is the "
-               "process's (every thread: Blender's threaded depsgraph evaluation counts).", "",
-               "| median of the runs | ScrewBender | nla.bake POSE | nla.bake / ours |", "| --- | --- | --- | --- |",
-               f"| wall-clock | {fmt_seconds(data['ours'])} | {fmt_seconds(data['nla'])} | "
-               f"{data['nla'] / data['ours']:.1f}x |",
-               f"| CPU time | {fmt_seconds(data['ours_cpu'])} | {fmt_seconds(data['nla_cpu'])} | "
-               f"{data['nla_cpu'] / data['ours_cpu']:.1f}x |", "",
-               "Per run (wall-clock): " + ", ".join(f"{t / o:.1f}x" for o, t in zip(data["ours_runs"], data["nla_runs"]))
-               + (f"; load average {data['load']:.1f} on this machine at the end." if data.get("load") is not None else "."),
-               "")
-        wall, cpu = data["nla"] / data["ours"], data["nla_cpu"] / data["ours_cpu"]
-        self.targets.append(("bake of a 100-bone rig >= 20x nla.bake POSE", f"{wall:.1f}x (wall), {cpu:.1f}x (CPU)",
+               f"rotation, scale) over the same {data['frames']:,} frames. Each writes "
+               f"{9 * data['bones'] * data['frames']:,} keys. In each of {len(runs)} runs, on fresh rigs, ours with "
+               "each timing then nla.bake, back to back in one process, after one untimed warm-up; medians of the "
+               "runs. CPU time is the process's (every thread: nla.bake's depsgraph evaluation may run on "
+               "several).", "",
+               "| median of the runs | wall-clock | CPU time | nla.bake / ours, wall | nla.bake / ours, CPU |",
+               "| --- | --- | --- | --- | --- |",
+               f"| nla.bake POSE | {fmt_seconds(m['nla'])} | {fmt_seconds(m['nla_cpu'])} | | |")
+        ratios = []
+        for t in data["timings"]:
+            wall, cpu = m["nla"] / m[t], m["nla_cpu"] / m[f"{t}_cpu"]
+            ratios.append((t, wall, cpu))
+            self.w(f"| ScrewBender, timing {t.title()}{' (default)' if t == 'keys' else ''} | {fmt_seconds(m[t])} | "
+                   f"{fmt_seconds(m[f'{t}_cpu'])} | {wall:.1f}x | {cpu:.1f}x |")
+        self.w("", "Per run (wall-clock, timing Keys): " + ", ".join(f"{r['nla'] / r['keys']:.1f}x" for r in runs)
+               + (f"; load average {data['load']:.1f} at the end." if data.get("load") is not None else "."), "")
+        t, wall, cpu = ratios[0]
+        measured = ", ".join(f"{w:.1f}x wall / {c:.1f}x CPU (timing {name.title()})" for name, w, c in ratios)
+        self.targets.append(("bake of a 100-bone rig >= 20x nla.bake POSE", measured,
                              verdict(min(wall, cpu) >= TARGET_BAKE_VS_NLA)))
 
     def other_criterion(self) -> None:

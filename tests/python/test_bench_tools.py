@@ -243,16 +243,20 @@ def test_bake_section_from_json_marks_extrapolations(tmp_path):
 
 
 def test_bone_section_reports_medians_and_both_ratios(tmp_path):
-    bones = {"bones": 100, "frames": 1000, "runs": 3, "ours_runs": [0.2, 0.3, 0.25], "nla_runs": [5.0, 5.4, 4.0],
-             "ours_cpu_runs": [0.1, 0.12, 0.11], "nla_cpu_runs": [2.4, 2.2, 2.5], "ours": 0.25, "nla": 5.0,
-             "ours_cpu": 0.11, "nla_cpu": 2.4, "load": 6.5}
+    run = {"keys": 0.25, "keys_cpu": 0.11, "smooth": 0.2, "smooth_cpu": 0.1, "nla": 5.0, "nla_cpu": 2.4}
+    bones = {"bones": 100, "frames": 1000, "timings": ["keys", "smooth"], "load": 6.5,
+             "runs": [run, dict(run, keys=0.5), dict(run, keys=0.2)], "median": run}
     (tmp_path / "bake.json").write_text(json.dumps(dict(BAKE_JSON, bones=bones)))
     rep = report.Report(tmp_path, {})
     rep.bones_section()
-    assert "| wall-clock | 250.00 ms | 5.000 s | 20.0x |" in rep.lines
-    assert "| CPU time | 110.00 ms | 2.400 s | 21.8x |" in rep.lines
-    assert any(line.startswith("Per run (wall-clock): 25.0x, 18.0x, 16.0x; load average 6.5") for line in rep.lines)
-    assert rep.targets[-1] == ("bake of a 100-bone rig >= 20x nla.bake POSE", "20.0x (wall), 21.8x (CPU)", "met")
+    assert "| nla.bake POSE | 5.000 s | 2.400 s | | |" in rep.lines
+    assert "| ScrewBender, timing Keys (default) | 250.00 ms | 110.00 ms | 20.0x | 21.8x |" in rep.lines
+    assert "| ScrewBender, timing Smooth | 200.00 ms | 100.00 ms | 25.0x | 24.0x |" in rep.lines
+    assert any(line.startswith("Per run (wall-clock, timing Keys): 20.0x, 10.0x, 25.0x; load average 6.5")
+               for line in rep.lines)
+    assert rep.targets[-1] == (
+        "bake of a 100-bone rig >= 20x nla.bake POSE",
+        "20.0x wall / 21.8x CPU (timing Keys), 25.0x wall / 24.0x CPU (timing Smooth)", "met")
     (tmp_path / "bake.json").write_text(json.dumps(BAKE_JSON))  # an older run without the bone case
     rep = report.Report(tmp_path, {})
     rep.bones_section()
