@@ -106,16 +106,19 @@ def _bone_of(data_path: str) -> tuple[str, str] | None:
     return name, prop
 
 
-def keyed_bones(obj: bpy.types.Object, fcurves) -> list[str]:
-    """The bones of armature `obj` with keyed transform curves among `fcurves`, in the
-    armature's bone order."""
+def keyed_bones(obj: bpy.types.Object, fcurves, grouped: dict | None = None) -> list[str]:
+    """The bones of armature `obj` with keyed transform curves among `fcurves` (or in
+    `grouped`, their :func:`curves_by_owner`), in the armature's bone order."""
     if obj.type != "ARMATURE" or obj.pose is None:
         return []
     keyed = set()
-    for fc in fcurves:
-        found = _bone_of(fc.data_path)
-        if found is not None and len(fc.keyframe_points):
-            keyed.add(found[0])
+    if grouped is not None:
+        keyed = {bone for bone, curves in grouped.items() if bone and any(len(fc.keyframe_points) for fc in curves)}
+    else:
+        for fc in fcurves:
+            found = _bone_of(fc.data_path)
+            if found is not None and len(fc.keyframe_points):
+                keyed.add(found[0])
     return [b.name for b in obj.pose.bones if b.name in keyed]
 
 
@@ -180,18 +183,19 @@ def selection(context: bpy.types.Context, armature: str = "BOTH", fcurves_of=Non
     return out
 
 
-def of_object(obj: bpy.types.Object, armature: str = "BOTH", fcurves=()) -> list[Owner]:
+def of_object(obj: bpy.types.Object, armature: str = "BOTH", fcurves=(), grouped: dict | None = None) -> list[Owner]:
     """The owners of one object that Smooth Motion takes in Object Mode: the object itself;
     for an armature, per `armature` (:data:`ARMATURE_MODES`), its own keys and/or its keyed
-    bones among `fcurves` (its F-curves), hidden bones and bones in hidden collections only
-    when selected; the armature itself when nothing is keyed (reading it says so)."""
+    bones among `fcurves` (its F-curves; `grouped`: their :func:`curves_by_owner` when the
+    caller has it), hidden bones and bones in hidden collections only when selected; the
+    armature itself when nothing is keyed (reading it says so)."""
     if obj.type != "ARMATURE" or armature == "OBJECT":
         return [Owner(obj)]
     out = []
-    own = armature == "BOTH" and has_own_keys(obj, fcurves)
+    own = armature == "BOTH" and has_own_keys(obj, fcurves if grouped is None else grouped.get("", []))
     if own:
         out.append(Owner(obj))
-    bones = [b for b in keyed_bones(obj, fcurves) if not is_hidden(obj, b) or is_selected(obj, b)]
+    bones = [b for b in keyed_bones(obj, fcurves, grouped) if not is_hidden(obj, b) or is_selected(obj, b)]
     out += [Owner(obj, b) for b in bones]
     if not bones and not own:
         out.append(Owner(obj))  # nothing keyed: read it to say so

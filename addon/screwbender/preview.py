@@ -26,6 +26,7 @@ and its parent bones as posed now).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 from dataclasses import astuple, dataclass, field
 
@@ -77,6 +78,11 @@ class PreviewOptions:
     def key(self) -> tuple:
         """A hashable summary of these options."""
         return (astuple(self.smooth), self.instances, self.trajectory_points, self.show_raw)
+
+    @functools.cached_property
+    def key_bytes(self) -> bytes:
+        """:meth:`key` as bytes for a digest, made once (every previewed owner hashes it)."""
+        return repr(self.key()).encode()
 
 
 @dataclass
@@ -291,7 +297,7 @@ def key_hash(
     owner = owners.as_owner(owner)
     obj, target = owner.obj, owner.target
     digest = hashlib.blake2b(digest_size=16)
-    digest.update(repr(options.key()).encode())
+    digest.update(options.key_bytes)
     mode = target.rotation_mode
     props = keys.transform_paths(mode)
     paths = tuple(owner.path(p) for p in props)
@@ -410,14 +416,17 @@ def cache_key(owner: owners.Owner | bpy.types.Object) -> int | tuple[int, str]:
     return (uid, owner.bone) if owner.bone else uid
 
 
-def preview_owners(obj: bpy.types.Object, armature: str = "BOTH", fcurves: list | None = None) -> list[owners.Owner]:
+def preview_owners(
+    obj: bpy.types.Object, armature: str = "BOTH", fcurves: list | None = None, grouped: dict | None = None
+) -> list[owners.Owner]:
     """What the preview of `obj` shows: the object itself; for an armature what Smooth Motion
     would smooth in Object Mode (:func:`owners.of_object`, per the Armatures option
     `armature`): its keyed bones (hidden ones only when selected) and/or its own keys.
-    `fcurves` are the object's F-curves (read from its action when not given)."""
+    `fcurves` are the object's F-curves (read from its action when not given), `grouped`
+    their :func:`owners.curves_by_owner` when the caller has it."""
     if obj.type != "ARMATURE":
         return [owners.Owner(obj)]
-    return owners.of_object(obj, armature, channels.object_fcurves(obj) if fcurves is None else fcurves)
+    return owners.of_object(obj, armature, channels.object_fcurves(obj) if fcurves is None else fcurves, grouped)
 
 
 class PreviewCache:

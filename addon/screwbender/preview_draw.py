@@ -106,7 +106,7 @@ def owners_with_curves(obj: bpy.types.Object, scene: bpy.types.Scene) -> list[tu
     own transform F-curves (the object's curves grouped once, not searched per bone)."""
     curves = channels.object_fcurves(obj)
     by_owner = owners.curves_by_owner(curves)
-    return [(o, by_owner.get(o.bone, [])) for o in preview.preview_owners(obj, armature_mode(scene), curves)]
+    return [(o, by_owner.get(o.bone, [])) for o in preview.preview_owners(obj, armature_mode(scene), curves, by_owner)]
 
 
 def previewed_owners(scene: bpy.types.Scene, objects: list[bpy.types.Object] | None = None) -> list[owners.Owner]:
@@ -340,6 +340,44 @@ def owner_space(owner: owners.Owner | bpy.types.Object) -> preview.Space:
     return preview.space_from_probes(world, to_pose(np.eye(4)), np.array(moved), to_pose(preview.CYCLE))
 
 
+def _matrices(collection, name: str) -> np.ndarray:
+    """(N, 4, 4) float64 of the 4x4 matrix property `name` of every item of `collection`, in
+    one `foreach_get` (Blender stores matrices column by column)."""
+    flat = np.empty(16 * len(collection), dtype=np.float32)
+    collection.foreach_get(name, flat)
+    return flat.reshape(-1, 4, 4).transpose(0, 2, 1).astype(np.float64)
+
+
+def owner_spaces(obj: bpy.types.Object, shown: list[owners.Owner]) -> list[preview.Space]:
+    """:func:`owner_space` of each of `shown` (owners of `obj`), the bones of the armature
+    together: a bone that inherits its parent's whole transform (Inherit Rotation, Inherit
+    Scale Full, Local Location: Blender's defaults) is in the space
+    `A P_parent L_parent^-1 L` (A the armature's world matrix, P the parent's current
+    `PoseBone.matrix`, L the rest `Bone.matrix_local`; `A L` for a root bone), read for all
+    bones in two `foreach_get` calls; any other bone through :func:`owner_space`."""
+    bones = [o for o in shown if o.bone]
+    if not bones:
+        return [owner_space(o) for o in shown]
+    pose, rest = obj.pose.bones, obj.data.bones
+    pose_index = {b.name: i for i, b in enumerate(pose)}
+    rest_index = {b.name: i for i, b in enumerate(rest)}
+    posed = _matrices(pose, "matrix")
+    local = _matrices(rest, "matrix_local")
+    world = np.array(obj.matrix_world, dtype=np.float64)
+    out = []
+    for owner in shown:
+        data = rest[owner.bone] if owner.bone else None
+        if data is None or not (data.use_inherit_rotation and data.inherit_scale == "FULL" and data.use_local_location):
+            out.append(owner_space(owner))
+            continue
+        offset = local[rest_index[owner.bone]]
+        if data.parent is not None:
+            parent = data.parent.name
+            offset = posed[pose_index[parent]] @ np.linalg.solve(local[rest_index[parent]], offset)
+        out.append(preview.Space.of_matrix(world @ offset))
+    return out
+
+
 def _geometry_key(owner: owners.Owner, style: _Style) -> tuple:
     obj = owner.obj
     if owner.bone:
@@ -492,11 +530,11 @@ def draw_previews(
         for obj in enabled_objects(scene):
             if not obj.visible_get(view_layer=view_layer):
                 continue
-            for owner, curves in owners_with_curves(obj, scene):
-                entry, _ = CACHE.refresh(owner, options, frame, auto, curves)
-                if entry.batches is None:
-                    continue
-                space = owner_space(owner)
+            shown = owners_with_curves(obj, scene)
+            entries = [CACHE.refresh(owner, options, frame, auto, curves)[0] for owner, curves in shown]
+            drawable = [(owner, entry) for (owner, _), entry in zip(shown, entries) if entry.batches is not None]
+            spaces = owner_spaces(obj, [owner for owner, _ in drawable])
+            for (owner, entry), space in zip(drawable, spaces):
                 matrix = space.matrix
                 batches = _batches_for(owner, entry, style, None if matrix is not None else space)
                 with gpu.matrix.push_pop():

@@ -135,6 +135,15 @@ def test_bone_batches_equal_polyscrew_sample_mapped_through_the_pose(pd):
         chain = np.array(rig.matrix_world) @ (np.array(parent.matrix) if parent else np.eye(4)) @ rest_offset(rig, bone)
         mapped = pd.owner_space(owner(rig, bone)).apply(b.instances)
         worst_formula = max(worst_formula, np.abs(mapped - chain @ expected).max())
+    # The draw code maps default bones together (two foreach_get for the whole armature, the
+    # parent's pose times the rest offset): the same spaces as Blender's bone transform above.
+    shown = [owner(rig, b) for b in CHAIN] + [owner(rig)]
+    together = pd.owner_spaces(rig, shown)
+    for space, one in zip(together, shown):
+        alone = pd.owner_space(one)
+        np.testing.assert_allclose(space.location, alone.location, rtol=0, atol=2e-6)
+        np.testing.assert_allclose(space.rotation, alone.rotation, rtol=0, atol=2e-6)
+        assert space.matrix is not None
     print(f"\nbone key poses mapped to the world vs Blender's pose: {worst_world:.1e}; "
           f"instances vs armature @ parent pose @ rest offset @ sample: {worst_formula:.1e}")
     assert worst_world < 2e-6  # Blender's pose matrices are float32 (3e-7 measured)
@@ -167,6 +176,8 @@ def test_bone_space_is_blenders_bone_transform_for_every_inherit_option(pd, opti
     for i, frame in enumerate(FRAMES):
         scene.frame_set(int(frame))
         space = pd.owner_space(owner(rig, "Child"))
+        together = pd.owner_spaces(rig, [owner(rig, "Root"), owner(rig, "Child")])[1]
+        np.testing.assert_allclose(together.apply(b.keys), space.apply(b.keys), rtol=0, atol=1e-12)
         single.append(space.matrix is not None)
         worst = max(worst, np.abs(space.apply(b.keys[i : i + 1])[0] - world_pose(rig, "Child")).max())
     print(f"\n{option}: mapped key poses vs Blender's pose {worst:.1e}; one matrix: {all(single)}")
