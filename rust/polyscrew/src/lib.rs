@@ -19,6 +19,9 @@
 //! | [`angular_velocity`] | fitting a rotation to a sketched angular velocity | Xie-Xu-Yu-Weng |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
+//! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
+//! allocation whose size depends on input is checked against one budget before it is made.
+//!
 //! What users reach for is re-exported here.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
@@ -40,6 +43,7 @@
 pub mod angular_velocity;
 pub mod error;
 pub mod feature;
+pub mod memory;
 pub mod motion;
 pub(crate) mod numeric;
 pub mod sweep;
@@ -58,6 +62,7 @@ pub use feature::registration::register;
 pub use feature::variational::{
     variational_curve, variational_subdivide, Parametrization, Stiffness,
 };
+pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{rotation_channels, EulerOrder, RotationMode};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};
