@@ -230,7 +230,11 @@ impl Screw {
                 let t = f64::from(k) / 16.0;
                 let (cos_th, sin_th) = sixteenth_turn(&turns, k);
                 let (cos_d, sin_d) = sixteenth_turn(&turns, k - 16);
-                let rho = if inv_sin_h > 0.0 { sin_th * inv_sin_h } else { t };
+                let rho = if inv_sin_h > 0.0 {
+                    sin_th * inv_sin_h
+                } else {
+                    t
+                };
                 let (a, b) = (rho * cos_d, rho * sin_d);
                 let two_sin = 2.0 * sin_th;
                 Pose {
@@ -761,14 +765,19 @@ mod tests {
             assert!(sc.is_translation(), "{a:?}");
             assert_eq!(sc.angle(), 0.0);
             let scale = 1.0 + position.length();
-            assert!((sc.slide() - 5.0).abs() < 1e-14 * scale, "{a:?}: {}", sc.slide());
+            assert!(
+                (sc.slide() - 5.0).abs() < 1e-14 * scale,
+                "{a:?}: {}",
+                sc.slide()
+            );
             assert!(sc.axis().distance(mv / 5.0) < 1e-14 * scale, "{a:?}");
             assert!(sc.eval(1.0).max_abs_diff(&b) < 1e-14 * scale);
-            assert!(
-                sc.eval(0.5).translation.distance(a.translation + 0.5 * mv) < 1e-14 * scale
-            );
+            assert!(sc.eval(0.5).translation.distance(a.translation + 0.5 * mv) < 1e-14 * scale);
         }
-        assert!(roundoff > 1000, "only {roundoff} pairs had a round-off turn");
+        assert!(
+            roundoff > 1000,
+            "only {roundoff} pairs had a round-off turn"
+        );
         // A true turn of 1e-13 rad is a screw, far above the threshold.
         let a = Pose::from_translation(DVec3::new(0.3, 0.2, 0.1));
         let b = Pose::from_rotation_translation(DQuat::from_rotation_x(1e-13), a.translation + mv);
