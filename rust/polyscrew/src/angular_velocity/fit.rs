@@ -28,6 +28,8 @@
 //! Times are in seconds and angular velocities in rad/s for the paper's defaults
 //! `alpha = 0.002` (units s^2) and `delta = 0.1` (units rad^2/s) to mean what they meant there.
 
+#![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` also catches NaN
+
 use glam::{DQuat, DVec3, DVec4};
 
 use crate::angular_velocity::quat_spline::{
