@@ -33,6 +33,9 @@ fi
 stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)'))"
 "$py" -m pytest -q -p no:cacheprovider tests/python
 
+stage "fuzz the module (Hypothesis, seeded; children under a 4 GB address-space cap)"
+"$py" tests/python/fuzz.py
+
 for dir in "$root"/.venv/bpy/*/; do
   version=$(basename "$dir")
   stage "pytest tests/blender under bpy $version"

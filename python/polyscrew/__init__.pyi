@@ -16,6 +16,7 @@ Working ranges (every value Blender can store, float32 below 3.4e38, is inside t
   poses at most a few times further out, so every square stays below about 1e303.
 - sweep vertices within +-1e75 (the area of a face is the fourth power of coordinates);
   the poses may move them anywhere within 1e150.
+- ``t`` of ``interpolate`` within +-1e12.
 - times (key times, sample times, the end of a period) within ``+-MAX_TIME`` (1e300), key
   times at least 1e-300 apart: the time map only takes differences, ratios and the
   reciprocal of two spacings.
@@ -112,7 +113,8 @@ def interpolate(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> FloatArray: ...
 def interpolate(a: ArrayLike, b: ArrayLike, t: float | ArrayLike) -> FloatArray:
     """``s(a, t, b)``: the pose a fraction ``t`` along the screw from ``a`` to ``b``.
 
-    ``t = 0`` gives ``a``, ``t = 1`` gives ``b``, other values move along or past the screw.
+    ``t = 0`` gives ``a``, ``t = 1`` gives ``b``, other values move along or past the screw,
+    within +-1e12 (beyond, ``t**2`` times a coordinate could overflow).
     Returns (4, 4) for a float ``t``, (len(t), 4, 4) for an array.
     """
 

@@ -13,6 +13,7 @@ use numpy::ndarray::{Array2, Array3, ArrayViewD};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::motion::sample::sample_footprint;
+use polyscrew::motion::screw::MAX_T;
 use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
     rotation_channels as core_rotation_channels, sample as core_sample,
@@ -291,8 +292,18 @@ fn interpolate<'py>(
     let b = read_one_pose(F, "b", b)?;
     let sc = Screw::between(&a, &b);
     let check_t = |index: usize, t: f64| {
-        if t.is_finite() {
+        if t.abs() <= MAX_T {
             Ok(())
+        } else if t.is_finite() {
+            Err(to_py_err(
+                F,
+                Error::OutOfRange {
+                    what: "t",
+                    index,
+                    value: t,
+                    range: "+-1e12",
+                },
+            ))
         } else {
             Err(to_py_err(F, Error::NotFinite { what: "t", index }))
         }
@@ -326,8 +337,8 @@ fn interpolate<'py>(
     )?;
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let ts = read_vector(F, "t", &view)?;
-        if let Some(index) = ts.iter().position(|v| !v.is_finite()) {
-            return Err(to_py_err(F, Error::NotFinite { what: "t", index }));
+        for (index, t) in ts.iter().enumerate() {
+            check_t(index, *t)?;
         }
         let mut poses = try_vec(ts.len(), "interpolated poses").map_err(|e| to_py_err(F, e))?;
         poses.extend(ts.iter().map(|t| sc.eval(*t)));

@@ -32,6 +32,17 @@ use crate::numeric::fastmath;
 use crate::numeric::fastmath::Real;
 use crate::numeric::lanes::{self, F4, LANES, Q4, V4};
 
+/// The working range of the screw parameter `t` of [`Screw::eval`] (`s(a, t, b)`):
+/// `|t| <= MAX_T`, a trillion times the screw and back.
+///
+/// Why: `M^t o_a` takes `rho^2 (v . o_a)` with `rho = sin(t h) / sin(h)`, which is `t` for a
+/// translation (whose `|v|` may still hold round-off up to [`ROTATION_ROUNDOFF`]) and at most
+/// `1 / sin(h)` for a turn; with coordinates within
+/// [`crate::motion::pose::MAX_COORDINATE`] every term stays below `1e180` for `|t|` up to
+/// `1e12`. Subdivision and sampling only evaluate `t` in `[-2, 3]`; callers passing any `t`
+/// (the Python `interpolate`) check it.
+pub const MAX_T: f64 = 1e12;
+
 /// A relative rotation whose vector part `|q.xyz| = sin(h)` is at most this is round-off:
 /// the screw is then a pure translation (axis along the translation, slide its length,
 /// angle 0).
