@@ -48,7 +48,7 @@ fn read_per_key(
     default: f32,
 ) -> PyResult<Vec<f64>> {
     match array {
-        Some(a) => read_vector(F, what, a.as_array()),
+        Some(a) => read_vector(F, what, &a.as_array()),
         None => Ok(vec![default as f64; k]),
     }
 }
@@ -205,7 +205,7 @@ fn evaluate_fcurves<'py>(
     period: Option<FloatArray<'py>>,
     cycles: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let times = read_vector(F, "times", times.as_array())?;
+    let times = read_vector(F, "times", &times.as_array())?;
     let offsets = read_ints("offsets", offsets.as_array())?;
     let c = offsets.len().saturating_sub(1);
     let co = read_pairs("co", co.as_array())?;

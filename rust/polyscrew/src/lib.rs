@@ -20,6 +20,9 @@
 //! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
+//! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
+//! allocation whose size depends on input is checked against one budget before it is made.
+//!
 //! What users reach for is re-exported here.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
@@ -42,6 +45,7 @@ pub mod angular_velocity;
 pub mod error;
 pub mod fcurve;
 pub mod feature;
+pub mod memory;
 pub mod motion;
 pub(crate) mod numeric;
 pub mod sweep;
@@ -64,6 +68,7 @@ pub use feature::registration::register;
 pub use feature::variational::{
     variational_curve, variational_subdivide, Parametrization, Stiffness,
 };
+pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{rotation_channels, EulerOrder, RotationMode};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};
