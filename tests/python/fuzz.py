@@ -32,7 +32,7 @@ TIMEOUT = 300
 
 GROUPS = [
     ["screw", "interpolate", "subdivide", "subdivide_vectors", "rotation_channels", "memory_budget"],
-    ["sample", "sample_vectors", "sample_channels"],
+    ["sample", "sample_vectors", "sample_channels", "evaluate_fcurves"],
     ["fit_angular_velocity", "AngularVelocityFit", "register_points", "inertia_points"],
     ["feature_motion", "sample_feature", "sweep"],
 ]
@@ -301,6 +301,51 @@ def worker(group: int, seed: int, examples: int) -> None:
     def sweep(v, t, p, steps, caps):
         check("sweep", lambda: ps.sweep(v, t, p, steps, caps))
 
+    @st.composite
+    def packed_curves(draw):
+        counts = draw(st.lists(st.integers(0, 5), min_size=1, max_size=3))
+        total = sum(counts)
+        offsets = [0]
+        for c in counts:
+            offsets.append(offsets[-1] + c)
+        if draw(st.booleans()):  # mostly well formed: increasing frames per curve
+            frames = []
+            for c in counts:
+                start = draw(st.floats(-100, 100))
+                steps = draw(st.lists(st.floats(0.01, 50), min_size=c, max_size=c))
+                frames += list(start + np.cumsum(steps))
+        else:
+            frames = draw(st.lists(real, min_size=total, max_size=total))
+        values = draw(st.lists(real, min_size=total, max_size=total))
+        co = np.array([frames, values], dtype=np.float64).T.reshape(total, 2)
+        shift = draw(st.lists(real, min_size=2, max_size=2))
+        codes = st.integers(-1, len(ps.INTERPOLATIONS))
+        mode = st.sampled_from(ps.CYCLE_MODES + ("NOPE",))
+        cycles = st.one_of(
+            st.none(),
+            st.fixed_dictionaries({"mode_before": mode, "mode_after": mode,
+                                   "cycles_before": st.integers(-2, 3), "cycles_after": st.integers(-2, 3)}),
+            junk,
+        )
+        return dict(
+            offsets=draw(mostly(
+                st.just(np.array(offsets, dtype=np.int64)),
+                st.lists(st.integers(-2, 9), max_size=4).map(lambda o: np.array(o, dtype=np.int64)),
+            )),
+            co=co,
+            handle_left=co - np.array(shift) * 0.1 if total else co,
+            handle_right=co + np.array(shift) * 0.1 if total else co,
+            interpolation=np.array(draw(st.lists(codes, min_size=total, max_size=total)), dtype=np.int64),
+            easing=np.array(draw(st.lists(st.integers(-1, len(ps.EASINGS)), min_size=total, max_size=total)), dtype=np.int64),
+            extrapolation=draw(st.one_of(st.none(), st.lists(st.sampled_from(ps.EXTRAPOLATIONS + ("NOPE",)), min_size=len(counts), max_size=len(counts)), junk)),
+            cycles=draw(st.one_of(st.none(), st.lists(cycles, min_size=len(counts), max_size=len(counts)), junk)),
+        )
+
+    @fuzz
+    @given(packed_curves(), st.one_of(times(increasing=False), st.lists(real, max_size=6), junk))
+    def evaluate_fcurves(curves, t):
+        check("evaluate_fcurves", lambda: ps.evaluate_fcurves(t, **curves))
+
     tests = {
         "screw": [screw], "interpolate": [interpolate], "subdivide": [subdivide],
         "subdivide_vectors": [subdivide_vectors], "rotation_channels": [rotation_channels],
@@ -308,7 +353,7 @@ def worker(group: int, seed: int, examples: int) -> None:
         "sample_channels": [sample_channels], "fit_angular_velocity": [fit_angular_velocity],
         "AngularVelocityFit": [angular_velocity_fit], "register_points": [register_points],
         "inertia_points": [inertia_points], "feature_motion": [feature_motion],
-        "sample_feature": [sample_feature], "sweep": [sweep],
+        "sample_feature": [sample_feature], "sweep": [sweep], "evaluate_fcurves": [evaluate_fcurves],
     }
     for name in GROUPS[group]:
         for test in tests[name]:
