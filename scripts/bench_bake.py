@@ -1,15 +1,21 @@
 """Benchmark: ScrewBender's bake against Blender's own `bpy.ops.nla.bake` and against a
 `keyframe_insert` loop, same objects and frames.
 
-The cases, all in the same Blender session:
+Four cases, all in the same Blender session:
   1. one object baked over 100,000 frames;
   2. 100 objects baked over 1,000 frames;
   3. 300 objects baked over 250 frames (issue 16: a scene of many short animations, where
-     the work per object counts more than the work per frame).
-Each object has location, rotation (XYZ Euler) and scale keys (ten keys at uneven frames),
-so every baker writes the same ten dense F-curves per object, one key per frame.
-ScrewBender's time covers everything the Smooth Motion operator does (reading keys,
-polyscrew sampling, writing the new action); nla.bake's time is the operator call.
+     the work per object counts more than the work per frame);
+  4. a 100-bone rig (ten chains of ten bones) baked over 1,000 frames, against
+     `nla.bake(bake_types={'POSE'})` of the same bones (Pose Mode, all bones selected).
+Each object and bone has location, rotation (XYZ Euler) and scale keys (ten keys at uneven
+frames), so every baker writes the same nine dense F-curves per object or bone, one key per
+frame. ScrewBender's time covers everything the Smooth Motion operator does (reading keys,
+polyscrew sampling, writing the new action); nla.bake's time is the operator call. The bone
+case runs ours (Jarek 4 levels, once with timing Keys, the default, once with timing Smooth,
+each on a fresh rig) and nla.bake back to back in each run (after one untimed warm-up
+smoothing), and reports the medians of the runs and their ratios, wall-clock and the
+process's CPU time (nla.bake's depsgraph evaluation runs on several threads).
 
 The `keyframe_insert` loop is what a script author writes today: for each frame, set the
 scene frame (`scene.frame_set`), set each object's location, rotation and scale from the
@@ -30,8 +36,10 @@ built .zip into a temporary Blender user directory):
 from __future__ import annotations
 
 import argparse
+import importlib
 import json
 import math
+import os
 import statistics
 import sys
 import time
@@ -103,6 +111,98 @@ def run_case(count: int, frames: int) -> tuple[float, float]:
     return ours, theirs
 
 
+def keyed_rig(bones: int, frames: int) -> bpy.types.Object:
+    """An armature of `bones` bones in chains of ten (each bone the child of the previous one,
+    not connected: its location counts), every bone keyed like the objects above."""
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    data = bpy.data.armatures.new("Rig")
+    rig = bpy.data.objects.new("Rig", data)
+    scene.collection.objects.link(rig)
+    select([rig])
+    bpy.ops.object.mode_set(mode="EDIT")
+    previous = None
+    for n in range(bones):
+        chain, link = divmod(n, 10)
+        bone = data.edit_bones.new(f"Bone{n:03d}")
+        bone.head, bone.tail = (chain, 0.0, link), (chain, 0.0, link + 1.0)
+        bone.parent = previous if link else None
+        previous = bone
+    bpy.ops.object.mode_set(mode="OBJECT")
+    for n, pose_bone in enumerate(rig.pose.bones):
+        pose_bone.rotation_mode = "XYZ"
+        for k in range(10):
+            u = (k / 9) ** 1.2  # uneven key spacing
+            frame = 1 + round(u * (frames - 1))
+            pose_bone.location = (0.3 * math.cos(4 * u + n), 0.3 * math.sin(3 * u), 0.2 * u)
+            pose_bone.rotation_euler = (0.5 * math.sin(5 * u), 0.3 * u, 6 * u + n)
+            pose_bone.scale = (1 + 0.3 * math.sin(7 * u), 1.0, 1 + 0.2 * u)
+            for path in ("location", "rotation_euler", "scale"):
+                pose_bone.keyframe_insert(path, frame=frame)
+    scene.frame_start, scene.frame_end = 1, frames
+    return rig
+
+
+#: The bone case's timings of the motion between keys: "keys" (the default since issue 17:
+#: Blender's own pace, read from its curves) and "smooth" (a monotone C1 time map).
+BONE_TIMINGS = ("keys", "smooth")
+
+
+def smooth_bones(bones: int, frames: int, timing: str) -> tuple[float, float, bpy.types.Object]:
+    """ScrewBender's Smooth Motion of every bone of a fresh rig (Object Mode, the armature
+    selected, Armatures: Bones Only), Jarek 4 levels with `timing`: wall-clock and process CPU
+    seconds, and the rig."""
+    rig = keyed_rig(bones, frames)
+    select([rig])
+    owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
+    start, cpu = time.perf_counter(), time.process_time()
+    selection = owners.selection(bpy.context, "BONES", bake.channels.object_fcurves)
+    result = bake.smooth(selection, bake.Options(scheme="jarek", levels=4, timing=timing))
+    ours, ours_cpu = time.perf_counter() - start, time.process_time() - cpu
+    assert result.bones == bones and not result.skipped, result.skipped
+    keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
+    assert keys == 9 * bones * frames, (keys, bones, frames)
+    return ours, ours_cpu, rig
+
+
+def run_bone_case(bones: int, frames: int) -> dict:
+    """One run: ScrewBender's Smooth Motion of every bone of a fresh rig with each of
+    :data:`BONE_TIMINGS`, then nla.bake POSE of the same bones over the same frames (on the
+    last rig's source action). Wall-clock seconds and the process's CPU seconds (every thread
+    of the process, so Blender's threaded depsgraph evaluation counts)."""
+    out = {}
+    for timing in BONE_TIMINGS:
+        out[timing], out[f"{timing}_cpu"], rig = smooth_bones(bones, frames, timing)
+
+    # Blender's baker on the source action, the same bones and frames
+    adt = rig.animation_data
+    bake.channels.assign(rig, adt.action[bake.SOURCE_KEY], adt.action.get(bake.SOURCE_SLOT_KEY, ""))
+    bpy.ops.object.mode_set(mode="POSE")
+    for pose_bone in rig.pose.bones:
+        (pose_bone if hasattr(pose_bone, "select") else pose_bone.bone).select = True
+    start, cpu = time.perf_counter(), time.process_time()
+    done = bpy.ops.nla.bake(
+        frame_start=1, frame_end=frames, step=1, only_selected=True, visual_keying=False,
+        clear_constraints=False, clear_parents=False, use_current_action=False, bake_types={"POSE"},
+        channel_types={"LOCATION", "ROTATION", "SCALE"},
+    )
+    out["nla"], out["nla_cpu"] = time.perf_counter() - start, time.process_time() - cpu
+    assert done == {"FINISHED"}, done
+    bpy.ops.object.mode_set(mode="OBJECT")
+    their_keys = sum(len(fc.keyframe_points) for fc in bake_fcurves(rig))
+    assert their_keys == 9 * bones * frames, their_keys
+    print(
+        f"{bones:4d} bones     x {frames:6d} frames: nla.bake {out['nla']:7.3f} s (CPU {out['nla_cpu']:.3f} s); "
+        + "; ".join(
+            f"ScrewBender timing {t} {out[t]:.3f} s (CPU {out[t + '_cpu']:.3f} s), ratio {out['nla'] / out[t]:.1f}x "
+            f"(CPU {out['nla_cpu'] / out[t + '_cpu']:.1f}x)"
+            for t in BONE_TIMINGS
+        )
+        + f"  ({their_keys} keys each)"
+    )
+    return out
+
+
 def keyframe_insert_loop(count: int, frames: int) -> float:
     """Seconds of the `keyframe_insert` loop over `count` fresh objects and `frames` frames."""
     objects = keyed_objects(count, frames)
@@ -139,8 +239,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="a tenth of the frames (a smoke run)")
     parser.add_argument("--repeat", type=int, default=3, help="runs per case; the best time of each baker counts")
+    parser.add_argument("--bone-runs", type=int, default=5, help="runs of the bone case (medians count)")
+    parser.add_argument("--only-bones", action="store_true", help="run the bone case only")
+    parser.add_argument("--bone-phases", action="store_true",
+                        help="where the bone case's Smooth Motion spends its time (phases, cProfile), nothing else")
     parser.add_argument("--out", type=Path, help="write the results as JSON here")
     args = parser.parse_args()
+    if args.bone_phases:
+        bone_phases()
+        return
+    if args.only_bones:
+        result = {"blender": bpy.app.version_string, "quick": args.quick, "bones": bone_case(args)}
+        if args.out:
+            args.out.write_text(json.dumps(result, indent=1))
+        return
     scale = 10 if args.quick else 1
     print(f"Blender {bpy.app.version_string}, bake over every frame, jarek 4 levels")
     result = {"blender": bpy.app.version_string, "quick": args.quick, "repeat": args.repeat,
@@ -179,8 +291,105 @@ def main() -> None:
                   f"{value:.0f} s (extrapolated from {len(one)} sizes, time ~ frames^{p:.2f})")
         print(f"  keyframe_insert loop / ScrewBender: {case['loop'] / case['ours']:.0f}x"
               + (" (extrapolated)" if case["loop_extrapolated"] else ""))
+    result["bones"] = bone_case(args)
     if args.out:
         args.out.write_text(json.dumps(result, indent=1))
+
+
+def bone_phases(bones: int = 100, frames: int = 1_000, runs: int = 3) -> dict:
+    """Where Smooth Motion of the rig spends its time: process CPU seconds in reading
+    (`keys.read`), sampling (`bake.sample_channels`) and writing (`bake.write`), medians of
+    `runs` per timing; then the top of a cProfile (CPU time) of one timing-Keys run."""
+    import cProfile
+    import functools
+    import io
+    import pstats
+
+    package = bake.__name__.rsplit(".", 1)[0]
+    keys_module = importlib.import_module(package + ".keys")
+    spent: dict[str, float] = {}
+
+    def timed(module, name):
+        function = getattr(module, name)
+
+        @functools.wraps(function)
+        def wrapper(*args, **kwargs):
+            start = time.process_time()
+            try:
+                return function(*args, **kwargs)
+            finally:
+                spent[name] = spent.get(name, 0.0) + time.process_time() - start
+
+        setattr(module, name, wrapper)
+        return module, name, function
+
+    smooth_bones(3, 20, "keys")  # warm-up: the first Smooth Motion of a session imports and allocates
+    originals = [timed(keys_module, "read"), timed(bake, "sample_channels"), timed(bake, "write")]
+    out = {}
+    try:
+        for timing in BONE_TIMINGS:
+            rows = []
+            for _ in range(runs):
+                spent.clear()
+                seconds, cpu, _rig = smooth_bones(bones, frames, timing)
+                rows.append(dict(spent, total=cpu))
+            out[timing] = {k: statistics.median(r[k] for r in rows) for k in rows[0]}
+            print(f"  phases, timing {timing} (CPU, median of {runs}): "
+                  + ", ".join(f"{k} {v * 1e3:.0f} ms" for k, v in out[timing].items()))
+    finally:
+        for module, name, function in originals:
+            setattr(module, name, function)
+    rig = keyed_rig(bones, frames)
+    select([rig])
+    owners = importlib.import_module(package + ".owners")
+    # Reading every bone, each read scanning all the rig's curves, against the curves grouped
+    # by owner once (what Smooth Motion does).
+    every = [owners.Owner(rig, b.name) for b in rig.pose.bones]
+    scans, grouped = [], []
+    for _ in range(runs):
+        start = time.process_time()
+        for owner in every:
+            keys_module.read(owner)
+        scans.append(time.process_time() - start)
+        start = time.process_time()
+        by_owner = owners.curves_by_owner(bake.channels.object_fcurves(rig))
+        for owner in every:
+            keys_module.read(owner, fcurves=by_owner[owner.bone])
+        grouped.append(time.process_time() - start)
+    out["read_scanning"], out["read_grouped"] = statistics.median(scans), statistics.median(grouped)
+    print(f"  reading {bones} bones (CPU, median of {runs}): each scanning all curves {out['read_scanning'] * 1e3:.0f} ms, "
+          f"curves grouped by owner once {out['read_grouped'] * 1e3:.0f} ms")
+    profile = cProfile.Profile(time.process_time)
+    profile.enable()
+    bake.smooth(owners.selection(bpy.context, "BONES", bake.channels.object_fcurves),
+                bake.Options(scheme="jarek", levels=4, timing="keys"))
+    profile.disable()
+    text = io.StringIO()
+    pstats.Stats(profile, stream=text).sort_stats("tottime").print_stats(12)
+    print(text.getvalue())
+    return out
+
+
+def bone_case(args) -> dict:
+    """The 100-bone rig x 1,000 frames (--quick: 100 frames): medians of --bone-runs runs."""
+    bones, frames = 100, 1_000 // (10 if args.quick else 1)
+    rig = keyed_rig(3, 20)  # warm-up: the first Smooth Motion of a session imports and allocates
+    select([rig])
+    owners = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".owners")
+    assert bake.smooth(owners.selection(bpy.context, "BONES", bake.channels.object_fcurves), bake.Options()).bones == 3
+    runs = [run_bone_case(bones, frames) for _ in range(args.bone_runs)]
+    median = {key: statistics.median(r[key] for r in runs) for key in runs[0]}
+    for t in BONE_TIMINGS:
+        per_run = ", ".join(f"{r['nla'] / r[t]:.1f}x" for r in runs)
+        print(f"  median of {len(runs)}, timing {t}: ScrewBender {median[t]:.3f} s, nla.bake {median['nla']:.3f} s, "
+              f"ratio {median['nla'] / median[t]:.1f}x (per run {per_run}); "
+              f"CPU time {median[t + '_cpu']:.3f} s vs {median['nla_cpu']:.3f} s, "
+              f"ratio {median['nla_cpu'] / median[t + '_cpu']:.1f}x")
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    if load is not None:
+        print(f"  machine: {os.cpu_count()} CPUs, load average {load:.1f}")
+    return {"bones": bones, "frames": frames, "runs": runs, "median": median, "timings": list(BONE_TIMINGS),
+            "load": load}
 
 
 if __name__ == "__main__":

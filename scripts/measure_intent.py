@@ -34,7 +34,7 @@ import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
-from mathutils import Euler, Matrix  # noqa: E402
+from mathutils import Euler  # noqa: E402
 
 
 def fresh() -> None:

@@ -46,6 +46,9 @@ fi
 stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)'))"
 "$py" -m pytest -q -p no:cacheprovider tests/python
 
+stage "fuzz the module (Hypothesis, seeded; children under a 4 GB address-space cap)"
+"$py" tests/python/fuzz.py
+
 # Packaging: the wheel's tag and GLIBC, Blender's validate on the zips, the multi-platform
 # assembly, the release workflow, `cargo publish --dry-run`, `twine check` (issue 20).
 stage "pytest tests/packaging"

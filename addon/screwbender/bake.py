@@ -459,13 +459,19 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
     skipped = []
+    # The objects share the action: its curves grouped by owner once (not scanned per bone).
+    listed = channels.object_fcurves(first) if read_from is None else channels.action_fcurves(read_from, source_slot)
+    by_owner = owners.curves_by_owner(listed)
     for bone in group.bones:
         row = []
         for obj in group.objects:
             owner = owners.Owner(obj, bone)
             try:
                 row.append(
-                    keys.read(owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range)
+                    keys.read(
+                        owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range,
+                        fcurves=by_owner.get(bone, []),
+                    )
                 )
             except SmoothError as err:
                 skipped.append((owner, str(err)))

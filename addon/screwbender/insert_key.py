@@ -9,9 +9,13 @@ moves slightly; :func:`insert_key` measures by how much, by sampling the motion 
 from the F-curves before and after, at every whole frame of the keyed range and at f.
 
 Keys are written with `FCurve.keyframe_points.insert` on every keyed transform channel
-(location and rotation always, scale when it is keyed), in the object's rotation mode and
+(location and rotation always, scale when it is keyed), in the owner's rotation mode and
 continuous with the curve there (quaternion sign, compatible Euler angles). F-curves store
 float32: the inserted pose is the motion's pose rounded to float32 channel values.
+
+The owner is an object or a pose bone (:mod:`owners`): a bone is keyed in its own space
+(`matrix_basis`), its curves in the F-curve group named after it, as Blender keys bones; a
+bone connected to its parent gets no location key (Blender ignores its location).
 """
 
 from __future__ import annotations
@@ -22,7 +26,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, transaction
+from . import bake, channels, keys, owners, transaction
 from .keys import SmoothError
 
 
@@ -33,7 +37,8 @@ class InsertResult:
     frame: float
     #: property name -> the inserted channel values.
     values: dict[str, np.ndarray]
-    #: Largest displacement of the object's origin over the checked frames (scene units).
+    #: Largest displacement of the owner's origin (a bone's head) over the checked frames, in
+    #: its own space (an object's parent space, a bone's rest space; scene units).
     max_translation: float
     #: Largest rotation between the old and new orientation over the checked frames (radians).
     max_angle: float
@@ -65,57 +70,68 @@ def pose_change(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return translation, angle
 
 
-def _current_values(obj: bpy.types.Object, curves: dict, path: str, size: int, frame: float) -> np.ndarray:
-    static = np.array(getattr(obj, path), dtype=np.float64)
+def _current_values(target, curves: dict, path: str, size: int, frame: float) -> np.ndarray:
+    static = np.array(getattr(target, path), dtype=np.float64)
     return np.array(
         [curves[(path, i)].evaluate(frame) if (path, i) in curves else static[i] for i in range(size)]
     )
 
 
-def insert_key(obj: bpy.types.Object, frame: float, options: bake.Options, t: transaction.Transaction) -> InsertResult:
-    """Keys the pose the smoothed motion of `obj` has at `frame` on its transform channels
-    (inside the transaction `t`: the curves get their old keys back if anything fails later).
+def insert_key(
+    owner: owners.Owner | bpy.types.Object, frame: float, options: bake.Options, t: transaction.Transaction
+) -> InsertResult:
+    """Keys the pose the smoothed motion of `owner` (an object or a pose bone) has at `frame`
+    on its transform channels (inside the transaction `t`: the curves get their old keys back
+    if anything fails later).
 
     Raises :class:`SmoothError` (nothing changed) when the keys cannot be smoothed.
     """
-    before = keys.read(obj, options.closed)
+    owner = owners.as_owner(owner)
+    name = owner.name
+    before = keys.read(owner, options.closed)
     frames = check_frames(before, frame)
     try:
-        poses_before, _ = bake.sample_poses(before, frames, options, obj)
-        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options, obj)
+        poses_before, _ = bake.sample_poses(before, frames, options, owner)
+        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options, owner)
     except ValueError as err:
-        raise SmoothError(f"{obj.name}: {err}") from err
+        raise SmoothError(f"{name}: {err}") from err
 
-    mode = obj.rotation_mode
+    mode = owner.rotation_mode
     rotation_path = keys.rotation_path(mode)
     size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
-    curves = {(fc.data_path, fc.array_index): fc for fc in channels.object_fcurves(obj)}
-    previous = _current_values(obj, curves, rotation_path, size, frame)
+    curves = {}
+    for fc in channels.object_fcurves(owner.obj):
+        prop = owner.prop_of(fc.data_path)
+        if prop is not None:
+            curves[(prop, fc.array_index)] = fc
+    previous = _current_values(owner.target, curves, rotation_path, size, frame)
     values = {
         "location": pose[0, :3, 3].copy(),
         rotation_path: polyscrew.rotation_channels(pose, mode, previous=previous)[0],
     }
+    if not before.located:
+        del values["location"]  # a connected bone: Blender ignores its location
     if before.scale_keyed:
         values["scale"] = scale[0]  # only its keyed axes are keyed again (below)
 
-    adt = obj.animation_data
-    bag = channels.ensure_container(adt.action, channels.assigned_slot(obj))
+    adt = owner.obj.animation_data
+    bag = channels.ensure_container(adt.action, channels.assigned_slot(owner.obj))
     for path, vector in values.items():
         for index, value in enumerate(vector):
             if path == "scale" and not before.scale_axes[index]:
                 continue  # unkeyed scale stays unkeyed (a mirrored object's static -1 included)
             fcurve = curves.get((path, index))
             if fcurve is None:
-                fcurve = t.new_fcurve(bag, path, index)
+                fcurve = t.new_fcurve(bag, owner.path(path), index, owner.group)
             else:
                 t.keep_keys(fcurve)
             channels.insert_key(fcurve, frame, float(value))
 
-    after = keys.read(obj, options.closed)
+    after = keys.read(owner, options.closed)
     try:
-        poses_after, _ = bake.sample_poses(after, frames, options, obj)
+        poses_after, _ = bake.sample_poses(after, frames, options, owner)
     except ValueError as err:
-        raise SmoothError(f"{obj.name}: {err}") from err
+        raise SmoothError(f"{name}: {err}") from err
     translation, angle = pose_change(poses_before, poses_after)
     worst = int(np.argmax(translation))
     return InsertResult(

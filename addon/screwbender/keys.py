@@ -188,6 +188,7 @@ def read(
     action: bpy.types.Action | None = None,
     slot: str = "",
     extend_to: tuple[float, float] | None = None,
+    fcurves: list | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -199,6 +200,9 @@ def read(
     original keys under a smoothed result). `extend_to` is the frame range to be covered
     when a Cycles modifier plays the keys on (Repeat with Offset, Mirror): the keys are
     extended by Blender's playback over it, plus :data:`intent.EXTRA_CYCLES` on each side.
+    `fcurves`, when given, are the F-curves to read from instead (the caller's grouping by
+    owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
+    scanning all its curves for each bone).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth.
     """
@@ -208,7 +212,10 @@ def read(
     name = owner.name
     mode = owner.rotation_mode
     paths = transform_paths(mode)
-    listed = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
+    if fcurves is not None:
+        listed = fcurves
+    else:
+        listed = channels.object_fcurves(obj) if action is None else channels.action_fcurves(action, slot)
     # A bone connected to its parent ignores its location (Blender's BKE_pchan_to_mat4): its
     # pose has no translation, and its location curves are not the bake's business.
     located = not owner.bone or not obj.data.bones[owner.bone].use_connect

@@ -12,6 +12,7 @@ for a bone (`PoseBone.matrix_basis`).
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import bpy
@@ -37,9 +38,10 @@ class Owner:
         """What holds the transform properties: the object or the pose bone."""
         return self.obj.pose.bones[self.bone] if self.bone else self.obj
 
-    @property
+    @functools.cached_property
     def prefix(self) -> str:
-        """The data-path prefix of the owner's F-curves in the object's action."""
+        """The data-path prefix of the owner's F-curves in the object's action (computed once:
+        reading and baking a bone asks for it for every curve)."""
         return f'pose.bones["{_quoted(self.bone)}"].' if self.bone else ""
 
     @property
@@ -104,17 +106,36 @@ def _bone_of(data_path: str) -> tuple[str, str] | None:
     return name, prop
 
 
-def keyed_bones(obj: bpy.types.Object, fcurves) -> list[str]:
-    """The bones of armature `obj` with keyed transform curves among `fcurves`, in the
-    armature's bone order."""
+def keyed_bones(obj: bpy.types.Object, fcurves, grouped: dict | None = None) -> list[str]:
+    """The bones of armature `obj` with keyed transform curves among `fcurves` (or in
+    `grouped`, their :func:`curves_by_owner`), in the armature's bone order."""
     if obj.type != "ARMATURE" or obj.pose is None:
         return []
     keyed = set()
-    for fc in fcurves:
-        found = _bone_of(fc.data_path)
-        if found is not None and len(fc.keyframe_points):
-            keyed.add(found[0])
+    if grouped is not None:
+        keyed = {bone for bone, curves in grouped.items() if bone and any(len(fc.keyframe_points) for fc in curves)}
+    else:
+        for fc in fcurves:
+            found = _bone_of(fc.data_path)
+            if found is not None and len(fc.keyframe_points):
+                keyed.add(found[0])
     return [b.name for b in obj.pose.bones if b.name in keyed]
+
+
+def curves_by_owner(fcurves) -> dict[str, list]:
+    """The transform F-curves among `fcurves` grouped by owner: bone name -> that bone's
+    location, rotation and scale curves, "" -> the object's own. One pass over the curves,
+    so that reading many bones of one action does not scan every curve once per bone."""
+    out: dict[str, list] = {}
+    for fc in fcurves:
+        path = fc.data_path
+        if path in _TRANSFORM_PROPS:
+            out.setdefault("", []).append(fc)
+            continue
+        found = _bone_of(path)
+        if found is not None:
+            out.setdefault(found[0], []).append(fc)
+    return out
 
 
 def is_hidden(obj: bpy.types.Object, bone: str) -> bool:
@@ -157,14 +178,25 @@ def selection(context: bpy.types.Context, armature: str = "BOTH", fcurves_of=Non
         return sorted((Owner(b.id_data, b.name) for b in bones), key=lambda o: (o.obj.name, o.bone))
     out = []
     for obj in sorted(context.selected_objects, key=lambda o: o.name):
-        if obj.type != "ARMATURE" or armature == "OBJECT":
-            out.append(Owner(obj))
-            continue
-        curves = fcurves_of(obj) if fcurves_of is not None else []
-        if armature == "BOTH" and has_own_keys(obj, curves):
-            out.append(Owner(obj))
-        bones = [b for b in keyed_bones(obj, curves) if not is_hidden(obj, b) or is_selected(obj, b)]
-        out += [Owner(obj, b) for b in bones]
-        if not bones and not (armature == "BOTH" and has_own_keys(obj, curves)):
-            out.append(Owner(obj))  # nothing keyed: read it to say so
+        curves = fcurves_of(obj) if fcurves_of is not None and obj.type == "ARMATURE" else []
+        out += of_object(obj, armature, curves)
+    return out
+
+
+def of_object(obj: bpy.types.Object, armature: str = "BOTH", fcurves=(), grouped: dict | None = None) -> list[Owner]:
+    """The owners of one object that Smooth Motion takes in Object Mode: the object itself;
+    for an armature, per `armature` (:data:`ARMATURE_MODES`), its own keys and/or its keyed
+    bones among `fcurves` (its F-curves; `grouped`: their :func:`curves_by_owner` when the
+    caller has it), hidden bones and bones in hidden collections only when selected; the
+    armature itself when nothing is keyed (reading it says so)."""
+    if obj.type != "ARMATURE" or armature == "OBJECT":
+        return [Owner(obj)]
+    out = []
+    own = armature == "BOTH" and has_own_keys(obj, fcurves if grouped is None else grouped.get("", []))
+    if own:
+        out.append(Owner(obj))
+    bones = [b for b in keyed_bones(obj, fcurves, grouped) if not is_hidden(obj, b) or is_selected(obj, b)]
+    out += [Owner(obj, b) for b in bones]
+    if not bones and not own:
+        out.append(Owner(obj))  # nothing keyed: read it to say so
     return out

@@ -1,34 +1,39 @@
 # SPDX-License-Identifier: GPL-3.0-or-later
 """The live stroboscopic preview's data: what the overlay draws, computed without a GPU.
 
-For each previewed object (ScrewBender paper, section 5 and figure 13: the "3D rubber band"):
+For each previewed owner (ScrewBender paper, section 5 and figure 13: the "3D rubber band"):
+an object, or a keyed bone of a previewed armature (:func:`preview_owners`):
 
-- N instances of the object at evenly spaced times over the motion's frame range,
-- the trajectory of its origin at M evenly spaced times,
+- N instances of the object (of the bone: its octahedral shape, :func:`bone_geometry`) at
+  evenly spaced times over the motion's frame range,
+- the trajectory of its origin (a bone's head) at M evenly spaced times,
 - the key poses,
 - optionally the raw polyscrew (0 levels, linear timing: one screw per key span).
 
 The keys are read by :func:`keys.read` and the motion sampled by :func:`bake.sample_poses`,
 the very functions Smooth Motion bakes with, in ONE `polyscrew.sample` call for instances and
 trajectory together (plus one `sample_vectors` call when scale is keyed, plus one call for
-the raw polyscrew when it is shown). :class:`PreviewCache` keeps the result per object under
-a hash of the object's transform F-curves (raw key data: co, handles, interpolation, ...) and
+the raw polyscrew when it is shown). :class:`PreviewCache` keeps the result per owner under
+a hash of the owner's transform F-curves (raw key data: co, handles, interpolation, ...) and
 the settings, and recomputes only when that hash changes. Nothing here writes Blender data.
 
-All matrices are in the object's parent space (what `matrix_basis` means); the draw code
-multiplies by the parent's world matrix.
+All matrices are in the owner's own space (what `matrix_basis` means: an object's parent
+space, a bone's rest pose under its parent bone); the draw code maps them to the world at
+the current frame (:mod:`preview_draw`: the parent's world matrix, or for a bone the armature
+and its parent bones as posed now).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 from dataclasses import astuple, dataclass, field
 
 import bpy
 import numpy as np
 
-from . import bake, channels, keys
+from . import bake, channels, keys, owners
 from .keys import SmoothError
 
 #: Default number of stroboscopic instances.
@@ -74,6 +79,11 @@ class PreviewOptions:
         """A hashable summary of these options."""
         return (astuple(self.smooth), self.instances, self.trajectory_points, self.show_raw)
 
+    @functools.cached_property
+    def key_bytes(self) -> bytes:
+        """:meth:`key` as bytes for a digest, made once (every previewed owner hashes it)."""
+        return repr(self.key()).encode()
+
 
 @dataclass
 class PreviewBatches:
@@ -117,11 +127,14 @@ def with_scale(poses: np.ndarray, scales: np.ndarray) -> np.ndarray:
     return out
 
 
-def compute(motion: keys.KeyedMotion, options: PreviewOptions, obj: bpy.types.Object | None = None) -> PreviewBatches:
+def compute(
+    motion: keys.KeyedMotion, options: PreviewOptions, obj: bpy.types.Object | owners.Owner | None = None
+) -> PreviewBatches:
     """The preview of `motion`: one :func:`bake.sample_poses` call for instances and trajectory.
 
-    `obj` is the object the motion was read from: the Feature Points method needs its mesh and
-    key selection (without it the preview falls back to screw subdivision, as the bake would).
+    `obj` is the owner the motion was read from (an object or a bone): the Feature Points
+    method needs its body (mesh, bone length) and key selection (without it the preview falls
+    back to screw subdivision, as the bake would).
     Raises `ValueError` from polyscrew for motions it refuses.
     """
     start, end = frame_range(motion, options.smooth)
@@ -154,6 +167,94 @@ def compute(motion: keys.KeyedMotion, options: PreviewOptions, obj: bpy.types.Ob
     return batches
 
 
+@dataclass(frozen=True)
+class Space:
+    """Where an owner's own-space matrices land in the world at the current frame.
+
+    For an object (and a bone that inherits its parent's whole transform, Blender's default)
+    this is one matrix: `world = P @ M`. A bone with Inherit Rotation off, Local Location off
+    or another Inherit Scale mode places its rotation and scale through one matrix and its
+    location through another (Blender's `BKE_bone_parent_transform_apply`); Inherit Scale
+    "Aligned" also scales the bone's own axes by its parent's scale afterwards. In general:
+
+        world(M)[:3, :3] = rotation @ (M[:3, :3] * ratio)      (ratio: elementwise, d_j / d_i)
+        world(M)[:3, 3]  = location[:3, :3] @ M[:3, 3] + location[:3, 3]
+
+    where `rotation @ ratio-scaling` is `R_parent @ M3 @ diag(d)` written so that only the
+    ratios of the post-scale `d` are needed.
+    """
+
+    #: The 3x3 matrix carrying the owner's rotation and scale.
+    rotation: np.ndarray
+    #: The 4x4 affine matrix carrying the owner's location.
+    location: np.ndarray
+    #: (3, 3) ratios d_j / d_i of the post-scale (all ones without one).
+    ratio: np.ndarray
+
+    @classmethod
+    def of_matrix(cls, matrix) -> Space:
+        """The space of one matrix: `world = matrix @ M`."""
+        m = np.asarray(matrix, dtype=np.float64)
+        return cls(m[:3, :3].copy(), m.copy(), np.ones((3, 3)))
+
+    @property
+    def matrix(self) -> np.ndarray | None:
+        """The one 4x4 matrix this space is (`world = matrix @ M`), or None when location and
+        rotation go through different matrices (the batches are then mapped on the CPU)."""
+        if np.array_equal(self.ratio, np.ones((3, 3))) and np.array_equal(self.rotation, self.location[:3, :3]):
+            return self.location
+        return None
+
+    def apply(self, matrices: np.ndarray) -> np.ndarray:
+        """Own-space matrices (N, 4, 4) in the world."""
+        out = np.zeros_like(matrices, dtype=np.float64)
+        out[:, :3, :3] = self.rotation @ (matrices[:, :3, :3] * self.ratio)
+        out[:, :3, 3] = matrices[:, :3, 3] @ self.location[:3, :3].T + self.location[:3, 3]
+        out[:, 3, 3] = 1.0
+        return out
+
+    def apply_points(self, points: np.ndarray) -> np.ndarray:
+        """Own-space origins (N, 3) in the world."""
+        return points @ self.location[:3, :3].T + self.location[:3, 3]
+
+    def key(self) -> bytes:
+        """The bytes that identify this space (for caching what is drawn in it)."""
+        return self.rotation.tobytes() + self.location.tobytes() + self.ratio.tobytes()
+
+
+#: A bone's parent space is measured by mapping these matrices through Blender's own bone
+#: transform (`Bone.convert_local_to_pose`): the identity, a unit translation along each axis
+#: (the location matrix), and a quarter-turn cycling the axes (the post-scale ratios).
+CYCLE = np.array([[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
+
+
+def space_from_probes(world: np.ndarray, identity: np.ndarray, moved: np.ndarray, cycled: np.ndarray) -> Space:
+    """The :class:`Space` of a bone from Blender's bone transform `f` (local to armature
+    space) of the probes: `identity = f(I)`, `moved[i] = f(T(e_i))`, `cycled = f(CYCLE)`, and
+    the armature's world matrix `world`.
+
+    `f(M) = [A M3 D | L t + l]`: f(I) gives `B = A D` and `l`; f(T(e_i)) the columns of L;
+    `B^-1 f(CYCLE)3 = D^-1 C D` holds the ratios of D's entries (where B is singular, a
+    zero-scaled parent, the ratios are taken as one).
+    """
+    b = identity[:3, :3]
+    origin = identity[:3, 3]
+    location = np.eye(4)
+    location[:3, :3] = np.stack([m[:3, 3] - origin for m in moved], axis=1)
+    location[:3, 3] = origin
+    ratio = np.ones((3, 3))
+    if abs(np.linalg.det(b)) > 1e-12:
+        q = np.linalg.solve(b, cycled[:3, :3])  # D^-1 C D: entries (0,2), (1,0), (2,1) are d2/d0, d0/d1, d1/d2
+        d = np.array([1.0, 1.0 / q[1, 0], q[0, 2]]) if q[1, 0] != 0.0 else np.ones(3)
+        ratio = d[None, :] / d[:, None]
+        if np.allclose(ratio, 1.0, rtol=0.0, atol=1e-6):
+            ratio = np.ones((3, 3))
+    w3 = world[:3, :3]
+    if np.allclose(location[:3, :3], b, rtol=0.0, atol=1e-7 * (1.0 + np.abs(b).max())):
+        location[:3, :3] = b  # one matrix (float32 probes agree to rounding)
+    return Space(w3 @ b, world @ location, ratio)
+
+
 #: Current transform values differing from the curves by more than this (relative) at a key
 #: frame mean the user is moving the object there.
 LIVE_TOLERANCE = 1e-5
@@ -173,24 +274,40 @@ class LiveKey:
 
 
 def key_hash(
-    obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
+    owner: owners.Owner | bpy.types.Object,
+    options: PreviewOptions,
+    frame: float | None = None,
+    auto_key: bool = False,
+    fcurves: list | None = None,
 ) -> tuple[bytes, LiveKey | None]:
-    """A digest of everything :func:`keys.read` reads from `obj`, and of `options`; and the
-    live key at `frame` (see :class:`LiveKey`), which enters the digest too.
+    """A digest of everything :func:`keys.read` reads from `owner` (an object or a pose
+    bone), and of `options`; and the live key at `frame` (see :class:`LiveKey`), which enters
+    the digest too.
 
     Raw F-curve data of the transform channels (key coordinates, handles, interpolation,
     easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
-    transform channels, the action and slot, NLA strips and transform drivers. Reading it is a
-    few `foreach_get` calls: far cheaper than reading and sampling the keys. The current
-    transform enters only when `frame` is a key frame (or `auto_key` is on) and it differs
-    from the curves there, so playing or scrubbing the timeline never recomputes anything.
+    transform channels, the action and slot, NLA strips and transform drivers (for a bone
+    also whether it is connected, which decides whether its location is read, and its
+    length). Reading it is a few `foreach_get` calls: far cheaper than reading and sampling
+    the keys. The current transform enters only when `frame` is a key frame (or `auto_key` is
+    on) and it differs from the curves there, so playing or scrubbing the timeline never
+    recomputes anything. `fcurves`: the owner's curves when the caller has grouped them
+    already (:func:`owners.curves_by_owner`), else the object's curves are searched.
     """
+    owner = owners.as_owner(owner)
+    obj, target = owner.obj, owner.target
     digest = hashlib.blake2b(digest_size=16)
-    digest.update(repr(options.key()).encode())
-    mode = obj.rotation_mode
-    paths = keys.transform_paths(mode)
+    digest.update(options.key_bytes)
+    mode = target.rotation_mode
+    props = keys.transform_paths(mode)
+    paths = tuple(owner.path(p) for p in props)
     adt = obj.animation_data
     digest.update(f"{mode}|{obj.name_full}".encode())
+    located = True
+    if owner.bone:
+        bone = obj.data.bones[owner.bone]
+        located = not bone.use_connect
+        digest.update(f"|{owner.bone}|{located}|{bone.length!r}".encode())
     if adt is not None:
         action = adt.action
         digest.update(
@@ -201,10 +318,13 @@ def key_hash(
     feature_method = options.smooth.method == "FEATURE"
     curves = {}
     at_key = False
-    for fc in channels.object_fcurves(obj):
+    for fc in channels.object_fcurves(obj) if fcurves is None else fcurves:
         if fc.data_path not in paths:
             continue
-        curves[(fc.data_path, fc.array_index)] = fc
+        prop = props[paths.index(fc.data_path)]
+        if prop == "location" and not located:
+            continue  # a connected bone's location is not read
+        curves[(prop, fc.array_index)] = fc
         points = fc.keyframe_points
         count = len(points)
         digest.update(
@@ -226,15 +346,17 @@ def key_hash(
             flags = np.empty(count, dtype=bool)
             points.foreach_get("select_control_point", flags)
             digest.update(flags.tobytes())
-    if feature_method and obj.type == "MESH":  # the feature points are the mesh's inertia points
+    if feature_method and not owner.bone and obj.type == "MESH":  # the feature points are the mesh's inertia points
         co = np.empty(3 * len(obj.data.vertices), dtype=np.float32)
         obj.data.vertices.foreach_get("co", co)
         digest.update(co.tobytes())
     # Unkeyed channels enter the key poses with their current (static) value.
     current = {}
     changed = False
-    for path in paths:
-        values = np.array(getattr(obj, path), dtype=np.float64)
+    for path in props:
+        values = np.array(getattr(target, path), dtype=np.float64)
+        if path == "location" and not located:
+            values = np.zeros(3)  # Blender ignores it: the pose has no translation
         current[path] = values
         static = [v for i, v in enumerate(values) if (path, i) not in curves]
         digest.update(np.asarray(static, dtype=np.float64).tobytes())
@@ -245,7 +367,7 @@ def key_hash(
                     changed = True
     live = None
     if changed:
-        live = LiveKey(frame, current[paths[0]], current[paths[1]], current[paths[2]])
+        live = LiveKey(frame, current[props[0]], current[props[1]], current[props[2]])
         digest.update(np.concatenate([[frame], live.location, live.rotation, live.scale]).tobytes())
     return digest.digest(), live
 
@@ -256,7 +378,8 @@ def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
     if not np.all(live.scale > 0.0):
         return motion
     rotation = keys.rotation_matrices(live.rotation[None, :], motion.rotation_mode)
-    pose = keys.compose(live.location[None, :], rotation)[0]
+    location = live.location if motion.located else np.zeros(3)  # a connected bone: no translation
+    pose = keys.compose(location[None, :], rotation)[0]
     hits = np.flatnonzero(np.abs(motion.frames - live.frame) < keys.FRAME_TOLERANCE)
     if len(hits):
         k = hits[0]
@@ -276,7 +399,7 @@ def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
 
 @dataclass
 class PreviewEntry:
-    """The cached preview of one object."""
+    """The cached preview of one owner (an object or a bone)."""
 
     digest: bytes
     #: The batches, or None when the object's keys cannot be previewed.
@@ -285,42 +408,74 @@ class PreviewEntry:
     error: str = ""
 
 
+def cache_key(owner: owners.Owner | bpy.types.Object) -> int | tuple[int, str]:
+    """Where the preview of `owner` is cached: an object under its `session_uid`, a bone
+    under (its armature object's `session_uid`, the bone's name)."""
+    owner = owners.as_owner(owner)
+    uid = owner.obj.session_uid
+    return (uid, owner.bone) if owner.bone else uid
+
+
+def preview_owners(
+    obj: bpy.types.Object, armature: str = "BOTH", fcurves: list | None = None, grouped: dict | None = None
+) -> list[owners.Owner]:
+    """What the preview of `obj` shows: the object itself; for an armature what Smooth Motion
+    would smooth in Object Mode (:func:`owners.of_object`, per the Armatures option
+    `armature`): its keyed bones (hidden ones only when selected) and/or its own keys.
+    `fcurves` are the object's F-curves (read from its action when not given), `grouped`
+    their :func:`owners.curves_by_owner` when the caller has it."""
+    if obj.type != "ARMATURE":
+        return [owners.Owner(obj)]
+    return owners.of_object(obj, armature, channels.object_fcurves(obj) if fcurves is None else fcurves, grouped)
+
+
 class PreviewCache:
-    """Previews per object (by `session_uid`), recomputed only when their key hash changes."""
+    """Previews per owner (:func:`cache_key`: objects by `session_uid`, bones by
+    (`session_uid`, bone name)), recomputed only when their key hash changes."""
 
     def __init__(self) -> None:
-        self.entries: dict[int, PreviewEntry] = {}
-        #: How many times each object (by name) was recomputed: for tests and statistics.
+        self.entries: dict[int | tuple[int, str], PreviewEntry] = {}
+        #: How many times each owner (by name: "Cube", "Rig: Hand") was recomputed: for tests
+        #: and statistics.
         self.recomputed: dict[str, int] = {}
 
     def refresh(
-        self, obj: bpy.types.Object, options: PreviewOptions, frame: float | None = None, auto_key: bool = False
+        self,
+        owner: owners.Owner | bpy.types.Object,
+        options: PreviewOptions,
+        frame: float | None = None,
+        auto_key: bool = False,
+        fcurves: list | None = None,
     ) -> tuple[PreviewEntry, bool]:
-        """The preview of `obj` and whether it was recomputed now (its hash changed).
+        """The preview of `owner` (an object or a bone) and whether it was recomputed now
+        (its hash changed).
 
-        `frame` is the current frame: when the object is being moved there, at a key frame or
-        with auto-keying on (`auto_key`), the preview shows the motion with the object's
-        current pose as the key at that frame.
+        `frame` is the current frame: when the owner is being moved there, at a key frame or
+        with auto-keying on (`auto_key`), the preview shows the motion with the owner's
+        current pose as the key at that frame. `fcurves`: the owner's own transform curves
+        when the caller has grouped them (:func:`owners.curves_by_owner`).
         """
-        digest, live = key_hash(obj, options, frame, auto_key)
-        uid = obj.session_uid
-        entry = self.entries.get(uid)
+        owner = owners.as_owner(owner)
+        digest, live = key_hash(owner, options, frame, auto_key, fcurves)
+        key = cache_key(owner)
+        entry = self.entries.get(key)
         if entry is not None and entry.digest == digest:
             return entry, False
+        name = owner.name
         try:
-            motion = keys.read(obj, options.smooth.closed, extend_to=options.smooth.frame_range)
+            motion = keys.read(owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves)
             if live is not None:
                 motion = with_live_key(motion, live)
-            entry = PreviewEntry(digest, compute(motion, options, obj))
+            entry = PreviewEntry(digest, compute(motion, options, owner))
         except (SmoothError, ValueError) as err:
             message = str(err)
-            entry = PreviewEntry(digest, None, message if message.startswith(obj.name) else f"{obj.name}: {message}")
-        self.entries[uid] = entry
-        self.recomputed[obj.name] = self.recomputed.get(obj.name, 0) + 1
+            entry = PreviewEntry(digest, None, message if message.startswith(name) else f"{name}: {message}")
+        self.entries[key] = entry
+        self.recomputed[name] = self.recomputed.get(name, 0) + 1
         return entry, True
 
-    def forget(self, keep: set[int] | None = None) -> None:
-        """Drops every entry (or every entry whose object is not in `keep`)."""
+    def forget(self, keep: set | None = None) -> None:
+        """Drops every entry (or every entry whose :func:`cache_key` is not in `keep`)."""
         if keep is None:
             self.entries.clear()
         else:
@@ -352,7 +507,8 @@ class Geometry:
     points: np.ndarray  # (V, 3) float32
     edges: np.ndarray  # (E, 2) int32
     tris: np.ndarray  # (T, 3) int32
-    #: "MESH", "BOX" (bounding box of a heavy mesh or of a non-mesh object) or "AXES".
+    #: "MESH", "BOX" (bounding box of a heavy mesh or of a non-mesh object), "AXES" or
+    #: "BONE" (:func:`bone_geometry`).
     kind: str
 
 
@@ -390,6 +546,34 @@ def object_geometry(obj: bpy.types.Object, heavy_limit: int) -> Geometry:
     size = float(getattr(obj, "empty_display_size", 1.0))
     axes = np.array([(0, 0, 0), (size, 0, 0), (0, 0, 0), (0, size, 0), (0, 0, 0), (0, 0, size)], dtype=np.float32)
     return Geometry(axes, np.array([(0, 1), (2, 3), (4, 5)], dtype=np.int32), np.zeros((0, 3), dtype=np.int32), "AXES")
+
+
+#: A bone's waist (where Blender's octahedral bone is widest) and half its width there, per
+#: unit of bone length.
+BONE_WAIST = 0.1
+#: Edges and triangles of the octahedral bone of :func:`bone_geometry`: head 0, tail 1, the
+#: waist square 2 to 5.
+BONE_EDGES = np.array(
+    [(0, 2), (0, 3), (0, 4), (0, 5), (1, 2), (1, 3), (1, 4), (1, 5), (2, 3), (3, 4), (4, 5), (5, 2)], dtype=np.int32
+)
+BONE_TRIS = np.array(
+    [(0, 3, 2), (0, 4, 3), (0, 5, 4), (0, 2, 5), (1, 2, 3), (1, 3, 4), (1, 4, 5), (1, 5, 2)], dtype=np.int32
+)
+
+
+def bone_geometry(length: float, box: bool = False) -> Geometry:
+    """The instance shape of a bone of `length` in its own space (head at the origin, the
+    bone along +Y, as `PoseBone.matrix` places it): Blender's octahedral bone (head, tail and
+    a square waist at a tenth of the length, so its roll shows), or with `box` the box around
+    it that the Feature Points method uses (:func:`feature.bone_points`)."""
+    w = BONE_WAIST * length
+    if box:
+        corners = box_corners(np.array([-w, 0.0, -w]), np.array([w, length, w]))
+        return Geometry(corners, BOX_EDGES, BOX_TRIS, "BOX")
+    points = np.array(
+        [(0.0, 0.0, 0.0), (0.0, length, 0.0), (w, w, 0.0), (0.0, w, w), (-w, w, 0.0), (0.0, w, -w)], dtype=np.float32
+    )
+    return Geometry(points, BONE_EDGES, BONE_TRIS, "BONE")
 
 
 def instance_vertices(points: np.ndarray, matrices: np.ndarray) -> np.ndarray:

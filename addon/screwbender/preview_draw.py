@@ -4,14 +4,20 @@
 - :func:`sync` installs the draw handler (`SpaceView3D.draw_handler_add`, POST_VIEW) and a
   `depsgraph_update_post` handler while at least one object has its preview on, and removes
   both as soon as none has: nothing is left behind.
-- The depsgraph handler only checks each previewed object's key hash
-  (:func:`preview.key_hash`); an object is recomputed only when its hash changed, and the
-  viewports are redrawn only then.
+- The depsgraph handler only checks the key hash of each previewed owner
+  (:func:`preview.key_hash`): every previewed object, and for an armature its keyed bones
+  (:func:`preview.preview_owners`); an owner is recomputed only when its hash changed, and
+  the viewports are redrawn only then.
 - :func:`draw_previews` draws the cached batches (also into an offscreen buffer:
   :func:`render_offscreen`). It reads Blender data and never writes any.
 
-Batches are built in each object's parent space and drawn under its parent's current world
-matrix (`matrix_world @ matrix_basis^-1`), so moving a parent does not recompute anything.
+Batches are built in each owner's own space and drawn in the world as it is at the current
+frame (:func:`owner_space`): an object under its parent's current world matrix
+(`matrix_world @ matrix_basis^-1`), a bone under its armature object and its parent bones as
+they are posed now (Blender's own bone transform, Inherit Rotation, Inherit Scale and Local
+Location included). Moving a parent, or posing a parent bone, does not recompute anything.
+The parents' own motion over time is not composed in: a bone's instances show its motion
+relative to its parent, placed where the parent is at the current frame.
 """
 
 from __future__ import annotations
@@ -25,7 +31,7 @@ from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 from mathutils import Matrix
 
-from . import bake, preview
+from . import bake, channels, owners, preview
 
 #: The object property that turns an object's preview on.
 OBJECT_PROP = "screwbender_preview"
@@ -43,12 +49,12 @@ SOLID_ALPHA = 0.25
 #: Size of the key origin points, pixels.
 KEY_POINT_SIZE = 8.0
 
-#: The previews of all objects.
+#: The previews of all owners.
 CACHE = preview.PreviewCache()
 
 _draw_handle = None
-#: object session_uid -> (batch key, {name: (batch, shader name)})
-_gpu_batches: dict[int, tuple[tuple, dict]] = {}
+#: owner cache key (:func:`preview.cache_key`) -> (batch key, {name: (batch, shader name)})
+_gpu_batches: dict[int | tuple[int, str], tuple[tuple, dict]] = {}
 #: object session_uid -> counter bumped when the depsgraph reports its geometry changed.
 _geometry_generation: dict[int, int] = {}
 _last_draw_error = ""
@@ -90,12 +96,37 @@ def enabled_objects(scene: bpy.types.Scene) -> list[bpy.types.Object]:
     return [obj for obj in scene.objects if getattr(obj, OBJECT_PROP, False)]
 
 
+def armature_mode(scene: bpy.types.Scene) -> str:
+    """The panel's Armatures option: which owners of a previewed armature are shown."""
+    return scene.screwbender.armature
+
+
+def owners_with_curves(obj: bpy.types.Object, scene: bpy.types.Scene) -> list[tuple[owners.Owner, list]]:
+    """The owners the preview of `obj` shows (:func:`preview.preview_owners`), each with its
+    own transform F-curves (the object's curves grouped once, not searched per bone)."""
+    curves = channels.object_fcurves(obj)
+    by_owner = owners.curves_by_owner(curves)
+    return [(o, by_owner.get(o.bone, [])) for o in preview.preview_owners(obj, armature_mode(scene), curves, by_owner)]
+
+
+def previewed_owners(scene: bpy.types.Scene, objects: list[bpy.types.Object] | None = None) -> list[owners.Owner]:
+    """Every owner previewed in `scene` (of `objects`, by default those with the preview on)."""
+    objects = enabled_objects(scene) if objects is None else objects
+    return [o for obj in objects for o, _ in owners_with_curves(obj, scene)]
+
+
 def moved_unkeyed(scene: bpy.types.Scene, objects: list[bpy.types.Object]) -> list[str]:
-    """Names of `objects` moved at a key frame and not keyed (the preview shows a live key)."""
+    """Names of the owners of `objects` moved at a key frame and not keyed (the preview shows
+    a live key)."""
     options = preview_options(scene)
     frame = current_frame(scene)
     auto = auto_keying(scene)
-    return [obj.name for obj in objects if preview.key_hash(obj, options, frame, auto)[1] is not None]
+    return [
+        owner.name
+        for obj in objects
+        for owner, curves in owners_with_curves(obj, scene)
+        if preview.key_hash(owner, options, frame, auto, curves)[1] is not None
+    ]
 
 
 # Handlers ---------------------------------------------------------------------------------
@@ -177,16 +208,18 @@ def _deferred_sync() -> None:
 
 
 def refresh(scene: bpy.types.Scene) -> bool:
-    """Checks the key hash of every previewed object of `scene`, recomputing those whose hash
-    changed; returns whether any was recomputed. Forgets objects no longer previewed."""
+    """Checks the key hash of every previewed owner of `scene`, recomputing those whose hash
+    changed; returns whether any was recomputed. Forgets owners no longer previewed."""
     options = preview_options(scene)
     objects = enabled_objects(scene)
     changed = False
     frame = current_frame(scene)
     auto = auto_keying(scene)
+    keep = set()
     for obj in objects:
-        changed = CACHE.refresh(obj, options, frame, auto)[1] or changed
-    keep = {obj.session_uid for obj in objects}
+        for owner, curves in owners_with_curves(obj, scene):
+            changed = CACHE.refresh(owner, options, frame, auto, curves)[1] or changed
+            keep.add(preview.cache_key(owner))
     CACHE.forget(keep)
     for uid in [u for u in _gpu_batches if u not in keep]:
         del _gpu_batches[uid]
@@ -272,12 +305,112 @@ def parent_space(obj: bpy.types.Object) -> Matrix:
     return obj.matrix_world @ obj.matrix_basis.inverted_safe()
 
 
-def _geometry_key(obj: bpy.types.Object, style: _Style) -> tuple:
+def owner_space(owner: owners.Owner | bpy.types.Object) -> preview.Space:
+    """Where the owner's own-space batches land in the world at the current frame.
+
+    An object: :func:`parent_space`. A bone: the armature object's world matrix times
+    Blender's own bone transform from the bone's local (`matrix_basis`) space to armature
+    space (`Bone.convert_local_to_pose`, with the parent bone's current `PoseBone.matrix`),
+    measured on a few probe matrices (:func:`preview.space_from_probes`). Constraints on the
+    bone itself are not drawn; its parents' are, as they pose the parents now.
+    """
+    owner = owners.as_owner(owner)
+    if not owner.bone:
+        return preview.Space.of_matrix(np.array(parent_space(owner.obj), dtype=np.float64))
+    pose_bone = owner.target
+    bone = pose_bone.bone
+    parent = pose_bone.parent
+
+    def to_pose(matrix: np.ndarray) -> np.ndarray:
+        m = Matrix(matrix.tolist())
+        if parent is None:
+            out = bone.convert_local_to_pose(m, bone.matrix_local)
+        else:
+            out = bone.convert_local_to_pose(
+                m, bone.matrix_local, parent_matrix=parent.matrix, parent_matrix_local=parent.bone.matrix_local
+            )
+        return np.array(out, dtype=np.float64)
+
+    moved = []
+    for axis in range(3):
+        m = np.eye(4)
+        m[axis, 3] = 1.0
+        moved.append(to_pose(m))
+    world = np.array(owner.obj.matrix_world, dtype=np.float64)
+    return preview.space_from_probes(world, to_pose(np.eye(4)), np.array(moved), to_pose(preview.CYCLE))
+
+
+def _matrices(collection, name: str) -> np.ndarray:
+    """(N, 4, 4) float64 of the 4x4 matrix property `name` of every item of `collection`, in
+    one `foreach_get` (Blender stores matrices column by column)."""
+    flat = np.empty(16 * len(collection), dtype=np.float32)
+    collection.foreach_get(name, flat)
+    return flat.reshape(-1, 4, 4).transpose(0, 2, 1).astype(np.float64)
+
+
+def owner_spaces(obj: bpy.types.Object, shown: list[owners.Owner]) -> list[preview.Space]:
+    """:func:`owner_space` of each of `shown` (owners of `obj`), the bones of the armature
+    together: a bone that inherits its parent's whole transform (Inherit Rotation, Inherit
+    Scale Full, Local Location: Blender's defaults) is in the space
+    `A P_parent L_parent^-1 L` (A the armature's world matrix, P the parent's current
+    `PoseBone.matrix`, L the rest `Bone.matrix_local`; `A L` for a root bone), read for all
+    bones in two `foreach_get` calls; any other bone through :func:`owner_space`."""
+    bones = [o for o in shown if o.bone]
+    if not bones:
+        return [owner_space(o) for o in shown]
+    pose, rest = obj.pose.bones, obj.data.bones
+    pose_index = {b.name: i for i, b in enumerate(pose)}
+    rest_index = {b.name: i for i, b in enumerate(rest)}
+    posed = _matrices(pose, "matrix")
+    local = _matrices(rest, "matrix_local")
+    world = np.array(obj.matrix_world, dtype=np.float64)
+    out = []
+    for owner in shown:
+        data = rest[owner.bone] if owner.bone else None
+        if data is None or not (data.use_inherit_rotation and data.inherit_scale == "FULL" and data.use_local_location):
+            out.append(owner_space(owner))
+            continue
+        offset = local[rest_index[owner.bone]]
+        if data.parent is not None:
+            parent = data.parent.name
+            offset = posed[pose_index[parent]] @ np.linalg.solve(local[rest_index[parent]], offset)
+        out.append(preview.Space.of_matrix(world @ offset))
+    return out
+
+
+def _geometry_key(owner: owners.Owner, style: _Style) -> tuple:
+    obj = owner.obj
+    if owner.bone:
+        return ("BONE", obj.data.name_full, owner.bone, obj.data.bones[owner.bone].length, style.style)
     data = obj.data
     counts = (len(data.vertices), len(data.edges)) if obj.type == "MESH" else ()
     return (
         obj.type, data.name_full if data is not None else "", counts,
         _geometry_generation.get(obj.session_uid, 0), style.style, style.heavy_limit,
+    )
+
+
+def owner_geometry(owner: owners.Owner, style: _Style) -> preview.Geometry:
+    """What one instance of `owner` looks like: the object's shape (:func:`preview.object_geometry`)
+    or the bone's (:func:`preview.bone_geometry`, its box for the Bounding Box display)."""
+    if owner.bone:
+        return preview.bone_geometry(owner.obj.data.bones[owner.bone].length, box=style.style == "BOX")
+    heavy = 0 if style.style == "BOX" else style.heavy_limit
+    return preview.object_geometry(owner.obj, heavy)
+
+
+def world_batches(batches: preview.PreviewBatches, space: preview.Space) -> preview.PreviewBatches:
+    """`batches` mapped into the world through `space` (for a space that is not one matrix)."""
+    raw = batches.raw_instances is not None
+    return preview.PreviewBatches(
+        instance_times=batches.instance_times,
+        instances=space.apply(batches.instances),
+        trajectory_times=batches.trajectory_times,
+        trajectory=space.apply_points(batches.trajectory),
+        key_frames=batches.key_frames,
+        keys=space.apply(batches.keys),
+        raw_instances=space.apply(batches.raw_instances) if raw else None,
+        raw_trajectory=space.apply_points(batches.raw_trajectory) if raw else None,
     )
 
 
@@ -290,9 +423,8 @@ def _point_shader() -> gpu.types.GPUShader:
     raise ValueError(f"none of the shaders {POINT_SHADERS} is built in")
 
 
-def _build(entry: preview.PreviewEntry, geometry: preview.Geometry, style: _Style) -> dict:
-    """GPU batches for one object: {name: (batch, shader name)}."""
-    b = entry.batches
+def _build(b: preview.PreviewBatches, geometry: preview.Geometry, style: _Style) -> dict:
+    """GPU batches for one owner: {name: (batch, shader name)}."""
     out = {}
     line_shader = gpu.shader.from_builtin(LINE_SHADER)
     face_shader = gpu.shader.from_builtin(FACE_SHADER)
@@ -331,14 +463,19 @@ def _build(entry: preview.PreviewEntry, geometry: preview.Geometry, style: _Styl
     return out
 
 
-def _batches_for(obj: bpy.types.Object, entry: preview.PreviewEntry, style: _Style) -> dict:
-    key = (entry.digest, _geometry_key(obj, style))
-    cached = _gpu_batches.get(obj.session_uid)
+def _batches_for(
+    owner: owners.Owner, entry: preview.PreviewEntry, style: _Style, space: preview.Space | None = None
+) -> dict:
+    """The GPU batches of `owner`'s preview: in its own space, or with `space` (one that is
+    not a single matrix) mapped into the world, rebuilt when that space changes."""
+    key = (entry.digest, _geometry_key(owner, style), space.key() if space is not None else b"")
+    cache_key = preview.cache_key(owner)
+    cached = _gpu_batches.get(cache_key)
     if cached is not None and cached[0] == key:
         return cached[1]
-    heavy = 0 if style.style == "BOX" else style.heavy_limit
-    built = _build(entry, preview.object_geometry(obj, heavy), style)
-    _gpu_batches[obj.session_uid] = (key, built)
+    batches = entry.batches if space is None else world_batches(entry.batches, space)
+    built = _build(batches, owner_geometry(owner, style), style)
+    _gpu_batches[cache_key] = (key, built)
     return built
 
 
@@ -378,8 +515,9 @@ def _draw_one(batches: dict, style: _Style, viewport_size: tuple[float, float]) 
 def draw_previews(
     scene: bpy.types.Scene, view_layer: bpy.types.ViewLayer, viewport_size: tuple[float, float]
 ) -> int:
-    """Draws the preview of every previewed, visible object of `scene` with the current GPU
-    matrices; returns how many objects were drawn."""
+    """Draws the preview of every previewed, visible object of `scene` (for an armature, of
+    its previewed bones and/or itself) with the current GPU matrices; returns how many
+    owners were drawn."""
     options = preview_options(scene)
     style = _style(scene)
     frame = current_frame(scene)
@@ -392,14 +530,18 @@ def draw_previews(
         for obj in enabled_objects(scene):
             if not obj.visible_get(view_layer=view_layer):
                 continue
-            entry, _ = CACHE.refresh(obj, options, frame, auto)
-            if entry.batches is None:
-                continue
-            batches = _batches_for(obj, entry, style)
-            with gpu.matrix.push_pop():
-                gpu.matrix.multiply_matrix(parent_space(obj))
-                _draw_one(batches, style, viewport_size)
-            drawn += 1
+            shown = owners_with_curves(obj, scene)
+            entries = [CACHE.refresh(owner, options, frame, auto, curves)[0] for owner, curves in shown]
+            drawable = [(owner, entry) for (owner, _), entry in zip(shown, entries) if entry.batches is not None]
+            spaces = owner_spaces(obj, [owner for owner, _ in drawable])
+            for (owner, entry), space in zip(drawable, spaces):
+                matrix = space.matrix
+                batches = _batches_for(owner, entry, style, None if matrix is not None else space)
+                with gpu.matrix.push_pop():
+                    if matrix is not None:
+                        gpu.matrix.multiply_matrix(Matrix(matrix.tolist()))
+                    _draw_one(batches, style, viewport_size)
+                drawn += 1
     finally:
         gpu.state.point_size_set(1.0)
         gpu.state.depth_mask_set(True)

@@ -4,7 +4,10 @@
 Scheme, levels, timing, cycle and frame range are Smooth Motion's own panel settings
 (`scene.screwbender`): the preview shows what Smooth Motion would bake, and Apply bakes it
 through the same :func:`bake.smooth`. The preview's display settings live in
-`scene.screwbender_preview`; the per-object switch is `Object.screwbender_preview`.
+`scene.screwbender_preview`; the per-object switch is `Object.screwbender_preview` (on an
+armature it previews the bones Smooth Motion would smooth in Object Mode, per the panel's
+Armatures option). Insert Key on Motion keys the owners Smooth Motion would smooth: in Pose
+Mode the selected bones, in Object Mode the selected objects and armatures' bones.
 """
 
 from __future__ import annotations
@@ -14,7 +17,7 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
 
-from . import bake, bake_ops, insert_key, preview, preview_draw, transaction
+from . import bake, bake_ops, channels, insert_key, owners, preview, preview_draw, transaction
 from .keys import SmoothError
 
 STYLES = (
@@ -73,6 +76,15 @@ def _keyed_selection(context) -> list[bpy.types.Object]:
     return [obj for obj in context.selected_objects if obj.animation_data is not None]
 
 
+def _key_owners(context) -> list[owners.Owner]:
+    """What Insert Key on Motion keys: the owners Smooth Motion would smooth (Pose Mode: the
+    selected bones; Object Mode: the selected keyed objects, for armatures per the panel's
+    Armatures option)."""
+    armature = context.scene.screwbender.armature
+    found = owners.selection(context, armature, channels.object_fcurves)
+    return [o for o in found if o.obj.animation_data is not None]
+
+
 class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
     """Bake the previewed motion of the objects with the preview on, exactly as shown, through Smooth Motion (the old actions are kept); their preview is turned off"""
 
@@ -82,8 +94,8 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
-        if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode")
+        if context.mode not in ("OBJECT", "POSE"):
+            cls.poll_message_set("Switch to Object Mode or Pose Mode")
             return False
         if not preview_draw.enabled_objects(context.scene):
             cls.poll_message_set("No object has its ScrewBender preview on")
@@ -102,7 +114,8 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
             return {"CANCELLED"}
         try:
             with transaction.atomic() as t:
-                result = bake.smooth(objects, preview_draw.smooth_options(context.scene), t=t)
+                selection = preview_draw.previewed_owners(context.scene, objects)
+                result = bake.smooth(selection, preview_draw.smooth_options(context.scene), t=t)
                 for obj in result.objects:
                     t.set(obj, preview_draw.OBJECT_PROP, False)
         except SmoothError as err:
@@ -116,7 +129,7 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
 
 
 class SCREWBENDER_OT_insert_key(bpy.types.Operator):
-    """Key, at the current frame, the pose the smoothed motion has there (on every keyed transform channel), to refine the motion locally; reports how much the motion moved"""
+    """Key, at the current frame, the pose the smoothed motion has there (on every keyed transform channel), to refine the motion locally; reports how much the motion moved. Pose Mode: the selected bones; Object Mode: the selected objects (armatures: their keyed bones, per the Armatures option)"""
 
     bl_idname = "screwbender.insert_key"
     bl_label = "Insert Key on Motion"
@@ -124,7 +137,7 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
 
     max_translation: FloatProperty(
         name="Largest Move", subtype="DISTANCE",
-        description="Largest displacement of an object's origin that the new key caused (output)",
+        description="Largest displacement of an object's origin (a bone's head, in its own space) that the new key caused (output)",
     )
     max_angle: FloatProperty(
         name="Largest Turn", subtype="ANGLE",
@@ -133,8 +146,13 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode == "POSE":
+            if not context.selected_pose_bones:
+                cls.poll_message_set("Select one or more keyed bones")
+                return False
+            return True
         if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode")
+            cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
             return False
         if not _keyed_selection(context):
             cls.poll_message_set("Select one or more keyed objects")
@@ -151,15 +169,15 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         scene = context.scene
         frame = scene.frame_current + scene.frame_subframe
         options = preview_draw.smooth_options(scene)
-        objects = sorted(_keyed_selection(context), key=lambda o: o.name)
+        selection = _key_owners(context)
         results = []
         errors = []
         try:
             with transaction.atomic() as t:
-                for obj in objects:  # an object that cannot be smoothed is skipped unchanged
+                for owner in selection:  # an owner that cannot be smoothed is skipped unchanged
                     try:
                         with transaction.atomic(t) as one:
-                            results.append((obj, insert_key.insert_key(obj, frame, options, one)))
+                            results.append((owner, insert_key.insert_key(owner, frame, options, one)))
                     except SmoothError as err:
                         errors.append(str(err))
         except Exception as err:  # every key inserted so far is taken back
@@ -170,10 +188,10 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
             return {"CANCELLED"}
         self.max_translation = max(r.max_translation for _, r in results)
         self.max_angle = max(r.max_angle for _, r in results)
-        for obj, r in results:
+        for owner, r in results:
             self.report(
                 {"INFO"},
-                f"{obj.name}: key at frame {frame:g}; the motion moved by at most {r.max_translation:.3g} "
+                f"{owner.name}: key at frame {frame:g}; the motion moved by at most {r.max_translation:.3g} "
                 f"(frame {r.worst_frame:g}) and turned by at most {math.degrees(r.max_angle):.3g} deg "
                 f"over {len(r.checked_frames)} frames",
             )
@@ -201,9 +219,17 @@ class VIEW3D_PT_screwbender_preview(bpy.types.Panel):
         obj = context.active_object
         if obj is not None:
             layout.prop(obj, preview_draw.OBJECT_PROP, text=f"Preview {obj.name}")
-            entry = preview_draw.CACHE.entries.get(obj.session_uid)
-            if getattr(obj, preview_draw.OBJECT_PROP) and entry is not None and entry.error:
-                layout.label(text=entry.error, icon="ERROR")
+            if getattr(obj, preview_draw.OBJECT_PROP):
+                shown = preview_draw.previewed_owners(context.scene, [obj])
+                entries = [preview_draw.CACHE.entries.get(preview.cache_key(o)) for o in shown]
+                errors = [e.error for e in entries if e is not None and e.error]
+                for error in errors[:3]:
+                    layout.label(text=error, icon="ERROR")
+                if len(errors) > 3:
+                    layout.label(text=f"... and {len(errors) - 3} more", icon="ERROR")
+                if obj.type == "ARMATURE":
+                    bones = sum(1 for o in shown if o.bone)
+                    layout.label(text=f"{bones} bone(s), placed by the pose at the current frame", icon="BONE_DATA")
         layout.label(text="Scheme and levels: as Smooth Motion above", icon="INFO")
         layout.use_property_split = True
         layout.use_property_decorate = False
@@ -245,7 +271,9 @@ def register_properties() -> None:
         BoolProperty(
             name="ScrewBender Preview", default=False, update=_toggled,
             description="Draw this object's smoothed motion live in the viewport (stroboscopic instances, "
-            "origin trajectory, key poses), recomputed whenever its keys change",
+            "origin trajectory, key poses), recomputed whenever its keys change. On an armature: its keyed "
+            "bones (and its own keys, per the Armatures option) as bone shapes, each in the world through "
+            "the armature and its parent bones as they are posed at the current frame",
         ),
     )
     bpy.types.VIEW3D_MT_object_animation.append(menu_func)

@@ -7,6 +7,8 @@ The pipeline, per object (Rossignac-Kim, "Swept volumes"):
    object's local frame, scaled by the object's (constant) world scale;
 2. :func:`world_poses` samples the object's rigid world motion: at every key of the action
    made by Smooth Motion where there is one, otherwise at every frame of the scene's range;
+   a mesh carried by a bone (:func:`bone_driver`: parented to it, or deformed rigidly by it
+   through an Armature modifier) moves with the bone's world motion;
 3. `polyscrew.sweep` builds the swept mesh (each pair of samples is one screw);
 4. :func:`create_object` writes it into a new object of the "Swept Regions" collection,
    optionally closed into a manifold volume by Blender's voxel remesh.
@@ -28,7 +30,7 @@ import polyscrew
 from mathutils import Matrix, Vector
 from mathutils.bvhtree import BVHTree
 
-from . import bake
+from . import bake, channels, owners
 
 #: Name of the collection that receives swept regions.
 COLLECTION = "Swept Regions"
@@ -70,28 +72,199 @@ def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
 
 
-def motion_frames(obj: bpy.types.Object, scene: bpy.types.Scene) -> np.ndarray:
-    """The frames to sample: the keys of the smoothed action (Smooth Motion bakes one key per
-    step, subframes included) where there is one, else every frame of the scene's range."""
-    if bake.source_of(obj) is not None:
-        from . import channels
+# Meshes carried by a bone --------------------------------------------------------------
 
+#: Modifiers that change a mesh's shape the same way wherever the mesh is (they use nothing
+#: but the mesh itself): allowed anywhere in the stack of a mesh deformed by a bone.
+SHAPE_ONLY_MODIFIERS = frozenset(
+    {"SUBSURF", "MULTIRES", "BEVEL", "SOLIDIFY", "TRIANGULATE", "EDGE_SPLIT", "WEIGHTED_NORMAL", "WELD",
+     "WIREFRAME", "DECIMATE", "UV_PROJECT", "UV_WARP"}
+)
+#: Blender's Armature modifier leaves a vertex whose weights sum to no more than this where it
+#: is (`armature_deform.cc`: `contrib > 0.0001f`).
+ARMATURE_WEIGHT_THRESHOLD = 1e-4
+
+
+@dataclass
+class BoneDriver:
+    """The bone that carries a mesh: `armature.pose.bones[bone]`, through an Armature
+    modifier (`deformed`) or as the mesh's parent bone."""
+
+    armature: bpy.types.Object
+    bone: str
+    deformed: bool
+
+
+def _before_armature_ok(mod: bpy.types.Modifier) -> bool:
+    """Whether `mod`, before the Armature modifier, only builds the rest shape from the mesh
+    itself (a mirror or array with no object)."""
+    if mod.type == "MIRROR":
+        return mod.mirror_object is None
+    if mod.type == "ARRAY":
+        return not mod.use_object_offset and mod.fit_type != "FIT_CURVE"
+    return False
+
+
+def bone_driver(obj: bpy.types.Object) -> BoneDriver | None:
+    """The bone carrying the mesh `obj` rigidly, or None when no bone does (its own transform
+    moves it); raises :class:`SweepError`, naming the mesh and why, for a bone deformation
+    that is not rigid.
+
+    Rigid: one Armature modifier (vertex groups, no envelopes, no mask group, not "multi")
+    and every vertex weighted to one and the same deforming bone, which is not a curved
+    B-Bone; no shape keys; other modifiers only those that shape the mesh by itself
+    (:data:`SHAPE_ONLY_MODIFIERS`; before the Armature modifier also a mirror or array with
+    no object). A vertex's weight need not be 1: Blender's Armature modifier divides by the
+    sum of a vertex's weights, so a vertex weighted 0.5 to one bone alone follows it fully
+    (only weights summing to no more than :data:`ARMATURE_WEIGHT_THRESHOLD` leave it behind).
+    A mesh parented to a bone (no Armature modifier) is carried by it through its own world
+    matrix.
+    """
+    name = obj.name
+    if obj.parent is not None and obj.parent_type == "ARMATURE":
+        raise SweepError(
+            f"{name}: deformed through Armature Deform parenting; give it an Armature modifier instead "
+            "(Object > Parent > Armature Deform adds one)"
+        )
+    modifiers = [m for m in obj.modifiers if m.show_viewport]
+    armatures = [m for m in modifiers if m.type == "ARMATURE" and m.object is not None and m.object.type == "ARMATURE"]
+    if not armatures:
+        if obj.parent is not None and obj.parent_type == "BONE" and obj.parent.type == "ARMATURE" and obj.parent_bone:
+            return BoneDriver(obj.parent, obj.parent_bone, False)
+        return None
+    if len(armatures) > 1:
+        raise SweepError(
+            f"{name}: deformed by {len(armatures)} Armature modifiers ({', '.join(m.name for m in armatures)}); "
+            "a swept region needs a mesh carried rigidly by one bone"
+        )
+    mod = armatures[0]
+    rig = mod.object
+    why = ""
+    if mod.use_bone_envelopes:
+        why = f"its Armature modifier '{mod.name}' uses bone envelopes (they deform by distance to the bones)"
+    elif not mod.use_vertex_groups:
+        return None  # the modifier moves nothing
+    elif mod.vertex_group:
+        why = f"its Armature modifier '{mod.name}' is masked by vertex group '{mod.vertex_group}' (it blends with the rest shape)"
+    elif mod.use_multi_modifier:
+        why = f"its Armature modifier '{mod.name}' is a Multi Modifier (it blends with the modifiers before it)"
+    if why:
+        raise SweepError(f"{name}: {why}: not a rigid motion")
+    index = modifiers.index(mod)
+    for i, other in enumerate(modifiers):
+        if other is mod or other.type in SHAPE_ONLY_MODIFIERS or (i < index and _before_armature_ok(other)):
+            continue
+        raise SweepError(
+            f"{name}: its {other.type.replace('_', ' ').title()} modifier '{other.name}' may change its shape as it "
+            "moves; a swept region needs a mesh carried rigidly by one bone (disable or apply it)"
+        )
+    keys_ = obj.data.shape_keys
+    if keys_ is not None and len(keys_.key_blocks) > 1:
+        raise SweepError(
+            f"{name}: has {len(keys_.key_blocks) - 1} shape key(s), which change its shape; a swept region needs "
+            "a mesh carried rigidly by one bone"
+        )
+    bone = _weighted_bone(obj, rig)
+    data = rig.data.bones[bone]
+    if data.bbone_segments > 1:
+        raise SweepError(
+            f"{name}: bone '{bone}' is a B-Bone with {data.bbone_segments} segments, which bends the mesh: "
+            "not a rigid motion"
+        )
+    return BoneDriver(rig, bone, True)
+
+
+def _weighted_bone(obj: bpy.types.Object, rig: bpy.types.Object) -> str:
+    """The one deforming bone of `rig` every vertex of `obj` is weighted to; raises
+    :class:`SweepError` naming the first vertex that is not."""
+    name = obj.name
+    deforming = {g.index: g.name for g in obj.vertex_groups if g.name in rig.data.bones and rig.data.bones[g.name].use_deform}
+    # Blender has no bulk access to vertex weights (MeshVertex.groups has no foreach_get):
+    # the weights are read vertex by vertex here, the one such loop of the add-on; nothing
+    # is computed per vertex.
+    weights = [
+        sorted((deforming[g.group], g.weight) for g in v.groups if g.group in deforming and g.weight > 0.0)
+        for v in obj.data.vertices
+    ]
+    found = None
+    for i, entries in enumerate(weights):
+        bones = sorted({b for b, _ in entries})
+        total = sum(w for _, w in entries)
+        if not bones or total <= ARMATURE_WEIGHT_THRESHOLD:
+            raise SweepError(
+                f"{name}: vertex {i} is weighted to no deforming bone of '{rig.name}' (it stays behind as the "
+                "bones move): not a rigid motion"
+            )
+        if len(bones) > 1:
+            listed = ", ".join(f"'{b}' {w:g}" for b, w in entries)
+            raise SweepError(f"{name}: vertex {i} is weighted to {len(bones)} bones ({listed}): it bends, not a rigid motion")
+        if found is None:
+            found = bones[0]
+        elif bones[0] != found:
+            raise SweepError(
+                f"{name}: its vertices follow different bones ('{found}', and '{bones[0]}' from vertex {i}): "
+                "it bends, not a rigid motion"
+            )
+    if found is None:
+        raise SweepError(f"{name}: has no vertices")
+    return found
+
+
+def carried_matrix(obj: bpy.types.Object, driver: BoneDriver | None) -> np.ndarray:
+    """The world matrix the mesh's local coordinates go through at the current frame: its
+    own `matrix_world`, or deformed by the bone through an Armature modifier
+    `A B_pose B_rest^-1 A^-1 O` (A the armature's world matrix, B the bone's pose and rest
+    matrices in armature space, O the mesh's world matrix: Blender's armature deform)."""
+    world = np.array(obj.matrix_world, dtype=np.float64)
+    if driver is None or not driver.deformed:
+        return world
+    rig = np.array(driver.armature.matrix_world, dtype=np.float64)
+    pose_bone = driver.armature.pose.bones[driver.bone]
+    deform = np.array(pose_bone.matrix, dtype=np.float64) @ np.linalg.inv(np.array(pose_bone.bone.matrix_local, dtype=np.float64))
+    return rig @ deform @ np.linalg.inv(rig) @ world
+
+
+def _carrier_frames(driver: BoneDriver) -> list[float]:
+    """The key frames of the smoothed action of the bone's armature that move the bone: its
+    own transform curves, its parent bones' and the armature object's."""
+    rig = driver.armature
+    chain, bone = {""}, rig.data.bones[driver.bone]
+    while bone is not None:
+        chain.add(bone.name)
+        bone = bone.parent
+    grouped = owners.curves_by_owner(channels.object_fcurves(rig))
+    return sorted({round(k.co[0], 6) for key in chain for fc in grouped.get(key, []) for k in fc.keyframe_points})
+
+
+def motion_frames(obj: bpy.types.Object, scene: bpy.types.Scene, driver: BoneDriver | None = None) -> np.ndarray:
+    """The frames to sample: the keys of the smoothed action (Smooth Motion bakes one key per
+    step, subframes included) where there is one (for a mesh carried by a bone, the keys of
+    its armature's smoothed action moving that bone), else every frame of the scene's range."""
+    if driver is not None:
+        if bake.source_of(driver.armature) is not None:
+            frames = _carrier_frames(driver)
+            if len(frames) >= 2:
+                return np.asarray(frames, dtype=np.float64)
+    elif bake.source_of(obj) is not None:
         frames = sorted({round(k.co[0], 6) for fc in channels.object_fcurves(obj) for k in fc.keyframe_points})
         if len(frames) >= 2:
             return np.asarray(frames, dtype=np.float64)
     return np.arange(scene.frame_start, scene.frame_end + 1, dtype=np.float64)
 
 
-def world_poses(obj: bpy.types.Object, scene: bpy.types.Scene, frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Rigid world poses (N, 4, 4) of `obj` at `frames` and its world scale (3,), which must
-    stay constant (a swept region is for rigid motion)."""
+def world_poses(
+    obj: bpy.types.Object, scene: bpy.types.Scene, frames: np.ndarray, driver: BoneDriver | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """Rigid world poses (N, 4, 4) of `obj` (carried by `driver`, see :func:`carried_matrix`)
+    at `frames` and its world scale (3,), which must stay constant (a swept region is for
+    rigid motion)."""
     frame, subframe = scene.frame_current, scene.frame_subframe
     poses, scales = [], []
     try:
         for f in frames:
             whole = math.floor(f)
             scene.frame_set(whole, subframe=float(f - whole))
-            loc, rot, scale = obj.matrix_world.decompose()
+            loc, rot, scale = Matrix(carried_matrix(obj, driver).tolist()).decompose()
             poses.append(np.array(Matrix.LocRotScale(loc, rot, None)))
             scales.append(np.array(scale))
     finally:
@@ -106,11 +279,19 @@ def world_poses(obj: bpy.types.Object, scene: bpy.types.Scene, frames: np.ndarra
 def compute(obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps: bool) -> Swept:
     """The swept mesh of `obj` along its world motion (nothing is created)."""
     scene = context.scene
+    if obj.type != "MESH":
+        raise SweepError(f"{obj.name}: not a mesh object")
+    driver = bone_driver(obj)
     verts, tris = body_mesh(obj, context.evaluated_depsgraph_get())
-    frames = motion_frames(obj, scene)
+    if driver is not None and driver.deformed:
+        # The evaluated mesh is deformed by the bone's current pose: back into the frame the
+        # bone carries, `C^-1 O v` (C: carried_matrix now, O: the mesh's world matrix).
+        to_body = np.linalg.inv(carried_matrix(obj, driver)) @ np.array(obj.matrix_world, dtype=np.float64)
+        verts = verts @ to_body[:3, :3].T + to_body[:3, 3]
+    frames = motion_frames(obj, scene, driver)
     if len(frames) < 2:
         raise SweepError(f"{obj.name}: the frame range has a single frame; a motion needs two poses")
-    poses, scale = world_poses(obj, scene, frames)
+    poses, scale = world_poses(obj, scene, frames, driver)
     start = time.perf_counter()
     try:
         v, t = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps)

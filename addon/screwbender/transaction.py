@@ -166,15 +166,18 @@ class Transaction:
 
         self.on_rollback(undo)
 
-    def new_fcurve(self, bag: Any, data_path: str, index: int) -> bpy.types.FCurve:
-        """A new F-curve in `bag` (see :func:`channels.new_fcurve`), removed on failure."""
-        had_group = channels.has_group(bag)
-        fcurve = channels.new_fcurve(bag, data_path, index)
+    def new_fcurve(
+        self, bag: Any, data_path: str, index: int, group: str = channels.TRANSFORM_GROUP
+    ) -> bpy.types.FCurve:
+        """A new F-curve in `bag`, in F-curve group `group` (see :func:`channels.new_fcurve`),
+        removed on failure (with the group, when it was made for it)."""
+        had_group = channels.has_group(bag, group)
+        fcurve = channels.new_fcurve(bag, data_path, index, group)
 
         def undo() -> None:
             channels.remove_fcurve_at(bag, data_path, index)
             if not had_group:
-                channels.remove_group_if_empty(bag)
+                channels.remove_group_if_empty(bag, group)
 
         self.on_rollback(undo)
         return fcurve

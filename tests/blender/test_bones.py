@@ -6,7 +6,6 @@ import bpy
 import numpy as np
 import polyscrew
 import pytest
-from mathutils import Matrix
 from scipy.spatial.transform import Rotation
 
 import bake_helpers as h

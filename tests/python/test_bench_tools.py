@@ -242,6 +242,27 @@ def test_bake_section_from_json_marks_extrapolations(tmp_path):
     assert rep.targets[-1] == ("bake >= 20x nla.bake", "25.0x, 12.0x", "**missed**")
 
 
+def test_bone_section_reports_medians_and_both_ratios(tmp_path):
+    run = {"keys": 0.25, "keys_cpu": 0.11, "smooth": 0.2, "smooth_cpu": 0.1, "nla": 5.0, "nla_cpu": 2.4}
+    bones = {"bones": 100, "frames": 1000, "timings": ["keys", "smooth"], "load": 6.5,
+             "runs": [run, dict(run, keys=0.5), dict(run, keys=0.2)], "median": run}
+    (tmp_path / "bake.json").write_text(json.dumps(dict(BAKE_JSON, bones=bones)))
+    rep = report.Report(tmp_path, {})
+    rep.bones_section()
+    assert "| nla.bake POSE | 5.000 s | 2.400 s | | |" in rep.lines
+    assert "| ScrewBender, timing Keys (default) | 250.00 ms | 110.00 ms | 20.0x | 21.8x |" in rep.lines
+    assert "| ScrewBender, timing Smooth | 200.00 ms | 100.00 ms | 25.0x | 24.0x |" in rep.lines
+    assert any(line.startswith("Per run (wall-clock, timing Keys): 20.0x, 10.0x, 25.0x; load average 6.5")
+               for line in rep.lines)
+    assert rep.targets[-1] == (
+        "bake of a 100-bone rig >= 20x nla.bake POSE",
+        "20.0x wall / 21.8x CPU (timing Keys), 25.0x wall / 24.0x CPU (timing Smooth)", "met")
+    (tmp_path / "bake.json").write_text(json.dumps(BAKE_JSON))  # an older run without the bone case
+    rep = report.Report(tmp_path, {})
+    rep.bones_section()
+    assert rep.targets[-1][1:] == ("not measured", "n/a") and "not available" in rep.lines[-2]
+
+
 SWEEP_JSON = {
     "quick": False,
     "case": {"body": "bumpy torus, 48 x 24 quads", "triangles": 2304, "poses": 25, "screws": 24, "motion": "a helix"},

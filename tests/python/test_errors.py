@@ -57,7 +57,7 @@ def test_wrong_shape(shape):
 def test_screw_and_interpolate_check_their_poses():
     bad = np.eye(4)
     bad[0, 0] = 2.0
-    with pytest.raises(ValueError, match="screw: pose 0: not rigid: scale"):
+    with pytest.raises(ValueError, match="screw: b: not rigid: scale"):
         polyscrew.screw(np.eye(4), bad)
     with pytest.raises(ValueError, match="expected shape"):
         polyscrew.screw(np.eye(3), np.eye(4))

@@ -415,7 +415,7 @@ def test_keys_timing_errors_name_the_argument():
         polyscrew.keys_parameters([1.0, 2.0], [1.5, np.nan], size=1.0, poses=poses)
     with pytest.raises(ValueError, match="keys_parameters: smooth poses: expected 17 entries, got 3"):
         polyscrew.keys_parameters([1.0, 2.0], [1.5], size=1.0, smooth=np.tile(np.eye(4), (3, 1, 1)))
-    with pytest.raises(ValueError, match="keys_parameters: pose 1: not rigid"):
+    with pytest.raises(ValueError, match="keys_parameters: poses: pose 1: not rigid"):
         bad = poses.copy()
         bad[1, 0, 0] = 2.0
         polyscrew.keys_parameters([1.0, 2.0], [1.5], size=1.0, poses=bad)

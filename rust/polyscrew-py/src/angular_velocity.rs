@@ -2,6 +2,8 @@
 //! 2011). Conversion only: quaternions arrive and leave as `(N, 4)` w, x, y, z arrays.
 
 use glam::{DQuat, DVec3};
+#[allow(unused_imports)]
+use numpy::ndarray::ShapeBuilder;
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -20,37 +22,31 @@ use polyscrew::{
     FitStatus,
 };
 
-use crate::{read_vector, shape_err, to_py_err, FloatArray};
+use crate::args::{self, FitAngularVelocity, Function};
+use crate::{check_budget, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len};
+use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
+use polyscrew::memory::{try_vec, Footprint};
+use polyscrew::Error;
 
-const F: &str = "fit_angular_velocity";
+const F: &str = FitAngularVelocity::NAME;
 
-/// Reads `(N, 4)` quaternions in w, x, y, z order (normalised by the core).
-fn read_quaternions(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DQuat>> {
+/// Reads `(N, 4)` quaternions in w, x, y, z order (normalised by the core), no GIL needed.
+fn read_quaternions(what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<DQuat>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 4 {
         return Err(shape_err(F, what, "(N, 4)", shape));
     }
-    let flat: Vec<f64> = array.iter().copied().collect();
-    Ok(flat
-        .chunks_exact(4)
-        .map(|q| DQuat::from_xyzw(q[1], q[2], q[3], q[0]))
-        .collect())
-}
-
-/// Reads `(M, 3)` vectors without judging their values (the core names the bad one).
-fn read_rows3(what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
-    let shape = array.shape();
-    if shape.len() != 2 || shape[1] != 3 {
-        return Err(shape_err(F, what, "(M, 3)", shape));
+    let mut out = try_vec(shape[0], "key quaternions").map_err(|e| to_py_err(F, e))?;
+    for q in array.rows() {
+        out.push(DQuat::from_xyzw(q[1], q[2], q[3], q[0]));
     }
-    let flat: Vec<f64> = array.iter().copied().collect();
-    Ok(flat.chunks_exact(3).map(DVec3::from_slice).collect())
+    Ok(out)
 }
 
 /// `constrained`: `None` (all keys), a boolean mask of length N, or key indices
 /// (negative indices count from the end, as in numpy).
 fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<Vec<bool>> {
-    let Some(c) = constrained else {
+    let Some(c) = constrained.filter(|c| !c.is_none()) else {
         return Ok(vec![true; n]);
     };
     if let Ok(mask) = c.extract::<Vec<bool>>() {
@@ -69,6 +65,12 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
             "{F}: constrained: expected None, a boolean mask of length {n} or key indices"
         ))
     })?;
+    if indices.len() > n.saturating_mul(4).max(64) {
+        return Err(PyValueError::new_err(format!(
+            "{F}: constrained: {} indices for {n} keys",
+            indices.len()
+        )));
+    }
     let mut mask = vec![false; n];
     for i in indices {
         let j = if i < 0 { i + n as i64 } else { i };
@@ -102,6 +104,13 @@ fn vectors_to_array(v: &[DVec3]) -> Array2<f64> {
         out[[i, 2]] = p.z;
     }
     out
+}
+
+/// The fitted angular velocity at `times`, allocated fallibly.
+fn angular_velocities(fit: &AngularVelocityFit, times: &[f64]) -> Result<Vec<DVec3>, Error> {
+    let mut w = try_vec(times.len(), "angular velocities")?;
+    w.extend(times.iter().map(|t| fit.angular_velocity(*t)));
+    Ok(w)
 }
 
 /// The result of `fit_angular_velocity`: the fitted rotation and how well it fits.
@@ -219,30 +228,55 @@ impl PyAngularVelocityFit {
     fn sample<'py>(
         &self,
         py: Python<'py>,
-        times: FloatArray<'py>,
+        times: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let times = read_vector("AngularVelocityFit.sample", "times", times.as_array())?;
-        let q = self
-            .inner
-            .sample(&times)
-            .map_err(|e| to_py_err("AngularVelocityFit.sample", e))?;
-        Ok(quaternions_to_array(&q).into_pyarray(py))
+        const G: &str = "AngularVelocityFit.sample";
+        let times = float_array(G, "times", times)?;
+        let m = vector_len(G, "times", &times)?;
+        check_budget(
+            G,
+            Footprint::of::<f64>(m).and::<DQuat>(m).and::<[f64; 4]>(m),
+            "the sampled orientations",
+            FIT_HINT,
+        )?;
+        let view = times.as_array();
+        let inner = &self.inner;
+        let out = py.detach(|| -> PyResult<Array2<f64>> {
+            let times = read_vector(G, "times", &view)?;
+            let q = inner.sample(&times).map_err(|e| to_py_err(G, e))?;
+            Ok(quaternions_to_array(&q))
+        })?;
+        Ok(out.into_pyarray(py))
     }
 
     /// Fitted world-frame angular velocity at `times` (T,) within the key range: (T, 3).
     fn angular_velocity<'py>(
         &self,
         py: Python<'py>,
-        times: FloatArray<'py>,
+        times: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         const G: &str = "AngularVelocityFit.angular_velocity";
-        let times = read_vector(G, "times", times.as_array())?;
-        self.inner.sample(&times).map_err(|e| to_py_err(G, e))?;
-        let w: Vec<DVec3> = times
-            .iter()
-            .map(|t| self.inner.angular_velocity(*t))
-            .collect();
-        Ok(vectors_to_array(&w).into_pyarray(py))
+        let times = float_array(G, "times", times)?;
+        let m = vector_len(G, "times", &times)?;
+        check_budget(
+            G,
+            Footprint::of::<f64>(m)
+                .and::<DQuat>(m)
+                .and::<DVec3>(m)
+                .and::<[f64; 3]>(m),
+            "the angular velocities",
+            FIT_HINT,
+        )?;
+        let view = times.as_array();
+        let inner = &self.inner;
+        let out = py.detach(|| -> PyResult<Array2<f64>> {
+            let times = read_vector(G, "times", &view)?;
+            // Checks the times (range, NaN) as `sample` does.
+            inner.sample(&times).map_err(|e| to_py_err(G, e))?;
+            let w = angular_velocities(inner, &times).map_err(|e| to_py_err(G, e))?;
+            Ok(vectors_to_array(&w))
+        })?;
+        Ok(out.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {
@@ -271,37 +305,43 @@ impl PyAngularVelocityFit {
 #[allow(clippy::too_many_arguments)]
 fn fit_angular_velocity(
     py: Python<'_>,
-    key_quaternions: FloatArray<'_>,
-    key_times: FloatArray<'_>,
-    target_times: FloatArray<'_>,
-    target_omega: FloatArray<'_>,
+    key_quaternions: &Bound<'_, PyAny>,
+    key_times: &Bound<'_, PyAny>,
+    target_times: &Bound<'_, PyAny>,
+    target_omega: &Bound<'_, PyAny>,
     constrained: Option<&Bound<'_, PyAny>>,
-    alpha: f64,
-    delta: f64,
-    max_iterations: usize,
-    max_frames: usize,
-    sample_times: Option<FloatArray<'_>>,
-    target_speed: Option<FloatArray<'_>>,
-    fragment_duration: Option<f64>,
+    #[pyo3(from_py_with = args::alpha::<FitAngularVelocity>)] alpha: f64,
+    #[pyo3(from_py_with = args::delta::<FitAngularVelocity>)] delta: f64,
+    #[pyo3(from_py_with = args::max_iterations::<FitAngularVelocity>)] max_iterations: usize,
+    #[pyo3(from_py_with = args::max_frames::<FitAngularVelocity>)] max_frames: usize,
+    sample_times: Option<&Bound<'_, PyAny>>,
+    target_speed: Option<&Bound<'_, PyAny>>,
+    fragment_duration: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<PyAngularVelocityFit> {
-    let keys = read_quaternions("key_quaternions", key_quaternions.as_array())?;
-    if keys.len() < 2 {
-        return Err(PyValueError::new_err(format!(
-            "{F}: key_quaternions: {} keys given, at least 2 needed",
-            keys.len()
-        )));
-    }
-    let key_times = read_vector(F, "key_times", key_times.as_array())?;
-    let target_times = read_vector(F, "target_times", target_times.as_array())?;
-    let target_omega = read_rows3("target_omega", target_omega.as_array())?;
+    let key_quaternions = float_array(F, "key_quaternions", key_quaternions)?;
+    let key_times = float_array(F, "key_times", key_times)?;
+    let target_times = float_array(F, "target_times", target_times)?;
+    let target_omega = float_array(F, "target_omega", target_omega)?;
     let target_speed = target_speed
-        .map(|s| read_vector(F, "target_speed", s.as_array()))
+        .filter(|o| !o.is_none())
+        .map(|s| float_array(F, "target_speed", s))
         .transpose()?;
-    let sample_times = match sample_times {
-        Some(s) => read_vector(F, "sample_times", s.as_array())?,
-        None => key_times.clone(),
+    let sample_times = sample_times
+        .filter(|o| !o.is_none())
+        .map(|s| float_array(F, "sample_times", s))
+        .transpose()?;
+    let fragment_duration = args::optional_float(F, "fragment_duration", fragment_duration)?;
+    let n = key_quaternions
+        .as_array()
+        .shape()
+        .first()
+        .copied()
+        .unwrap_or(0);
+    let n_targets = target_times.as_array().len();
+    let n_samples = match &sample_times {
+        Some(s) => vector_len(F, "sample_times", s)?,
+        None => vector_len(F, "key_times", &key_times)?,
     };
-    let constrained = read_constrained(constrained, keys.len())?;
     let options = FitOptions {
         alpha,
         delta,
@@ -309,8 +349,45 @@ fn fit_angular_velocity(
         max_frames,
         fragment_duration,
     };
-    let (fit, quaternions, omega) = py
-        .detach(|| {
+    check_budget(
+        F,
+        Footprint::of::<[f64; 5]>(n)
+            + Footprint::of::<[f64; 8]>(n_targets)
+            + fit_footprint(n, n_targets, &options)
+            + Footprint::of::<[f64; 8]>(n_samples).times(2),
+        "the fit",
+        FIT_HINT,
+    )?;
+    let constrained = read_constrained(constrained, n)?;
+    let views = (
+        key_quaternions.as_array(),
+        key_times.as_array(),
+        target_times.as_array(),
+        target_omega.as_array(),
+        target_speed.as_ref().map(|s| s.as_array()),
+        sample_times.as_ref().map(|s| s.as_array()),
+    );
+    let (fit, sample_times, quaternions, omega) = py.detach(|| -> PyResult<_> {
+        let (kq, kt, tt, to, ts, st) = &views;
+        let keys = read_quaternions("key_quaternions", kq)?;
+        if keys.len() < 2 {
+            return Err(PyValueError::new_err(format!(
+                "{F}: key_quaternions: {} keys given, at least 2 needed",
+                keys.len()
+            )));
+        }
+        let key_times = read_vector(F, "key_times", kt)?;
+        let target_times = read_vector(F, "target_times", tt)?;
+        let target_omega = read_rows3(F, "target_omega", to, "(M, 3)")?;
+        let target_speed = ts
+            .as_ref()
+            .map(|s| read_vector(F, "target_speed", s))
+            .transpose()?;
+        let sample_times = match st {
+            Some(s) => read_vector(F, "sample_times", s)?,
+            None => key_times.clone(),
+        };
+        let run = || -> Result<_, Error> {
             let target = match &target_speed {
                 Some(speed) => {
                     AngularVelocityTarget::from_directions(&target_times, &target_omega, speed)
@@ -319,13 +396,12 @@ fn fit_angular_velocity(
             }?;
             let fit = core_fit(&keys, &key_times, &constrained, &target, &options)?;
             let q = fit.sample(&sample_times)?;
-            let w: Vec<DVec3> = sample_times
-                .iter()
-                .map(|t| fit.angular_velocity(*t))
-                .collect();
+            let w = angular_velocities(&fit, &sample_times)?;
             Ok((fit, q, w))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+        };
+        let (fit, q, w) = run().map_err(|e| to_py_err(F, e))?;
+        Ok((fit, sample_times, q, w))
+    })?;
     let result = PyAngularVelocityFit {
         inner: fit,
         sample_times,

@@ -19,7 +19,7 @@ use polyscrew::fcurve::{
 use crate::{read_vector, shape_err, to_py_err, FloatArray};
 
 /// An integer array-like argument converted to int64 on the way in.
-pub(crate) type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
 
 const F: &str = "evaluate_fcurves";
 
@@ -49,7 +49,7 @@ fn read_per_key(
     default: f32,
 ) -> PyResult<Vec<f64>> {
     match array {
-        Some(a) => read_vector(f, what, a.as_array()),
+        Some(a) => read_vector(f, what, &a.as_array()),
         None => Ok(vec![default as f64; k]),
     }
 }
@@ -284,7 +284,7 @@ fn evaluate_fcurves<'py>(
     period: Option<FloatArray<'py>>,
     cycles: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let times = read_vector(F, "times", times.as_array())?;
+    let times = read_vector(F, "times", &times.as_array())?;
     let args = CurveArgs::read(
         F,
         offsets,

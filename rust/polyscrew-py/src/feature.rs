@@ -5,26 +5,30 @@
 use glam::DVec3;
 use numpy::ndarray::{ArrayViewD, Axis};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+use polyscrew::feature::motion::{feature_footprint, FEATURE_HINT};
+use polyscrew::memory::Footprint;
 use polyscrew::{
     feature_motion as core_feature_motion, register as core_register, CurveScheme, FeatureSpec,
-    InertiaFrame, Parametrization, Stiffness, Timing, MAX_LEVELS,
+    InertiaFrame, Parametrization, Pose, Stiffness, Timing,
 };
 
+use crate::args::{self, FeatureMotion, Function, SampleFeature};
 use crate::{
-    poses_to_array, read_keys, read_vector, shape_err, to_py_err, vec3s_to_array, FloatArray,
+    check_budget, float_array, key_count, poses_to_array, read_keys, read_rows3, read_vector,
+    to_py_err, vec3s_to_array, vector_len,
 };
 
-/// Reads `(K, 3)` points; finiteness is checked by the core, which names the point.
-fn read_points(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
-    let shape = array.shape();
-    if shape.len() != 2 || shape[1] != 3 {
-        return Err(shape_err(function, what, "(K, 3)", shape));
-    }
-    let flat: Vec<f64> = array.iter().copied().collect();
-    Ok(flat.chunks_exact(3).map(DVec3::from_slice).collect())
+/// Reads `(K, 3)` points; finiteness and range are checked by the core, which names the
+/// point (no GIL needed).
+fn read_points(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
+    read_rows3(function, what, array, "(K, 3)")
+}
+
+/// The feature points' count of an optional `(K, 3)` argument.
+fn points_len(points: Option<&crate::FloatArray<'_>>) -> usize {
+    points.map_or(6, |p| p.as_array().shape().first().copied().unwrap_or(0))
 }
 
 /// Parses the design options shared by `feature_motion` and `sample_feature`.
@@ -33,42 +37,41 @@ fn read_feature_spec(
     function: &str,
     n: usize,
     scheme: &str,
-    levels: i64,
+    levels: u32,
     closed: bool,
     parametrization: &str,
     stiffness: Option<&Bound<'_, PyAny>>,
-    inserted_stiffness: f64,
+    inserted_stiffness: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<FeatureSpec> {
     let scheme = CurveScheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
     let parametrization =
         Parametrization::from_name(parametrization).map_err(|e| to_py_err(function, e))?;
-    let levels = u32::try_from(levels)
-        .ok()
-        .filter(|l| *l <= MAX_LEVELS)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "{function}: levels {levels} out of range 0..={MAX_LEVELS}"
-            ))
-        })?;
-    let keys = match stiffness {
+    let keys = match stiffness.filter(|s| !s.is_none()) {
         None => None,
-        Some(s) => match s.extract::<f64>() {
-            Ok(x) => Some(vec![x; n]),
-            Err(_) => {
-                let a: FloatArray<'_> = s.extract()?;
-                Some(read_vector(function, "stiffness", a.as_array())?)
+        Some(s) => {
+            if s.is_instance_of::<pyo3::types::PyFloat>()
+                || s.is_instance_of::<pyo3::types::PyInt>()
+            {
+                Some(vec![args::float_scalar(function, "stiffness", s)?; n])
+            } else {
+                let a = float_array(function, "stiffness", s)?;
+                let view = a.as_array();
+                if view.ndim() == 0 {
+                    Some(vec![view.iter().next().copied().unwrap_or(f64::NAN); n])
+                } else {
+                    Some(read_vector(function, "stiffness", &view)?)
+                }
             }
-        },
+        }
     };
+    let inserted = args::optional_float(function, "inserted_stiffness", inserted_stiffness)?
+        .unwrap_or(f64::INFINITY);
     Ok(FeatureSpec {
         scheme,
         levels,
         closed,
         parametrization,
-        stiffness: Stiffness {
-            keys,
-            inserted: inserted_stiffness,
-        },
+        stiffness: Stiffness { keys, inserted },
     })
 }
 
@@ -82,22 +85,41 @@ fn read_feature_spec(
 #[pyo3(signature = (src, dst, weights=None))]
 fn register_points<'py>(
     py: Python<'py>,
-    src: FloatArray<'py>,
-    dst: FloatArray<'py>,
-    weights: Option<FloatArray<'py>>,
+    src: &Bound<'py, PyAny>,
+    dst: &Bound<'py, PyAny>,
+    weights: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     const F: &str = "register_points";
-    let src = read_points(F, "src", src.as_array())?;
-    let dst = read_points(F, "dst", dst.as_array())?;
+    let src = float_array(F, "src", src)?;
+    let dst = float_array(F, "dst", dst)?;
     let weights = weights
-        .map(|w| read_vector(F, "weights", w.as_array()))
+        .filter(|w| !w.is_none())
+        .map(|w| float_array(F, "weights", w))
         .transpose()?;
-    let pose = py
-        .detach(|| core_register(&src, &dst, weights.as_deref()))
-        .map_err(|e| to_py_err(F, e))?;
-    Ok(poses_to_array(&[pose])
-        .index_axis_move(Axis(0), 0)
-        .into_pyarray(py))
+    let k = src.as_array().len() + dst.as_array().len();
+    check_budget(
+        F,
+        Footprint::of::<f64>(k).and::<f64>(weights.as_ref().map_or(0, |w| w.as_array().len())),
+        "the point copies",
+        "register fewer points",
+    )?;
+    let views = (
+        src.as_array(),
+        dst.as_array(),
+        weights.as_ref().map(|w| w.as_array()),
+    );
+    let pose = py.detach(|| -> PyResult<Pose> {
+        let (s, d, w) = &views;
+        let src = read_points(F, "src", s)?;
+        let dst = read_points(F, "dst", d)?;
+        let weights = w
+            .as_ref()
+            .map(|w| read_vector(F, "weights", w))
+            .transpose()?;
+        core_register(&src, &dst, weights.as_deref()).map_err(|e| to_py_err(F, e))
+    })?;
+    let out = poses_to_array(&[pose]).map_err(|e| to_py_err(F, e))?;
+    Ok(out.index_axis_move(Axis(0), 0).into_pyarray(py))
 }
 
 /// inertia_points(points) -> ndarray
@@ -109,12 +131,24 @@ fn register_points<'py>(
 #[pyfunction]
 fn inertia_points<'py>(
     py: Python<'py>,
-    points: FloatArray<'py>,
+    points: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     const F: &str = "inertia_points";
-    let points = read_points(F, "points", points.as_array())?;
-    let frame = InertiaFrame::of(&points).map_err(|e| to_py_err(F, e))?;
-    Ok(vec3s_to_array(&frame.inertia_points()).into_pyarray(py))
+    let points = float_array(F, "points", points)?;
+    check_budget(
+        F,
+        Footprint::of::<f64>(points.as_array().len()),
+        "the point copy",
+        "pass fewer points",
+    )?;
+    let view = points.as_array();
+    let six = py.detach(|| -> PyResult<[DVec3; 6]> {
+        let points = read_points(F, "points", &view)?;
+        let frame = InertiaFrame::of(&points).map_err(|e| to_py_err(F, e))?;
+        Ok(frame.inertia_points())
+    })?;
+    let out = vec3s_to_array(&six).map_err(|e| to_py_err(F, e))?;
+    Ok(out.into_pyarray(py))
 }
 
 /// feature_motion(poses, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None) -> ndarray
@@ -130,33 +164,59 @@ fn inertia_points<'py>(
 #[allow(clippy::too_many_arguments)]
 fn feature_motion<'py>(
     py: Python<'py>,
-    poses: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
-    feature_points: Option<FloatArray<'py>>,
-    parametrization: &str,
+    poses: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<FeatureMotion>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<FeatureMotion>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<FeatureMotion>)] closed: bool,
+    feature_points: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::parametrization::<FeatureMotion>)] parametrization: &str,
     stiffness: Option<&Bound<'py, PyAny>>,
-    inserted_stiffness: Option<f64>,
+    inserted_stiffness: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "feature_motion";
-    let keys = read_keys(F, &poses)?;
+    const F: &str = FeatureMotion::NAME;
+    let poses = float_array(F, "poses", poses)?;
+    let n = key_count(F, &poses)?;
     let spec = read_feature_spec(
         F,
-        keys.len(),
+        n,
         scheme,
         levels,
         closed,
         parametrization,
         stiffness,
-        inserted_stiffness.unwrap_or(f64::INFINITY),
+        inserted_stiffness,
     )?;
     let points = feature_points
-        .map(|p| read_points(F, "feature_points", p.as_array()))
+        .filter(|p| !p.is_none())
+        .map(|p| float_array(F, "feature_points", p))
         .transpose()?;
-    let out = py
-        .detach(|| core_feature_motion(&keys, points.as_deref(), &spec).map(|d| poses_to_array(&d)))
-        .map_err(|e| to_py_err(F, e))?;
+    let k = points_len(points.as_ref());
+    let out_len = if n >= 2 {
+        polyscrew::subdivided_len(n, levels, closed)
+    } else {
+        0
+    };
+    check_budget(
+        F,
+        Footprint::of::<Pose>(n)
+            + Footprint::of::<DVec3>(k)
+            + feature_footprint(n, k, &spec)
+            + Footprint::of::<[f64; 16]>(out_len),
+        "the feature-point motion",
+        FEATURE_HINT,
+    )?;
+    let views = (poses.as_array(), points.as_ref().map(|p| p.as_array()));
+    let out = py.detach(|| -> PyResult<_> {
+        let (v, p) = &views;
+        let keys = read_keys(F, v)?;
+        let points = p
+            .as_ref()
+            .map(|p| read_points(F, "feature_points", p))
+            .transpose()?;
+        core_feature_motion(&keys, points.as_deref(), &spec)
+            .and_then(|d| poses_to_array(&d))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
@@ -172,51 +232,75 @@ fn feature_motion<'py>(
 #[allow(clippy::too_many_arguments)]
 fn sample_feature<'py>(
     py: Python<'py>,
-    poses: FloatArray<'py>,
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
-    feature_points: Option<FloatArray<'py>>,
-    parametrization: &str,
+    poses: &Bound<'py, PyAny>,
+    key_times: &Bound<'py, PyAny>,
+    times: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<SampleFeature>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<SampleFeature>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<SampleFeature>)] closed: bool,
+    feature_points: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::parametrization::<SampleFeature>)] parametrization: &str,
     stiffness: Option<&Bound<'py, PyAny>>,
-    inserted_stiffness: Option<f64>,
-    period: Option<f64>,
-    timing: &str,
+    inserted_stiffness: Option<&Bound<'py, PyAny>>,
+    period: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::timing::<SampleFeature>)] timing: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "sample_feature";
-    let keys = read_keys(F, &poses)?;
+    const F: &str = SampleFeature::NAME;
+    let poses = float_array(F, "poses", poses)?;
+    let n = key_count(F, &poses)?;
     let spec = read_feature_spec(
         F,
-        keys.len(),
+        n,
         scheme,
         levels,
         closed,
         parametrization,
         stiffness,
-        inserted_stiffness.unwrap_or(f64::INFINITY),
+        inserted_stiffness,
     )?;
+    let period = args::optional_float(F, "period", period)?;
     let timing = Timing::from_name(timing).map_err(|e| to_py_err(F, e))?;
-    let key_times = read_vector(F, "key_times", key_times.as_array())?;
-    let times = read_vector(F, "times", times.as_array())?;
+    let key_times = float_array(F, "key_times", key_times)?;
+    let times = float_array(F, "times", times)?;
+    let n_key_times = vector_len(F, "key_times", &key_times)?;
+    let m = vector_len(F, "times", &times)?;
     let points = feature_points
-        .map(|p| read_points(F, "feature_points", p.as_array()))
+        .filter(|p| !p.is_none())
+        .map(|p| float_array(F, "feature_points", p))
         .transpose()?;
-    let out = py
-        .detach(|| {
-            polyscrew::feature_motion_timed(
-                &keys,
-                &key_times,
-                points.as_deref(),
-                &spec,
-                period,
-                timing,
-            )
+    let k = points_len(points.as_ref());
+    check_budget(
+        F,
+        Footprint::of::<Pose>(n)
+            + Footprint::of::<f64>(n_key_times + m)
+            + Footprint::of::<DVec3>(k)
+            + feature_footprint(n, k, &spec)
+            + Footprint::of::<f64>(n.saturating_add(1)).times(2)
+            + Footprint::of::<Pose>(m)
+            + Footprint::of::<[f64; 16]>(m),
+        "the sampled feature-point motion",
+        FEATURE_HINT,
+    )?;
+    let views = (
+        poses.as_array(),
+        key_times.as_array(),
+        times.as_array(),
+        points.as_ref().map(|p| p.as_array()),
+    );
+    let out = py.detach(|| -> PyResult<_> {
+        let (v, kt, tt, p) = &views;
+        let keys = read_keys(F, v)?;
+        let key_times = read_vector(F, "key_times", kt)?;
+        let times = read_vector(F, "times", tt)?;
+        let points = p
+            .as_ref()
+            .map(|p| read_points(F, "feature_points", p))
+            .transpose()?;
+        polyscrew::feature_motion_timed(&keys, &key_times, points.as_deref(), &spec, period, timing)
             .and_then(|m| m.sample(&times))
-            .map(|p| poses_to_array(&p))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+            .and_then(|p| poses_to_array(&p))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 

@@ -15,30 +15,39 @@ use polyscrew::intent::{
     screw_pace_poses, Channel, KeysTiming, Playback, HOLD_TOLERANCE, MAX_SPAN_SAMPLES,
     PACE_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
 };
-use polyscrew::{Error, RotationMode, Scheme, MAX_LEVELS};
+use polyscrew::memory::{try_vec, Footprint};
+use polyscrew::{Error, Pose, RotationMode};
 
-use crate::fcurve::{CurveArgs, IntArray};
-use crate::{read_poses, read_vector, shape_err, to_py_err, FloatArray};
+use crate::args::{self, float_array, Function, IntArray, KeysParameters};
+use crate::fcurve::CurveArgs;
+use crate::{
+    check_budget, key_count, pose_count, read_poses, read_vector, shape_err, to_py_err, vector_len,
+    FloatArray,
+};
 
-/// Reads `(N, width)` rows, flattened.
-fn read_rows(
-    function: &str,
-    what: &str,
-    array: &FloatArray<'_>,
-    width: usize,
-) -> PyResult<Vec<f64>> {
-    let array = array.as_array();
-    let shape = array.shape();
-    if shape.len() != 2 || shape[1] != width {
-        return Err(shape_err(function, what, &format!("(N, {width})"), shape));
-    }
-    Ok(array.iter().copied().collect())
-}
+/// How to ask these functions for less memory.
+const HINT: &str = "pass fewer frames or keys in one call";
 
-/// The rows of `values` (`n x width`, row-major) as an `(n, width)` array.
+/// `values` (`n x width`, row-major) as an `(n, width)` array.
 fn rows_array(values: Vec<f64>, width: usize) -> Array2<f64> {
     let n = values.len() / width;
     Array2::from_shape_vec((n, width), values).expect("n * width values")
+}
+
+/// The `Playback` argument `obj`, or a `TypeError` naming `function` and `what`.
+fn playback_arg<'a, 'py>(
+    function: &str,
+    what: &str,
+    obj: &'a Bound<'py, PyAny>,
+) -> PyResult<&'a Bound<'py, PyPlayback>> {
+    obj.cast::<PyPlayback>().map_err(|_| {
+        PyTypeError::new_err(format!("{function}: {what}: expected a polyscrew.Playback"))
+    })
+}
+
+/// `located`, a bool.
+fn located(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    args::bool_arg("Playback", "located", obj)
 }
 
 /// Playback(*, channels, unkeyed, mode, located=True, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None)
@@ -61,10 +70,10 @@ impl PyPlayback {
     #[allow(clippy::too_many_arguments)]
     fn new<'py>(
         py: Python<'py>,
-        channels: Bound<'py, PyAny>,
-        unkeyed: FloatArray<'py>,
-        mode: &str,
-        located: bool,
+        channels: &Bound<'py, PyAny>,
+        unkeyed: &Bound<'py, PyAny>,
+        mode: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = located)] located: bool,
         offsets: IntArray<'py>,
         co: FloatArray<'py>,
         handle_left: FloatArray<'py>,
@@ -78,7 +87,8 @@ impl PyPlayback {
         cycles: Option<Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         const F: &str = "Playback";
-        let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
+        let mode = RotationMode::from_name(args::str_arg(F, "mode", mode)?)
+            .map_err(|e| to_py_err(F, e))?;
         let pairs: Vec<(String, i64)> = channels.extract().map_err(|_| {
             PyTypeError::new_err(format!(
                 "{F}: channels: expected a sequence of (property, index) pairs"
@@ -100,7 +110,8 @@ impl PyPlayback {
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
-        let unkeyed = read_vector(F, "unkeyed", unkeyed.as_array())?;
+        let unkeyed = float_array(F, "unkeyed", unkeyed)?;
+        let unkeyed = read_vector(F, "unkeyed", &unkeyed.as_array())?;
         let args = CurveArgs::read(
             F,
             offsets,
@@ -134,31 +145,44 @@ impl PyPlayback {
     fn channels<'py>(
         &self,
         py: Python<'py>,
-        frames: FloatArray<'py>,
+        frames: &Bound<'py, PyAny>,
     ) -> PyResult<(
         Bound<'py, PyArray2<f64>>,
         Bound<'py, PyArray2<f64>>,
         Bound<'py, PyArray2<f64>>,
     )> {
         const F: &str = "Playback.channels";
-        let frames = read_vector(F, "frames", frames.as_array())?;
+        let frames = float_array(F, "frames", frames)?;
+        let t = vector_len(F, "frames", &frames)?;
         let inner = &self.inner;
         let width = inner.width();
         let w = inner.mode().width();
-        let rows = py
-            .detach(|| inner.channels(&frames))
-            .map_err(|e| to_py_err(F, e))?;
-        let n = frames.len();
-        let (mut location, mut rotation, mut scale) = (
-            Vec::with_capacity(3 * n),
-            Vec::with_capacity(w * n),
-            Vec::with_capacity(3 * n),
-        );
-        for row in rows.chunks_exact(width) {
-            location.extend_from_slice(&row[..3]);
-            rotation.extend_from_slice(&row[3..3 + w]);
-            scale.extend_from_slice(&row[3 + w..]);
-        }
+        // the frames, the rows, the three outputs
+        check_budget(
+            F,
+            Footprint::of::<f64>(t).and::<f64>(t.saturating_mul(2 * width)),
+            "the channel values",
+            HINT,
+        )?;
+        let view = frames.as_array();
+        let (location, rotation, scale) = py.detach(|| -> PyResult<_> {
+            let frames = read_vector(F, "frames", &view)?;
+            let split = || -> Result<(Vec<f64>, Vec<f64>, Vec<f64>), Error> {
+                let rows = inner.channels(&frames)?;
+                let (mut location, mut rotation, mut scale) = (
+                    try_vec(3 * t, "locations")?,
+                    try_vec(w * t, "rotations")?,
+                    try_vec(3 * t, "scales")?,
+                );
+                for row in rows.chunks_exact(width) {
+                    location.extend_from_slice(&row[..3]);
+                    rotation.extend_from_slice(&row[3..3 + w]);
+                    scale.extend_from_slice(&row[3 + w..]);
+                }
+                Ok((location, rotation, scale))
+            };
+            split().map_err(|e| to_py_err(F, e))
+        })?;
         Ok((
             rows_array(location, 3).into_pyarray(py),
             rows_array(rotation, w).into_pyarray(py),
@@ -184,8 +208,8 @@ impl PyPlayback {
 #[allow(clippy::type_complexity)]
 fn analyse_spans<'py>(
     py: Python<'py>,
-    playback: &Bound<'py, PyPlayback>,
-    frames: FloatArray<'py>,
+    playback: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
@@ -193,17 +217,30 @@ fn analyse_spans<'py>(
     Bound<'py, PyArray1<f64>>,
 )> {
     const F: &str = "analyse_spans";
-    let frames = read_vector(F, "frames", frames.as_array())?;
+    let playback = playback_arg(F, "playback", playback)?;
+    let frames = float_array(F, "frames", frames)?;
+    let k = vector_len(F, "frames", &frames)?;
+    check_budget(F, Footprint::of::<f64>(k), "the frames", HINT)?;
     let inner = &playback.get().inner;
-    let spans = py
-        .detach(|| core_analyse_spans(inner, &frames))
-        .map_err(|e| to_py_err(F, e))?;
+    let view = frames.as_array();
+    let spans = py.detach(|| -> PyResult<_> {
+        let frames = read_vector(F, "frames", &view)?;
+        core_analyse_spans(inner, &frames).map_err(|e| to_py_err(F, e))
+    })?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
         spans.turn.into_pyarray(py),
         spans.inserted.into_pyarray(py),
     ))
+}
+
+/// Where `keys_parameters` gets the smoothed motion from.
+enum Smoothed {
+    /// The key poses, smoothed by the scheme and levels.
+    Keys(Vec<Pose>),
+    /// The caller's poses at `pace_parameters(spans)`.
+    Given(Vec<Pose>),
 }
 
 /// keys_parameters(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme="four_point", levels=4, smooth=None) -> ndarray
@@ -219,20 +256,20 @@ fn analyse_spans<'py>(
 #[allow(clippy::too_many_arguments)]
 fn keys_parameters<'py>(
     py: Python<'py>,
-    key_frames: FloatArray<'py>,
-    frames: FloatArray<'py>,
-    size: f64,
-    closed: bool,
-    period: Option<f64>,
-    playback: Option<Bound<'py, PyPlayback>>,
-    poses: Option<FloatArray<'py>>,
-    scheme: &str,
-    levels: i64,
-    smooth: Option<FloatArray<'py>>,
+    key_frames: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
+    size: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::closed::<KeysParameters>)] closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    playback: Option<&Bound<'py, PyAny>>,
+    poses: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::scheme::<KeysParameters>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<KeysParameters>)] levels: u32,
+    smooth: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    const F: &str = "keys_parameters";
-    let key_frames = read_vector(F, "key_frames", key_frames.as_array())?;
-    let frames = read_vector(F, "frames", frames.as_array())?;
+    const F: &str = KeysParameters::NAME;
+    let size = args::float_scalar(F, "size", size)?;
+    let period = args::optional_float(F, "period", period)?;
     let period = match (closed, period) {
         (true, Some(p)) => Some(p),
         (true, None) => {
@@ -242,49 +279,66 @@ fn keys_parameters<'py>(
         }
         (false, _) => None,
     };
-    let scheme = Scheme::from_name(scheme).map_err(|e| to_py_err(F, e))?;
-    let levels = u32::try_from(levels)
-        .ok()
-        .filter(|l| *l <= MAX_LEVELS)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "{F}: levels {levels} out of range 0..={MAX_LEVELS}"
-            ))
-        })?;
-    /// Where the smoothed motion comes from.
-    enum Smoothed {
-        /// The key poses, smoothed here by `scheme` and `levels`.
-        Keys(Vec<polyscrew::Pose>),
-        /// The caller's poses at `pace_parameters(spans)`.
-        Given(Vec<polyscrew::Pose>),
-    }
-    let smoothed = match (&poses, &smooth) {
-        (Some(p), None) => Smoothed::Keys(read_poses(F, "poses", p.as_array())?.0),
-        (None, Some(s)) => Smoothed::Given(read_poses(F, "smooth", s.as_array())?.0),
+    let scheme = polyscrew::Scheme::from_name(scheme).map_err(|e| to_py_err(F, e))?;
+    let playback = playback
+        .filter(|p| !p.is_none())
+        .map(|p| playback_arg(F, "playback", p))
+        .transpose()?;
+    let key_frames = float_array(F, "key_frames", key_frames)?;
+    let frames = float_array(F, "frames", frames)?;
+    let k = vector_len(F, "key_frames", &key_frames)?;
+    let t = vector_len(F, "frames", &frames)?;
+    let (poses, smooth) = (
+        poses.filter(|p| !p.is_none()),
+        smooth.filter(|p| !p.is_none()),
+    );
+    let (array, is_keys) = match (poses, smooth) {
+        (Some(p), None) => (float_array(F, "poses", p)?, true),
+        (None, Some(s)) => (float_array(F, "smooth", s)?, false),
         _ => {
             return Err(PyValueError::new_err(format!(
                 "{F}: give either poses (the key poses) or smooth (the smoothed motion's poses)"
             )))
         }
     };
-    let playback = playback.as_ref().map(|p| &p.get().inner);
-    let out = py
-        .detach(|| {
-            let timing = KeysTiming {
-                key_frames: &key_frames,
-                period,
-                size,
-                playback,
-            };
-            match &smoothed {
-                Smoothed::Keys(keys) => {
-                    let smooth = screw_pace_poses(keys, scheme, levels, closed)?;
-                    core_keys_parameters(&timing, &frames, &smooth)
-                }
-                Smoothed::Given(smooth) => core_keys_parameters(&timing, &frames, smooth),
+    let n = if is_keys {
+        key_count(F, &array)?
+    } else {
+        pose_count(F, "smooth", array.as_array().shape())?.0
+    };
+    // the copies of the input and the output (the core checks its own working memory)
+    check_budget(
+        F,
+        Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
+        "timing Keys",
+        HINT,
+    )?;
+    let inner = playback.map(|p| &p.get().inner);
+    let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
+    let out = py.detach(|| -> PyResult<Vec<f64>> {
+        let key_frames = read_vector(F, "key_frames", &kv)?;
+        let frames = read_vector(F, "frames", &fv)?;
+        let smoothed = if is_keys {
+            if pv.ndim() != 3 {
+                return Err(shape_err(F, "poses", "(N, 4, 4)", pv.shape()));
             }
-        })
-        .map_err(|e| to_py_err(F, e))?;
+            Smoothed::Keys(read_poses(F, "poses", &pv)?)
+        } else {
+            Smoothed::Given(read_poses(F, "smooth", &pv)?)
+        };
+        let timing = KeysTiming {
+            key_frames: &key_frames,
+            period,
+            size,
+            playback: inner,
+        };
+        match &smoothed {
+            Smoothed::Keys(keys) => screw_pace_poses(keys, scheme, levels, closed)
+                .and_then(|smooth| core_keys_parameters(&timing, &frames, &smooth)),
+            Smoothed::Given(smooth) => core_keys_parameters(&timing, &frames, smooth),
+        }
+        .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
@@ -293,8 +347,14 @@ fn keys_parameters<'py>(
 /// The motion parameters `s + j / PACE_SAMPLES` (j = 0..PACE_SAMPLES) of each span s, span
 /// after span: where `keys_parameters` wants the smoothed motion (`smooth`).
 #[pyfunction]
-fn pace_parameters(py: Python<'_>, spans: usize) -> PyResult<Bound<'_, PyArray1<f64>>> {
-    let out = core_pace_parameters(spans).map_err(|e| to_py_err("pace_parameters", e))?;
+fn pace_parameters<'py>(
+    py: Python<'py>,
+    spans: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    const F: &str = "pace_parameters";
+    let spans = args::int_in(F, "spans", spans, 0, i64::MAX)?;
+    let spans = usize::try_from(spans).unwrap_or(usize::MAX);
+    let out = core_pace_parameters(spans).map_err(|e| to_py_err(F, e))?;
     Ok(out.into_pyarray(py))
 }
 
@@ -307,27 +367,42 @@ fn pace_parameters(py: Python<'_>, spans: usize) -> PyResult<Bound<'_, PyArray1<
 #[pyfunction]
 fn rotation_matrices<'py>(
     py: Python<'py>,
-    values: FloatArray<'py>,
-    mode: &str,
+    values: &Bound<'py, PyAny>,
+    mode: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = "rotation_matrices";
-    let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
-    let values = read_rows(F, "values", &values, mode.width())?;
-    let out = py
-        .detach(|| {
-            core_rotation_matrices(&values, mode).map(|m| {
-                let mut out = Array3::<f64>::zeros((m.len(), 3, 3));
-                for (i, m) in m.iter().enumerate() {
-                    for r in 0..3 {
-                        for c in 0..3 {
-                            out[[i, r, c]] = m.col(c)[r];
-                        }
-                    }
+    let mode =
+        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    let values = float_array(F, "values", values)?;
+    let view = values.as_array();
+    let width = mode.width();
+    let shape = view.shape();
+    if shape.len() != 2 || shape[1] != width {
+        return Err(shape_err(F, "values", &format!("(N, {width})"), shape));
+    }
+    let n = shape[0];
+    // the values read, the matrices, the output
+    check_budget(
+        F,
+        Footprint::of::<f64>(n.saturating_mul(width)).and::<[f64; 9]>(n.saturating_mul(2)),
+        "the rotation matrices",
+        HINT,
+    )?;
+    let out = py.detach(|| -> PyResult<Array3<f64>> {
+        let run = || -> Result<Array3<f64>, Error> {
+            let mut values = try_vec(n.saturating_mul(width), "input values")?;
+            values.extend(view.iter().copied());
+            let matrices = core_rotation_matrices(&values, mode)?;
+            let mut flat = try_vec(n.saturating_mul(9), "output matrices")?;
+            for m in &matrices {
+                for r in 0..3 {
+                    flat.extend([m.x_axis[r], m.y_axis[r], m.z_axis[r]]);
                 }
-                out
-            })
-        })
-        .map_err(|e| to_py_err(F, e))?;
+            }
+            Ok(Array3::from_shape_vec((n, 3, 3), flat).expect("9 values per matrix"))
+        };
+        run().map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 

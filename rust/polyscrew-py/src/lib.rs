@@ -4,27 +4,55 @@
 //! the core, map the error once (`to_py_err`), wrap the result as numpy arrays.
 
 mod angular_velocity;
+mod args;
 mod fcurve;
 mod feature;
 mod intent;
 mod sweep;
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array2, Array3, ArrayViewD};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArray3, PyArrayLikeDyn};
+use numpy::{IntoPyArray, PyArray2, PyArray3};
+use polyscrew::memory::{try_vec, Footprint};
+use polyscrew::motion::sample::sample_footprint;
+use polyscrew::motion::screw::MAX_T;
+use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
-    rotation_channels as core_rotation_channels, subdivide as core_subdivide, Error, Motion,
-    MotionSpec, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
+    rotation_channels as core_rotation_channels, sample as core_sample,
+    subdivide as core_subdivide, subdivided_len, Error, MotionSpec, Pose, RotationMode, Scheme,
+    Screw, Timing, MAX_LEVELS,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 
-/// An array-like argument converted to float64 on the way in.
-pub type FloatArray<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+pub use args::{float_array, FloatArray};
+use args::{Function, Sample, SampleChannels, SampleVectors, Subdivide, SubdivideVectors};
 
-/// The one place a core error becomes a Python exception, with the function's name.
+/// The one place a core error becomes a Python exception, with the function's name:
+/// `ValueError`, or `MemoryError` when the allocator refused memory within the budget.
 pub fn to_py_err(function: &str, err: Error) -> PyErr {
-    PyValueError::new_err(format!("{function}: {err}"))
+    match err {
+        Error::Memory { budget: None, .. } => PyMemoryError::new_err(format!("{function}: {err}")),
+        _ => PyValueError::new_err(format!("{function}: {err}")),
+    }
+}
+
+/// A core error about argument `what`: `"{function}: {what}: {err}"`.
+pub fn arg_err(function: &str, what: &str, err: Error) -> PyErr {
+    to_py_err(&format!("{function}: {what}"), err)
+}
+
+/// Checks a call's footprint against the memory budget (before anything input-sized is
+/// allocated or copied).
+pub fn check_budget(
+    function: &str,
+    footprint: Footprint,
+    what: &'static str,
+    hint: &'static str,
+) -> PyResult<()> {
+    footprint
+        .check(what, hint)
+        .map_err(|e| to_py_err(function, e))
 }
 
 /// A shape error naming the argument, what was expected and what came.
@@ -34,112 +62,138 @@ pub fn shape_err(function: &str, what: &str, expected: &str, got: &[usize]) -> P
     ))
 }
 
-/// Reads `(4, 4)` or `(N, 4, 4)` matrices into validated poses. Returns the poses and
-/// whether a single matrix was given.
-pub fn read_poses(
-    function: &str,
-    what: &str,
-    array: ArrayViewD<'_, f64>,
-) -> PyResult<(Vec<Pose>, bool)> {
-    let shape = array.shape().to_vec();
-    let single = match shape.as_slice() {
-        [4, 4] => true,
-        [_, 4, 4] => false,
-        _ => return Err(shape_err(function, what, "(4, 4) or (N, 4, 4)", &shape)),
-    };
-    let flat: Vec<f64> = array.iter().copied().collect();
-    let poses = flat
-        .chunks_exact(16)
-        .enumerate()
-        .map(|(i, m)| {
-            let row = |r: usize| [m[4 * r], m[4 * r + 1], m[4 * r + 2], m[4 * r + 3]];
-            Pose::from_rows(&[row(0), row(1), row(2), row(3)], i)
-        })
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| to_py_err(function, e))?;
-    Ok((poses, single))
+/// The number of `(4, 4)` matrices in a `(4, 4)` or `(N, 4, 4)` shape (and whether it is a
+/// single matrix), or a shape error.
+pub fn pose_count(function: &str, what: &str, shape: &[usize]) -> PyResult<(usize, bool)> {
+    match shape {
+        [4, 4] => Ok((1, true)),
+        [n, 4, 4] => Ok((*n, false)),
+        _ => Err(shape_err(function, what, "(4, 4) or (N, 4, 4)", shape)),
+    }
 }
 
-/// Reads `(N, 4, 4)` key poses (a single matrix is refused).
-pub fn read_keys(function: &str, poses: &FloatArray<'_>) -> PyResult<Vec<Pose>> {
-    let (keys, single) = read_poses(function, "poses", poses.as_array())?;
+/// Reads `(4, 4)` or `(N, 4, 4)` matrices into validated poses (no GIL needed). Errors name
+/// the argument: `"{function}: {what}: pose 2: ..."` (`"{function}: {what}: ..."` for a
+/// single matrix).
+pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<Pose>> {
+    let (n, single) = pose_count(function, what, array.shape())?;
+    let mut poses = try_vec(n, "input poses").map_err(|e| to_py_err(function, e))?;
+    let mut values = array.iter();
+    for i in 0..n {
+        let mut m = [0.0; 16];
+        for (slot, v) in m.iter_mut().zip(&mut values) {
+            *slot = *v;
+        }
+        let row = |r: usize| [m[4 * r], m[4 * r + 1], m[4 * r + 2], m[4 * r + 3]];
+        let pose = Pose::from_rows(&[row(0), row(1), row(2), row(3)], i).map_err(|e| {
+            if single {
+                match e {
+                    Error::BadPose { defect, .. } => {
+                        PyValueError::new_err(format!("{function}: {what}: {defect}"))
+                    }
+                    other => to_py_err(function, other),
+                }
+            } else {
+                PyValueError::new_err(format!("{function}: {what}: {e}"))
+            }
+        })?;
+        poses.push(pose);
+    }
+    Ok(poses)
+}
+
+/// Reads `(N, 4, 4)` key poses (a single matrix is refused), no GIL needed.
+pub fn read_keys(function: &str, poses: &ArrayViewD<'_, f64>) -> PyResult<Vec<Pose>> {
+    let (_, single) = pose_count(function, "poses", poses.shape())?;
     if single {
         return Err(shape_err(function, "poses", "(N, 4, 4)", &[4, 4]));
     }
-    Ok(keys)
+    read_poses(function, "poses", poses)
 }
 
-/// Poses as an `(N, 4, 4)` array in Blender's layout.
-pub fn poses_to_array(poses: &[Pose]) -> Array3<f64> {
-    let mut out = Array3::<f64>::zeros((poses.len(), 4, 4));
-    for (i, p) in poses.iter().enumerate() {
-        for (r, row) in p.to_rows().iter().enumerate() {
-            for (c, v) in row.iter().enumerate() {
-                out[[i, r, c]] = *v;
-            }
-        }
+/// The key count of an `(N, 4, 4)` argument (checked again when read).
+pub fn key_count(function: &str, poses: &FloatArray<'_>) -> PyResult<usize> {
+    pose_count(function, "poses", poses.as_array().shape()).map(|(n, _)| n)
+}
+
+/// Poses as an `(N, 4, 4)` array in Blender's layout (allocated fallibly).
+pub fn poses_to_array(poses: &[Pose]) -> Result<Array3<f64>, Error> {
+    let mut flat = try_vec(poses.len().saturating_mul(16), "output poses")?;
+    for p in poses {
+        flat.extend(p.to_rows().iter().flatten());
     }
-    out
+    Ok(Array3::from_shape_vec((poses.len(), 4, 4), flat).expect("16 values per pose"))
 }
 
-/// Reads a 1-D float array.
-pub fn read_vector(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+/// Reads a 1-D float array (no GIL needed).
+pub fn read_vector(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
     if array.ndim() != 1 {
         return Err(shape_err(function, what, "(N,)", array.shape()));
     }
-    Ok(array.iter().copied().collect())
+    let mut out = try_vec(array.len(), "input values").map_err(|e| to_py_err(function, e))?;
+    out.extend(array.iter().copied());
+    Ok(out)
 }
 
-/// Reads `(N, 3)` vectors.
-pub fn read_vec3s(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
+/// The length of a 1-D array (checked again when read).
+pub fn vector_len(function: &str, what: &str, array: &FloatArray<'_>) -> PyResult<usize> {
+    let a = array.as_array();
+    if a.ndim() != 1 {
+        return Err(shape_err(function, what, "(N,)", a.shape()));
+    }
+    Ok(a.len())
+}
+
+/// Reads `(N, 3)` rows without judging their values (no GIL needed).
+pub fn read_rows3(
+    function: &str,
+    what: &str,
+    array: &ArrayViewD<'_, f64>,
+    expected: &str,
+) -> PyResult<Vec<DVec3>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 3 {
-        return Err(shape_err(function, what, "(N, 3)", shape));
+        return Err(shape_err(function, what, expected, shape));
     }
-    let flat: Vec<f64> = array.iter().copied().collect();
-    let v: Vec<DVec3> = flat.chunks_exact(3).map(DVec3::from_slice).collect();
-    if let Some(index) = v.iter().position(|p| !p.is_finite()) {
-        return Err(to_py_err(
-            function,
-            Error::NotFinite {
-                what: "vector",
-                index,
-            },
-        ));
+    let mut out = try_vec(shape[0], "input vectors").map_err(|e| to_py_err(function, e))?;
+    for row in array.rows() {
+        out.push(DVec3::new(row[0], row[1], row[2]));
     }
+    Ok(out)
+}
+
+/// The row count of an `(N, 3)` argument (checked again when read).
+pub fn rows3_len(array: &FloatArray<'_>) -> usize {
+    array.as_array().shape().first().copied().unwrap_or(0)
+}
+
+/// Reads `(N, 3)` vectors, finite and within the working range (no GIL needed).
+pub fn read_vec3s(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
+    let v = read_rows3(function, what, array, "(N, 3)")?;
+    polyscrew::motion::subdivision::check_range(&v).map_err(|e| arg_err(function, what, e))?;
     Ok(v)
 }
 
-/// `(N, 3)` vectors as an array.
-pub fn vec3s_to_array(v: &[DVec3]) -> Array2<f64> {
-    let mut out = Array2::<f64>::zeros((v.len(), 3));
-    for (i, p) in v.iter().enumerate() {
-        out[[i, 0]] = p.x;
-        out[[i, 1]] = p.y;
-        out[[i, 2]] = p.z;
+/// `(N, 3)` vectors as an array (allocated fallibly).
+pub fn vec3s_to_array(v: &[DVec3]) -> Result<Array2<f64>, Error> {
+    let mut flat = try_vec(v.len().saturating_mul(3), "output vectors")?;
+    for p in v {
+        flat.extend(p.to_array());
     }
-    out
+    Ok(Array2::from_shape_vec((v.len(), 3), flat).expect("3 values per vector"))
 }
 
-/// Parses a scheme name, levels and timing name shared by several functions.
+/// Parses a scheme name and timing name shared by several functions.
 pub fn read_spec(
     function: &str,
     scheme: &str,
-    levels: i64,
+    levels: u32,
     closed: bool,
     period: Option<f64>,
     timing: &str,
 ) -> PyResult<MotionSpec> {
     let scheme = Scheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
     let timing = Timing::from_name(timing).map_err(|e| to_py_err(function, e))?;
-    let levels = u32::try_from(levels)
-        .ok()
-        .filter(|l| *l <= MAX_LEVELS)
-        .ok_or_else(|| {
-            PyValueError::new_err(format!(
-                "{function}: levels {levels} out of range 0..={MAX_LEVELS}"
-            ))
-        })?;
     Ok(MotionSpec {
         scheme,
         levels,
@@ -148,6 +202,9 @@ pub fn read_spec(
         timing,
     })
 }
+
+/// How to ask a sampling call for less memory.
+const SAMPLE_HINT: &str = polyscrew::motion::sample::SAMPLE_HINT;
 
 /// The screw between two poses (Rossignac-Kim): axis, point on the axis, angle, slide.
 #[pyclass(frozen, module = "polyscrew", name = "Screw")]
@@ -194,17 +251,14 @@ impl PyScrew {
 }
 
 /// Reads exactly one pose.
-fn read_one_pose(function: &str, what: &str, array: &FloatArray<'_>) -> PyResult<Pose> {
-    let (poses, single) = read_poses(function, what, array.as_array())?;
+fn read_one_pose(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Pose> {
+    let array = float_array(function, what, obj)?;
+    let view = array.as_array();
+    let (_, single) = pose_count(function, what, view.shape())?;
     if !single {
-        return Err(shape_err(
-            function,
-            what,
-            "(4, 4)",
-            array.as_array().shape(),
-        ));
+        return Err(shape_err(function, what, "(4, 4)", view.shape()));
     }
-    Ok(poses[0])
+    Ok(read_poses(function, what, &view)?[0])
 }
 
 /// screw(a, b) -> Screw
@@ -215,9 +269,9 @@ fn read_one_pose(function: &str, what: &str, array: &FloatArray<'_>) -> PyResult
 /// `a`, `b`: (4, 4) rigid matrices, translation in the last column.
 /// Raises ValueError for a non-rigid matrix, NaN or a wrong shape.
 #[pyfunction]
-fn screw(a: FloatArray<'_>, b: FloatArray<'_>) -> PyResult<PyScrew> {
-    let a = read_one_pose("screw", "a", &a)?;
-    let b = read_one_pose("screw", "b", &b)?;
+fn screw(a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<PyScrew> {
+    let a = read_one_pose("screw", "a", a)?;
+    let b = read_one_pose("screw", "b", b)?;
     Ok(PyScrew {
         inner: Screw::between(&a, &b),
     })
@@ -231,37 +285,73 @@ fn screw(a: FloatArray<'_>, b: FloatArray<'_>) -> PyResult<PyScrew> {
 #[pyfunction]
 fn interpolate<'py>(
     py: Python<'py>,
-    a: FloatArray<'py>,
-    b: FloatArray<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
     t: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     const F: &str = "interpolate";
-    let a = read_one_pose(F, "a", &a)?;
-    let b = read_one_pose(F, "b", &b)?;
+    let a = read_one_pose(F, "a", a)?;
+    let b = read_one_pose(F, "b", b)?;
     let sc = Screw::between(&a, &b);
-    if let Ok(t) = t.extract::<f64>() {
-        if !t.is_finite() {
-            return Err(to_py_err(
+    let check_t = |index: usize, t: f64| {
+        if t.abs() <= MAX_T {
+            Ok(())
+        } else if t.is_finite() {
+            Err(to_py_err(
                 F,
-                Error::NotFinite {
+                Error::OutOfRange {
                     what: "t",
-                    index: 0,
+                    index,
+                    value: t,
+                    range: "+-1e12",
                 },
-            ));
+            ))
+        } else {
+            Err(to_py_err(F, Error::NotFinite { what: "t", index }))
         }
-        let out = poses_to_array(&[sc.eval(t)]);
+    };
+    if t.is_instance_of::<pyo3::types::PyFloat>() || t.is_instance_of::<pyo3::types::PyInt>() {
+        let t = args::float_scalar(F, "t", t)?;
+        check_t(0, t)?;
+        let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
         return Ok(out
             .index_axis_move(numpy::ndarray::Axis(0), 0)
             .into_pyarray(py)
             .into_any());
     }
-    let ts: FloatArray<'py> = t.extract()?;
-    let ts = read_vector(F, "t", ts.as_array())?;
-    if let Some(index) = ts.iter().position(|v| !v.is_finite()) {
-        return Err(to_py_err(F, Error::NotFinite { what: "t", index }));
+    let ts = float_array(F, "t", t)?;
+    let view = ts.as_array();
+    if view.ndim() == 0 {
+        let t = view.iter().next().copied().unwrap_or(f64::NAN);
+        check_t(0, t)?;
+        let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
+        return Ok(out
+            .index_axis_move(numpy::ndarray::Axis(0), 0)
+            .into_pyarray(py)
+            .into_any());
     }
-    let out = py.detach(|| poses_to_array(&ts.iter().map(|t| sc.eval(*t)).collect::<Vec<_>>()));
+    let m = vector_len(F, "t", &ts)?;
+    check_budget(
+        F,
+        Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
+        "the interpolated poses",
+        "pass fewer t at once",
+    )?;
+    let out = py.detach(|| -> PyResult<Array3<f64>> {
+        let ts = read_vector(F, "t", &view)?;
+        for (index, t) in ts.iter().enumerate() {
+            check_t(index, *t)?;
+        }
+        let mut poses = try_vec(ts.len(), "interpolated poses").map_err(|e| to_py_err(F, e))?;
+        poses.extend(ts.iter().map(|t| sc.eval(*t)));
+        poses_to_array(&poses).map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py).into_any())
+}
+
+/// The input keys' footprint: the poses read from them.
+fn keys_footprint(n: usize) -> Footprint {
+    Footprint::of::<Pose>(n)
 }
 
 /// subdivide(poses, scheme="jarek", levels=4, closed=False) -> ndarray
@@ -275,32 +365,61 @@ fn interpolate<'py>(
 #[pyo3(signature = (poses, scheme="jarek", levels=4, closed=false))]
 fn subdivide<'py>(
     py: Python<'py>,
-    poses: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
+    poses: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<Subdivide>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<Subdivide>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<Subdivide>)] closed: bool,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "subdivide";
+    const F: &str = Subdivide::NAME;
     let spec = read_spec(F, scheme, levels, closed, None, "smooth")?;
-    let keys = read_keys(F, &poses)?;
-    let out = py
-        .detach(|| {
-            core_subdivide(&keys, spec.scheme, spec.levels, spec.closed).map(|d| poses_to_array(&d))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+    let poses = float_array(F, "poses", poses)?;
+    let n = key_count(F, &poses)?;
+    let out_len = if n >= 2 {
+        subdivided_len(n, levels, closed)
+    } else {
+        0
+    };
+    check_budget(
+        F,
+        keys_footprint(n)
+            + subdivision_footprint::<Pose>(n, levels, closed)
+            + Footprint::of::<[f64; 16]>(out_len),
+        "the subdivided poses",
+        SUBDIVISION_HINT,
+    )?;
+    let view = poses.as_array();
+    let out = py.detach(|| -> PyResult<Array3<f64>> {
+        let keys = read_keys(F, &view)?;
+        core_subdivide(&keys, spec.scheme, spec.levels, spec.closed)
+            .and_then(|d| poses_to_array(&d))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
-/// Reads the key poses, key times and sample times shared by `sample` and `sample_vectors`.
-fn read_times(
+/// The inputs of the sampling functions: key count, key times and times arrays.
+struct TimedInput<'py> {
+    key_times: FloatArray<'py>,
+    times: FloatArray<'py>,
+    n_times: usize,
+    n_key_times: usize,
+}
+
+fn read_timed<'py>(
     function: &str,
-    key_times: &FloatArray<'_>,
-    times: &FloatArray<'_>,
-) -> PyResult<(Vec<f64>, Vec<f64>)> {
-    Ok((
-        read_vector(function, "key_times", key_times.as_array())?,
-        read_vector(function, "times", times.as_array())?,
-    ))
+    key_times: &Bound<'py, PyAny>,
+    times: &Bound<'py, PyAny>,
+) -> PyResult<TimedInput<'py>> {
+    let key_times = float_array(function, "key_times", key_times)?;
+    let times = float_array(function, "times", times)?;
+    let n_key_times = vector_len(function, "key_times", &key_times)?;
+    let n_times = vector_len(function, "times", &times)?;
+    Ok(TimedInput {
+        key_times,
+        times,
+        n_times,
+        n_key_times,
+    })
 }
 
 /// sample(poses, key_times, times, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> ndarray
@@ -316,26 +435,44 @@ fn read_times(
 #[allow(clippy::too_many_arguments)]
 fn sample<'py>(
     py: Python<'py>,
-    poses: FloatArray<'py>,
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
-    period: Option<f64>,
-    timing: &str,
+    poses: &Bound<'py, PyAny>,
+    key_times: &Bound<'py, PyAny>,
+    times: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<Sample>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<Sample>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<Sample>)] closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::timing::<Sample>)] timing: &str,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "sample";
+    const F: &str = Sample::NAME;
+    let period = args::optional_float(F, "period", period)?;
     let spec = read_spec(F, scheme, levels, closed, period, timing)?;
-    let keys = read_keys(F, &poses)?;
-    let (key_times, times) = read_times(F, &key_times, &times)?;
-    let out = py
-        .detach(|| {
-            Motion::new(&keys, &key_times, &spec)
-                .and_then(|m| m.sample(&times))
-                .map(|p| poses_to_array(&p))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+    let poses = float_array(F, "poses", poses)?;
+    let n = key_count(F, &poses)?;
+    let input = read_timed(F, key_times, times)?;
+    let m = input.n_times;
+    check_budget(
+        F,
+        keys_footprint(n)
+            + Footprint::of::<f64>(input.n_key_times + m)
+            + sample_footprint::<Pose>(n, m, &spec)
+            + Footprint::of::<[f64; 16]>(m),
+        "the sampled poses",
+        SAMPLE_HINT,
+    )?;
+    let (view, kt, tt) = (
+        poses.as_array(),
+        input.key_times.as_array(),
+        input.times.as_array(),
+    );
+    let out = py.detach(|| -> PyResult<Array3<f64>> {
+        let keys = read_keys(F, &view)?;
+        let key_times = read_vector(F, "key_times", &kt)?;
+        let times = read_vector(F, "times", &tt)?;
+        core_sample(&keys, &key_times, &times, &spec)
+            .and_then(|p| poses_to_array(&p))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
@@ -350,36 +487,71 @@ fn sample<'py>(
 #[allow(clippy::type_complexity)]
 fn sample_channels<'py>(
     py: Python<'py>,
-    poses: FloatArray<'py>,
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
-    mode: &str,
-    previous: Option<FloatArray<'py>>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
-    period: Option<f64>,
-    timing: &str,
+    poses: &Bound<'py, PyAny>,
+    key_times: &Bound<'py, PyAny>,
+    times: &Bound<'py, PyAny>,
+    mode: &Bound<'py, PyAny>,
+    previous: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::scheme::<SampleChannels>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<SampleChannels>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<SampleChannels>)] closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::timing::<SampleChannels>)] timing: &str,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
-    const F: &str = "sample_channels";
-    let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
+    const F: &str = SampleChannels::NAME;
+    let mode =
+        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    let period = args::optional_float(F, "period", period)?;
     let spec = read_spec(F, scheme, levels, closed, period, timing)?;
-    let keys = read_keys(F, &poses)?;
-    let (key_times, times) = read_times(F, &key_times, &times)?;
+    let poses = float_array(F, "poses", poses)?;
+    let n = key_count(F, &poses)?;
+    let input = read_timed(F, key_times, times)?;
     let previous = previous
-        .map(|p| read_vector(F, "previous", p.as_array()))
+        .filter(|p| !p.is_none())
+        .map(|p| float_array(F, "previous", p))
         .transpose()?;
-    let (locations, rotations) = py
-        .detach(|| {
-            let dense = Motion::new(&keys, &key_times, &spec)?.sample(&times)?;
-            let quats: Vec<_> = dense.iter().map(|p| p.rotation).collect();
-            let locations: Vec<_> = dense.iter().map(|p| p.translation).collect();
-            core_rotation_channels(&quats, mode, previous.as_deref())
-                .map(|r| (vec3s_to_array(&locations), r))
-        })
-        .map_err(|e| to_py_err(F, e))?;
-    let rotations =
-        Array2::from_shape_vec((times.len(), mode.width()), rotations).expect("width * n values");
+    let m = input.n_times;
+    let width = mode.width();
+    check_budget(
+        F,
+        keys_footprint(n)
+            + Footprint::of::<f64>(input.n_key_times + m)
+            + sample_footprint::<Pose>(n, m, &spec)
+            + Footprint::of::<(DQuat, DVec3)>(m)
+            + Footprint::of::<[f64; 3]>(m)
+            + Footprint::of::<f64>(m.saturating_mul(width)),
+        "the sampled channels",
+        SAMPLE_HINT,
+    )?;
+    let (view, kt, tt) = (
+        poses.as_array(),
+        input.key_times.as_array(),
+        input.times.as_array(),
+    );
+    let pv = previous.as_ref().map(|p| p.as_array());
+    let (locations, rotations) = py.detach(|| -> PyResult<(Array2<f64>, Array2<f64>)> {
+        let keys = read_keys(F, &view)?;
+        let key_times = read_vector(F, "key_times", &kt)?;
+        let times = read_vector(F, "times", &tt)?;
+        let previous = pv
+            .as_ref()
+            .map(|p| read_vector(F, "previous", p))
+            .transpose()?;
+        let run = || -> Result<(Array2<f64>, Vec<f64>), Error> {
+            let dense = core_sample(&keys, &key_times, &times, &spec)?;
+            let mut quats = try_vec(dense.len(), "sampled rotations")?;
+            quats.extend(dense.iter().map(|p| p.rotation));
+            let mut locations = try_vec(dense.len(), "sampled locations")?;
+            locations.extend(dense.iter().map(|p| p.translation));
+            drop(dense);
+            let rotations = core_rotation_channels(&quats, mode, previous.as_deref())?;
+            Ok((vec3s_to_array(&locations)?, rotations))
+        };
+        let (locations, rotations) = run().map_err(|e| to_py_err(F, e))?;
+        let rotations = Array2::from_shape_vec((times.len(), width), rotations)
+            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+        Ok((locations, rotations))
+    })?;
     Ok((locations.into_pyarray(py), rotations.into_pyarray(py)))
 }
 
@@ -391,19 +563,35 @@ fn sample_channels<'py>(
 #[pyo3(signature = (values, scheme="jarek", levels=4, closed=false))]
 fn subdivide_vectors<'py>(
     py: Python<'py>,
-    values: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
+    values: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<SubdivideVectors>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<SubdivideVectors>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<SubdivideVectors>)] closed: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const F: &str = "subdivide_vectors";
+    const F: &str = SubdivideVectors::NAME;
     let spec = read_spec(F, scheme, levels, closed, None, "smooth")?;
-    let keys = read_vec3s(F, "values", values.as_array())?;
-    let out = py
-        .detach(|| {
-            core_subdivide(&keys, spec.scheme, spec.levels, spec.closed).map(|d| vec3s_to_array(&d))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+    let values = float_array(F, "values", values)?;
+    let n = rows3_len(&values);
+    let out_len = if n >= 2 {
+        subdivided_len(n, levels, closed)
+    } else {
+        0
+    };
+    check_budget(
+        F,
+        Footprint::of::<DVec3>(n)
+            + subdivision_footprint::<DVec3>(n, levels, closed)
+            + Footprint::of::<[f64; 3]>(out_len),
+        "the subdivided vectors",
+        SUBDIVISION_HINT,
+    )?;
+    let view = values.as_array();
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let keys = read_vec3s(F, "values", &view)?;
+        core_subdivide(&keys, spec.scheme, spec.levels, spec.closed)
+            .and_then(|d| vec3s_to_array(&d))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
@@ -416,27 +604,84 @@ fn subdivide_vectors<'py>(
 #[allow(clippy::too_many_arguments)]
 fn sample_vectors<'py>(
     py: Python<'py>,
-    values: FloatArray<'py>,
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
-    scheme: &str,
-    levels: i64,
-    closed: bool,
-    period: Option<f64>,
-    timing: &str,
+    values: &Bound<'py, PyAny>,
+    key_times: &Bound<'py, PyAny>,
+    times: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::scheme::<SampleVectors>)] scheme: &str,
+    #[pyo3(from_py_with = args::levels::<SampleVectors>)] levels: u32,
+    #[pyo3(from_py_with = args::closed::<SampleVectors>)] closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::timing::<SampleVectors>)] timing: &str,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const F: &str = "sample_vectors";
+    const F: &str = SampleVectors::NAME;
+    let period = args::optional_float(F, "period", period)?;
     let spec = read_spec(F, scheme, levels, closed, period, timing)?;
-    let keys = read_vec3s(F, "values", values.as_array())?;
-    let (key_times, times) = read_times(F, &key_times, &times)?;
-    let out = py
-        .detach(|| {
-            Motion::new(&keys, &key_times, &spec)
-                .and_then(|m| m.sample(&times))
-                .map(|v| vec3s_to_array(&v))
-        })
-        .map_err(|e| to_py_err(F, e))?;
+    let values = float_array(F, "values", values)?;
+    let n = rows3_len(&values);
+    let input = read_timed(F, key_times, times)?;
+    let m = input.n_times;
+    check_budget(
+        F,
+        Footprint::of::<DVec3>(n)
+            + Footprint::of::<f64>(input.n_key_times + m)
+            + sample_footprint::<DVec3>(n, m, &spec)
+            + Footprint::of::<[f64; 3]>(m),
+        "the sampled vectors",
+        SAMPLE_HINT,
+    )?;
+    let (view, kt, tt) = (
+        values.as_array(),
+        input.key_times.as_array(),
+        input.times.as_array(),
+    );
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let keys = read_vec3s(F, "values", &view)?;
+        let key_times = read_vector(F, "key_times", &kt)?;
+        let times = read_vector(F, "times", &tt)?;
+        core_sample(&keys, &key_times, &times, &spec)
+            .and_then(|v| vec3s_to_array(&v))
+            .map_err(|e| to_py_err(F, e))
+    })?;
     Ok(out.into_pyarray(py))
+}
+
+/// Reads `(N, 3, 3)` or `(N, 4, 4)` rotations as quaternions (no GIL needed).
+fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<DQuat>> {
+    let shape = array.shape();
+    match shape {
+        [_, 4, 4] => {
+            let poses = read_poses(function, "rotations", array)?;
+            let mut out = try_vec(poses.len(), "rotations").map_err(|e| to_py_err(function, e))?;
+            out.extend(poses.iter().map(|p| p.rotation));
+            Ok(out)
+        }
+        [n, 3, 3] => {
+            let mut out = try_vec(*n, "rotations").map_err(|e| to_py_err(function, e))?;
+            let mut values = array.iter();
+            for i in 0..*n {
+                let mut m = [0.0; 9];
+                for (slot, v) in m.iter_mut().zip(&mut values) {
+                    *slot = *v;
+                }
+                let rows = [
+                    [m[0], m[1], m[2], 0.0],
+                    [m[3], m[4], m[5], 0.0],
+                    [m[6], m[7], m[8], 0.0],
+                    [0.0, 0.0, 0.0, 1.0],
+                ];
+                let pose = Pose::from_rows(&rows, i)
+                    .map_err(|e| PyValueError::new_err(format!("{function}: rotations: {e}")))?;
+                out.push(pose.rotation);
+            }
+            Ok(out)
+        }
+        _ => Err(shape_err(
+            function,
+            "rotations",
+            "(N, 3, 3) or (N, 4, 4)",
+            shape,
+        )),
+    }
 }
 
 /// rotation_channels(rotations, mode, previous=None) -> ndarray
@@ -451,48 +696,60 @@ fn sample_vectors<'py>(
 #[pyo3(signature = (rotations, mode, previous=None))]
 fn rotation_channels<'py>(
     py: Python<'py>,
-    rotations: FloatArray<'py>,
-    mode: &str,
-    previous: Option<FloatArray<'py>>,
+    rotations: &Bound<'py, PyAny>,
+    mode: &Bound<'py, PyAny>,
+    previous: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     const F: &str = "rotation_channels";
-    let mode = RotationMode::from_name(mode).map_err(|e| to_py_err(F, e))?;
-    let array = rotations.as_array();
-    let shape = array.shape().to_vec();
-    let quats = match shape.as_slice() {
-        [_, 4, 4] => read_poses(F, "rotations", array)?
-            .0
-            .iter()
-            .map(|p| p.rotation)
-            .collect::<Vec<_>>(),
-        [n, 3, 3] => {
-            // Embed each 3x3 into a pose to share the validation.
-            let mut m = numpy::ndarray::Array3::<f64>::zeros((*n, 4, 4));
-            for i in 0..*n {
-                for r in 0..3 {
-                    for c in 0..3 {
-                        m[[i, r, c]] = array[[i, r, c]];
-                    }
-                }
-                m[[i, 3, 3]] = 1.0;
-            }
-            read_poses(F, "rotations", m.into_dyn().view())?
-                .0
-                .iter()
-                .map(|p| p.rotation)
-                .collect()
-        }
-        _ => return Err(shape_err(F, "rotations", "(N, 3, 3) or (N, 4, 4)", &shape)),
-    };
+    let mode =
+        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    let rotations = float_array(F, "rotations", rotations)?;
     let previous = previous
-        .map(|p| read_vector(F, "previous", p.as_array()))
+        .filter(|p| !p.is_none())
+        .map(|p| float_array(F, "previous", p))
         .transpose()?;
+    let view = rotations.as_array();
+    let n = view.shape().first().copied().unwrap_or(0);
     let width = mode.width();
-    let values = py
-        .detach(|| core_rotation_channels(&quats, mode, previous.as_deref()))
-        .map_err(|e| to_py_err(F, e))?;
-    let out = Array2::from_shape_vec((quats.len(), width), values).expect("width * n values");
+    check_budget(
+        F,
+        Footprint::of::<DQuat>(n) + Footprint::of::<f64>(n.saturating_mul(width)),
+        "the rotation channels",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    let pv = previous.as_ref().map(|p| p.as_array());
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let quats = read_rotations(F, &view)?;
+        let previous = pv
+            .as_ref()
+            .map(|p| read_vector(F, "previous", p))
+            .transpose()?;
+        let values = core_rotation_channels(&quats, mode, previous.as_deref())
+            .map_err(|e| to_py_err(F, e))?;
+        Array2::from_shape_vec((quats.len(), width), values)
+            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))
+    })?;
     Ok(out.into_pyarray(py))
+}
+
+/// memory_budget() -> int
+///
+/// The memory budget in bytes: the most one call may hold at its peak (output, working
+/// memory, the copies it makes of its input). A call that would need more raises
+/// ValueError up front, saying how much it asked for and how to ask for less.
+#[pyfunction]
+fn memory_budget() -> usize {
+    polyscrew::memory_budget()
+}
+
+/// set_memory_budget(bytes) -> int
+///
+/// Sets the memory budget (bytes, >= 0) for every later call in the process and returns the
+/// previous one. `DEFAULT_MEMORY_BUDGET` restores the default.
+#[pyfunction]
+fn set_memory_budget(bytes: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let bytes = args::int_in("set_memory_budget", "bytes", bytes, 0, i64::MAX)?;
+    Ok(polyscrew::set_memory_budget(bytes as usize))
 }
 
 /// The extension module `polyscrew._polyscrew`; `polyscrew/__init__.py` re-exports it.
@@ -507,7 +764,12 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(subdivide_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
+    m.add_function(wrap_pyfunction!(memory_budget, m)?)?;
+    m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
     m.add("MAX_LEVELS", MAX_LEVELS)?;
+    m.add("DEFAULT_MEMORY_BUDGET", polyscrew::DEFAULT_MEMORY_BUDGET)?;
+    m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
+    m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
     angular_velocity::register(m)?;
     sweep::register(m)?;
     feature::register(m)?;

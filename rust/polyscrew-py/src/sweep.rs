@@ -1,41 +1,33 @@
 //! Binding of the swept region (`polyscrew::sweep`): conversion only.
 
 use numpy::ndarray::{Array2, ArrayViewD};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLikeDyn};
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 use glam::DVec3;
-use polyscrew::sweep::{sweep_mesh, SweepOptions, MAX_STEPS};
-use polyscrew::Error;
+use polyscrew::memory::{try_vec, Footprint};
+use polyscrew::sweep::{body_footprint, sweep_mesh, SweepOptions, MAX_STEPS, SWEEP_HINT};
+use polyscrew::{Error, Pose};
 
-use crate::{read_poses, shape_err, to_py_err, FloatArray};
+use crate::args::{self, Function, Sweep};
+use crate::{check_budget, float_array, pose_count, read_poses, read_rows3, shape_err, to_py_err};
 
-/// An integer array-like argument converted to int64 on the way in.
-type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
-
-/// Reads `(N, 3)` float coordinates without judging them (the core names a bad vertex).
-fn read_points(function: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<DVec3>> {
-    let shape = array.shape();
-    if shape.len() != 2 || shape[1] != 3 {
-        return Err(shape_err(function, what, "(N, 3)", shape));
-    }
-    let flat: Vec<f64> = array.iter().copied().collect();
-    Ok(flat.chunks_exact(3).map(DVec3::from_slice).collect())
-}
-
-/// Reads `(T, 3)` integer triangles.
+/// Reads `(T, 3)` integer triangles (no GIL needed).
 fn read_triangles(
     function: &str,
     what: &str,
-    array: ArrayViewD<'_, i64>,
+    array: &ArrayViewD<'_, i64>,
 ) -> PyResult<Vec<[i64; 3]>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 3 {
         return Err(shape_err(function, what, "(T, 3)", shape));
     }
-    let flat: Vec<i64> = array.iter().copied().collect();
-    Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    let mut out = try_vec(shape[0], "triangles").map_err(|e| to_py_err(function, e))?;
+    for t in array.rows() {
+        out.push([t[0], t[1], t[2]]);
+    }
+    Ok(out)
 }
 
 /// sweep(vertices, triangles, poses, steps=8, caps=True) -> (ndarray, ndarray)
@@ -55,49 +47,52 @@ fn read_triangles(
 #[allow(clippy::type_complexity)]
 fn sweep<'py>(
     py: Python<'py>,
-    vertices: FloatArray<'py>,
-    triangles: IntArray<'py>,
-    poses: FloatArray<'py>,
-    steps: i64,
-    caps: bool,
+    vertices: &Bound<'py, PyAny>,
+    triangles: &Bound<'py, PyAny>,
+    poses: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::steps::<Sweep>)] steps: u32,
+    #[pyo3(from_py_with = args::caps::<Sweep>)] caps: bool,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>)> {
-    const F: &str = "sweep";
-    let v = read_points(F, "vertices", vertices.as_array())?;
-    let t = read_triangles(F, "triangles", triangles.as_array())?;
-    let (p, single) = read_poses(F, "poses", poses.as_array())?;
+    const F: &str = Sweep::NAME;
+    let vertices = float_array(F, "vertices", vertices)?;
+    let triangles = args::int_array(F, "triangles", triangles)?;
+    let poses = float_array(F, "poses", poses)?;
+    let (n, single) = pose_count(F, "poses", poses.as_array().shape())?;
     if single {
         return Err(to_py_err(F, Error::TooFew { got: 1, need: 2 }));
     }
-    let steps = u32::try_from(steps)
-        .ok()
-        .filter(|s| (1..=MAX_STEPS).contains(s))
-        .ok_or_else(|| {
-            to_py_err(
-                F,
-                Error::Invalid {
-                    what: "steps",
-                    reason: format!("{steps} is outside 1..={MAX_STEPS}"),
-                },
-            )
-        })?;
+    let (nv, nt) = (
+        vertices.as_array().shape().first().copied().unwrap_or(0),
+        triangles.as_array().shape().first().copied().unwrap_or(0),
+    );
+    // The inputs read and the body built; the core checks the output span by span.
+    check_budget(
+        F,
+        Footprint::of::<Pose>(n) + body_footprint(nv, nt),
+        "the swept body",
+        SWEEP_HINT,
+    )?;
     let options = SweepOptions { steps, caps };
-    let (vo, to) = py
-        .detach(|| {
-            sweep_mesh(&v, &t, &p, &options).map(|out| {
-                let flat: Vec<f64> = out.vertices.iter().flat_map(|q| q.to_array()).collect();
-                let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat);
-                let flat: Vec<i64> = out
-                    .triangles
-                    .iter()
-                    .flat_map(|t| t.map(|i| i as i64))
-                    .collect();
-                let to = Array2::from_shape_vec((out.triangles.len(), 3), flat);
-                (vo, to)
-            })
-        })
-        .map_err(|e| to_py_err(F, e))?;
-    let shape_bug = |e: numpy::ndarray::ShapeError| PyValueError::new_err(format!("{F}: {e}"));
-    let (vo, to) = (vo.map_err(shape_bug)?, to.map_err(shape_bug)?);
+    let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
+    let (vo, to) = py.detach(|| -> PyResult<(Array2<f64>, Array2<i64>)> {
+        let (va, ta, pa) = &views;
+        let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
+        let t = read_triangles(F, "triangles", ta)?;
+        let p = read_poses(F, "poses", pa)?;
+        let out = sweep_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))?;
+        drop((v, t, p));
+        let mut flat =
+            try_vec(out.vertices.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
+        flat.extend(out.vertices.iter().flat_map(|q| q.to_array()));
+        let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat)
+            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+        let mut flat =
+            try_vec(out.triangles.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
+        flat.extend(out.triangles.iter().flat_map(|t| t.map(i64::from)));
+        let to = Array2::from_shape_vec((out.triangles.len(), 3), flat)
+            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+        Ok((vo, to))
+    })?;
     Ok((vo.into_pyarray(py), to.into_pyarray(py)))
 }
 

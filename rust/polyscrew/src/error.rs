@@ -3,6 +3,8 @@
 
 use std::fmt;
 
+use crate::memory::human_bytes;
+
 /// Why a pose matrix was rejected.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[non_exhaustive]
@@ -29,6 +31,14 @@ pub enum PoseDefect {
     },
     /// The 3x3 part has a negative determinant.
     Mirror,
+    /// A translation entry lies outside the working range `+-limit` (see
+    /// [`crate::motion::pose::MAX_COORDINATE`]).
+    OutOfRange {
+        /// The entry.
+        value: f64,
+        /// The working range's bound.
+        limit: f64,
+    },
 }
 
 impl fmt::Display for PoseDefect {
@@ -46,6 +56,10 @@ impl fmt::Display for PoseDefect {
                 )
             }
             Self::Mirror => write!(f, "not rigid: mirror (negative determinant)"),
+            Self::OutOfRange { value, limit } => write!(
+                f,
+                "translation {value:e} is outside the working range +-{limit:e}"
+            ),
         }
     }
 }
@@ -103,6 +117,29 @@ pub enum Error {
         /// The span `times[n - 1] - times[0]` it must exceed.
         span: f64,
     },
+    /// A value outside the working range in which the formulas stay finite.
+    OutOfRange {
+        /// What the value is (for example `"key time"`).
+        what: &'static str,
+        /// Its index.
+        index: usize,
+        /// The value.
+        value: f64,
+        /// The working range, for the message (for example `"+-1e300"`).
+        range: &'static str,
+    },
+    /// A call would need more memory than it may use (see [`crate::memory`]).
+    Memory {
+        /// What would be allocated.
+        what: &'static str,
+        /// The bytes it would need (saturated at `usize::MAX`).
+        bytes: usize,
+        /// The budget it exceeds ([`crate::memory::memory_budget`]), or `None` when the
+        /// allocator refused within the budget.
+        budget: Option<usize>,
+        /// How to ask for less.
+        hint: &'static str,
+    },
     /// A free-form invalid argument, with the argument's name and the reason.
     Invalid {
         /// The argument.
@@ -134,6 +171,37 @@ impl fmt::Display for Error {
             Self::Period { period, span } => write!(
                 f,
                 "period {period} must be finite and exceed the key times' span {span}"
+            ),
+            Self::OutOfRange {
+                what,
+                index,
+                value,
+                range,
+            } => write!(
+                f,
+                "{what} {index} ({value:e}) is outside the working range {range}"
+            ),
+            Self::Memory {
+                what,
+                bytes,
+                budget: Some(budget),
+                hint,
+            } => write!(
+                f,
+                "{what} would need {}, over the memory budget of {}: {hint} \
+                 (or raise the budget with set_memory_budget)",
+                human_bytes(*bytes),
+                human_bytes(*budget)
+            ),
+            Self::Memory {
+                what,
+                bytes,
+                budget: None,
+                hint,
+            } => write!(
+                f,
+                "could not allocate {} for {what}: {hint}",
+                human_bytes(*bytes)
             ),
             Self::Invalid { what, reason } => write!(f, "{what}: {reason}"),
         }

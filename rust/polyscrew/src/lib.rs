@@ -21,6 +21,9 @@
 //! | [`intent`] | what the animator meant between the keys: Blender's playback of an owner's channels, holds, pops, spins, the pace of timing "Keys" | ScrewBender issue 17 |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
+//! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
+//! allocation whose size depends on input is checked against one budget before it is made.
+//!
 //! What users reach for is re-exported here.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
@@ -44,6 +47,7 @@ pub mod error;
 pub mod fcurve;
 pub mod feature;
 pub mod intent;
+pub mod memory;
 pub mod motion;
 pub(crate) mod numeric;
 pub mod sweep;
@@ -70,6 +74,7 @@ pub use intent::{
     analyse_spans, keys_parameters, rotation_matrices, rotation_matrix, Channel, KeysTiming,
     Playback, Spans,
 };
+pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{rotation_channels, EulerOrder, RotationMode};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};

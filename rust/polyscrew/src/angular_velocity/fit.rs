@@ -28,13 +28,97 @@
 //! Times are in seconds and angular velocities in rad/s for the paper's defaults
 //! `alpha = 0.002` (units s^2) and `delta = 0.1` (units rad^2/s) to mean what they meant there.
 
+#![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` also catches NaN
+
 use glam::{DQuat, DVec3, DVec4};
 
 use crate::angular_velocity::quat_spline::{
     check_keys, hermite_weights, quat_conj, quat_exp, quat_mul, QuatSpline,
 };
 use crate::error::{Error, Result};
+use crate::memory::{try_vec, Footprint};
 use crate::numeric::banded::SymBand;
+
+/// The working range of the fit's times (key, target and sample times): `|t| <= MAX_TIME`,
+/// and consecutive key times at least [`MIN_KEY_SPACING`] apart.
+///
+/// Why: the energy integrates `|q''|^2`, and `q''` of a Hermite segment of length `h` is up
+/// to `6 / h^2 + 4 |q'| / h` with `|q'| ~ |omega|`; with times, spacings (`1e-30`),
+/// angular velocities ([`MAX_ANGULAR_VELOCITY`]) and `alpha` ([`MAX_ALPHA`]) in these ranges
+/// every energy, Jacobian entry and damped normal equation stays below about `1e200`. An
+/// animator's seconds and radians per second are far inside.
+pub const MAX_TIME: f64 = 1e30;
+
+/// [`MAX_TIME`] as it reads in messages.
+pub const TIME_RANGE: &str = "+-1e30";
+
+/// The smallest spacing of consecutive key times of a fit (see [`MAX_TIME`]).
+pub const MIN_KEY_SPACING: f64 = 1e-30;
+
+/// The largest target angular velocity (rad per time unit) and target speed (see
+/// [`MAX_TIME`]).
+pub const MAX_ANGULAR_VELOCITY: f64 = 1e30;
+
+/// [`MAX_ANGULAR_VELOCITY`] as it reads in messages.
+pub const ANGULAR_VELOCITY_RANGE: &str = "+-1e30";
+
+/// The largest `alpha` (see [`MAX_TIME`]).
+pub const MAX_ALPHA: f64 = 1e30;
+
+/// The most fragments the key range may be cut into (`fragment_duration` at least
+/// `span / MAX_FRAGMENTS`): each costs eight spline evaluations per round.
+pub const MAX_FRAGMENTS: usize = 1_000_000;
+
+/// The largest `max_iterations` and `max_frames` accepted.
+pub const MAX_ITERATIONS: usize = 1_000_000;
+
+/// Bytes a fit holds per control point (key or variable frame) at its peak, with room: the
+/// quadrature points of its segment (8 x 144 bytes), its share of the banded normal
+/// equations and their copies (3 x 7 x 14 x 8 bytes), the node itself and the step vectors.
+pub const FIT_BYTES_PER_NODE: usize = 8192;
+
+/// How to ask the fit for less memory.
+pub const FIT_HINT: &str = "use fewer keys, fewer variable frames (max_frames) or a longer \
+     fragment_duration";
+
+/// What [`fit_angular_velocity`] holds at its peak for `keys` keys, `targets` target
+/// samples and the options (the fragments counted as `options` asks).
+pub fn fit_footprint(keys: usize, targets: usize, options: &FitOptions) -> Footprint {
+    let fragments = fragment_count(keys, options).unwrap_or(MAX_FRAGMENTS);
+    let nodes = keys.saturating_add(options.max_frames.min(fragments));
+    Footprint::bytes(FIT_BYTES_PER_NODE).times(nodes)
+        + Footprint::of::<[f64; 3]>(fragments)
+        + Footprint::of::<[f64; 4]>(targets).times(2)
+}
+
+/// The number of fragments of the key range (`span` known only to the fit: here the
+/// default count, or an upper bound from the duration when the range is not known).
+fn fragment_count(keys: usize, options: &FitOptions) -> Option<usize> {
+    match options.fragment_duration {
+        None => Some(
+            FRAGMENTS_PER_KEY_SPAN
+                .saturating_mul(keys.saturating_sub(1))
+                .max(MIN_FRAGMENTS),
+        ),
+        Some(_) => None,
+    }
+}
+
+fn check_fit_time(what: &'static str, index: usize, t: f64) -> Result<()> {
+    if t.abs() <= MAX_TIME {
+        return Ok(());
+    }
+    if t.is_finite() {
+        Err(Error::OutOfRange {
+            what,
+            index,
+            value: t,
+            range: TIME_RANGE,
+        })
+    } else {
+        Err(Error::NotFinite { what, index })
+    }
+}
 
 /// The paper's weight of the tangential-acceleration term `W_T` (section 2: 0.002; it found
 /// `[0.001, 0.005]` to work well).
@@ -147,9 +231,24 @@ impl AngularVelocityTarget {
                 index,
             });
         }
+        if let Some(index) = omega
+            .iter()
+            .position(|w| w.abs().max_element() > MAX_ANGULAR_VELOCITY)
+        {
+            return Err(Error::OutOfRange {
+                what: "target angular velocity",
+                index,
+                value: omega[index].abs().max_element(),
+                range: ANGULAR_VELOCITY_RANGE,
+            });
+        }
+        let mut own_times = try_vec(times.len(), "target")?;
+        own_times.extend_from_slice(times);
+        let mut own_omega = try_vec(omega.len(), "target")?;
+        own_omega.extend_from_slice(omega);
         Ok(Self {
-            times: times.to_vec(),
-            omega: omega.to_vec(),
+            times: own_times,
+            omega: own_omega,
         })
     }
 
@@ -176,7 +275,7 @@ impl AngularVelocityTarget {
                 });
             }
         }
-        let mut omega = Vec::with_capacity(times.len());
+        let mut omega = try_vec(times.len(), "target")?;
         for (index, (d, s)) in directions.iter().zip(speeds).enumerate() {
             if !d.is_finite() {
                 return Err(Error::NotFinite {
@@ -190,6 +289,20 @@ impl AngularVelocityTarget {
                     index,
                 });
             }
+            if s.abs() > MAX_ANGULAR_VELOCITY {
+                return Err(Error::OutOfRange {
+                    what: "target speed",
+                    index,
+                    value: *s,
+                    range: ANGULAR_VELOCITY_RANGE,
+                });
+            }
+            // Directions are only normalised: scale huge ones first so |d|^2 stays finite.
+            let d = if d.abs().max_element() > 1e150 {
+                *d * 1e-150
+            } else {
+                *d
+            };
             let length = d.length();
             if length < MIN_DIRECTION_LENGTH {
                 return Err(Error::Invalid {
@@ -199,7 +312,7 @@ impl AngularVelocityTarget {
                     ),
                 });
             }
-            omega.push(*d * (*s / length));
+            omega.push(d * (*s / length));
         }
         Self::new(times, &omega)
     }
@@ -214,16 +327,17 @@ impl AngularVelocityTarget {
         &self.omega
     }
 
-    /// The target at time `t`: linear between samples, the end samples held outside.
+    /// The target at time `t`: linear between samples, the end samples held outside (and
+    /// the first for a NaN time).
     pub fn eval(&self, t: f64) -> DVec3 {
         let n = self.times.len();
-        if t <= self.times[0] {
+        if !(t > self.times[0]) {
             return self.omega[0];
         }
         if t >= self.times[n - 1] {
             return self.omega[n - 1];
         }
-        let j = self.times.partition_point(|&x| x <= t) - 1;
+        let j = (self.times.partition_point(|&x| x <= t).max(1) - 1).min(n - 2);
         let u = (t - self.times[j]) / (self.times[j + 1] - self.times[j]);
         self.omega[j].lerp(self.omega[j + 1], u)
     }
@@ -237,12 +351,7 @@ fn check_target_times(times: &[f64]) -> Result<()> {
         });
     }
     for (i, t) in times.iter().enumerate() {
-        if !t.is_finite() {
-            return Err(Error::NotFinite {
-                what: "target time",
-                index: i,
-            });
-        }
+        check_fit_time("target time", i, *t)?;
         if i > 0 && *t <= times[i - 1] {
             return Err(Error::Invalid {
                 what: "target times",
@@ -293,14 +402,26 @@ impl FitOptions {
                 reason: reason.to_owned(),
             })
         };
-        if !(self.alpha.is_finite() && self.alpha >= 0.0) {
-            return bad("alpha", &format!("{} must be finite and >= 0", self.alpha));
+        if !(self.alpha >= 0.0 && self.alpha <= MAX_ALPHA) {
+            return bad(
+                "alpha",
+                &format!("{} must be in the working range 0..=1e30", self.alpha),
+            );
         }
         if !(self.delta.is_finite() && self.delta > 0.0) {
             return bad("delta", &format!("{} must be finite and > 0", self.delta));
         }
-        if self.max_iterations == 0 {
-            return bad("max_iterations", "must be at least 1");
+        if self.max_iterations == 0 || self.max_iterations > MAX_ITERATIONS {
+            return bad(
+                "max_iterations",
+                &format!("{} is outside 1..={MAX_ITERATIONS}", self.max_iterations),
+            );
+        }
+        if self.max_frames > MAX_ITERATIONS {
+            return bad(
+                "max_frames",
+                &format!("{} is outside 0..={MAX_ITERATIONS}", self.max_frames),
+            );
         }
         if let Some(d) = self.fragment_duration {
             if !(d.is_finite() && d > 0.0) {
@@ -378,14 +499,15 @@ impl AngularVelocityFit {
     ///
     /// # Errors
     /// [`Error::NotFinite`] for a NaN time, [`Error::Invalid`] for a time outside the key
-    /// range (beyond [`TIME_TOLERANCE`] of its length).
+    /// range (beyond [`TIME_TOLERANCE`] of its length), [`Error::Memory`] when the output
+    /// exceeds the memory budget.
     pub fn sample(&self, times: &[f64]) -> Result<Vec<DQuat>> {
         let (t0, t1) = self.spline.range();
         let slack = TIME_TOLERANCE * (t1 - t0);
-        times
-            .iter()
-            .enumerate()
-            .map(|(index, &t)| {
+        Footprint::of::<DQuat>(times.len()).check("sampled orientations", FIT_HINT)?;
+        let mut out = try_vec(times.len(), "sampled orientations")?;
+        for (index, &t) in times.iter().enumerate() {
+            out.push({
                 if !t.is_finite() {
                     return Err(Error::NotFinite {
                         what: "sample time",
@@ -398,9 +520,10 @@ impl AngularVelocityFit {
                         reason: format!("time {index} ({t}) is outside the key range [{t0}, {t1}]"),
                     });
                 }
-                Ok(self.spline.rotation(t))
-            })
-            .collect()
+                self.spline.rotation(t)
+            });
+        }
+        Ok(out)
     }
 
     /// `Ok(self)` when converged, otherwise a [`FitFailure`] carrying this best result.
@@ -839,6 +962,24 @@ pub fn fit_angular_velocity(
     options: &FitOptions,
 ) -> Result<AngularVelocityFit> {
     options.check()?;
+    for (index, &t) in key_times.iter().enumerate() {
+        check_fit_time("key time", index, t)?;
+        if index > 0 && t - key_times[index - 1] < MIN_KEY_SPACING {
+            // (Not increasing at all is reported by check_keys below.)
+            if t > key_times[index - 1] {
+                return Err(Error::Invalid {
+                    what: "key times",
+                    reason: format!(
+                        "key times {} and {index} are {:e} apart, closer than the fit's \
+                         {MIN_KEY_SPACING:e}",
+                        index - 1,
+                        t - key_times[index - 1]
+                    ),
+                });
+            }
+        }
+    }
+    fit_footprint(keys.len(), target.times.len(), options).check("the fit", FIT_HINT)?;
     let values = check_keys(key_times, keys)?;
     if constrained.len() != keys.len() {
         return Err(Error::LengthMismatch {
@@ -860,9 +1001,23 @@ pub fn fit_angular_velocity(
     }
     let (values, derivatives) = initial_curve(key_times, values, target);
     let fragments = match options.fragment_duration {
-        Some(d) => ((span / d).round() as usize).max(1),
+        Some(d) => {
+            let count = (span / d).round();
+            if !(count <= MAX_FRAGMENTS as f64) {
+                return Err(Error::Invalid {
+                    what: "fragment_duration",
+                    reason: format!(
+                        "{d:e} cuts the key range ({span:e} long) into {count:e} fragments, \
+                         more than {MAX_FRAGMENTS}: use at least {:e}",
+                        span / MAX_FRAGMENTS as f64
+                    ),
+                });
+            }
+            (count as usize).max(1)
+        }
         None => (FRAGMENTS_PER_KEY_SPAN * (k - 1)).max(MIN_FRAGMENTS),
     };
+    Footprint::of::<[f64; 3]>(fragments).check("fit fragments", FIT_HINT)?;
     let fragment_duration = span / fragments as f64;
     let mut nodes = Nodes {
         times: key_times.to_vec(),
@@ -946,6 +1101,19 @@ pub fn fit_angular_velocity(
         tangential: f64::INFINITY,
         deviation: f64::INFINITY,
     });
+    // Finite in, finite out: inside the working ranges nothing overflows; should anything
+    // still, say so rather than report NaN.
+    let finite = errors.iter().all(|e| e.is_finite())
+        && spline.values().iter().all(|v| v.is_finite())
+        && spline.derivatives().iter().all(|v| v.is_finite());
+    if !finite {
+        return Err(Error::Invalid {
+            what: "fit",
+            reason: "the optimisation overflowed; scale times or angular velocities towards \
+                     seconds and radians per second"
+                .into(),
+        });
+    }
     Ok(AngularVelocityFit {
         spline,
         keys: fitted_keys,

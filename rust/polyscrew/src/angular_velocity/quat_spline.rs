@@ -282,7 +282,12 @@ pub(crate) fn check_keys(times: &[f64], keys: &[DQuat]) -> Result<Vec<DVec4>> {
     check_key_times(times)?;
     let mut out: Vec<DVec4> = Vec::with_capacity(keys.len());
     for (index, key) in keys.iter().enumerate() {
-        let v = DVec4::from(*key);
+        let mut v = DVec4::from(*key);
+        // Scale huge or tiny keys by a power of two first (exact), so |v|^2 stays finite.
+        let big = v.abs().max_element();
+        if big > 1e150 || (big > 0.0 && big < 1e-150) {
+            v *= 2f64.powi(-(big.log2().floor() as i32).clamp(-1020, 1020));
+        }
         if !v.is_finite() {
             return Err(Error::NotFinite {
                 what: "key quaternion",

@@ -1,9 +1,11 @@
 //! The sizes an F-curve batch may reach, checked in one place ([`check_batch`]) before
 //! anything is allocated: the add-on runs inside the user's Blender session, and a request
-//! too large for memory must be an error, not an abort. (When the crate gets one memory
-//! budget, this function is where the F-curve module asks it.)
+//! too large for memory must be an error, not an abort: after its own caps it asks the
+//! crate's memory budget ([`crate::memory`]) for the keys and the values.
 
 use crate::error::{Error, Result};
+use crate::fcurve::Key;
+use crate::memory::Footprint;
 
 /// Most keys one batch may hold (all curves together): 2^26, about 67 million (each is
 /// copied once into a 40-byte key).
@@ -14,10 +16,10 @@ pub const MAX_KEYS: usize = 1 << 26;
 pub const MAX_VALUES: usize = 1 << 27;
 
 /// Checks a batch of `curves` curves holding `keys` keys in all, evaluated at `times` times,
-/// against [`MAX_KEYS`] and [`MAX_VALUES`].
+/// against [`MAX_KEYS`] and [`MAX_VALUES`], then against the memory budget.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming the size that is too large.
+/// [`Error::Invalid`] naming the size that is too large; [`Error::Memory`] over the budget.
 pub fn check_batch(curves: usize, keys: usize, times: usize) -> Result<()> {
     if keys > MAX_KEYS {
         return Err(Error::Invalid {
@@ -26,7 +28,9 @@ pub fn check_batch(curves: usize, keys: usize, times: usize) -> Result<()> {
         });
     }
     match curves.checked_mul(times) {
-        Some(values) if values <= MAX_VALUES => Ok(()),
+        Some(values) if values <= MAX_VALUES => Footprint::of::<Key>(keys)
+            .and::<f64>(values)
+            .check("the F-curve evaluation", "evaluate fewer curves or times in one call"),
         _ => Err(Error::Invalid {
             what: "times",
             reason: format!(

@@ -26,6 +26,7 @@
 use glam::{DMat3, DVec3};
 
 use crate::error::{Error, Result};
+use crate::motion::pose::{COORDINATE_RANGE, MAX_COORDINATE};
 use crate::numeric::eigen::symmetric_eigen;
 
 /// A cloud counts as collinear (its rotation about the line undetermined) when the second
@@ -66,10 +67,32 @@ impl InertiaFrame {
                 reason: format!("{} given, at least 3 needed", points.len()),
             });
         }
+        if let Some(index) = points
+            .iter()
+            .position(|p| p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(Error::OutOfRange {
+                what: "feature point",
+                index,
+                value: points[index].abs().max_element(),
+                range: COORDINATE_RANGE,
+            });
+        }
         let centroid = points.iter().sum::<DVec3>() / points.len() as f64;
+        // The tensor of the centred points scaled by a power of two to below 1 (exact), so
+        // its entries and Jacobi's sums of their squares stay finite; scaled back below.
+        let big = points
+            .iter()
+            .map(|p| (*p - centroid).abs().max_element())
+            .fold(0.0, f64::max);
+        let scale = if big > 0.0 {
+            2f64.powi(-(big.log2().floor() as i32 + 1).clamp(-1020, 1020))
+        } else {
+            1.0
+        };
         let mut j = [[0.0; 3]; 3];
         for p in points {
-            let x = (*p - centroid).to_array();
+            let x = ((*p - centroid) * scale).to_array();
             for a in 0..3 {
                 for b in 0..3 {
                     j[a][b] += x[a] * x[b];
@@ -88,8 +111,8 @@ impl InertiaFrame {
         let e0 = DVec3::from_array(vectors[0]);
         let e1 = DVec3::from_array(vectors[1]);
         let e2 = e0.cross(e1).normalize();
-        let extents = values.map(|l| (l.max(0.0) / 2.0).sqrt());
-        let radius = ((j[0][0] + j[1][1] + j[2][2]) / points.len() as f64).sqrt();
+        let extents = values.map(|l| (l.max(0.0) / 2.0).sqrt() / scale);
+        let radius = ((j[0][0] + j[1][1] + j[2][2]) / points.len() as f64).sqrt() / scale;
         Ok(Self {
             centroid,
             axes: [e0, e1, e2],

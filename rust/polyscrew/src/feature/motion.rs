@@ -56,9 +56,10 @@ use crate::feature::registration::{cross_covariance, rotation_from_covariance_wa
 use crate::feature::variational::{
     spans_spacing, variational_subdivide, Parametrization, Stiffness,
 };
+use crate::memory::{try_vec, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::sample::Motion;
-use crate::motion::subdivision::{check_subdivision, subdivide, Scheme};
+use crate::motion::subdivision::{check_subdivision, subdivide_checked, subdivided_len, Scheme};
 use crate::motion::timing::Timing;
 
 /// The curve scheme run on the feature points' trajectories.
@@ -163,6 +164,25 @@ pub const UNIT_FRAME_POINTS: [DVec3; 6] = [
     DVec3::NEG_Z,
 ];
 
+/// Bytes [`feature_motion`] holds per output pose at its peak, with room: the four control
+/// points' trajectories (96) and, for the variational scheme, the last level's system
+/// (unknowns, stencils, springs, band factor, right-hand side: about 200), the pose (56).
+pub const FEATURE_BYTES_PER_POSE: usize = 512;
+
+/// How to ask the feature-point design for less memory.
+pub const FEATURE_HINT: &str = "use fewer levels or fewer keys";
+
+/// What [`feature_motion`] holds at its peak for `keys` keys and `feature_points` points.
+pub fn feature_footprint(keys: usize, feature_points: usize, spec: &FeatureSpec) -> Footprint {
+    let poses = subdivided_len(keys, spec.levels, spec.closed);
+    let centripetal = if spec.parametrization == Parametrization::Centripetal {
+        Footprint::of::<DVec3>(keys.saturating_mul(feature_points))
+    } else {
+        Footprint::ZERO
+    };
+    Footprint::bytes(FEATURE_BYTES_PER_POSE).times(poses) + centripetal
+}
+
 /// The rigid motion designed from the keys by the feature-point method, as dense poses:
 /// `n 2^levels` closed, `(n - 1) 2^levels + 1` open, pose `i 2^levels` belonging to key `i`.
 ///
@@ -181,6 +201,9 @@ pub fn feature_motion(
 ) -> Result<Vec<Pose>> {
     let n = keys.len();
     check_subdivision(n, spec.levels)?;
+    crate::motion::subdivision::check_range(keys)?;
+    feature_footprint(n, feature_points.map_or(6, <[DVec3]>::len), spec)
+        .check("the feature-point motion", FEATURE_HINT)?;
     if spec.scheme != CurveScheme::Variational {
         if spec.stiffness != Stiffness::default() {
             return Err(Error::Invalid {
@@ -206,7 +229,7 @@ pub fn feature_motion(
     let dense_tracks = match spec.scheme.split() {
         Some(scheme) => tracks
             .iter()
-            .map(|t| subdivide(t, scheme, spec.levels, spec.closed))
+            .map(|t| subdivide_checked(t, scheme, spec.levels, spec.closed))
             .collect::<Result<Vec<_>>>()?,
         None => {
             let spacing = match spec.parametrization {
@@ -227,7 +250,7 @@ pub fn feature_motion(
     let per_span = 1usize << spec.levels;
     let keep_keys = spec.interpolates_keys();
     let m = dense_tracks[0].len();
-    let mut out: Vec<Pose> = Vec::with_capacity(m);
+    let mut out: Vec<Pose> = try_vec(m, "the feature-point motion")?;
     // Eigenvectors of the previous sample's Horn matrix: a warm start for the next.
     let mut basis = IDENTITY4;
     for j in 0..m {
@@ -483,7 +506,7 @@ mod tests {
             let dense: Vec<Vec<DVec3>> = match spec.scheme.split() {
                 Some(s) => all
                     .iter()
-                    .map(|t| subdivide(t, s, spec.levels, spec.closed).unwrap())
+                    .map(|t| crate::subdivide(t, s, spec.levels, spec.closed).unwrap())
                     .collect(),
                 None => {
                     let spacing = spans_spacing(&all, spec.closed, spec.parametrization).unwrap();

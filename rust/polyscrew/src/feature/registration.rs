@@ -33,7 +33,7 @@
 use glam::{DMat3, DQuat, DVec3};
 
 use crate::error::{Error, Result};
-use crate::motion::pose::Pose;
+use crate::motion::pose::{Pose, COORDINATE_RANGE, MAX_COORDINATE};
 use crate::numeric::eigen::symmetric_eigen_from;
 
 /// The largest eigenvalue of Horn's matrix counts as repeated when the gap to the second is
@@ -45,9 +45,23 @@ pub const REPEATED_EIGENVALUE_GAP: f64 = 1e-10;
 /// The fewest points registration needs (three non-collinear ones fix a rotation).
 pub const MIN_POINTS: usize = 3;
 
+/// `2^-e` for the power of two `2^e` nearest above `big` (1 for `big` 0 or not finite):
+/// multiplying by it is exact and brings `big` into `[0.5, 1)`.
+fn power_of_two_scale(big: f64) -> f64 {
+    if !(big > 0.0 && big.is_finite()) {
+        return 1.0;
+    }
+    2f64.powi(-(big.log2().floor() as i32 + 1).clamp(-1020, 1020))
+}
+
 /// Weighted barycentre and cross-covariance `S = sum_k w_k x'_k y'_k^T` of two clouds
-/// (`004_*` eqs. 3-6). `S` is returned with `S.col(b)[a] = S_ab`, so `S = sum w x' y'^T` as a
-/// glam matrix.
+/// (`004_*` eqs. 3-6), up to a positive power-of-two factor. `S` is returned with
+/// `S.col(b)[a] = S_ab`, so `S ~ sum w x' y'^T` as a glam matrix.
+///
+/// The weights are scaled by a power of two to at most 1 and the centred points to below 1
+/// before the products, so `S` stays finite for any coordinates within
+/// [`crate::motion::pose::MAX_COORDINATE`] and any finite weights; the scaling is exact,
+/// so the rotation (Horn's eigenvector, scale-free) is the same to the bit.
 ///
 /// # Errors
 /// As [`register`].
@@ -57,7 +71,10 @@ pub fn cross_covariance(
     weights: Option<&[f64]>,
 ) -> Result<(DVec3, DVec3, DMat3)> {
     check_clouds(src, dst, weights)?;
-    let w = |k: usize| weights.map_or(1.0, |w| w[k]);
+    let weight_scale = weights.map_or(1.0, |w| {
+        power_of_two_scale(w.iter().copied().fold(0.0, f64::max))
+    });
+    let w = |k: usize| weights.map_or(1.0, |w| w[k] * weight_scale);
     let mut total = 0.0;
     let mut xbar = DVec3::ZERO;
     let mut ybar = DVec3::ZERO;
@@ -68,10 +85,16 @@ pub fn cross_covariance(
     }
     xbar /= total;
     ybar /= total;
+    let big = src
+        .iter()
+        .map(|p| (*p - xbar).abs().max_element())
+        .chain(dst.iter().map(|p| (*p - ybar).abs().max_element()))
+        .fold(0.0, f64::max);
+    let scale = power_of_two_scale(big);
     let mut s = DMat3::ZERO;
     for k in 0..src.len() {
-        let x = w(k) * (src[k] - xbar);
-        let y = dst[k] - ybar;
+        let x = w(k) * ((src[k] - xbar) * scale);
+        let y = (dst[k] - ybar) * scale;
         // Column b of x y^T is x * y_b.
         s.x_axis += x * y.x;
         s.y_axis += x * y.y;
@@ -179,6 +202,17 @@ fn check_clouds(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result
     for (what, cloud) in [("source point", src), ("target point", dst)] {
         if let Some(index) = cloud.iter().position(|p| !p.is_finite()) {
             return Err(Error::NotFinite { what, index });
+        }
+        if let Some(index) = cloud
+            .iter()
+            .position(|p| p.abs().max_element() > MAX_COORDINATE)
+        {
+            return Err(Error::OutOfRange {
+                what,
+                index,
+                value: cloud[index].abs().max_element(),
+                range: COORDINATE_RANGE,
+            });
         }
     }
     if let Some(w) = weights {

@@ -130,9 +130,10 @@ impl Stiffness {
             what: "stiffness",
             reason,
         };
-        if !(self.inserted > 0.0) {
+        let in_range = |l: f64| l == f64::INFINITY || l <= MAX_STIFFNESS;
+        if !(self.inserted > 0.0) || !in_range(self.inserted) {
             return Err(invalid(format!(
-                "inserted-point stiffness {} must be positive (or infinite)",
+                "inserted-point stiffness {} must be positive and at most 1e100 (or infinite)",
                 self.inserted
             )));
         }
@@ -144,9 +145,9 @@ impl Stiffness {
                     got: k.len(),
                 });
             }
-            if let Some(i) = k.iter().position(|l| !(*l >= 0.0)) {
+            if let Some(i) = k.iter().position(|l| !(*l >= 0.0) || !in_range(*l)) {
                 return Err(invalid(format!(
-                    "key {i} has stiffness {}, need >= 0 or inf",
+                    "key {i} has stiffness {}, need 0..=1e100 or inf",
                     k[i]
                 )));
             }
@@ -162,6 +163,12 @@ impl Stiffness {
         Ok(())
     }
 }
+
+/// The largest finite spring `lambda` (`inf` keeps the key exactly): the systems add
+/// `lambda v` with `|v|` up to a few times [`crate::motion::pose::MAX_COORDINATE`], so a
+/// finite `lambda` up to `1e100` keeps them finite (`1e8` already pins a key to
+/// `1e-8` of its neighbours' spacing).
+pub const MAX_STIFFNESS: f64 = 1e100;
 
 /// Smallest parameter spacing (relative to the mean) accepted by the centripetal
 /// parametrisation: consecutive keys closer than this are reported as coincident.
@@ -196,8 +203,23 @@ pub fn spans_spacing(
             let d: Vec<f64> = (0..spans)
                 .map(|i| {
                     let j = (i + 1) % n;
-                    let sq: f64 = curves.iter().map(|c| c[j].distance_squared(c[i])).sum();
-                    sq.sqrt().sqrt()
+                    // Differences scaled by 4^-k (exact, and the fourth root of the sum
+                    // scales back by exactly 2^k) so the sum of squares cannot overflow.
+                    let big = curves
+                        .iter()
+                        .map(|c| (c[j] - c[i]).abs().max_element())
+                        .fold(0.0, f64::max);
+                    let k = if big > 1.0 && big.is_finite() {
+                        (big.log2() / 2.0).ceil() as i32
+                    } else {
+                        0
+                    };
+                    let scale = 4f64.powi(-k);
+                    let sq: f64 = curves
+                        .iter()
+                        .map(|c| ((c[j] - c[i]) * scale).length_squared())
+                        .sum();
+                    sq.sqrt().sqrt() * 2f64.powi(k)
                 })
                 .collect();
             let mean = d.iter().sum::<f64>() / spans.max(1) as f64;

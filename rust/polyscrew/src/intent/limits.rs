@@ -1,29 +1,35 @@
-//! The sizes this module may allocate, checked in one place ([`check_footprint`]) before
+//! The sizes this module allocates, checked in one place ([`check_footprint`]) before
 //! anything input-sized is allocated: the add-on runs inside the user's Blender session, and
-//! a request too large for memory must be an error, not an abort. (When the crate gets one
-//! memory budget, this function is where the module asks it.)
+//! a request too large for memory must be an error, not an abort. The check asks the crate's
+//! memory budget ([`crate::memory`]); the buffers are then allocated fallibly ([`filled`],
+//! [`collected`]).
 
-use crate::error::{Error, Result};
+use crate::error::Result;
+use crate::memory::{try_vec, Footprint};
 
-/// Most bytes one call of this module may hold for its samples, channel values and output:
-/// 1 GiB. The largest legitimate use, timing "Keys" over a 100,000-frame bake, holds about
-/// 10 MB; a spin analysed at [`MAX_SPAN_SAMPLES`](super::MAX_SPAN_SAMPLES) samples per span
-/// holds about 400 kB per span.
-pub const MAX_BYTES: usize = 1 << 30;
-
-/// Checks that `bytes` (computed with saturating arithmetic) fit within [`MAX_BYTES`].
+/// Checks that `bytes` (computed with saturating arithmetic) fit within the memory budget.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming `what` would be allocated, its size and `hint` (how to ask for
-/// less).
+/// [`Error::Memory`](crate::Error::Memory) naming `what` would be allocated, its size and
+/// `hint` (how to ask for less).
 pub fn check_footprint(bytes: usize, what: &'static str, hint: &'static str) -> Result<()> {
-    if bytes > MAX_BYTES {
-        return Err(Error::Invalid {
-            what,
-            reason: format!(
-                "would need {bytes} bytes, more than the limit of {MAX_BYTES} in one call: {hint}"
-            ),
-        });
-    }
-    Ok(())
+    Footprint::bytes(bytes).check(what, hint)
+}
+
+/// `n` copies of `value`, allocated fallibly.
+pub(crate) fn filled<T: Clone>(n: usize, value: T, what: &'static str) -> Result<Vec<T>> {
+    let mut v = try_vec(n, what)?;
+    v.resize(n, value);
+    Ok(v)
+}
+
+/// The items of `items` (at most `n` of them expected), allocated fallibly.
+pub(crate) fn collected<T>(
+    n: usize,
+    items: impl IntoIterator<Item = T>,
+    what: &'static str,
+) -> Result<Vec<T>> {
+    let mut v = try_vec(n, what)?;
+    v.extend(items);
+    Ok(v)
 }

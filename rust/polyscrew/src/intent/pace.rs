@@ -4,9 +4,10 @@
 use glam::{DMat3, DVec3};
 
 use super::interp::interp;
-use super::limits::check_footprint;
+use super::limits::{check_footprint, collected};
 use super::playback::Playback;
 use crate::error::{Error, Result};
+use crate::memory::try_vec;
 use crate::motion::pose::Pose;
 use crate::motion::sample::{Motion, MotionSpec};
 use crate::motion::subdivision::Scheme;
@@ -55,9 +56,11 @@ pub fn pace_parameters(spans: usize) -> Result<Vec<f64>> {
         "pass fewer keys",
     )?;
     let grid = |j: usize| j as f64 / PACE_SAMPLES as f64;
-    Ok((0..spans)
-        .flat_map(|s| (0..=PACE_SAMPLES).map(move |j| s as f64 + grid(j)))
-        .collect())
+    collected(
+        n,
+        (0..spans).flat_map(|s| (0..=PACE_SAMPLES).map(move |j| s as f64 + grid(j))),
+        "pace parameters",
+    )
 }
 
 /// The smoothed screw motion of `keys` at [`pace_parameters`]: keys at parameters
@@ -80,7 +83,7 @@ pub fn screw_pace_poses(
         "pace poses",
         "pass fewer keys",
     )?;
-    let times: Vec<f64> = (0..k).map(|i| i as f64).collect();
+    let times = collected(k, (0..k).map(|i| i as f64), "key parameters")?;
     let spec = MotionSpec {
         scheme,
         levels,
@@ -147,7 +150,7 @@ pub fn keys_parameters(
     check_key_times(key_frames)?;
     let first = key_frames[0];
     let last = key_frames[k - 1];
-    let mut ends = key_frames.to_vec();
+    let mut ends = collected(k + 1, key_frames.iter().copied(), "span ends")?;
     if let Some(period) = timing.period {
         let end = first + period;
         if !(end.is_finite() && end > last) {
@@ -196,33 +199,38 @@ pub fn keys_parameters(
             .saturating_sub(1)
             .min(spans - 1)
     };
-    let located: Vec<(usize, f64)> = frames
-        .iter()
-        .map(|&f| {
+    let located = collected(
+        t,
+        frames.iter().map(|&f| {
             let s = span_of(f);
             (s, (f - ends[s]) / (ends[s + 1] - ends[s]))
-        })
-        .collect();
+        }),
+        "frame spans",
+    )?;
     let inside = |tau: f64| tau > 0.0 && tau < 1.0;
     let grid = |j: usize| j as f64 / PACE_SAMPLES as f64;
 
     // Blender's playback: per span the grid, plus the output frames inside it, in order.
-    let mut sampled: Vec<(usize, f64)> = Vec::with_capacity(samples);
+    let mut sampled: Vec<(usize, f64)> = try_vec(samples, "pace samples")?;
     sampled.extend((0..spans).flat_map(|s| (0..per_span).map(move |j| (s, grid(j)))));
     sampled.extend(located.iter().copied().filter(|&(_, tau)| inside(tau)));
     sampled.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let done = playback_fractions(timing.playback, &ends, &sampled, size)?;
-    let xp: Vec<f64> = sampled.iter().map(|&(s, f)| s as f64 + f).collect();
-    let fp: Vec<f64> = sampled
-        .iter()
-        .zip(&done)
-        .map(|(&(s, _), d)| s as f64 + d)
-        .collect();
+    let xp = collected(
+        samples,
+        sampled.iter().map(|&(s, f)| s as f64 + f),
+        "pace samples",
+    )?;
+    let fp = collected(
+        samples,
+        sampled.iter().zip(&done).map(|(&(s, _), d)| s as f64 + d),
+        "pace samples",
+    )?;
     drop(sampled);
 
     // The smoothed motion's own travel along each span.
-    let mut x = Vec::with_capacity(grid_len);
-    let mut y = Vec::with_capacity(grid_len);
+    let mut x = try_vec(grid_len, "pace table")?;
+    let mut y = try_vec(grid_len, "pace table")?;
     let mut along = Vec::with_capacity(per_span);
     for s in 0..spans {
         let poses = &smooth[s * per_span..(s + 1) * per_span];
@@ -238,9 +246,9 @@ pub fn keys_parameters(
             y.push(s as f64 + grid(j));
         }
     }
-    Ok(located
-        .iter()
-        .map(|&(s, tau)| {
+    collected(
+        t,
+        located.iter().map(|&(s, tau)| {
             let base = s as f64;
             if inside(tau) {
                 let travelled = interp(base + tau, &xp, &fp) - base;
@@ -248,8 +256,9 @@ pub fn keys_parameters(
             } else {
                 base + tau
             }
-        })
-        .collect())
+        }),
+        "motion parameters",
+    )
 }
 
 /// The fraction of its span's travel along Blender's playback done at each sample
@@ -262,9 +271,13 @@ fn playback_fractions(
     size: f64,
 ) -> Result<Vec<f64>> {
     let Some(playback) = playback else {
-        return Ok(sampled.iter().map(|&(_, f)| f).collect());
+        return collected(
+            sampled.len(),
+            sampled.iter().map(|&(_, f)| f),
+            "pace fractions",
+        );
     };
-    let mut done = Vec::with_capacity(sampled.len());
+    let mut done = try_vec(sampled.len(), "pace fractions")?;
     let mut row = Vec::with_capacity(playback.width());
     let mut previous: Option<(usize, DVec3, DMat3)> = None;
     let mut start = 0; // the first sample of the current span

@@ -7,9 +7,10 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use super::limits::check_footprint;
+use super::limits::{check_footprint, collected};
 use crate::error::{Error, Result};
 use crate::fcurve::FCurve;
+use crate::memory::try_reserve;
 use crate::motion::channels::RotationMode;
 
 /// One transform channel: a property and an index into it.
@@ -154,20 +155,22 @@ pub fn rotation_matrices(values: &[f64], mode: RotationMode) -> Result<Vec<DMat3
         "rotation matrices",
         "pass fewer rotations",
     )?;
-    values
+    if let Some(index) = values
         .chunks_exact(width)
-        .enumerate()
-        .map(|(index, row)| {
-            if row.iter().all(|x| x.is_finite()) {
-                Ok(rotation_matrix(mode, row))
-            } else {
-                Err(Error::NotFinite {
-                    what: "rotation",
-                    index,
-                })
-            }
-        })
-        .collect()
+        .position(|row| !row.iter().all(|x| x.is_finite()))
+    {
+        return Err(Error::NotFinite {
+            what: "rotation",
+            index,
+        });
+    }
+    collected(
+        n,
+        values
+            .chunks_exact(width)
+            .map(|row| rotation_matrix(mode, row)),
+        "rotation matrices",
+    )
 }
 
 /// An owner's transform channels as Blender plays them: the keyed channels from their
@@ -302,7 +305,7 @@ impl Playback {
     fn rows_into(&self, times: &[f64], out: &mut Vec<f64>, upto: usize) -> Result<()> {
         let width = self.width();
         out.clear();
-        out.reserve(times.len() * width);
+        try_reserve(out, times.len().saturating_mul(width), "channel values")?;
         for (index, &t) in times.iter().enumerate() {
             let t32 = t as f32;
             if !t32.is_finite() {

@@ -5,9 +5,10 @@ use std::f64::consts::PI;
 use glam::DMat3;
 
 use super::interp::interp;
-use super::limits::check_footprint;
+use super::limits::{check_footprint, collected, filled};
 use super::playback::Playback;
 use crate::error::{Error, Result};
+use crate::memory::try_vec;
 use crate::motion::channels::RotationMode;
 use crate::motion::timing::check_key_times;
 
@@ -135,19 +136,21 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
     )?;
     let at_keys = playback.channels(frames)?;
     let key_row = |i: usize| &at_keys[i * width..(i + 1) * width];
-    let counts: Vec<usize> = (0..spans)
-        .map(|s| {
+    let counts = collected(
+        spans,
+        (0..spans).map(|s| {
             sample_count(
                 mode,
                 &key_row(s)[rotation.clone()],
                 &key_row(s + 1)[rotation.clone()],
             )
-        })
-        .collect();
+        }),
+        "spans",
+    )?;
 
-    let mut held = vec![true; spans];
-    let mut pops = vec![false; spans];
-    let mut turn = vec![0.0; spans];
+    let mut held = filled(spans, true, "spans")?;
+    let mut pops = filled(spans, false, "spans")?;
+    let mut turn = filled(spans, 0.0, "spans")?;
     let mut times = Vec::with_capacity(MAX_SPAN_SAMPLES);
     let mut rows = Vec::with_capacity(MAX_SPAN_SAMPLES * width);
     let mut steps = Vec::with_capacity(MAX_SPAN_SAMPLES);
@@ -178,12 +181,13 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
 
     let mut inserted = Vec::new();
     if mode != RotationMode::Quaternion {
-        let spins: Vec<usize> = (0..spans)
-            .filter(|&s| turn[s] > WIND_LIMIT && !held[s])
-            .collect();
-        let mut spinning = vec![false; spans];
+        let mut spinning = filled(spans, false, "spans")?;
         let turning = |s: usize| turn[s] > WIND_STEP && !held[s];
-        for &s in &spins {
+        for s in 0..spans {
+            let spin = turn[s] > WIND_LIMIT && !held[s];
+            if !spin {
+                continue; // the runs of neighbours are found from the spins
+            }
             spinning[s] = true;
             let mut left = s;
             while left > 0 && turning(left - 1) {
@@ -206,7 +210,7 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
             "inserted frames",
             "analyse fewer key frames",
         )?;
-        inserted.reserve(added);
+        inserted = try_vec(added, "inserted frames")?;
         let mut cumulative = Vec::with_capacity(MAX_SPAN_SAMPLES + 1);
         let mut at = Vec::with_capacity(MAX_SPAN_SAMPLES + 1);
         for s in (0..spans).filter(|&s| spinning[s]) {

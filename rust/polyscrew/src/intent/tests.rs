@@ -489,20 +489,24 @@ fn keys_timing_of_a_cycle_and_its_errors() {
 }
 
 #[test]
-fn sizes_are_checked_before_allocating() {
+fn sizes_are_checked_against_the_budget_before_allocating() {
     let p = playback(vec![], XYZ);
-    assert!(matches!(
-        pace_parameters(usize::MAX / 4),
-        Err(Error::Invalid {
-            what: "pace parameters",
-            ..
-        })
-    ));
-    let huge = limits::MAX_BYTES / 8;
-    assert!(matches!(
-        limits::check_footprint(huge * 9, "x", "y"),
-        Err(Error::Invalid { what: "x", .. })
+    let over = |e: Error| {
+        matches!(
+            e,
+            Error::Memory {
+                budget: Some(_),
+                ..
+            }
+        )
+    };
+    assert!(over(pace_parameters(usize::MAX / 4).unwrap_err()));
+    assert!(over(
+        limits::check_footprint(usize::MAX, "x", "y").unwrap_err()
     ));
     assert!(limits::check_footprint(1024, "x", "y").is_ok());
-    assert!(p.width() == 9);
+    // a frame list as long as memory: refused before its channel rows are allocated
+    let budget = crate::memory::memory_budget();
+    let frames = vec![1.0; budget / (8 * p.width()) + 1];
+    assert!(over(p.channels(&frames).unwrap_err()));
 }

@@ -14,6 +14,7 @@ use std::f64::consts::{PI, TAU};
 use glam::{DMat3, DQuat, DVec3};
 
 use crate::error::{Error, Result};
+use crate::memory::{try_vec, Footprint};
 
 /// Below this `cos(middle angle)` an Euler triple is in gimbal lock: the first and last axes
 /// coincide and the last angle is set to 0 (as Blender does, with its f32 threshold scaled).
@@ -198,6 +199,9 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
     }
 }
 
+/// How to ask [`rotation_channels`] for less memory.
+pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
+
 /// Channel values of a sequence of rotations in `mode`, continuous frame to frame.
 ///
 /// `previous` (3 values for Euler, 4 otherwise) is the value just before the first frame;
@@ -207,7 +211,7 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
-/// it holds NaN or infinity.
+/// it holds NaN or infinity, [`Error::Memory`] when the channels exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
     mode: RotationMode,
@@ -229,7 +233,9 @@ pub fn rotation_channels(
             });
         }
     }
-    let mut out = Vec::with_capacity(rotations.len() * width);
+    let values = rotations.len().saturating_mul(width);
+    Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    let mut out = try_vec(values, "rotation channels")?;
     match mode {
         RotationMode::Quaternion => {
             let mut prev = previous.map(|p| DQuat::from_xyzw(p[1], p[2], p[3], p[0]));

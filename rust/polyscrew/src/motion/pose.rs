@@ -10,6 +10,21 @@ use crate::error::{Error, PoseDefect, Result};
 /// Blender stores matrices in f32 (about 1e-7 relative), well inside this bound.
 pub const RIGID_TOLERANCE: f64 = 1e-6;
 
+/// The working range of coordinates: translations, vectors and points must satisfy
+/// `|x| <= MAX_COORDINATE` (every value Blender can store, float32 below `3.4e38`, is inside).
+///
+/// Why `1e150`: the screw formulas are bilinear in a unit quaternion and a coordinate, and
+/// the only squares of coordinates they take are lengths (`|tau|^2` to normalise the axis of
+/// a translation). Subdivision moves no pose further than about 4 times the keys' largest
+/// coordinate (`1.125^12` for the widest mask, phantom ends `2 p0 - p1`), and the translation
+/// between two poses is at most twice that, so every square stays below
+/// `3 (2 * 4 * 3e150)^2 ~ 2e303`, short of `f64::MAX ~ 1.8e308`. Where a formula squares
+/// coordinates of many points (registration, inertia) it scales them by a power of two first.
+pub const MAX_COORDINATE: f64 = 1e150;
+
+/// [`MAX_COORDINATE`] as it reads in messages.
+pub const COORDINATE_RANGE: &str = "+-1e150";
+
 /// A rigid transform `x -> R x + o` with `R` a unit quaternion.
 ///
 /// The rotation is kept normalised by every constructor, so a pose converted back to a
@@ -63,6 +78,15 @@ impl Pose {
         let bad = |defect| Error::BadPose { index, defect };
         if rows.iter().flatten().any(|v| !v.is_finite()) {
             return Err(bad(PoseDefect::NotFinite));
+        }
+        if let Some(value) = (0..3)
+            .map(|r| rows[r][3])
+            .find(|v| v.abs() > MAX_COORDINATE)
+        {
+            return Err(bad(PoseDefect::OutOfRange {
+                value,
+                limit: MAX_COORDINATE,
+            }));
         }
         let bottom = rows[3];
         if bottom[0].abs() > RIGID_TOLERANCE
@@ -164,6 +188,26 @@ impl Pose {
     #[inline]
     pub fn transform_vector3(&self, v: DVec3) -> DVec3 {
         self.rotation * v
+    }
+
+    /// Whether the pose is usable by the crate's formulas: a finite rotation and a translation
+    /// within [`MAX_COORDINATE`].
+    ///
+    /// # Errors
+    /// [`Error::BadPose`] with `index` (`NotFinite` or `OutOfRange`).
+    pub fn check_range(&self, index: usize) -> Result<()> {
+        let bad = |defect| Err(Error::BadPose { index, defect });
+        if !self.rotation.is_finite() || !self.translation.is_finite() {
+            return bad(PoseDefect::NotFinite);
+        }
+        let value = self.translation.abs().max_element();
+        if value > MAX_COORDINATE {
+            return bad(PoseDefect::OutOfRange {
+                value,
+                limit: MAX_COORDINATE,
+            });
+        }
+        Ok(())
     }
 
     /// Largest absolute difference between the matrices of two poses (an honest distance for

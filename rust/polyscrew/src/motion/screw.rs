@@ -32,6 +32,33 @@ use crate::numeric::fastmath;
 use crate::numeric::fastmath::Real;
 use crate::numeric::lanes::{self, F4, LANES, Q4, V4};
 
+/// The working range of the screw parameter `t` of [`Screw::eval`] (`s(a, t, b)`):
+/// `|t| <= MAX_T`, a trillion times the screw and back.
+///
+/// Why: `M^t o_a` takes `rho^2 (v . o_a)` with `rho = sin(t h) / sin(h)`, which is `t` for a
+/// translation (whose `|v|` may still hold round-off up to [`ROTATION_ROUNDOFF`]) and at most
+/// `1 / sin(h)` for a turn; with coordinates within
+/// [`crate::motion::pose::MAX_COORDINATE`] every term stays below `1e180` for `|t|` up to
+/// `1e12`. Subdivision and sampling only evaluate `t` in `[-2, 3]`; callers passing any `t`
+/// (the Python `interpolate`) check it.
+pub const MAX_T: f64 = 1e12;
+
+/// A relative rotation whose vector part `|q.xyz| = sin(h)` is at most this is round-off:
+/// the screw is then a pure translation (axis along the translation, slide its length,
+/// angle 0).
+///
+/// The scale of rotation data is fixed: quaternions are unit. Each component of
+/// `q = q_b q_a^-1` is a sum of four rounded products of numbers of magnitude at most 1, so
+/// the product alone leaves up to a few `eps` in `q.xyz` when `q_a = q_b`; rotation matrices
+/// that went through another conversion (a quaternion, a rotation library) and back leave
+/// up to `2 eps` (measured over 20,000 random rotations). `16 eps = 3.6e-15` covers both with
+/// room, and is 14 times below the half angle of a `1e-13` rad turn, which stays a screw
+/// (exact to `1e-12`). Positions do not enter: the rotation is computed from the rotations
+/// alone, so the same round-off angle appears whatever the poses' extent, and comparing it
+/// with the translation instead would report a real turn (`1e-6` rad with a `1e-10` move)
+/// as a translation.
+pub const ROTATION_ROUNDOFF: f64 = 16.0 * f64::EPSILON;
+
 /// The minimal screw carrying pose `a` to pose `b`, ready to be evaluated at any `t`.
 ///
 /// Built once per pair by [`Screw::between`]; [`Screw::eval`] then costs one `sin_cos`.
@@ -81,11 +108,11 @@ impl Screw {
         let (v_dot_o, v_x_o) = (v.dot(oa), v.cross(oa));
         let tau =
             b.translation - (oa * (q.w * q.w - b2) + v * (v_dot_o * 2.0) + v_x_o * (q.w * 2.0));
-        let (inv_sin_half, axis) = if sin_h > 0.0 {
+        let (inv_sin_half, axis) = if sin_h > ROTATION_ROUNDOFF {
             let inv = 1.0 / sin_h;
             (inv, v * inv)
         } else {
-            (0.0, tau.try_normalize().unwrap_or(DVec3::Z))
+            (0.0, direction(tau).unwrap_or(DVec3::Z))
         };
         Self {
             base: *a,
@@ -120,8 +147,9 @@ impl Screw {
         let (sin_h, cos_h) = (self.sin_half, self.rotation.w);
         // rho = sin(t h) / sin(h), t at h = 0. No series is needed near 0: sin(h) = |q.xyz| is
         // computed directly and sin(t h) by a kernel of relative accuracy, so the quotient is
-        // accurate to a few ulps however small h is.
-        let rho = if sin_h > 0.0 {
+        // accurate to a few ulps however small h is. A round-off turn
+        // (`ROTATION_ROUNDOFF`) counts as none (`inv_sin_half = 0`): rho = t.
+        let rho = if self.inv_sin_half > 0.0 {
             sin_th * self.inv_sin_half
         } else {
             t
@@ -213,7 +241,11 @@ impl Screw {
                 let t = f64::from(k) / 16.0;
                 let (cos_th, sin_th) = sixteenth_turn(&turns, k);
                 let (cos_d, sin_d) = sixteenth_turn(&turns, k - 16);
-                let rho = if sin_h > 0.0 { sin_th * inv_sin_h } else { t };
+                let rho = if inv_sin_h > 0.0 {
+                    sin_th * inv_sin_h
+                } else {
+                    t
+                };
                 let (a, b) = (rho * cos_d, rho * sin_d);
                 let two_sin = 2.0 * sin_th;
                 Pose {
@@ -248,14 +280,24 @@ impl Screw {
         self.base
     }
 
-    /// Unit direction `S` of the screw axis. For a pure translation it is the translation's
-    /// direction; when `a == b` it is `+z` (any direction would do).
+    /// Unit direction `S` of the screw axis. For a pure translation (a turn of at most
+    /// [`ROTATION_ROUNDOFF`] counts as none) it is the translation's direction; when
+    /// `a == b` it is `+z` (any direction would do).
     pub fn axis(&self) -> DVec3 {
         self.axis
     }
 
-    /// Rotation angle `r` in `[0, pi]`, radians.
+    /// Whether the screw is a pure translation: the relative rotation is round-off
+    /// (`|q.xyz| <= ROTATION_ROUNDOFF`).
+    pub fn is_translation(&self) -> bool {
+        self.inv_sin_half == 0.0
+    }
+
+    /// Rotation angle `r` in `[0, pi]`, radians (0 for a pure translation).
     pub fn angle(&self) -> f64 {
+        if self.is_translation() {
+            return 0.0;
+        }
         2.0 * self.half_angle
     }
 
@@ -270,7 +312,7 @@ impl Screw {
     /// pure translation, the origin of `a` itself. Far away (like `1 / r`) as `r -> 0`.
     pub fn point(&self) -> DVec3 {
         let o = self.base.translation;
-        if self.half_angle == 0.0 {
+        if self.is_translation() {
             return o;
         }
         let s = self.axis;
@@ -329,6 +371,17 @@ fn sixteenth_turn(turns: &[(f64, f64); 5], k: i32) -> (f64, f64) {
         }
     }
     turn.unwrap_or((1.0, 0.0))
+}
+
+/// The unit direction of `v`, for any finite `v` (scaled by a power of two first, so that
+/// `|v|^2` cannot overflow); `None` for zero or non-finite `v`.
+fn direction(v: DVec3) -> Option<DVec3> {
+    let big = v.abs().max_element();
+    if !(big > 0.0 && big.is_finite()) {
+        return None;
+    }
+    let scale = 2f64.powi(-(big.log2().floor() as i32).clamp(-1020, 1020));
+    (v * scale).try_normalize()
 }
 
 /// `s(a, 1/2, b)`, the pose halfway along the minimal screw, without trigonometry.
@@ -429,7 +482,7 @@ fn s_lanes(a: &[Pose], t: &[f64], b: &[Pose], out: &mut [Pose]) {
     let sin_h = b2.sqrt();
     let h = fastmath::turn_angle(cos_h, sin_h);
     let inv = F4::splat(1.0) / sin_h;
-    let turning = inv.finite_positive();
+    let turning = sin_h.gt(ROTATION_ROUNDOFF);
     let inv = turning.select(inv, F4::splat(0.0));
     let axis = v.scale(inv);
     // q o_a = o_a (w^2 - |v|^2) + v (2 v . o_a) + (v x o_a) (2 w); v . o_a and v x o_a serve
@@ -692,6 +745,56 @@ mod tests {
             Err(Error::LengthMismatch { what: "out", .. })
         ));
         assert_eq!(s_many(&[], &[], &[], &mut []), Ok(()));
+    }
+
+    /// A pose moved by a pure translation gives the translation's screw (axis along it, slide
+    /// its length, angle 0) whatever the pose's rotation and position, although the relative
+    /// rotation computed from two equal rotations is not exactly the identity (issue 15:
+    /// slide 3 instead of 5 for a move of (0, 3, 4)); tiny true turns stay screws.
+    #[test]
+    fn translation_of_a_rotated_pose() {
+        let mut x = 0.7f64;
+        let mut next = move || {
+            x = (x * 3.7 + 0.123).fract();
+            x
+        };
+        let mv = DVec3::new(0.0, 3.0, 4.0);
+        let mut roundoff = 0usize;
+        for i in 0..20_000 {
+            let axis = DVec3::new(next() - 0.5, next() - 0.5, next() - 0.5 + 1e-3).normalize();
+            let position = (DVec3::new(next(), next(), next()) - 0.5) * 10f64.powi(i % 9 - 2);
+            let a = Pose::from_rotation_translation(
+                DQuat::from_axis_angle(axis, next() * 2.0 * PI),
+                position,
+            );
+            let b = Pose {
+                translation: a.translation + mv,
+                ..a
+            };
+            let sc = Screw::between(&a, &b);
+            roundoff += usize::from(sc.rotation().xyz().length() > 0.0);
+            assert!(sc.is_translation(), "{a:?}");
+            assert_eq!(sc.angle(), 0.0);
+            let scale = 1.0 + position.length();
+            assert!(
+                (sc.slide() - 5.0).abs() < 1e-14 * scale,
+                "{a:?}: {}",
+                sc.slide()
+            );
+            assert!(sc.axis().distance(mv / 5.0) < 1e-14 * scale, "{a:?}");
+            assert!(sc.eval(1.0).max_abs_diff(&b) < 1e-14 * scale);
+            assert!(sc.eval(0.5).translation.distance(a.translation + 0.5 * mv) < 1e-14 * scale);
+        }
+        assert!(
+            roundoff > 1000,
+            "only {roundoff} pairs had a round-off turn"
+        );
+        // A true turn of 1e-13 rad is a screw, far above the threshold.
+        let a = Pose::from_translation(DVec3::new(0.3, 0.2, 0.1));
+        let b = Pose::from_rotation_translation(DQuat::from_rotation_x(1e-13), a.translation + mv);
+        let sc = Screw::between(&a, &b);
+        assert!(!sc.is_translation());
+        assert!((sc.angle() - 1e-13).abs() < 1e-25);
     }
 
     #[test]

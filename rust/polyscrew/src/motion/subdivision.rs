@@ -27,7 +27,8 @@
 use glam::DVec3;
 
 use crate::error::{Error, Result};
-use crate::motion::pose::Pose;
+use crate::memory::{try_vec, Footprint};
+use crate::motion::pose::{Pose, COORDINATE_RANGE, MAX_COORDINATE};
 use crate::motion::screw::Screw;
 
 /// The largest number of subdivision levels accepted (closed output `n 2^12` poses).
@@ -95,6 +96,24 @@ pub trait Interpolant: Copy {
     fn eval_sixteenths<const N: usize>(seg: &Self::Segment, ks: [i32; N]) -> [Self; N] {
         ks.map(|k| Self::eval(seg, f64::from(k) / 16.0))
     }
+    /// Checks that the element is finite and within the working range
+    /// ([`MAX_COORDINATE`]) in which the formulas stay finite; `index` is its position.
+    ///
+    /// # Errors
+    /// [`Error::BadPose`] for a pose, [`Error::NotFinite`] or [`Error::OutOfRange`] for a
+    /// point.
+    fn check_range(&self, index: usize) -> Result<()>;
+}
+
+/// Checks every element with [`Interpolant::check_range`].
+///
+/// # Errors
+/// The first element outside the working range, by index.
+pub fn check_range<T: Interpolant>(items: &[T]) -> Result<()> {
+    items
+        .iter()
+        .enumerate()
+        .try_for_each(|(i, item)| item.check_range(i))
 }
 
 impl Interpolant for Pose {
@@ -115,6 +134,9 @@ impl Interpolant for Pose {
     fn eval_sixteenths<const N: usize>(seg: &Screw, ks: [i32; N]) -> [Self; N] {
         seg.eval_sixteenths(ks)
     }
+    fn check_range(&self, index: usize) -> Result<()> {
+        Pose::check_range(self, index)
+    }
 }
 
 impl Interpolant for DVec3 {
@@ -126,6 +148,24 @@ impl Interpolant for DVec3 {
     #[inline]
     fn eval(seg: &(DVec3, DVec3), t: f64) -> Self {
         seg.0 + t * seg.1
+    }
+    fn check_range(&self, index: usize) -> Result<()> {
+        if !self.is_finite() {
+            return Err(Error::NotFinite {
+                what: "vector",
+                index,
+            });
+        }
+        let value = self.abs().max_element();
+        if value > MAX_COORDINATE {
+            return Err(Error::OutOfRange {
+                what: "vector",
+                index,
+                value,
+                range: COORDINATE_RANGE,
+            });
+        }
+        Ok(())
     }
 }
 
@@ -150,14 +190,30 @@ pub fn check_subdivision(n: usize, levels: u32) -> Result<()> {
 }
 
 /// The number of elements after `levels` levels: `n 2^levels` closed, `(n - 1) 2^levels + 1`
-/// open.
+/// open (saturating at `usize::MAX`, which no allocation can reach).
 pub fn subdivided_len(n: usize, levels: u32, closed: bool) -> usize {
+    let scale = 1usize.checked_shl(levels).unwrap_or(usize::MAX);
     if closed {
-        n << levels
+        n.saturating_mul(scale)
     } else {
-        ((n - 1) << levels) + 1
+        n.saturating_sub(1).saturating_mul(scale).saturating_add(1)
     }
 }
+
+/// What [`subdivide`] holds at its peak for `n` elements: the last level and the one
+/// before it (two buffers used in turn).
+pub fn subdivision_footprint<T>(n: usize, levels: u32, closed: bool) -> Footprint {
+    let last = subdivided_len(n, levels, closed);
+    let before = if levels == 0 {
+        0
+    } else {
+        subdivided_len(n, levels - 1, closed)
+    };
+    Footprint::of::<T>(last).and::<T>(before)
+}
+
+/// How to ask [`subdivide`] for less memory.
+pub const SUBDIVISION_HINT: &str = "use fewer levels or fewer keys";
 
 /// How a scheme's old element is made from the evaluations on its two edges.
 #[derive(Debug, Clone, Copy)]
@@ -228,7 +284,10 @@ const BSPLINE: Rules<3> = Rules {
 /// `(n - 1) 2^levels + 1`, first and last kept exactly. Level 0 returns the input.
 ///
 /// # Errors
-/// See [`check_subdivision`].
+/// See [`check_subdivision`]; the first element outside the working range
+/// ([`Interpolant::check_range`]); [`Error::Memory`] when the result (see
+/// [`subdivision_footprint`]) exceeds the memory budget ([`crate::memory`]) or cannot be
+/// allocated.
 pub fn subdivide<T: Interpolant>(
     items: &[T],
     scheme: Scheme,
@@ -236,8 +295,24 @@ pub fn subdivide<T: Interpolant>(
     closed: bool,
 ) -> Result<Vec<T>> {
     check_subdivision(items.len(), levels)?;
+    check_range(items)?;
+    subdivision_footprint::<T>(items.len(), levels, closed)
+        .check("subdivided poses", SUBDIVISION_HINT)?;
+    subdivide_checked(items, scheme, levels, closed)
+}
+
+/// [`subdivide`] without the range and budget checks (the caller made them).
+pub(crate) fn subdivide_checked<T: Interpolant>(
+    items: &[T],
+    scheme: Scheme,
+    levels: u32,
+    closed: bool,
+) -> Result<Vec<T>> {
+    check_subdivision(items.len(), levels)?;
     if levels == 0 {
-        return Ok(items.to_vec());
+        let mut out = try_vec(items.len(), "subdivided poses")?;
+        out.extend_from_slice(items);
+        return Ok(out);
     }
     // Two buffers in turn, each allocated once at the size of the last level written to it:
     // the result (level `levels`) and the one before (level `levels - 1`, or the input).
@@ -249,9 +324,9 @@ pub fn subdivide<T: Interpolant>(
     } else {
         (before_last, last)
     };
-    let mut current = Vec::with_capacity(cap_current);
+    let mut current = try_vec(cap_current, "subdivided poses")?;
     current.extend_from_slice(items);
-    let mut next = Vec::with_capacity(cap_next);
+    let mut next = try_vec(cap_next, "subdivided poses")?;
     for _ in 0..levels {
         next.clear();
         match scheme {

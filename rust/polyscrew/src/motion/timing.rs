@@ -6,7 +6,25 @@
 //! of the neighbouring secants, as in PCHIP): it is C1, strictly increasing whenever the key
 //! times are, and exactly linear when the keys are evenly spaced.
 
+#![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` also catches NaN
+
 use crate::error::{Error, Result};
+
+/// The working range of times (key times, sample times, the end of a closed motion's
+/// period): `|t| <= MAX_TIME`.
+///
+/// Why `1e300`: the time map uses times only through differences (at most `4e300` with a
+/// period), their ratios and the reciprocal of a sum of two key spacings; no time is
+/// squared, so any range short of `f64::MAX / 4` keeps it finite.
+pub const MAX_TIME: f64 = 1e300;
+
+/// [`MAX_TIME`] as it reads in messages.
+pub const TIME_RANGE: &str = "+-1e300";
+
+/// The smallest spacing of consecutive key times (and of the last key and the end of a
+/// closed motion's period): the slopes of the time map are `3 / (h_prev + h)` at most, finite
+/// for spacings down to about `2e-308`; `1e-300` leaves room.
+pub const MIN_KEY_SPACING: f64 = 1e-300;
 
 /// How time maps to the motion parameter between keys.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
@@ -47,17 +65,59 @@ pub struct TimeMap {
     period: Option<f64>,
 }
 
-/// Checks that key times are finite and strictly increasing.
+/// Checks that key times are finite, strictly increasing, within [`MAX_TIME`] and at least
+/// [`MIN_KEY_SPACING`] apart.
 ///
 /// # Errors
-/// [`Error::KeyTimes`] with the index of the first offending time.
+/// [`Error::KeyTimes`] with the index of the first time that is not finite or not greater
+/// than the one before, [`Error::OutOfRange`] for a time beyond [`MAX_TIME`],
+/// [`Error::Invalid`] (`"key times"`) for two keys closer than [`MIN_KEY_SPACING`].
 pub fn check_key_times(times: &[f64]) -> Result<()> {
     for (i, t) in times.iter().enumerate() {
         if !t.is_finite() || (i > 0 && *t <= times[i - 1]) {
             return Err(Error::KeyTimes { index: i });
         }
+        if t.abs() > MAX_TIME {
+            return Err(Error::OutOfRange {
+                what: "key time",
+                index: i,
+                value: *t,
+                range: TIME_RANGE,
+            });
+        }
+        if i > 0 && *t - times[i - 1] < MIN_KEY_SPACING {
+            return Err(Error::Invalid {
+                what: "key times",
+                reason: format!(
+                    "key times {} and {i} are {:e} apart, closer than {MIN_KEY_SPACING:e}",
+                    i - 1,
+                    *t - times[i - 1]
+                ),
+            });
+        }
     }
     Ok(())
+}
+
+/// Checks one sample time: finite and within [`MAX_TIME`].
+///
+/// # Errors
+/// [`Error::NotFinite`] or [`Error::OutOfRange`] naming `what` and `index`.
+#[inline]
+pub fn check_time(what: &'static str, index: usize, t: f64) -> Result<()> {
+    if t.abs() <= MAX_TIME {
+        return Ok(());
+    }
+    if t.is_finite() {
+        Err(Error::OutOfRange {
+            what,
+            index,
+            value: t,
+            range: TIME_RANGE,
+        })
+    } else {
+        Err(Error::NotFinite { what, index })
+    }
 }
 
 impl TimeMap {
@@ -84,10 +144,16 @@ impl TimeMap {
         let mut knots = key_times.to_vec();
         let period = if closed {
             let period = period.unwrap_or(span * n as f64 / (n - 1) as f64);
-            if !period.is_finite() || period <= span {
+            // The cycle's end, a knot like the others: in range and far enough from the last key.
+            let end = key_times[0] + period;
+            if !period.is_finite()
+                || period <= span
+                || end.abs() > MAX_TIME
+                || !(end - key_times[n - 1] >= MIN_KEY_SPACING)
+            {
                 return Err(Error::Period { period, span });
             }
-            knots.push(key_times[0] + period);
+            knots.push(end);
             Some(period)
         } else {
             None
@@ -97,10 +163,14 @@ impl TimeMap {
         let secant = |k: usize| 1.0 / h[k];
         let harmonic = |k_prev: usize, k: usize| {
             // Fritsch-Butland: (w1 + w2) / (w1 / d_prev + w2 / d), w1 = 2 h + h_prev,
-            // w2 = h + 2 h_prev; bounded by 3 min(d_prev, d), hence monotone.
+            // w2 = h + 2 h_prev; bounded by 3 min(d_prev, d), hence monotone. With
+            // s = h_prev + h, a = h / s, b = h_prev / s (a + b = 1) it is 3 / (s (1 + 2 a b)):
+            // no product of two spacings, so it stays finite for spacings near 1e-300 and
+            // 1e300 alike.
             let (hp, hk) = (h[k_prev], h[k]);
-            let (w1, w2) = (2.0 * hk + hp, hk + 2.0 * hp);
-            (w1 + w2) / (w1 * hp + w2 * hk)
+            let sum = hp + hk;
+            let (a, b) = (hk / sum, hp / sum);
+            3.0 / (sum * (1.0 + 2.0 * a * b))
         };
         let slopes = match timing {
             Timing::Linear => vec![0.0; m],
@@ -134,7 +204,8 @@ impl TimeMap {
     }
 
     /// The motion parameter at time `t`. Open motions hold their end poses outside the keys'
-    /// range (`u` clamped to `[0, n - 1]`); closed motions repeat with the period.
+    /// range (`u` clamped to `[0, n - 1]`); closed motions repeat with the period. A NaN
+    /// time gives 0 (callers check times first, see [`check_time`]).
     pub fn parameter(&self, t: f64) -> f64 {
         let t0 = self.knots[0];
         let t = match self.period {
@@ -142,14 +213,14 @@ impl TimeMap {
             None => t,
         };
         let last = self.knots.len() - 1;
-        if t <= t0 {
+        if !(t > t0) {
             return 0.0;
         }
         if t >= self.knots[last] {
             return last as f64;
         }
-        // Knot interval k with knots[k] <= t < knots[k + 1].
-        let k = self.knots.partition_point(|&x| x <= t) - 1;
+        // Knot interval k with knots[k] <= t < knots[k + 1] (t0 < t < knots[last]).
+        let k = (self.knots.partition_point(|&x| x <= t).max(1) - 1).min(last - 1);
         let h = self.knots[k + 1] - self.knots[k];
         let s = (t - self.knots[k]) / h;
         let u = match self.timing {

@@ -101,10 +101,10 @@ impl F4 {
         self.compare(F4::splat(o), |a, b| a < b)
     }
 
-    /// Lanes that are finite and positive.
+    /// `self > o` per lane (false for NaN).
     #[inline(always)]
-    pub(crate) fn finite_positive(self) -> M4 {
-        self.compare(F4::splat(0.0), |a, b| a > b && a.is_finite())
+    pub(crate) fn gt(self, o: f64) -> M4 {
+        self.compare(F4::splat(o), |a, b| a > b)
     }
 
     /// Lanes that are neither NaN nor `>= bound` in magnitude.

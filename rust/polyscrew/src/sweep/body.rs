@@ -12,6 +12,7 @@
 use glam::DVec3;
 
 use crate::error::{Error, Result};
+use crate::memory::Footprint;
 
 /// A triangle whose cross product `|(b - a) x (c - a)|` is at most this fraction of the
 /// square of its longest edge (its smallest angle below about `1e-12` radians, or a repeated
@@ -22,8 +23,33 @@ pub const ZERO_AREA_REL: f64 = 1e-12;
 /// lies within this fraction of its distance from the edge of the other's plane.
 pub const FLAT_REL: f64 = 1e-9;
 
+/// The working range of the body's vertex coordinates: `|x| <= MAX_VERTEX_COORDINATE`.
+///
+/// Why `1e75` (not the poses' `1e150`): a face's area test squares the cross product of two
+/// edges, a fourth power of coordinates: `3 (2 (2e75)^2)^2 ~ 2e302`. Poses may still move the
+/// body anywhere within `1e150`.
+pub const MAX_VERTEX_COORDINATE: f64 = 1e75;
+
 /// No face on this side of an edge (border edges have one face).
 pub const NO_FACE: u32 = u32::MAX;
+
+/// Bytes a [`Body`] and the sweep's per-body buffers hold per vertex and per triangle, with
+/// room for the caller's copy of the input (the Python module's: 24 per vertex and per
+/// triangle): vertices (24), remap and scratch (40) per vertex; triangles, normals, edges and
+/// their half-edge sort, face values and flags (about 200) per triangle.
+pub const BODY_BYTES_PER_VERTEX: usize = 96;
+
+/// See [`BODY_BYTES_PER_VERTEX`].
+pub const BODY_BYTES_PER_TRIANGLE: usize = 320;
+
+/// How to ask the sweep for less memory.
+pub const SWEEP_HINT: &str = "use fewer steps, fewer poses or a coarser mesh";
+
+/// What a [`Body`] of `vertices` and `triangles` and the sweep's buffers for it hold.
+pub fn body_footprint(vertices: usize, triangles: usize) -> Footprint {
+    Footprint::bytes(BODY_BYTES_PER_VERTEX).times(vertices)
+        + Footprint::bytes(BODY_BYTES_PER_TRIANGLE).times(triangles)
+}
 
 /// How the faces at an edge meet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -106,6 +132,18 @@ impl Body {
                 index: i,
             });
         }
+        if let Some(i) = vertices
+            .iter()
+            .position(|v| v.abs().max_element() > MAX_VERTEX_COORDINATE)
+        {
+            return Err(Error::OutOfRange {
+                what: "vertex",
+                index: i,
+                value: vertices[i].abs().max_element(),
+                range: "+-1e75",
+            });
+        }
+        body_footprint(vertices.len(), triangles.len()).check("the swept body", SWEEP_HINT)?;
         let n = vertices.len();
         let mut tris = Vec::with_capacity(triangles.len());
         let mut normals = Vec::with_capacity(triangles.len());

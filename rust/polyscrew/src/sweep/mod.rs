@@ -34,12 +34,16 @@ pub mod generator;
 
 use glam::DVec3;
 
-pub use body::{Body, Edge, EdgeKind, FLAT_REL, NO_FACE, ZERO_AREA_REL};
+pub use body::{
+    body_footprint, Body, Edge, EdgeKind, FLAT_REL, MAX_VERTEX_COORDINATE, NO_FACE, SWEEP_HINT,
+    ZERO_AREA_REL,
+};
 pub use generator::{
     Generator, Scratch, Segment, SegmentKind, Velocity, MOTIONLESS_REL, TANGENT_REL,
 };
 
-use crate::error::{Error, PoseDefect, Result};
+use crate::error::{Error, Result};
+use crate::memory::{try_reserve, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::screw::Screw;
 
@@ -56,6 +60,19 @@ pub const TWIST_REL: f64 = 5e-3;
 
 /// Most pieces a generator segment is cut into against twist.
 pub const MAX_PIECES: u32 = 256;
+
+/// Bytes the sweep counts per output vertex against the memory budget: its own (24) and
+/// the float64 copy the Python module returns (24).
+pub const BYTES_PER_OUTPUT_VERTEX: usize = 48;
+
+/// Bytes the sweep counts per output triangle: its own (12) and the int64 copy (24).
+pub const BYTES_PER_OUTPUT_TRIANGLE: usize = 36;
+
+/// What a swept mesh of `vertices` and `triangles` holds, its Python copy included.
+fn output_footprint(vertices: usize, triangles: usize) -> Footprint {
+    Footprint::bytes(BYTES_PER_OUTPUT_VERTEX).times(vertices)
+        + Footprint::bytes(BYTES_PER_OUTPUT_TRIANGLE).times(triangles)
+}
 
 /// Options of [`sweep`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -96,7 +113,10 @@ pub struct SweptMesh {
 /// - [`Error::TooFew`] for fewer than 2 poses;
 /// - [`Error::BadPose`] (`NotFinite`) for a pose with a NaN or infinite entry;
 /// - [`Error::Invalid`] (`"steps"`) for `steps` outside `1..=MAX_STEPS`, or an output of
-///   more than `u32::MAX` vertices.
+///   more than `u32::MAX` vertices;
+/// - [`Error::Memory`] before the span whose quads would take the mesh (with its Python
+///   copy, [`BYTES_PER_OUTPUT_VERTEX`], [`BYTES_PER_OUTPUT_TRIANGLE`]) and the body's
+///   buffers ([`body_footprint`]) over the memory budget.
 pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<SweptMesh> {
     if poses.len() < 2 {
         return Err(Error::TooFew {
@@ -104,15 +124,10 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
             need: 2,
         });
     }
-    if let Some(index) = poses
+    poses
         .iter()
-        .position(|p| !p.rotation.is_finite() || !p.translation.is_finite())
-    {
-        return Err(Error::BadPose {
-            index,
-            defect: PoseDefect::NotFinite,
-        });
-    }
+        .enumerate()
+        .try_for_each(|(index, p)| p.check_range(index))?;
     let k = options.steps;
     if k == 0 || k > MAX_STEPS {
         return Err(Error::Invalid {
@@ -122,10 +137,23 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
     }
     let nf = body.triangles().len();
     let min_cross = DEGENERATE_REL * body.extent() * body.extent();
+    let fixed = body_footprint(body.vertices().len(), nf);
+    // The mesh so far plus `vertices` and `triangles` more, checked before they are added.
+    let reserve = |out: &mut SweptMesh, vertices: usize, triangles: usize| -> Result<()> {
+        let total = fixed
+            + output_footprint(
+                out.vertices.len().saturating_add(vertices),
+                out.triangles.len().saturating_add(triangles),
+            );
+        total.check("the swept mesh", SWEEP_HINT)?;
+        try_reserve(&mut out.vertices, vertices, "the swept mesh")?;
+        try_reserve(&mut out.triangles, triangles, "the swept mesh")
+    };
     let mut out = SweptMesh::default();
     let mut remap = vec![u32::MAX; body.vertices().len()];
     let all: Vec<u32> = (0..nf as u32).collect();
     if options.caps {
+        reserve(&mut out, body.vertices().len(), nf)?;
         add_faces(&mut out, body, &poses[0], &all, &mut remap);
     }
     let mut gen = Generator::default();
@@ -150,6 +178,7 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
             *prev = vals[0].max(vals[1]).max(vals[2]);
         }
         if i > 0 {
+            reserve(&mut out, 3 * keep.len(), keep.len())?;
             add_faces(&mut out, body, a, &keep, &mut remap);
         }
         prev_tol = tol;
@@ -184,13 +213,17 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
                 reason: format!("the swept mesh would have {total} vertices, over 2^32 - 1"),
             });
         }
+        reserve(
+            &mut out,
+            (k as usize + 1).saturating_mul(g),
+            (2 * k as usize).saturating_mul(segments.len()),
+        )?;
         let base = out.vertices.len() as u32;
         for j in 0..=k {
             let pose = a.mul_pose(&screw.motion(j as f64 / k as f64));
             out.vertices
                 .extend(points.iter().map(|&p| pose.transform_point3(p)));
         }
-        out.triangles.reserve(2 * k as usize * segments.len());
         for &[sa, sb] in &segments {
             for j in 0..k {
                 let a0 = base + j * g as u32 + sa;
@@ -203,6 +236,7 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         }
     }
     if options.caps {
+        reserve(&mut out, body.vertices().len(), nf)?;
         add_faces(&mut out, body, &poses[poses.len() - 1], &all, &mut remap);
     }
     Ok(out)
@@ -221,7 +255,6 @@ fn push_triangle(out: &mut SweptMesh, t: [u32; 3], min_cross: f64) {
 fn add_faces(out: &mut SweptMesh, body: &Body, pose: &Pose, faces: &[u32], remap: &mut [u32]) {
     let verts = body.vertices();
     let tris = body.triangles();
-    out.triangles.reserve(faces.len());
     for &f in faces {
         let tri = tris[f as usize].map(|i| {
             let slot = &mut remap[i as usize];

@@ -1,0 +1,304 @@
+//! Reading arguments with errors that name the function and the argument.
+//!
+//! Python's conventions are kept (a wrong type is a `TypeError`, a wrong value a
+//! `ValueError`), but nothing reaches the caller as an `OverflowError` or with a message that
+//! does not say which argument it is about. Array-likes are taken as `&Bound<PyAny>` and read
+//! in the function body ([`float_array`], [`int_array`]); scalars with a default are read by
+//! `#[pyo3(from_py_with = ...)]` converters generic over a [`Function`] marker (so the
+//! message names the function too while the signature keeps its literal default).
+
+use numpy::ndarray::Dimension;
+use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn};
+use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyFloat, PyString};
+
+use polyscrew::sweep::MAX_STEPS;
+use polyscrew::MAX_LEVELS;
+
+/// An array-like argument converted to float64.
+pub type FloatArray<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+
+/// An integer array-like argument converted to int64.
+pub type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+
+/// A Python function of the module, for the messages of the argument converters.
+pub trait Function {
+    /// Its Python name.
+    const NAME: &'static str;
+}
+
+macro_rules! functions {
+    ($($ty:ident = $name:literal),* $(,)?) => {
+        $(
+            #[doc = concat!("`", $name, "`.")]
+            pub struct $ty;
+            impl Function for $ty {
+                const NAME: &'static str = $name;
+            }
+        )*
+    };
+}
+
+functions!(
+    Subdivide = "subdivide",
+    Sample = "sample",
+    SampleChannels = "sample_channels",
+    SubdivideVectors = "subdivide_vectors",
+    SampleVectors = "sample_vectors",
+    FeatureMotion = "feature_motion",
+    SampleFeature = "sample_feature",
+    Sweep = "sweep",
+    FitAngularVelocity = "fit_angular_velocity",
+    KeysParameters = "keys_parameters",
+);
+
+/// The name of `obj`'s type, for messages.
+fn type_name(obj: &Bound<'_, PyAny>) -> String {
+    obj.get_type()
+        .name()
+        .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+}
+
+/// `err` with `"{function}: {what}: "` before its message, of the same exception type.
+pub fn named(py: Python<'_>, function: &str, what: &str, err: PyErr) -> PyErr {
+    let message = err.value(py).to_string();
+    let prefix = format!("{function}: {what}: ");
+    if message.starts_with(&prefix) {
+        return err;
+    }
+    let renamed = PyErr::from_type(err.get_type(py), format!("{prefix}{message}"));
+    renamed.set_cause(py, Some(err));
+    renamed
+}
+
+/// Reads a float array-like: float64 arrays as they are, other real numbers (ints, bools,
+/// float32, nested lists) converted; complex, strings and objects refused with a
+/// `TypeError`, ragged lists with numpy's `ValueError`, each naming the argument.
+pub fn float_array<'py>(
+    function: &str,
+    what: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<FloatArray<'py>> {
+    let py = obj.py();
+    if obj.cast::<PyArrayDyn<f64>>().is_err() {
+        let array = as_numpy(function, what, obj)?;
+        let kind = dtype_kind(&array)?;
+        if !matches!(kind, 'b' | 'i' | 'u' | 'f') {
+            return Err(PyTypeError::new_err(format!(
+                "{function}: {what}: expected real numbers, got {}",
+                dtype_name(&array)
+            )));
+        }
+    }
+    obj.extract::<FloatArray<'py>>()
+        .map_err(|e| named(py, function, what, e))
+}
+
+/// Reads an integer array-like: integer arrays as they are, float arrays only when every
+/// entry is a whole number (`2.0`, not `2.7`, which is a `ValueError` naming the entry);
+/// anything else a `TypeError`.
+pub fn int_array<'py>(
+    function: &str,
+    what: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<IntArray<'py>> {
+    let py = obj.py();
+    if obj.cast::<PyArrayDyn<i64>>().is_err() {
+        let array = as_numpy(function, what, obj)?;
+        match dtype_kind(&array)? {
+            'i' | 'u' => {}
+            'f' => {
+                let floats = float_array(function, what, &array)?;
+                let view = floats.as_array();
+                if let Some((index, value)) = view
+                    .indexed_iter()
+                    .find(|(_, v)| !(v.fract() == 0.0 && v.abs() < 9.2e18))
+                {
+                    return Err(PyValueError::new_err(format!(
+                        "{function}: {what}: entry {:?} is {value}, not an integer",
+                        index.slice()
+                    )));
+                }
+            }
+            _ => {
+                return Err(PyTypeError::new_err(format!(
+                    "{function}: {what}: expected integers, got {}",
+                    dtype_name(&array)
+                )))
+            }
+        }
+        let converted = array
+            .call_method1("astype", ("int64",))
+            .map_err(|e| named(py, function, what, e))?;
+        return converted
+            .extract::<IntArray<'py>>()
+            .map_err(|e| named(py, function, what, e));
+    }
+    obj.extract::<IntArray<'py>>()
+        .map_err(|e| named(py, function, what, e))
+}
+
+fn as_numpy<'py>(
+    function: &str,
+    what: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let py = obj.py();
+    py.import("numpy")?
+        .call_method1("asarray", (obj,))
+        .map_err(|e| named(py, function, what, e))
+}
+
+fn dtype_kind(array: &Bound<'_, PyAny>) -> PyResult<char> {
+    array.getattr("dtype")?.getattr("kind")?.extract::<char>()
+}
+
+fn dtype_name(array: &Bound<'_, PyAny>) -> String {
+    array
+        .getattr("dtype")
+        .and_then(|d| d.str())
+        .map_or_else(|_| "?".to_owned(), |s| s.to_string())
+}
+
+/// Reads a real number: ints (any size that fits a float), floats and numpy scalars; a
+/// `ValueError` for an int too large for a float, a `TypeError` for anything else.
+pub fn float_scalar(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    obj.extract::<f64>().map_err(|e| {
+        if e.is_instance_of::<PyOverflowError>(obj.py()) {
+            PyValueError::new_err(format!(
+                "{function}: {what}: {} is too large for a float",
+                obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string())
+            ))
+        } else {
+            PyTypeError::new_err(format!(
+                "{function}: {what}: expected a real number, got {}",
+                type_name(obj)
+            ))
+        }
+    })
+}
+
+/// An optional real number (`None` stays `None`).
+pub fn optional_float(
+    function: &str,
+    what: &str,
+    obj: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Option<f64>> {
+    match obj {
+        Some(o) if !o.is_none() => float_scalar(function, what, o).map(Some),
+        _ => Ok(None),
+    }
+}
+
+/// An int in `lo..=hi`: a `ValueError` naming the argument, the value and the range for any
+/// int outside it (huge ones included), a `TypeError` for a float or any other type.
+pub fn int_in(
+    function: &str,
+    what: &str,
+    obj: &Bound<'_, PyAny>,
+    lo: i64,
+    hi: i64,
+) -> PyResult<i64> {
+    let out_of_range = |shown: String| {
+        PyValueError::new_err(format!(
+            "{function}: {what} {shown} out of range {lo}..={hi}"
+        ))
+    };
+    if obj.is_instance_of::<PyFloat>() {
+        return Err(PyTypeError::new_err(format!(
+            "{function}: {what}: expected an int, got float {}",
+            obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string())
+        )));
+    }
+    match obj.extract::<i64>() {
+        Ok(v) if (lo..=hi).contains(&v) => Ok(v),
+        Ok(v) => Err(out_of_range(v.to_string())),
+        Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => Err(out_of_range(
+            obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string()),
+        )),
+        Err(_) => Err(PyTypeError::new_err(format!(
+            "{function}: {what}: expected an int, got {}",
+            type_name(obj)
+        ))),
+    }
+}
+
+/// `levels` in `0..=MAX_LEVELS`.
+pub fn levels<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<u32> {
+    int_in(F::NAME, "levels", obj, 0, i64::from(MAX_LEVELS)).map(|v| v as u32)
+}
+
+/// `steps` in `1..=MAX_STEPS`.
+pub fn steps<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<u32> {
+    int_in(F::NAME, "steps", obj, 1, i64::from(MAX_STEPS)).map(|v| v as u32)
+}
+
+/// `max_iterations` in `1..=MAX_ITERATIONS`.
+pub fn max_iterations<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let max = polyscrew::angular_velocity::MAX_ITERATIONS as i64;
+    int_in(F::NAME, "max_iterations", obj, 1, max).map(|v| v as usize)
+}
+
+/// `max_frames` in `0..=MAX_ITERATIONS`.
+pub fn max_frames<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let max = polyscrew::angular_velocity::MAX_ITERATIONS as i64;
+    int_in(F::NAME, "max_frames", obj, 0, max).map(|v| v as usize)
+}
+
+/// `alpha`, a real number (its range is checked by the core).
+pub fn alpha<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    float_scalar(F::NAME, "alpha", obj)
+}
+
+/// `delta`, a real number (its range is checked by the core).
+pub fn delta<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
+    float_scalar(F::NAME, "delta", obj)
+}
+
+/// A bool argument.
+pub fn bool_arg(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    obj.extract::<bool>().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "{function}: {what}: expected a bool, got {}",
+            type_name(obj)
+        ))
+    })
+}
+
+/// `closed`, a bool.
+pub fn closed<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    bool_arg(F::NAME, "closed", obj)
+}
+
+/// `caps`, a bool.
+pub fn caps<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    bool_arg(F::NAME, "caps", obj)
+}
+
+/// A str argument, borrowed.
+pub fn str_arg<'a>(function: &str, what: &str, obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
+    obj.cast::<PyString>()
+        .map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{function}: {what}: expected a str, got {}",
+                type_name(obj)
+            ))
+        })?
+        .to_str()
+}
+
+/// `scheme`, a str.
+pub fn scheme<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
+    str_arg(F::NAME, "scheme", obj)
+}
+
+/// `timing`, a str.
+pub fn timing<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
+    str_arg(F::NAME, "timing", obj)
+}
+
+/// `parametrization`, a str.
+pub fn parametrization<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
+    str_arg(F::NAME, "parametrization", obj)
+}

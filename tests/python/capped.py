@@ -1,0 +1,63 @@
+"""Running polyscrew calls in a child process under a 4 GB address-space cap (issue 15).
+
+The child sets `RLIMIT_AS` before importing anything, runs the code it is given and prints
+one JSON line per `report(...)`: the exception type and message of a `ValueError`,
+`TypeError` or `MemoryError`, or whether the result is finite. Anything else (a signal, an
+abort, a `PanicException`, which is a `BaseException`) ends the child abnormally, and
+`run_capped` fails the test with its output.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+#: The address-space cap of the child processes: 4 GB.
+CAP = 4 << 30
+
+PRELUDE = f"""
+import json, math, resource, sys
+resource.setrlimit(resource.RLIMIT_AS, ({CAP}, {CAP}))
+sys.path.insert(0, {str(Path(__file__).parent)!r})
+import numpy as np
+import polyscrew as ps
+
+def finite(value):
+    '''Whether every number in a result (arrays, tuples, a Screw, a fit) is finite.'''
+    if isinstance(value, (tuple, list)):
+        return all(finite(v) for v in value)
+    if isinstance(value, np.ndarray):
+        return bool(np.isfinite(value).all()) if value.dtype.kind in "fc" else True
+    if isinstance(value, (float, int)):
+        return math.isfinite(value)
+    if isinstance(value, ps.Screw):
+        return finite((value.axis, value.point, value.angle, value.slide))
+    if isinstance(value, ps.AngularVelocityFit):
+        return finite((value.quaternions, value.omega, value.key_quaternions, value.frame_times,
+                       value.fit_error, value.fragment_errors, value.energy))
+    return True
+
+def report(call):
+    '''Runs `call` and prints what came of it as one JSON line.'''
+    try:
+        out = call()
+    except (ValueError, TypeError, MemoryError) as e:
+        print(json.dumps({{"error": type(e).__name__, "message": str(e)}}), flush=True)
+        return None
+    print(json.dumps({{"finite": finite(out)}}), flush=True)
+    return out
+"""
+
+
+def run_capped(code: str, timeout: float = 600) -> list[dict]:
+    """Runs `code` after the prelude in a capped child; returns its `report` lines. Fails
+    unless the child exits normally (status 0)."""
+    proc = subprocess.run(
+        [sys.executable, "-c", PRELUDE + code], capture_output=True, text=True, timeout=timeout
+    )
+    assert proc.returncode == 0, (
+        f"child ended with status {proc.returncode}\n{proc.stdout[-3000:]}\n{proc.stderr[-3000:]}"
+    )
+    return [json.loads(line) for line in proc.stdout.splitlines() if line.startswith("{")]
