@@ -35,6 +35,7 @@ GROUPS = [
     ["sample", "sample_vectors", "sample_channels", "evaluate_fcurves"],
     ["fit_angular_velocity", "AngularVelocityFit", "register_points", "inertia_points"],
     ["feature_motion", "sample_feature", "sweep"],
+    ["rotation_matrices", "Playback", "analyse_spans", "keys_parameters", "pace_parameters"],
 ]
 
 
@@ -346,7 +347,90 @@ def worker(group: int, seed: int, examples: int) -> None:
     def evaluate_fcurves(curves, t):
         check("evaluate_fcurves", lambda: ps.evaluate_fcurves(t, **curves))
 
+    def playback_of(curves, columns, unkeyed, m, located):
+        return ps.Playback(channels=columns, unkeyed=unkeyed, mode=m, located=located, **curves)
+
+    channel = st.tuples(
+        st.sampled_from(["location", "scale", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "x"]),
+        st.one_of(st.integers(-1, 4), big_int),
+    )
+    columns = st.one_of(st.lists(channel, min_size=0, max_size=3), junk)
+    unkeyed = mostly(st.lists(st.floats(-5, 5), min_size=9, max_size=10), st.lists(real, min_size=9, max_size=10), junk)
+    located_ = mostly(st.booleans(), junk)
+
+    @fuzz
+    @given(st.one_of(vectors(6, 3), vectors(6, 4), junk), mode)
+    def rotation_matrices(v, m):
+        check("rotation_matrices", lambda: ps.rotation_matrices(v, m))
+
+    @fuzz
+    @given(packed_curves(), st.one_of(st.none(), columns), unkeyed, mode, located_, st.one_of(times(increasing=False), junk))
+    def playback(curves, cols, unk, m, loc, t):
+        if cols is None:  # one location channel per curve, as many as there are offsets
+            try:
+                cols = [("location", i) for i in range(len(curves["offsets"]) - 1)]
+            except TypeError:
+                cols = []
+        try:
+            pb = playback_of(curves, cols, unk, m, loc)
+        except (ValueError, TypeError, MemoryError):
+            counts["Playback"] = counts.get("Playback", 0) + 1
+            return
+        check("Playback", lambda: pb)
+        check("Playback.channels", lambda: pb.channels(t))
+
+    # A playback that constructs: location x and a rotation angle, keyed where the frames are.
+    @st.composite
+    def good_playback(draw):
+        m = draw(st.sampled_from(["XYZ", "ZYX", "QUATERNION", "AXIS_ANGLE"]))
+        frames = np.cumsum(draw(st.lists(st.one_of(st.floats(0.01, 20), extreme.filter(lambda x: x > 0)), min_size=2, max_size=5)))
+        values = draw(st.lists(st.one_of(st.floats(-50, 50), extreme), min_size=len(frames), max_size=len(frames)))
+        co = np.c_[frames, values]
+        curves = dict(offsets=np.array([0, len(frames), 2 * len(frames)]), co=np.r_[co, co],
+                      handle_left=np.r_[co, co] - 0.3, handle_right=np.r_[co, co] + 0.3,
+                      interpolation=np.array(draw(st.lists(st.integers(0, 12), min_size=2 * len(frames), max_size=2 * len(frames)))),
+                      easing=np.zeros(2 * len(frames), dtype=np.int64))
+        path = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}.get(m, "rotation_euler")
+        width = 4 if m in ("QUATERNION", "AXIS_ANGLE") else 3
+        unk = np.array(draw(st.lists(st.floats(-5, 5), min_size=6 + width, max_size=6 + width)))
+        try:
+            return playback_of(curves, [("location", 0), (path, 0)], unk, m, draw(st.booleans())), frames
+        except (ValueError, TypeError, MemoryError):
+            return None, frames
+
+    @fuzz
+    @given(good_playback(), st.one_of(times(), st.just(None)), st.one_of(times(increasing=False), junk))
+    def analyse_spans(pf, t, anywhen):
+        pb, frames = pf
+        if pb is None:
+            return
+        check("analyse_spans", lambda: ps.analyse_spans(pb, frames if t is None else t))
+        check("Playback.channels", lambda: pb.channels(anywhen))
+
+    @fuzz
+    @given(good_playback(), st.one_of(times(increasing=False), junk), mostly(st.floats(0.01, 5), real, junk), closed,
+           period, poses(min_size=2, max_size=5), scheme, small_levels, st.booleans())
+    def keys_parameters(pf, t, size, c, pe, p, s, lv, use_smooth):
+        pb, frames = pf
+        try:
+            n = len(frames) if not c else len(frames) + 1
+            smooth = ps.sample(p, np.arange(len(p), dtype=float), ps.pace_parameters(n - 1), timing="linear") if use_smooth else None
+        except (ValueError, TypeError, MemoryError):
+            smooth = None
+        kwargs = dict(size=size, closed=c, period=pe, playback=pb, scheme=s, levels=lv)
+        if smooth is not None:
+            check("keys_parameters", lambda: ps.keys_parameters(frames, t, smooth=smooth, **kwargs))
+        else:
+            check("keys_parameters", lambda: ps.keys_parameters(frames, t, poses=p, **kwargs))
+
+    @fuzz
+    @given(st.one_of(st.integers(-3, 2000), big_int, junk))
+    def pace_parameters(n):
+        check("pace_parameters", lambda: ps.pace_parameters(n))
+
     tests = {
+        "rotation_matrices": [rotation_matrices], "Playback": [playback], "analyse_spans": [analyse_spans],
+        "keys_parameters": [keys_parameters], "pace_parameters": [pace_parameters],
         "screw": [screw], "interpolate": [interpolate], "subdivide": [subdivide],
         "subdivide_vectors": [subdivide_vectors], "rotation_channels": [rotation_channels],
         "memory_budget": [memory_budget], "sample": [sample], "sample_vectors": [sample_vectors],

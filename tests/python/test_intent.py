@@ -409,7 +409,7 @@ def test_keys_timing_errors_name_the_argument():
         polyscrew.keys_parameters([1.0, 2.0], [1.5], size=1.0, closed=True, poses=poses)
     with pytest.raises(ValueError, match="keys_parameters: period 0.5 must be finite and exceed"):
         polyscrew.keys_parameters([1.0, 2.0], [1.5], size=1.0, closed=True, period=0.5, poses=poses)
-    with pytest.raises(ValueError, match="keys_parameters: size: -1 is not a positive"):
+    with pytest.raises(ValueError, match=r"keys_parameters: size: -1 is not in the working range \(0, 1e150\]"):
         polyscrew.keys_parameters([1.0, 2.0], [1.5], size=-1.0, poses=poses)
     with pytest.raises(ValueError, match="keys_parameters: frame 1 is NaN"):
         polyscrew.keys_parameters([1.0, 2.0], [1.5, np.nan], size=1.0, poses=poses)

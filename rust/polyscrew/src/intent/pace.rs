@@ -9,9 +9,10 @@ use super::playback::Playback;
 use crate::error::{Error, Result};
 use crate::memory::try_vec;
 use crate::motion::pose::Pose;
+use crate::motion::pose::MAX_COORDINATE;
 use crate::motion::sample::{Motion, MotionSpec};
 use crate::motion::subdivision::Scheme;
-use crate::motion::timing::{check_key_times, Timing};
+use crate::motion::timing::{check_key_times, check_time, Timing};
 
 /// Steps per key span along which the travel of Blender's playback and of the smoothed
 /// motion is measured (the output frames inside a span are measured too).
@@ -131,12 +132,15 @@ pub struct KeysTiming<'a> {
 /// and the parameter stays within the span.
 ///
 /// # Errors
-/// [`Error::TooFew`] for fewer than two keys, [`Error::KeyTimes`] for key frames that are
-/// not strictly increasing, [`Error::Period`] for a period not beyond the keys,
-/// [`Error::Invalid`] for a size that is not positive and finite, [`Error::NotFinite`] for
-/// a frame that is not finite, [`Error::LengthMismatch`] when `smooth` does not hold
-/// `PACE_SAMPLES + 1` poses per span, the errors of [`Playback::channels`], and a request
-/// over the size limit ([`check_footprint`]).
+/// [`Error::TooFew`] for fewer than two keys, the errors of
+/// [`check_key_times`](crate::check_key_times) for the key frames (strictly increasing,
+/// within the time range), [`Error::Period`] for a period not beyond the keys,
+/// [`Error::Invalid`] for a size outside `(0, 1e150]` or a frame so far outside the keys that
+/// its parameter is not finite, [`Error::NotFinite`] or [`Error::OutOfRange`] for a frame
+/// outside the time range, [`Error::LengthMismatch`] when `smooth` does not hold
+/// `PACE_SAMPLES + 1` poses per span, [`Error::BadPose`] for a smoothed pose outside the
+/// coordinate range, the errors of [`Playback::channels`], and a request over the memory
+/// budget ([`check_footprint`]).
 pub fn keys_parameters(
     timing: &KeysTiming<'_>,
     frames: &[f64],
@@ -163,18 +167,16 @@ pub fn keys_parameters(
     }
     let spans = ends.len() - 1;
     let size = timing.size;
-    if !(size.is_finite() && size > 0.0) {
+    if !(size > 0.0 && size <= MAX_COORDINATE) {
         return Err(Error::Invalid {
             what: "size",
-            reason: format!("{size} is not a positive finite number"),
+            reason: format!("{size} is not in the working range (0, {MAX_COORDINATE:e}]"),
         });
     }
-    if let Some(index) = frames.iter().position(|f| !f.is_finite()) {
-        return Err(Error::NotFinite {
-            what: "frame",
-            index,
-        });
+    for (index, &f) in frames.iter().enumerate() {
+        check_time("frame", index, f)?;
     }
+    crate::motion::subdivision::check_range(smooth)?;
     let per_span = PACE_SAMPLES + 1;
     let grid_len = spans * per_span;
     if smooth.len() != grid_len {
@@ -246,7 +248,7 @@ pub fn keys_parameters(
             y.push(s as f64 + grid(j));
         }
     }
-    collected(
+    let out = collected(
         t,
         located.iter().map(|&(s, tau)| {
             let base = s as f64;
@@ -258,7 +260,19 @@ pub fn keys_parameters(
             }
         }),
         "motion parameters",
-    )
+    )?;
+    // Outside the keys the parameter extrapolates: a frame far from keys very close together
+    // could leave the floating-point range.
+    if let Some(index) = out.iter().position(|u| !u.is_finite()) {
+        return Err(Error::Invalid {
+            what: "frames",
+            reason: format!(
+                "frame {index} ({}) is too far from the keys for their spacing: its motion parameter is not finite",
+                frames[index]
+            ),
+        });
+    }
+    Ok(out)
 }
 
 /// The fraction of its span's travel along Blender's playback done at each sample

@@ -105,19 +105,22 @@ pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
     let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
     match mode {
         RotationMode::Quaternion => {
+            // scaled by its largest component first: no overflow for huge values
             let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
-            let norm = q.length();
-            if norm > 0.0 {
-                DMat3::from_quat(q / norm)
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            if largest > 0.0 {
+                let q = q / largest;
+                DMat3::from_quat(q / q.length())
             } else {
                 DMat3::IDENTITY
             }
         }
         RotationMode::AxisAngle => {
             let axis = DVec3::new(v(1), v(2), v(3));
-            let norm = axis.length();
-            if norm > 0.0 {
-                let k = axis / norm;
+            let largest = axis.abs().max_element();
+            if largest > 0.0 {
+                let axis = axis / largest;
+                let k = axis / axis.length();
                 let (s, c) = v(0).sin_cos();
                 // K v = k x v, as columns of the skew matrix.
                 let skew = DMat3::from_cols(
