@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels, keys, owners, sampling, transaction
+from . import channels, feature, keys, owners, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -280,6 +280,8 @@ def sample_channels(
                 f"({budget[0]:,} left for this one): raise Step, shorten the Frame Range or smooth fewer objects"
             )
         budget[0] -= int(keys_needed)
+    if options.method == "FEATURE" and options.approximate:
+        feature.check_approximate(owner, motion, options.stiffness)
     try:
         frames = bake_frames(start, end, options.step)
         mode = motion.rotation_mode
@@ -469,7 +471,23 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
             group.objects.append(owner.obj)
         if owner.bone not in group.bones:
             group.bones.append(owner.bone)
+    # Every object the action animates through that slot keeps sharing it, selected or not.
+    for (pointer, identifier), group in groups.items():
+        for obj in users_of(group.objects[0].animation_data.action, identifier):
+            if obj not in group.objects:
+                group.objects.append(obj)
     return list(groups.values()), skipped
+
+
+def users_of(action: bpy.types.Action, identifier: str) -> list[bpy.types.Object]:
+    """The objects `action` animates through the slot `identifier` ("" before 4.4)."""
+    return [
+        o
+        for o in bpy.data.objects
+        if o.animation_data is not None
+        and o.animation_data.action == action
+        and channels.slot_identifier(o) == identifier
+    ]
 
 
 def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[list[ActionBake], list, list[str]]:
@@ -659,14 +677,7 @@ def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
     smoothed = obj.animation_data.action
-    identifier = channels.slot_identifier(obj)
-    sharing = [
-        o
-        for o in bpy.data.objects
-        if o.animation_data is not None
-        and o.animation_data.action == smoothed
-        and channels.slot_identifier(o) == identifier
-    ]
+    sharing = users_of(smoothed, channels.slot_identifier(obj))
     for other in sharing:
         t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
