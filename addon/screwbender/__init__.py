@@ -13,16 +13,17 @@ drawing. The features:
   :mod:`insert_key` (Insert Key on Motion).
 - Swept regions and clearance: :mod:`swept` + :mod:`swept_ops`.
 - Angular-velocity editing: :mod:`angvel` + :mod:`angvel_ops`.
+- Remove Noise (captured keys): :mod:`denoise` + :mod:`denoise_ops`.
 """
 
 from __future__ import annotations
 
 import bpy
 
-from . import angvel_ops, bake_ops, preview_ops, swept_ops
+from . import angvel_ops, bake_ops, denoise_ops, preview_ops, swept_ops
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(
-    bake_ops.classes + angvel_ops.classes + swept_ops.classes + preview_ops.classes
+    bake_ops.classes + angvel_ops.classes + swept_ops.classes + preview_ops.classes + denoise_ops.classes
 )
 
 
@@ -30,9 +31,11 @@ def register() -> None:
     _register_classes()
     bake_ops.register_properties()
     preview_ops.register_properties()
+    denoise_ops.register_properties()
 
 
 def unregister() -> None:
+    denoise_ops.unregister_properties()
     preview_ops.unregister_properties()
     bake_ops.unregister_properties()
     _unregister_classes()

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels, keys, owners, sampling, transaction
+from . import channels, feature, keys, owners, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -76,6 +76,8 @@ RANGE_MODES = (
 SOURCE_KEY = "screwbender_source"
 SOURCE_SLOT_KEY = "screwbender_source_slot"
 SOURCE_FAKE_USER_KEY = "screwbender_source_fake_user"
+#: Which operator made a result ("smooth", "denoise"; absent: Smooth Motion).
+MADE_BY_KEY = "screwbender_made_by"
 
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
@@ -278,6 +280,8 @@ def sample_channels(
                 f"({budget[0]:,} left for this one): raise Step, shorten the Frame Range or smooth fewer objects"
             )
         budget[0] -= int(keys_needed)
+    if options.method == "FEATURE" and options.approximate:
+        feature.check_approximate(owner, motion, options.stiffness)
     try:
         frames = bake_frames(start, end, options.step)
         mode = motion.rotation_mode
@@ -343,44 +347,74 @@ def _write_curves(
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
-def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
-    """Gives the objects of `bake` a copy of their current action whose transform curves of
-    the smoothed owners are the baked ones (every other curve as it was); the original keys'
-    action keeps a fake user and is recorded on the copy for :func:`revert`. A result of
-    Smooth Motion that no object uses any more is removed once everything has worked."""
-    source, current, identifier = bake.source, bake.current, bake.identifier
-    smoothed = current.copy()
-    smoothed.name = f"{source.name}.smooth"
-    smoothed.use_fake_user = False
-    bag = channels.ensure_container(smoothed, channels.find_slot(smoothed, identifier))
-    # Transform curves the bake replaces; every other curve stays as copied.
-    replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
-    for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced]:
-        channels.remove_fcurve(bag, fcurve)
-    for part in bake.parts:
-        for prop, values in part.values.items():
-            indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
-            _write_curves(
-                bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group,
-                part.constant, part.cycle_modes, prop,
-            )
-    smoothed[SOURCE_KEY] = source
+def new_result(
+    objects: list[bpy.types.Object],
+    source: bpy.types.Action,
+    current: bpy.types.Action,
+    identifier: str,
+    t: transaction.Transaction,
+    edit,
+    made_by: str = "smooth",
+) -> bpy.types.Action:
+    """A copy of `current` (the action `objects` have now) edited by `edit(bag)` (the copy's
+    F-curve container for slot `identifier`), named after `source` (the action holding the
+    original keys) and assigned to every object of `objects`; `source` keeps a fake user and
+    is recorded on the copy for :func:`revert`. When `current` is an earlier result of the same
+    operator (`made_by`: "smooth", "denoise") it is replaced: removed once everything has
+    worked, if nothing uses it any more. Everything goes through the transaction `t`."""
+    suffix = f".{made_by}" if made_by != "smooth" else ".smooth"
+    result = current.copy()
+    result.name = f"{source.name}{suffix}"
+    result.use_fake_user = False
+    edit(channels.ensure_container(result, channels.find_slot(result, identifier)))
+    result[SOURCE_KEY] = source
+    result[MADE_BY_KEY] = made_by
     if current is source:
-        smoothed[SOURCE_SLOT_KEY] = identifier
-        smoothed[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
-    # (re-smoothing: the copy of the earlier result already records the original's slot and flag)
+        result[SOURCE_SLOT_KEY] = identifier
+        result[SOURCE_FAKE_USER_KEY] = bool(source.use_fake_user)
+    # (replacing an earlier result: its copy already records the original's slot and flag)
     t.set(source, "use_fake_user", True)
-    for obj in bake.objects:
-        t.assign_action(obj, smoothed, identifier)
-    if current is not source:
-        name = f"{source.name}.smooth"
+    for obj in objects:
+        t.assign_action(obj, result, identifier)
+    if current is not source and current.get(SOURCE_KEY) is not None:
+        name = f"{source.name}{suffix}"
 
         def replace_earlier_result() -> None:
             if _remove_if_unused(current):
-                smoothed.name = name  # the earlier result's name is free again
+                result.name = name  # the earlier result's name is free again
 
         t.on_commit(replace_earlier_result)
-    return smoothed
+    return result
+
+
+def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Action, str] | None:
+    """The action holding the original keys of `action` and its slot identifier, when `action`
+    is a result of the operator `made_by` (whose reruns start from the original keys)."""
+    original = action.get(SOURCE_KEY)
+    if isinstance(original, bpy.types.Action) and action.get(MADE_BY_KEY, "smooth") == made_by:
+        return original, action.get(SOURCE_SLOT_KEY, "")
+    return None
+
+
+def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
+    """Gives the objects of `bake` a copy of their current action whose transform curves of
+    the smoothed owners are the baked ones (every other curve as it was); see
+    :func:`new_result`."""
+
+    def replace_curves(bag) -> None:
+        # Transform curves the bake replaces; every other curve stays as copied.
+        replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
+        for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced]:
+            channels.remove_fcurve(bag, fcurve)
+        for part in bake.parts:
+            for prop, values in part.values.items():
+                indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
+                _write_curves(
+                    bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group,
+                    part.constant, part.cycle_modes, prop,
+                )
+
+    return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves)
 
 
 def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
@@ -437,7 +471,23 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
             group.objects.append(owner.obj)
         if owner.bone not in group.bones:
             group.bones.append(owner.bone)
+    # Every object the action animates through that slot keeps sharing it, selected or not.
+    for (pointer, identifier), group in groups.items():
+        for obj in users_of(group.objects[0].animation_data.action, identifier):
+            if obj not in group.objects:
+                group.objects.append(obj)
     return list(groups.values()), skipped
+
+
+def users_of(action: bpy.types.Action, identifier: str) -> list[bpy.types.Object]:
+    """The objects `action` animates through the slot `identifier` ("" before 4.4)."""
+    return [
+        o
+        for o in bpy.data.objects
+        if o.animation_data is not None
+        and o.animation_data.action == action
+        and channels.slot_identifier(o) == identifier
+    ]
 
 
 def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[list[ActionBake], list, list[str]]:
@@ -451,10 +501,10 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     current = first.animation_data.action
     identifier = channels.slot_identifier(first)
     source, source_slot = current, identifier
-    original = current.get(SOURCE_KEY)
-    if isinstance(original, bpy.types.Action) and not options.smooth_result:
+    found = original_of(current, "smooth")
+    if found is not None and not options.smooth_result:
         # A result of Smooth Motion: smooth the original keys again with the new options.
-        source, source_slot = original, current.get(SOURCE_SLOT_KEY, "")
+        source, source_slot = found
     read_from = None if source is current else source
     # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
@@ -627,14 +677,7 @@ def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
     smoothed = obj.animation_data.action
-    identifier = channels.slot_identifier(obj)
-    sharing = [
-        o
-        for o in bpy.data.objects
-        if o.animation_data is not None
-        and o.animation_data.action == smoothed
-        and channels.slot_identifier(o) == identifier
-    ]
+    sharing = users_of(smoothed, channels.slot_identifier(obj))
     for other in sharing:
         t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))

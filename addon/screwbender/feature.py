@@ -113,6 +113,24 @@ def key_stiffness(motion: keys.KeyedMotion, selected: np.ndarray, approximate: b
     return lam
 
 
+def check_approximate(owner: owners.Owner | bpy.types.Object, motion: keys.KeyedMotion, stiffness: float) -> None:
+    """Refuses what Approximate Keys cannot do sensibly, with the reason: a Stiffness of 0 (the
+    selected keys would pull nothing: the motion would ignore them), and no selected key (there
+    is nothing to approximate; every key would be hit as without the option)."""
+    owner = owners.as_owner(owner)
+    if not stiffness > 0.0:
+        raise keys.SmoothError(
+            f"{owner.name}: Approximate Keys with Stiffness 0 would ignore the selected keys "
+            "altogether: use a small positive Stiffness (0.001 is very smooth), or Remove Noise "
+            "for captured keys"
+        )
+    if not selected_keys(owner, motion.frames).any():
+        raise keys.SmoothError(
+            f"{owner.name}: Approximate Keys: no key of its transform curves is selected; select "
+            "the keys to approximate (Graph Editor or Dope Sheet) or turn the option off: skipped"
+        )
+
+
 def sample_poses_at(
     owner: owners.Owner | bpy.types.Object,
     motion: keys.KeyedMotion,

@@ -189,6 +189,7 @@ def read(
     slot: str = "",
     extend_to: tuple[float, float] | None = None,
     fcurves: list | None = None,
+    analyse: bool = True,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -197,7 +198,8 @@ def read(
     period: it is dropped from the poses and `period` is its distance from the first key.
     `action` (with the slot identifier `slot`, 4.4+) reads the keys of another action than the
     active one, with the object's own values for unkeyed channels (re-smoothing reads the
-    original keys under a smoothed result). `extend_to` is the frame range to be covered
+    original keys under a smoothed result). `analyse=False` reads the key poses alone (no spins,
+    holds or extended cycles: what Remove Noise needs). `extend_to` is the frame range to be covered
     when a Cycles modifier plays the keys on (Repeat with Offset, Mirror): the keys are
     extended by Blender's playback over it, plus :data:`intent.EXTRA_CYCLES` on each side.
     `fcurves`, when given, are the F-curves to read from instead (the caller's grouping by
@@ -319,7 +321,7 @@ def read(
 
     held = pops = None
     is_key = np.ones(len(frames), dtype=bool)
-    if source is not None:
+    if source is not None and analyse:
         held, pops, turn, inserted = intent.analyse_spans(source, frames, rotation_matrices, compose)
         if len(inserted):
             spins = int(np.sum((turn > intent.WIND_LIMIT) & ~held))

@@ -141,3 +141,21 @@ def test_smooth_blend_script_feature_method(tmp_path):
         np.testing.assert_array_equal(got[path][0], points, err_msg=str(path))
     bad = run(SCRIPT, source, "--stiffness", "1", "--out", result)
     assert bad.returncode == 2 and "--stiffness needs --method FEATURE" in bad.stderr
+
+
+def test_approximate_keys_refuses_stiffness_zero_and_no_selection(sb):
+    obj = h.new_object("Noisy", "MESH", "XYZ")
+    rng = np.random.default_rng(3)
+    for f in range(1, 40, 4):
+        obj.location = rng.normal(0, 1, 3)
+        obj.keyframe_insert("location", frame=f)
+    h.select_only(obj)
+    before = h.snapshot_data()
+    with pytest.raises(RuntimeError, match="Stiffness 0 would ignore the selected keys"):
+        bpy.ops.screwbender.smooth(method="FEATURE", approximate=True, stiffness=0.0)
+    for fc in h.fcurves(obj):
+        for kp in fc.keyframe_points:
+            kp.select_control_point = False
+    with pytest.raises(RuntimeError, match="Approximate Keys: no key of its transform curves is selected"):
+        bpy.ops.screwbender.smooth(method="FEATURE", approximate=True, stiffness=0.5)
+    assert h.snapshot_data() == before

@@ -174,3 +174,11 @@ def test_many_objects_are_reported_in_one_line(sb, capfd):
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     lines = [line for line in capfd.readouterr().out.splitlines() if line.startswith("Info: Smoothed")]
     assert lines == ["Info: Smoothed 12 object(s): Prop.000, Prop.001, Prop.002 and 9 more"]
+
+
+def test_a_linked_duplicate_smoothed_alone_keeps_sharing(sb):
+    obj = keyed("Rotor")
+    dup = linked_duplicate(obj, "Rotor.001")
+    h.select_only(obj)  # only one of them selected
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    assert dup.animation_data.action == obj.animation_data.action  # still shared

@@ -1,0 +1,187 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Remove Noise: the operator and its panel. It collects options, calls :mod:`denoise` and
+reports; the panel only draws."""
+
+from __future__ import annotations
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, FloatProperty
+
+from . import bake, bake_ops, channels, denoise, owners, transaction
+from .keys import SmoothError
+
+
+class SCREWBENDER_OT_denoise(bpy.types.Operator):
+    """Remove the jitter of captured keys (camera tracks, motion capture, baked simulations) from the selected objects or bones: the rigid motion itself is smoothed, the same in any coordinate frame, with the strength chosen from the data. The keys stay keys (their values move), the old action is kept"""
+
+    bl_idname = "screwbender.denoise"
+    bl_label = "Remove Noise"
+    bl_options = {"REGISTER", "UNDO"}
+
+    auto_strength: BoolProperty(
+        name="Auto Strength",
+        default=True,
+        description="Choose the strength from the data (generalised cross-validation, rotation and "
+        "translation apart); the values chosen are shown below after the run",
+    )
+    strength: FloatProperty(
+        name="Strength",
+        default=2.0,
+        min=0.0,
+        soft_max=20.0,
+        subtype="TIME_ABSOLUTE",
+        description="Smoothing time in frames: motion faster than about 6 times this per cycle is "
+        "removed (0 leaves the keys as they are). Used when Auto Strength is off",
+    )
+    range_mode: EnumProperty(
+        name="Frame Range",
+        items=(
+            ("KEYS", "All Keys", "Smooth every key"),
+            ("SCENE", "Scene", "Smooth the keys in the scene's frame range (the others are kept)"),
+            ("CUSTOM", "Custom", "Smooth the keys between Start and End (the others are kept)"),
+        ),
+        default="KEYS",
+        description="Which keys are smoothed; keys outside are kept as they are",
+    )
+    frame_start: FloatProperty(name="Start", default=1.0, description="First smoothed frame (Custom)")
+    frame_end: FloatProperty(name="End", default=250.0, description="Last smoothed frame (Custom)")
+    armature: EnumProperty(
+        name="Armatures",
+        items=owners.ARMATURE_MODES,
+        default="BOTH",
+        description="Object Mode, selected armatures: their keyed bones, their own keys, or both. "
+        "In Pose Mode the selected bones",
+    )
+    smooth_result: BoolProperty(
+        name="Smooth Result",
+        default=False,
+        description="On an action that is already a result of Remove Noise, smooth that result "
+        "(else the original keys again, replacing the earlier result)",
+    )
+    # Shown after the run (the redo panel): what Auto chose, or what was used.
+    rotation_strength: FloatProperty(
+        name="Rotation Strength", description="The strength used for rotation, frames (output)"
+    )
+    translation_strength: FloatProperty(
+        name="Translation Strength", description="The strength used for translation, frames (output)"
+    )
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        if context.mode == "POSE":
+            if not context.selected_pose_bones:
+                cls.poll_message_set("Select one or more keyed bones")
+                return False
+            return True
+        if context.mode != "OBJECT":
+            cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
+            return False
+        if not context.selected_objects:
+            cls.poll_message_set("Select one or more keyed objects")
+            return False
+        return True
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        layout.use_property_split = True
+        layout.use_property_decorate = False
+        layout.prop(self, "auto_strength")
+        row = layout.row()
+        row.active = not self.auto_strength
+        row.prop(self, "strength")
+        layout.prop(self, "range_mode")
+        if self.range_mode == "CUSTOM":
+            col = layout.column(align=True)
+            col.prop(self, "frame_start")
+            col.prop(self, "frame_end")
+        layout.prop(self, "armature")
+        layout.prop(self, "smooth_result")
+        col = layout.column()
+        col.enabled = False
+        col.prop(self, "rotation_strength")
+        col.prop(self, "translation_strength")
+
+    def options(self, context: bpy.types.Context) -> denoise.Options:
+        if self.range_mode == "SCENE":
+            frame_range = (float(context.scene.frame_start), float(context.scene.frame_end))
+        elif self.range_mode == "CUSTOM":
+            frame_range = (self.frame_start, self.frame_end)
+        else:
+            frame_range = None
+        return denoise.Options(
+            strength=None if self.auto_strength else self.strength,
+            frame_range=frame_range,
+            smooth_result=self.smooth_result,
+        )
+
+    def execute(self, context: bpy.types.Context) -> set[str]:
+        selection = owners.selection(context, self.armature, channels.object_fcurves)
+        wm = context.window_manager
+        wm.progress_begin(0, 2 * len(selection))
+        try:
+            result = denoise.remove_noise(selection, self.options(context), lambda done, total: wm.progress_update(done))
+        except SmoothError as err:
+            self.report({"ERROR"}, str(err))
+            return {"CANCELLED"}
+        except Exception as err:  # remove_noise has undone its changes
+            return transaction.report_failure(self, err, "Remove Noise")
+        finally:
+            wm.progress_end()
+        if not result.actions:
+            bake_ops.report_skipped(self, result.skipped, "ERROR")
+            return {"CANCELLED"}
+        bake_ops.report_skipped(self, result.skipped, "WARNING")
+        rotation = sorted(s[0] for s in result.strengths)
+        translation = sorted(s[1] for s in result.strengths)
+        self.rotation_strength = rotation[len(rotation) // 2]
+        self.translation_strength = translation[len(translation) // 2]
+        spread = "" if len(rotation) == 1 else " (median over them)"
+        how = "chosen from the data" if self.auto_strength else "given"
+        self.report(
+            {"INFO"},
+            f"Removed noise from {len(result.owners)}: {bake.summary(result.owners)}; strength {how}: rotation "
+            f"{self.rotation_strength:.3g}, translation {self.translation_strength:.3g} frames{spread}",
+        )
+        return {"FINISHED"}
+
+
+class VIEW3D_PT_screwbender_denoise(bpy.types.Panel):
+    """Remove Noise in the 3D Viewport sidebar, Animation tab."""
+
+    bl_label = "ScrewBender Remove Noise"
+    bl_space_type = "VIEW_3D"
+    bl_region_type = "UI"
+    bl_category = "Animation"
+
+    def draw(self, context: bpy.types.Context) -> None:
+        layout = self.layout
+        layout.operator(SCREWBENDER_OT_denoise.bl_idname, icon="MOD_SMOOTH")
+        layout.label(text="Strength is chosen from the data; select keys to hold the others")
+
+
+class GRAPH_PT_screwbender_denoise(bpy.types.Panel):
+    """Remove Noise in the Graph Editor sidebar."""
+
+    bl_label = "Remove Noise"
+    bl_space_type = "GRAPH_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "ScrewBender"
+
+    def draw(self, context: bpy.types.Context) -> None:
+        self.layout.operator(SCREWBENDER_OT_denoise.bl_idname, icon="MOD_SMOOTH")
+
+
+def menu_func(self, context: bpy.types.Context) -> None:
+    """Object > Animation menu entry."""
+    self.layout.operator(SCREWBENDER_OT_denoise.bl_idname)
+
+
+classes = (SCREWBENDER_OT_denoise, VIEW3D_PT_screwbender_denoise, GRAPH_PT_screwbender_denoise)
+
+
+def register_properties() -> None:
+    bpy.types.VIEW3D_MT_object_animation.append(menu_func)
+
+
+def unregister_properties() -> None:
+    bpy.types.VIEW3D_MT_object_animation.remove(menu_func)
