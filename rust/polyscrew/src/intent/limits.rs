@@ -1,8 +1,7 @@
 //! The sizes this module allocates, checked in one place ([`check_footprint`]) before
 //! anything input-sized is allocated: the add-on runs inside the user's Blender session, and
 //! a request too large for memory must be an error, not an abort. The check asks the crate's
-//! memory budget ([`crate::memory`]); the buffers are then allocated fallibly ([`filled`],
-//! [`collected`]).
+//! memory budget ([`crate::memory`]); the buffers are then allocated fallibly.
 
 use crate::error::Result;
 use crate::memory::{try_vec, Footprint};

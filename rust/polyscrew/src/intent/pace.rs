@@ -133,7 +133,7 @@ pub struct KeysTiming<'a> {
 ///
 /// # Errors
 /// [`Error::TooFew`] for fewer than two keys, the errors of
-/// [`check_key_times`](crate::check_key_times) for the key frames (strictly increasing,
+/// [`check_key_times`] for the key frames (strictly increasing,
 /// within the time range), [`Error::Period`] for a period not beyond the keys,
 /// [`Error::Invalid`] for a size outside `(0, 1e150]` or a frame so far outside the keys that
 /// its parameter is not finite, [`Error::NotFinite`] or [`Error::OutOfRange`] for a frame
