@@ -4,6 +4,7 @@
 //! the core, map the error once (`to_py_err`), wrap the result as numpy arrays.
 
 mod angular_velocity;
+mod denoise;
 mod feature;
 mod sweep;
 
@@ -509,5 +510,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     angular_velocity::register(m)?;
     sweep::register(m)?;
     feature::register(m)?;
+    denoise::register(m)?;
     Ok(())
 }

@@ -29,6 +29,7 @@ pub mod angular_velocity;
 mod banded;
 pub mod channels;
 pub(crate) mod cyclic_band;
+pub mod denoise;
 pub mod eigen;
 pub mod error;
 pub mod fastmath;
@@ -51,6 +52,7 @@ pub use angular_velocity::{
     FitStatus,
 };
 pub use channels::{rotation_channels, EulerOrder, RotationMode};
+pub use denoise::{denoise, denoise_batch, DenoiseOptions, Denoised, Strength};
 pub use error::{Error, PoseDefect, Result};
 pub use feature_motion::{
     feature_motion, feature_motion_timed, sample_feature_motion, CurveScheme, FeatureSpec,
