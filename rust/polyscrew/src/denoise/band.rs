@@ -7,7 +7,7 @@
 // Index loops mirror the textbook band algorithms; iterator forms would hide the band.
 #![allow(clippy::needless_range_loop)]
 
-use std::ops::{Add, Mul, Sub};
+use std::ops::{Mul, Sub};
 
 /// An `n x n` symmetric band matrix, half-bandwidth `W`, stored as its diagonal and its
 /// lower band: `off[i][W - (i - j)]` holds `a[i][j]` for `i - W <= j < i` (after
@@ -62,24 +62,6 @@ impl<const W: usize> Band<W> {
         self.off.clear();
         self.off
             .extend(other.off.iter().map(|r| r.map(|v| v * scale)));
-    }
-
-    /// `out = a v` (the full symmetric matrix times `v`).
-    pub(crate) fn mul<T>(&self, v: &[T], out: &mut Vec<T>)
-    where
-        T: Copy + Add<Output = T> + Mul<f64, Output = T>,
-    {
-        let n = self.len();
-        out.clear();
-        out.extend(v.iter().zip(&self.diag).map(|(x, d)| *x * *d));
-        for i in 0..n {
-            let row = &self.off[i];
-            for p in W.saturating_sub(i)..W {
-                let j = i + p - W;
-                out[i] = out[i] + v[j] * row[p];
-                out[j] = out[j] + v[i] * row[p];
-            }
-        }
     }
 
     /// Sets row and column `i` to those of the identity (a held unknown).

@@ -220,6 +220,12 @@ pub fn denoise_batch(
     threads: usize,
 ) -> Result<Vec<Result<Denoised>>> {
     let n = times.len();
+    if n > MAX_DENOISE_POSES {
+        return Err(Error::Invalid {
+            what: "poses",
+            reason: format!("{n} poses per clip exceed the limit of {MAX_DENOISE_POSES}"),
+        });
+    }
     let total = bodies
         .checked_mul(n)
         .filter(|t| *t <= MAX_DENOISE_BATCH)

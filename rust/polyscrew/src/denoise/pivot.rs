@@ -77,12 +77,19 @@ pub(crate) fn refine<const W: usize>(
     paths: &mut [Vec<DVec3>; 4],
     zs: &mut [Vec<DVec3>; 4],
 ) -> DVec3 {
+    // Every path relative to its first sample: the spline keeps constants, so `J` is the
+    // same (`<1, H z(y)> = lambda <M 1, x> = 0`), but large common offsets would leave
+    // rounding of the solve (relative to `lambda` times the offset) that a rigid motion of
+    // the world or of the body frame changes; without them the equations change with the
+    // frames exactly as the pivot does, to rounding of the paths' own variation.
     for (v, axis) in paths.iter_mut().zip([DVec3::X, DVec3::Y, DVec3::Z]) {
+        let first = quats[0] * axis;
         v.clear();
-        v.extend(quats.iter().map(|q| *q * axis));
+        v.extend(quats.iter().map(|q| *q * axis - first));
     }
+    let o0 = poses[0].translation;
     paths[3].clear();
-    paths[3].extend(poses.iter().map(|p| p.translation));
+    paths[3].extend(poses.iter().map(|p| p.translation - o0));
     let inputs = [&paths[0][..], &paths[1][..], &paths[2][..], &paths[3][..]];
     if !smoother.corrections(index, &inputs, zs) {
         return DVec3::NAN;

@@ -137,12 +137,31 @@ impl<const W: usize> Whittaker<W> {
     }
 
     /// Replaces the data, keeping the penalty.
+    ///
+    /// `M y` is formed as `D^T (U (D y))`, by the stencils, not by the assembled band: the
+    /// rounding of `D y` (relative to `|y|`) then has no low frequencies left after `D^T`,
+    /// where [`Whittaker::smooth`]'s `lambda (H + lambda M)^-1` would multiply it by up to
+    /// `lambda` (measured: a change of body frame moved a path by 5e-10 that way, by 1e-12
+    /// this way).
     pub(crate) fn set_data(&mut self, y: &[DVec3]) {
         self.y.clear();
         self.y.extend_from_slice(y);
-        let mut my = std::mem::take(&mut self.my);
-        self.m.mul(y, &mut my);
-        self.my = my;
+        self.my.clear();
+        self.my.resize(y.len(), DVec3::ZERO);
+        for (k, row) in self.rows.iter().enumerate() {
+            let c = self.u[k];
+            if c == 0.0 {
+                continue;
+            }
+            let mut dy = DVec3::ZERO;
+            for a in 0..=W {
+                dy += y[k + a] * row[a];
+            }
+            let dy = dy * c;
+            for a in 0..=W {
+                self.my[k + a] += dy * row[a];
+            }
+        }
     }
 
     /// The number of grid strengths in the range.
@@ -247,22 +266,28 @@ impl<const W: usize> Whittaker<W> {
 
     /// The corrections `z(v) = v - x(v)` of several inputs at grid strength `k` (no held
     /// samples): `out[j]` receives `z(inputs[j])`. False on overflow.
+    ///
+    /// Unlike [`Whittaker::smooth`] this solves for the fit, `x = (H + lambda M)^-1 H v`:
+    /// `lambda M v` would carry the rounding of `M v` (relative to `|v|`) times `lambda`
+    /// into `z` at low frequencies, while `x` is accurate relative to `|v|` there. The
+    /// pivot's refinement needs that: its equations must change with the body frame
+    /// exactly as the pivot does.
     pub(crate) fn corrections(
         &mut self,
         k: usize,
         inputs: &[&[DVec3]],
         out: &mut [Vec<DVec3>],
     ) -> bool {
-        let lambda = self.grid(k).powi(2 * W as i32);
         let Some(i) = self.system(k) else {
             return false;
         };
         for (v, z) in inputs.iter().zip(out.iter_mut()) {
-            self.m.mul(v, z);
-            for p in z.iter_mut() {
-                *p *= lambda;
-            }
+            z.clear();
+            z.extend(v.iter().zip(&self.h).map(|(p, h)| *p * *h));
             self.cache[i].band.solve(z);
+            for (z, p) in z.iter_mut().zip(v.iter()) {
+                *z = *p - *z;
+            }
             if !z.iter().all(|p| p.is_finite()) {
                 return false;
             }
