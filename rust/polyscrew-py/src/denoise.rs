@@ -108,6 +108,9 @@ fn read_held(
 #[pyclass(frozen, module = "polyscrew", name = "Denoised")]
 pub struct PyDenoised {
     results: Vec<Denoised>,
+    /// The smooth poses as (B, N, 4, 4), held ones copied from the input bit for bit (a
+    /// matrix read into a quaternion and written back may differ in the last bit).
+    matrices: Array4<f64>,
     n: usize,
     batch: bool,
 }
@@ -132,18 +135,7 @@ impl PyDenoised {
     /// The smooth poses, shape of the input ((N, 4, 4) or (B, N, 4, 4)); held ones exact.
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArrayDyn<f64>> {
-        let b = self.results.len();
-        let mut out = Array4::<f64>::zeros((b, self.n, 4, 4));
-        for (bi, r) in self.results.iter().enumerate() {
-            for (i, p) in r.poses.iter().enumerate() {
-                for (row, vals) in p.to_rows().iter().enumerate() {
-                    for (c, v) in vals.iter().enumerate() {
-                        out[[bi, i, row, c]] = *v;
-                    }
-                }
-            }
-        }
-        let out = out.into_dyn();
+        let out = self.matrices.clone().into_dyn();
         if self.batch {
             out.into_pyarray(py)
         } else {
@@ -271,8 +263,15 @@ fn denoise(
     kinks: bool,
     threads: usize,
 ) -> PyResult<PyDenoised> {
-    let (poses, bodies, n, batch) = read_clips(poses.as_array())?;
+    let input = poses.as_array();
+    let (poses, bodies, n, batch) = read_clips(input.view())?;
     let times = read_vector(F, "times", times.as_array())?;
+    if times.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "{F}: times: expected {n} entries, got {}",
+            times.len()
+        )));
+    }
     let strength = read_strength(strength)?;
     let held = read_held(held, bodies, n)?;
     let options = DenoiseOptions {
@@ -293,8 +292,28 @@ fn denoise(
             Err(e) => return Err(to_py_err(F, e)),
         }
     }
+    let mut matrices = Array4::<f64>::zeros((bodies, n, 4, 4));
+    let flat = input.as_standard_layout();
+    let flat = flat.as_slice().expect("standard layout");
+    for (b, r) in out.iter().enumerate() {
+        for (i, p) in r.poses.iter().enumerate() {
+            let g = b * n + i;
+            let is_held = held.as_ref().is_some_and(|h| h[g]);
+            let rows = p.to_rows();
+            for row in 0..4 {
+                for c in 0..4 {
+                    matrices[[b, i, row, c]] = if is_held {
+                        flat[16 * g + 4 * row + c]
+                    } else {
+                        rows[row][c]
+                    };
+                }
+            }
+        }
+    }
     Ok(PyDenoised {
         results: out,
+        matrices,
         n,
         batch,
     })
