@@ -41,7 +41,7 @@ use super::stencil::{Stencils, MAX_ORDER};
 
 /// Steps (largest rotation of any frame, radians) below which the iteration stops (the
 /// remaining error is a few per cent of it: far below what a key stored in `f32` resolves).
-pub(crate) const STEP_TOLERANCE: f64 = 1e-10;
+pub(crate) const STEP_TOLERANCE: f64 = 1e-9;
 
 /// The most Gauss-Newton iterations (it converges quadratically, in 2 to 5 on our clips).
 pub(crate) const MAX_ITERATIONS: usize = 50;

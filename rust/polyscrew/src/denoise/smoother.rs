@@ -314,7 +314,8 @@ impl<const W: usize> Whittaker<W> {
         })
     }
 
-    /// GCV at grid strength `k` (the fit in `x`). None on overflow.
+    /// GCV at grid strength `k` (the correction in `z`; the fit is not formed). None on
+    /// overflow.
     pub(crate) fn gcv_grid(&mut self, k: usize) -> Option<Gcv> {
         let tau = self.grid(k);
         let lambda = tau.powi(2 * W as i32);
@@ -322,7 +323,7 @@ impl<const W: usize> Whittaker<W> {
         self.z.clear();
         self.z.extend(self.my.iter().map(|v| *v * lambda));
         self.cache[i].band.solve(&mut self.z);
-        if !self.finish() {
+        if !self.z.iter().all(|v| v.is_finite()) {
             return None;
         }
         let trace = self.cache[i].trace;
@@ -363,7 +364,8 @@ impl<const W: usize> Whittaker<W> {
                 Some(g) => {
                     if best.is_none_or(|(b, _)| g.score < b.score) {
                         best = Some((g, k));
-                        wh.best.clone_from(&wh.x);
+                        wh.best.clear();
+                        wh.best.extend(wh.y.iter().zip(&wh.z).map(|(y, z)| *y - *z));
                     }
                     g.score
                 }
@@ -421,8 +423,8 @@ impl<const W: usize> Whittaker<W> {
                 lo = c;
             }
         }
-        for k in lo..=hi {
-            eval(self, k);
+        if hi - lo == 2 {
+            eval(self, lo + 1);
         }
         best
     }
