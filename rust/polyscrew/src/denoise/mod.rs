@@ -14,38 +14,41 @@
 //! translation:  sum_i h_i |p_i - (Q_i c + o_i)|^2 + lambda_t sum_k u_k |D_k p|^2
 //! ```
 //!
-//! - `c` is the *pivot* ([`pivot`]), the body point of least jitter; its world path is the
-//!   translation that is smoothed. It moves with the body, so the result does not depend on
-//!   where the body's origin is.
+//! - `c` is the *pivot* (`pivot.rs`), a body point chosen from the data: the point of least
+//!   jitter, then refined to the point whose path the spline changes least. Its world path is
+//!   the translation that is smoothed. It moves with the body, so the result does not depend
+//!   on where the body's origin is.
 //! - `y(R)` is the development of the spatial increments `log(R_{j+1} R_j^-1)` and `D_k` are
 //!   divided differences of order `m` (3 by default: a quintic spline, which keeps constant
 //!   accelerations; 2 gives the cubic spline) on the given, possibly uneven, times
-//!   ([`stencil`]). Rotation vectors' norms do not change when every pose is multiplied by one
-//!   rotation on either side, and world distances do not change under a rigid motion of the
-//!   world, so for any rigid `G`, `H`: `denoise(G P H) = G denoise(P) H` (with automatic
-//!   strengths too: everything they are chosen from is invariant).
+//!   (`stencil.rs`), `h_i` the time each pose stands for, `u_k` 1 or 0 (a kink). Rotation
+//!   vectors' norms do not change when every pose is multiplied by one rotation on either
+//!   side, and world distances do not change under a rigid motion of the world, so for any
+//!   rigid `G`, `H`: `denoise(G P H) = G denoise(P) H` (with automatic strengths too:
+//!   everything they are chosen from is invariant; measured to 1e-9 and better in
+//!   `tests/denoise_properties.rs`).
 //! - A rotation at constant angular velocity and a pivot moving at constant velocity (for
 //!   `m = 3`, constant acceleration) cost nothing: such motion, in particular every screw
 //!   motion (its pivot lies on the axis), comes back unchanged.
-//! - The rotation energy is minimised by Gauss-Newton ([`rotation`]), the translation one is
-//!   a linear band system ([`smoother`]): both are `O(n)` per iteration, one call per clip.
+//! - The rotation energy is minimised by Gauss-Newton (`rotation.rs`), the translation one is
+//!   a linear band system (`smoother.rs`): both are `O(n)`, one call per clip.
 //! - `lambda = tau^(2m)`: the strength `tau` is a time (in the units of the times) with the
 //!   frequency response `1 / (1 + (tau omega)^(2m))`: motion faster than about `2 pi tau` per
 //!   cycle is removed. Rotation and translation have their own (noise of 2 cm and of 0.5
 //!   degrees are different things), chosen by generalised cross-validation (Craven and
 //!   Wahba, 1979) on the linear model unless given.
 //! - Kinks (a prop that stops dead, a foot that plants) are found in a pilot fit and the
-//!   penalty is released there ([`kinks`]), so a hard stop stays sharp instead of being
+//!   penalty is released there (`kinks.rs`), so a hard stop stays sharp instead of being
 //!   rounded over the spline's time scale.
 //! - Held poses (`held[i]`) are kept exactly; the smooth motion passes through them.
 //!
-//! What was measured to choose this (`scripts/bench_denoise.py`, and the report in
-//! BENCHMARKS.md): the SE(3) spline on logarithms relative to each pose (screw motions as
-//! the straight lines) smooths a spinning object that travels along a curve badly, because
-//! in its geometry the translation of a spinning body oscillates; splitting rotation and
-//! the pivot's path keeps both smooth. Order 3 beat order 2 on every smooth clip; robust
-//! (Huber, Cauchy) reweighting of the penalty rounded a hard stop almost as much as no
-//! reweighting, releasing the rows at detected kinks did not.
+//! What was measured to choose this (`scripts/bench_denoise.py`, the tables in
+//! BENCHMARKS.md, the alternatives in `docs/denoise.md`): the SE(3) spline on logarithms
+//! relative to each pose (screw motions as the straight lines) smooths a spinning object that
+//! travels along a curve badly, because in its geometry the translation of a spinning body
+//! oscillates; splitting rotation and the pivot's path keeps both smooth. Order 3 beat order
+//! 2 on every smooth clip; robust (Huber, Cauchy) reweighting of the penalty rounded a hard
+//! stop almost as much as no reweighting, releasing the rows at detected kinks did not.
 
 mod band;
 mod blockband;
@@ -67,7 +70,7 @@ use stencil::Stencils;
 /// The fewest poses [`denoise`] accepts (a third difference needs four).
 pub const MIN_DENOISE_POSES: usize = 4;
 
-/// Times the pivot is refined at the translation's strength ([`pivot::refine`]): the second
+/// Times the pivot is refined at the translation's strength (`pivot::refine`): the second
 /// refinement still moved it on the hard stop clip, a third did not.
 pub const PIVOT_REFINEMENTS: usize = 2;
 
@@ -114,7 +117,9 @@ pub struct DenoiseOptions {
     /// The order `m` of the divided differences penalised: 3 (default, quintic spline:
     /// constant acceleration is free) or 2 (cubic spline: constant velocity is free).
     pub order: usize,
-    /// Let kinks through (default true): see [`kinks`].
+    /// Let kinks through (default true): an abrupt turn (a second difference of a pilot fit
+    /// six times the median one) is kept sharp instead of rounded (see the module
+    /// documentation).
     pub kinks: bool,
 }
 
@@ -204,8 +209,8 @@ pub fn denoise(
 
 /// [`denoise`] for many bodies sampled at the same times: `poses` holds `bodies` clips of
 /// `times.len()` poses one after the other (body-major), `held` (if given) the same layout.
-/// Bodies are spread over `threads` threads (0: as many as the machine has). Each body's
-/// result or error is returned in order.
+/// Bodies are spread over `threads` threads (0, or more than the machine has: as many as it
+/// has). Each body's result or error is returned in order.
 ///
 /// # Errors
 /// The checks of [`denoise`] that concern every body (times, order, strength, sizes:
@@ -255,12 +260,12 @@ pub fn denoise_batch(
         return Ok(Vec::new());
     }
     check(n, times, options)?;
-    let threads = if threads == 0 {
-        std::thread::available_parallelism().map_or(1, |p| p.get())
-    } else {
-        threads
-    }
-    .min(bodies);
+    // More threads than cores gains nothing; the count is bounded so that a huge request
+    // cannot exhaust the system.
+    let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
+    let threads = if threads == 0 { cores } else { threads }
+        .min(cores)
+        .min(bodies);
     let run = |range: std::ops::Range<usize>| {
         let mut ws = Workspace::default();
         range
@@ -275,18 +280,23 @@ pub fn denoise_batch(
         return Ok(run(0..bodies));
     }
     let per = bodies.div_ceil(threads);
-    let results = std::thread::scope(|scope| {
+    let parts = std::thread::scope(|scope| {
         let handles: Vec<_> = (0..threads)
             .map(|t| {
                 let range = (t * per).min(bodies)..((t + 1) * per).min(bodies);
                 scope.spawn(move || run(range))
             })
             .collect();
-        handles
-            .into_iter()
-            .flat_map(|h| h.join().unwrap_or_default())
-            .collect::<Vec<_>>()
+        handles.into_iter().map(|h| h.join()).collect::<Vec<_>>()
     });
+    let mut results = Vec::with_capacity(bodies);
+    for part in parts {
+        // A worker only fails by a bug (the core does not panic on data): report it.
+        results.extend(part.map_err(|_| Error::Invalid {
+            what: "poses",
+            reason: "a worker thread failed".into(),
+        })?);
+    }
     Ok(results)
 }
 
