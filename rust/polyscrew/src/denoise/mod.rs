@@ -61,8 +61,7 @@ pub(crate) mod stencil;
 
 use glam::{DQuat, DVec3};
 
-use crate::error::{Error, PoseDefect, Result};
-use crate::pose::Pose;
+use crate::{Error, Pose, PoseDefect, Result};
 use rotation::RotationSpline;
 use smoother::{Gcv, Whittaker};
 use stencil::Stencils;
@@ -321,7 +320,7 @@ fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
             got: times.len(),
         });
     }
-    crate::timing::check_key_times(times)?;
+    crate::check_key_times(times)?;
     if !(2..=3).contains(&options.order) {
         return Err(Error::Invalid {
             what: "order",

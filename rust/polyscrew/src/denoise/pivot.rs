@@ -27,7 +27,7 @@ use glam::{DMat3, DQuat, DVec3};
 use super::smoother::Whittaker;
 use super::stencil::Stencils;
 use crate::eigen::symmetric_eigen;
-use crate::pose::Pose;
+use crate::Pose;
 
 /// Eigenvalues of the pivot's normal equations below this fraction of the largest are
 /// treated as zero.

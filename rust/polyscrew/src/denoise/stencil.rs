@@ -15,7 +15,7 @@
 //! densely the motion is sampled: on even samples the smoother's frequency response is
 //! `1 / (1 + (tau omega)^(2m))` at low frequencies.
 
-use crate::error::{Error, Result};
+use crate::{Error, Result};
 
 /// The largest order of differences used (third differences: the quintic spline).
 pub(crate) const MAX_ORDER: usize = 3;
