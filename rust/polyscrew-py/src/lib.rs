@@ -6,6 +6,7 @@
 mod angular_velocity;
 mod args;
 mod fcurve;
+mod denoise;
 mod feature;
 mod sweep;
 
@@ -773,5 +774,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     sweep::register(m)?;
     feature::register(m)?;
     fcurve::register(m)?;
+    denoise::register(m)?;
     Ok(())
 }
