@@ -169,4 +169,12 @@ json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), inden
 PY
 "$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
   --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md
+
+# Remove Noise against Blender's own filters: its section of BENCHMARKS.md (between the
+# denoise markers) and docs/denoise_error.png; then the operator on a 100-bone rig against
+# graph.gaussian_smooth (printed, and kept in the run folder).
+stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise.py --json "$run/denoise.json" || echo "scripts/bench_denoise.py failed"
+stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench_denoise_rig.py failed"
 stage "done"

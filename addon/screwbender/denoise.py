@@ -163,9 +163,9 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
     return out
 
 
-def _edit_keys(bag, cleaned: Cleaned) -> None:
+def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
     """Writes the smoothed values into the keys of the owner's location and rotation curves
-    (frames in the range), moving each key's handles with it."""
+    among `fcurves` (frames in the range), moving each key's handles with it."""
     motion, owner = cleaned.motion, cleaned.owner
     mode = motion.rotation_mode
     frames = motion.frames[cleaned.rows]
@@ -174,7 +174,7 @@ def _edit_keys(bag, cleaned: Cleaned) -> None:
     values = {keys.rotation_path(mode): rotation}
     if motion.located:
         values["location"] = cleaned.poses[:, :3, 3]
-    for fc in channels.fcurves(bag):
+    for fc in fcurves:
         prop = owner.prop_of(fc.data_path)
         if prop not in values or fc.array_index >= values[prop].shape[1]:
             continue
@@ -263,8 +263,9 @@ def remove_noise(
             parts = [cleaned[(o.obj.as_pointer(), o.bone)] for o in done]
 
             def edit(bag, parts=parts) -> None:
+                by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
                 for part in parts:
-                    _edit_keys(bag, part)
+                    _edit_keys(by_owner.get(part.owner.bone, []), part)
 
             actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise"))
             if progress is not None:

@@ -101,7 +101,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         col.prop(self, "rotation_strength")
         col.prop(self, "translation_strength")
 
-    def options(self, context: bpy.types.Context) -> denoise.Options:
+    def denoise_options(self, context: bpy.types.Context) -> denoise.Options:
         if self.range_mode == "SCENE":
             frame_range = (float(context.scene.frame_start), float(context.scene.frame_end))
         elif self.range_mode == "CUSTOM":
@@ -119,7 +119,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         wm = context.window_manager
         wm.progress_begin(0, 2 * len(selection))
         try:
-            result = denoise.remove_noise(selection, self.options(context), lambda done, total: wm.progress_update(done))
+            result = denoise.remove_noise(selection, self.denoise_options(context), lambda done, total: wm.progress_update(done))
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}

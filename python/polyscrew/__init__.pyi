@@ -614,3 +614,78 @@ def rotation_matrices(values: ArrayLike, mode: RotationModeName) -> FloatArray:
     the normalised axis (zero axis: identity); Euler (x, y, z) radians, ``"XYZ"`` meaning X
     applied first (``R = Rz Ry Rx``). GIL released. Raises ValueError for a wrong shape or a
     row that is not finite."""
+# --- Remove Noise (coordinate-free smoothing of captured motion), issue 19 -----------------
+
+class Denoised:
+    """The result of ``denoise``: the smooth poses and what was chosen on the way.
+
+    For one clip the strengths, noises and iterations are floats (ints) and the pivot is
+    (3,); for a batch of B clips they are (B,) arrays, the pivot (B, 3), the kinks a list.
+    """
+
+    @property
+    def poses(self) -> FloatArray:
+        """The smooth poses, in the input's shape ((N, 4, 4) or (B, N, 4, 4)), rigid;
+        held poses exactly as given."""
+    @property
+    def rotation_strength(self) -> float | FloatArray:
+        """The rotation's strength tau, a time in the units of ``times`` (chosen or given)."""
+    @property
+    def translation_strength(self) -> float | FloatArray:
+        """The translation's strength tau."""
+    @property
+    def rotation_noise(self) -> float | FloatArray:
+        """Estimated rotation noise of the input: standard deviation per axis, radians."""
+    @property
+    def translation_noise(self) -> float | FloatArray:
+        """Estimated position noise of the pivot, per axis, in the units of the poses."""
+    @property
+    def pivot(self) -> FloatArray:
+        """The body point (body coordinates) whose world path was smoothed: (3,) or (B, 3)."""
+    @property
+    def rotation_kinks(self) -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]:
+        """Indices of the poses where an abrupt turn of the rotation was let through."""
+    @property
+    def translation_kinks(self) -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]:
+        """Indices of the poses where an abrupt turn of the path was let through."""
+    @property
+    def iterations(self) -> int | npt.NDArray[np.int64]:
+        """Gauss-Newton iterations of the rotation solve."""
+    @property
+    def converged(self) -> bool:
+        """Whether every rotation solve converged (last step below 1e-9 rad)."""
+
+def denoise(
+    poses: ArrayLike,
+    times: ArrayLike,
+    strength: float | tuple[float, float] | None = None,
+    held: ArrayLike | None = None,
+    order: int = 3,
+    kinks: bool = True,
+    threads: int = 0,
+) -> Denoised:
+    """Remove noise from a captured rigid motion (camera solve, motion capture, baked
+    simulation): the smooth motion nearest to ``poses`` (N, 4, 4) at ``times`` (N,), or to
+    each of B clips (B, N, 4, 4) at the same times, in one call.
+
+    Coordinate-free: ``denoise(G @ poses @ H)`` is ``G @ denoise(poses) @ H`` for rigid G, H,
+    with the automatic strengths too; a screw motion (and any motion turning at constant
+    angular velocity while one body point moves at constant velocity) comes back unchanged.
+    The rotation is smoothed on the rotation group and the path of one body point (the
+    ``pivot``, the point of least jitter) in space, each by a smoothing spline of ``order``
+    3 (quintic: constant acceleration is free; 2: cubic) on the given, possibly uneven, times.
+
+    ``strength``: None chooses the strengths from the data (generalised cross-validation,
+    rotation and translation apart, reported back); a time tau (in the units of ``times``)
+    or (rotation, translation) times: motion faster than about ``2 pi tau`` per cycle is
+    removed, 0 leaves that part as is. ``held``: boolean mask (N,) or (B, N); held poses are
+    kept exactly and the motion passes through them. ``kinks``: let abrupt turns (a prop
+    stopping against a wall) through instead of rounding them. ``threads``: clips of a batch
+    are spread over this many threads (0: all the machine has).
+
+    Raises ValueError for a wrong shape, fewer than 4 poses, more than 1,000,000 poses per
+    clip or 20,000,000 in all, a non-rigid or non-finite pose (naming the index, and the
+    body of a batch), times that are not finite and increasing, a held mask of the wrong
+    shape, an order other than 2 or 3, a negative or non-finite strength, and values so
+    large that the computation overflows.
+    """

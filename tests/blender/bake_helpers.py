@@ -315,3 +315,11 @@ def snapshot_data() -> dict:
         "collections": {c.name: sorted(o.name for o in c.objects) for c in bpy.data.collections},
         "scene_collections": sorted(c.name for c in scene.collection.children),
     }
+
+
+def channel_from(obj, path: str, size: int) -> tuple[np.ndarray, np.ndarray]:
+    """(frames, values (N, size)) of the curves of `path` (any data path, bones included)."""
+    curves = {fc.array_index: fc for fc in fcurves(obj) if fc.data_path == path}
+    assert sorted(curves) == list(range(size)), f"{obj.name}: {path} curves {sorted(curves)}"
+    points = [curve_points(curves[i]) for i in range(size)]
+    return points[0][:, 0], np.stack([p[:, 1] for p in points], axis=1)

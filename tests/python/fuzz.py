@@ -33,7 +33,7 @@ TIMEOUT = 300
 GROUPS = [
     ["screw", "interpolate", "subdivide", "subdivide_vectors", "rotation_channels", "memory_budget"],
     ["sample", "sample_vectors", "sample_channels", "evaluate_fcurves"],
-    ["fit_angular_velocity", "AngularVelocityFit", "register_points", "inertia_points"],
+    ["fit_angular_velocity", "AngularVelocityFit", "register_points", "inertia_points", "denoise"],
     ["feature_motion", "sample_feature", "sweep"],
     ["rotation_matrices", "Playback", "analyse_spans", "keys_parameters", "pace_parameters"],
 ]
@@ -427,6 +427,35 @@ def worker(group: int, seed: int, examples: int) -> None:
     @given(st.one_of(st.integers(-3, 2000), big_int, junk))
     def pace_parameters(n):
         check("pace_parameters", lambda: ps.pace_parameters(n))
+    @st.composite
+    def clip(draw):
+        """Poses and times of one clip: mostly a well-formed clip (rigid poses, increasing
+        times of the same length, whose values the strategies still push to the extremes),
+        sometimes anything."""
+        n = draw(st.integers(0, 12).map(lambda k: 12 - k))  # mostly long enough
+        if draw(st.integers(0, 3)) == 3:  # (Hypothesis favours 0: the well-formed case)
+            return draw(poses(min_size=n, max_size=n)), draw(times(n=n))
+        p = np.array([draw(rigid(st.floats(-5, 5))) for _ in range(n)]).reshape(n, 4, 4)
+        start = draw(st.one_of(st.floats(-100, 100), extreme))
+        step = draw(st.one_of(st.floats(1e-3, 10), extreme))
+        return p, start + step * np.arange(n)
+
+    @fuzz
+    @given(
+        clip(),
+        st.one_of(st.sampled_from([None] * 5 + [0.0, 1.0, 4.0, (2.0, 8.0), -1.0, float("nan"), 1e300, "x"]), real),
+        st.one_of(st.sampled_from([None] * 5 + ["x", 3]), st.lists(st.booleans(), min_size=0, max_size=12)),
+        st.sampled_from([3] * 6 + [2] * 3 + [-1, 4, 2**63, "3", None]),
+    )
+    def denoise(pt, strength, held, order):
+        p, t = pt
+        if isinstance(held, list) and isinstance(p, np.ndarray) and p.ndim == 3 and len(held) != len(p):
+            held = held[: len(p)] + [False] * max(0, len(p) - len(held))
+        def run():
+            result = ps.denoise(p, t, strength=strength, held=held, order=order)
+            return [result.poses, result.rotation_strength, result.translation_strength]
+
+        check("denoise", run)
 
     tests = {
         "rotation_matrices": [rotation_matrices], "Playback": [playback], "analyse_spans": [analyse_spans],
@@ -437,7 +466,7 @@ def worker(group: int, seed: int, examples: int) -> None:
         "sample_channels": [sample_channels], "fit_angular_velocity": [fit_angular_velocity],
         "AngularVelocityFit": [angular_velocity_fit], "register_points": [register_points],
         "inertia_points": [inertia_points], "feature_motion": [feature_motion],
-        "sample_feature": [sample_feature], "sweep": [sweep], "evaluate_fcurves": [evaluate_fcurves],
+        "sample_feature": [sample_feature], "sweep": [sweep], "evaluate_fcurves": [evaluate_fcurves], "denoise": [denoise],
     }
     for name in GROUPS[group]:
         for test in tests[name]:

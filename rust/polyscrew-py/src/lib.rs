@@ -5,6 +5,7 @@
 
 mod angular_velocity;
 mod args;
+mod denoise;
 mod fcurve;
 mod feature;
 mod intent;
@@ -775,5 +776,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     feature::register(m)?;
     fcurve::register(m)?;
     intent::register(m)?;
+    denoise::register(m)?;
     Ok(())
 }

@@ -43,6 +43,7 @@
 #![deny(missing_docs)]
 
 pub mod angular_velocity;
+pub mod denoise;
 pub mod error;
 pub mod fcurve;
 pub mod feature;
@@ -56,6 +57,7 @@ pub use angular_velocity::{
     fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
     FitStatus, QuatJet, QuatSpline,
 };
+pub use denoise::{denoise, denoise_batch, DenoiseOptions, Denoised, Strength};
 pub use error::{Error, PoseDefect, Result};
 pub use fcurve::{
     evaluate_fcurves, CycleMode, Cycles, Easing, Extrapolation, FCurve, Interpolation, Key,

@@ -3,8 +3,8 @@
 //! a request too large for memory must be an error, not an abort. The check asks the crate's
 //! memory budget ([`crate::memory`]); the buffers are then allocated fallibly.
 
-use crate::error::Result;
-use crate::memory::{try_vec, Footprint};
+use crate::memory::try_vec;
+use crate::{Footprint, Result};
 
 /// Checks that `bytes` (computed with saturating arithmetic) fit within the memory budget.
 ///

@@ -6,13 +6,10 @@ use glam::{DMat3, DVec3};
 use super::interp::interp;
 use super::limits::{check_footprint, collected};
 use super::playback::Playback;
-use crate::error::{Error, Result};
 use crate::memory::try_vec;
-use crate::motion::pose::Pose;
 use crate::motion::pose::MAX_COORDINATE;
-use crate::motion::sample::{Motion, MotionSpec};
-use crate::motion::subdivision::Scheme;
-use crate::motion::timing::{check_key_times, check_time, Timing};
+use crate::motion::timing::check_time;
+use crate::{check_key_times, Error, Motion, MotionSpec, Pose, Result, Scheme, Timing};
 
 /// Steps per key span along which the travel of Blender's playback and of the smoothed
 /// motion is measured (the output frames inside a span are measured too).
@@ -176,7 +173,9 @@ pub fn keys_parameters(
     for (index, &f) in frames.iter().enumerate() {
         check_time("frame", index, f)?;
     }
-    crate::motion::subdivision::check_range(smooth)?;
+    for (index, pose) in smooth.iter().enumerate() {
+        pose.check_range(index)?;
+    }
     let per_span = PACE_SAMPLES + 1;
     let grid_len = spans * per_span;
     if smooth.len() != grid_len {

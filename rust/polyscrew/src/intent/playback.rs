@@ -8,10 +8,8 @@
 use glam::{DMat3, DQuat, DVec3};
 
 use super::limits::{check_footprint, collected};
-use crate::error::{Error, Result};
-use crate::fcurve::FCurve;
 use crate::memory::try_reserve;
-use crate::motion::channels::RotationMode;
+use crate::{Error, FCurve, Result, RotationMode};
 
 /// One transform channel: a property and an index into it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -77,7 +75,7 @@ pub fn rotation_property(mode: RotationMode) -> &'static str {
 }
 
 fn mode_name(mode: RotationMode) -> &'static str {
-    use crate::motion::channels::EulerOrder::*;
+    use crate::EulerOrder::*;
     match mode {
         RotationMode::Quaternion => "QUATERNION",
         RotationMode::AxisAngle => "AXIS_ANGLE",

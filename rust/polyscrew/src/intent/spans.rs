@@ -7,10 +7,8 @@ use glam::DMat3;
 use super::interp::interp;
 use super::limits::{check_footprint, collected, filled};
 use super::playback::Playback;
-use crate::error::{Error, Result};
 use crate::memory::try_vec;
-use crate::motion::channels::RotationMode;
-use crate::motion::timing::check_key_times;
+use crate::{check_key_times, Error, Result, RotationMode};
 
 /// A span whose channels turn further than this (radians, 150 degrees) along Blender's
 /// playback gets poses from that playback added inside it: the screw between its keys alone,

@@ -8,11 +8,9 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use glam::{DMat3, DQuat, DVec3};
 
 use super::*;
-use crate::error::Error;
-use crate::fcurve::{Extrapolation, FCurve, Interpolation, Key};
-use crate::motion::channels::{EulerOrder, RotationMode};
-use crate::motion::pose::Pose;
-use crate::motion::subdivision::Scheme;
+use crate::{
+    Error, EulerOrder, Extrapolation, FCurve, Interpolation, Key, Pose, RotationMode, Scheme,
+};
 
 const XYZ: RotationMode = RotationMode::Euler(EulerOrder::Xyz);
 
@@ -370,7 +368,7 @@ fn keys_timing_follows_the_smoothed_motions_own_pace() {
     };
     let frames: Vec<f64> = (0..=30).map(|i| i as f64).collect();
     let u = keys_parameters(&timing, &frames, &smooth).unwrap();
-    let motion = crate::motion::sample::Motion::new(
+    let motion = crate::Motion::new(
         &keys,
         &[0.0, 1.0, 2.0, 3.0],
         &crate::MotionSpec {

@@ -1,0 +1,353 @@
+//! `denoise`: the binding of `polyscrew::denoise` (Remove Noise). Conversion only: poses
+//! arrive as `(N, 4, 4)` or `(B, N, 4, 4)` arrays and leave in the same shape.
+
+use numpy::ndarray::{Array1, Array2, Array4, ArrayViewD};
+use numpy::{IntoPyArray, PyArray1, PyArrayDyn};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+use polyscrew::denoise::{MAX_DENOISE_BATCH, MAX_DENOISE_POSES, MIN_DENOISE_POSES};
+use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
+
+use crate::{read_vector, shape_err, to_py_err};
+
+const F: &str = "denoise";
+
+/// Reads `(N, 4, 4)` or `(B, N, 4, 4)` poses: (poses body-major, bodies, frames, batch?).
+fn read_clips(array: ArrayViewD<'_, f64>) -> PyResult<(Vec<Pose>, usize, usize, bool)> {
+    let shape = array.shape().to_vec();
+    let (bodies, n, batch) = match shape.as_slice() {
+        [n, 4, 4] => (1, *n, false),
+        [b, n, 4, 4] => (*b, *n, true),
+        _ => return Err(shape_err(F, "poses", "(N, 4, 4) or (B, N, 4, 4)", &shape)),
+    };
+    if n > MAX_DENOISE_POSES || bodies.saturating_mul(n) > MAX_DENOISE_BATCH {
+        return Err(PyValueError::new_err(format!(
+            "{F}: poses: {bodies} x {n} poses exceed the limits ({MAX_DENOISE_POSES} per clip, {MAX_DENOISE_BATCH} in all)"
+        )));
+    }
+    if n < MIN_DENOISE_POSES {
+        return Err(PyValueError::new_err(format!(
+            "{F}: poses: {n} poses given, at least {MIN_DENOISE_POSES} needed"
+        )));
+    }
+    let mut poses = Vec::with_capacity(bodies * n);
+    let mut m = [[0.0; 4]; 4];
+    let mut it = array.iter();
+    for g in 0..bodies * n {
+        for row in m.iter_mut() {
+            for v in row.iter_mut() {
+                *v = *it.next().expect("16 values per pose");
+            }
+        }
+        let (b, i) = (g / n, g % n);
+        poses.push(Pose::from_rows(&m, i).map_err(|e| {
+            if batch {
+                PyValueError::new_err(format!("{F}: body {b}: {e}"))
+            } else {
+                to_py_err(F, e)
+            }
+        })?);
+    }
+    Ok((poses, bodies, n, batch))
+}
+
+/// `strength`: None (automatic), one time for both, or (rotation, translation).
+fn read_strength(strength: Option<&Bound<'_, PyAny>>) -> PyResult<Strength> {
+    let Some(s) = strength else {
+        return Ok(Strength::Auto);
+    };
+    if let Ok(t) = s.extract::<f64>() {
+        return Ok(Strength::Fixed {
+            rotation: t,
+            translation: t,
+        });
+    }
+    let pair: (f64, f64) = s.extract().map_err(|_| {
+        PyValueError::new_err(format!(
+            "{F}: strength: expected None, a time or (rotation, translation) times"
+        ))
+    })?;
+    Ok(Strength::Fixed {
+        rotation: pair.0,
+        translation: pair.1,
+    })
+}
+
+/// `held`: None, a boolean mask (N,) for every body or (B, N).
+fn read_held(
+    held: Option<&Bound<'_, PyAny>>,
+    bodies: usize,
+    n: usize,
+) -> PyResult<Option<Vec<bool>>> {
+    let Some(h) = held else {
+        return Ok(None);
+    };
+    let err = || {
+        PyValueError::new_err(format!(
+            "{F}: held: expected a boolean mask of shape ({n},) or ({bodies}, {n})"
+        ))
+    };
+    if let Ok(mask) = h.extract::<Vec<bool>>() {
+        if mask.len() != n {
+            return Err(err());
+        }
+        return Ok(Some(
+            mask.iter().copied().cycle().take(bodies * n).collect(),
+        ));
+    }
+    let rows: Vec<Vec<bool>> = h.extract().map_err(|_| err())?;
+    if rows.len() != bodies || rows.iter().any(|r| r.len() != n) {
+        return Err(err());
+    }
+    Ok(Some(rows.concat()))
+}
+
+/// The result of `denoise`: the smooth poses and what was chosen.
+#[pyclass(frozen, module = "polyscrew", name = "Denoised")]
+pub struct PyDenoised {
+    results: Vec<Denoised>,
+    /// The smooth poses as (B, N, 4, 4), held ones copied from the input bit for bit (a
+    /// matrix read into a quaternion and written back may differ in the last bit).
+    matrices: Array4<f64>,
+    n: usize,
+    batch: bool,
+}
+
+impl PyDenoised {
+    fn scalar<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&Denoised) -> f64,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        if self.batch {
+            let v: Vec<f64> = self.results.iter().map(f).collect();
+            Ok(Array1::from(v).into_pyarray(py).into_any())
+        } else {
+            Ok(f(&self.results[0]).into_pyobject(py)?.into_any())
+        }
+    }
+}
+
+#[pymethods]
+impl PyDenoised {
+    /// The smooth poses, shape of the input ((N, 4, 4) or (B, N, 4, 4)); held ones exact.
+    #[getter]
+    fn poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArrayDyn<f64>> {
+        let out = self.matrices.clone().into_dyn();
+        if self.batch {
+            out.into_pyarray(py)
+        } else {
+            out.index_axis_move(numpy::ndarray::Axis(0), 0)
+                .into_pyarray(py)
+        }
+    }
+
+    /// The rotation's strength tau (a time, in the units of `times`): float, or (B,).
+    #[getter]
+    fn rotation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.scalar(py, |r| r.rotation_strength)
+    }
+
+    /// The translation's strength tau: float, or (B,).
+    #[getter]
+    fn translation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.scalar(py, |r| r.translation_strength)
+    }
+
+    /// Estimated rotation noise of the input, radians per axis: float, or (B,).
+    #[getter]
+    fn rotation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.scalar(py, |r| r.rotation_noise)
+    }
+
+    /// Estimated position noise of the pivot, per axis, units of the poses: float, or (B,).
+    #[getter]
+    fn translation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.scalar(py, |r| r.translation_noise)
+    }
+
+    /// The pivot (body coordinates) whose world path was smoothed: (3,), or (B, 3).
+    #[getter]
+    fn pivot<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
+        let mut out = Array2::<f64>::zeros((self.results.len(), 3));
+        for (b, r) in self.results.iter().enumerate() {
+            for c in 0..3 {
+                out[[b, c]] = r.pivot[c];
+            }
+        }
+        if self.batch {
+            out.into_pyarray(py).into_any()
+        } else {
+            out.row(0).to_owned().into_pyarray(py).into_any()
+        }
+    }
+
+    /// Samples where a kink in the rotation was let through: int array, or a list of them.
+    #[getter]
+    fn rotation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.kinks(py, |r| &r.rotation_kinks)
+    }
+
+    /// Samples where a kink in the translation was let through.
+    #[getter]
+    fn translation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.kinks(py, |r| &r.translation_kinks)
+    }
+
+    /// Gauss-Newton iterations of the rotation solve: int, or (B,).
+    #[getter]
+    fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        if self.batch {
+            let v: Vec<i64> = self.results.iter().map(|r| r.iterations as i64).collect();
+            Ok(Array1::from(v).into_pyarray(py).into_any())
+        } else {
+            Ok(self.results[0].iterations.into_pyobject(py)?.into_any())
+        }
+    }
+
+    /// Whether every rotation solve converged.
+    #[getter]
+    fn converged(&self) -> bool {
+        self.results.iter().all(|r| r.converged)
+    }
+
+    fn __repr__(&self) -> String {
+        let r = &self.results[0];
+        if self.batch {
+            format!("Denoised({} bodies x {} poses)", self.results.len(), self.n)
+        } else {
+            format!(
+                "Denoised({} poses, rotation_strength={:.4}, translation_strength={:.4}, rotation_noise={:.3e}, translation_noise={:.3e})",
+                self.n, r.rotation_strength, r.translation_strength, r.rotation_noise, r.translation_noise
+            )
+        }
+    }
+}
+
+impl PyDenoised {
+    fn kinks<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&Denoised) -> &Vec<usize>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        let arrays: Vec<Bound<'py, PyArray1<i64>>> = self
+            .results
+            .iter()
+            .map(|r| {
+                Array1::from(f(r).iter().map(|k| *k as i64).collect::<Vec<_>>()).into_pyarray(py)
+            })
+            .collect();
+        if self.batch {
+            Ok(PyList::new(py, arrays)?.into_any())
+        } else {
+            Ok(arrays.into_iter().next().expect("one clip").into_any())
+        }
+    }
+}
+
+/// denoise(poses, times, strength=None, held=None, order=3, kinks=True, threads=0) -> Denoised
+///
+/// Removes noise from dense captured poses (see the stub for the full contract).
+#[pyfunction]
+#[pyo3(signature = (poses, times, strength=None, held=None, order=None, kinks=None, threads=None))]
+#[pyo3(text_signature = "(poses, times, strength=None, held=None, order=3, kinks=True, threads=0)")]
+#[allow(clippy::too_many_arguments)]
+fn denoise(
+    py: Python<'_>,
+    poses: &Bound<'_, PyAny>,
+    times: &Bound<'_, PyAny>,
+    strength: Option<&Bound<'_, PyAny>>,
+    held: Option<&Bound<'_, PyAny>>,
+    order: Option<&Bound<'_, PyAny>>,
+    kinks: Option<&Bound<'_, PyAny>>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<PyDenoised> {
+    let order = match order {
+        Some(o) if !o.is_none() => crate::args::int_in(F, "order", o, 2, 3)? as usize,
+        _ => 3,
+    };
+    let kinks = match kinks {
+        Some(k) if !k.is_none() => k.extract::<bool>().map_err(|_| {
+            pyo3::exceptions::PyTypeError::new_err(format!("{F}: kinks: expected a bool"))
+        })?,
+        _ => true,
+    };
+    let threads = match threads {
+        Some(t) if !t.is_none() => crate::args::int_in(F, "threads", t, 0, 1024)? as usize,
+        _ => 0,
+    };
+    let poses = crate::args::float_array(F, "poses", poses)?;
+    let times = crate::args::float_array(F, "times", times)?;
+    let input = poses.as_array();
+    // Before anything is copied: the input copy, the scratch of the solves (about 1 kB per
+    // pose, see polyscrew::denoise) and the output, against the memory budget.
+    let count: usize = input.shape().iter().rev().skip(2).product();
+    crate::check_budget(
+        F,
+        polyscrew::Footprint::bytes(count.saturating_mul(16 * 8 * 2 + 1024)),
+        "the noise removal",
+        "denoise fewer frames or fewer bodies in one call",
+    )?;
+    let (poses, bodies, n, batch) = read_clips(input.view())?;
+    let times = read_vector(F, "times", &times.as_array())?;
+    if times.len() != n {
+        return Err(PyValueError::new_err(format!(
+            "{F}: times: expected {n} entries, got {}",
+            times.len()
+        )));
+    }
+    let strength = read_strength(strength)?;
+    let held = read_held(held, bodies, n)?;
+    let options = DenoiseOptions {
+        strength,
+        order,
+        kinks,
+    };
+    let results = py
+        .detach(|| denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads))
+        .map_err(|e| to_py_err(F, e))?;
+    let mut out = Vec::with_capacity(bodies);
+    for (b, r) in results.into_iter().enumerate() {
+        match r {
+            Ok(d) => out.push(d),
+            Err(e) if batch => {
+                return Err(PyValueError::new_err(format!("{F}: body {b}: {e}")));
+            }
+            Err(e) => return Err(to_py_err(F, e)),
+        }
+    }
+    let mut matrices = Array4::<f64>::zeros((bodies, n, 4, 4));
+    let flat = input.as_standard_layout();
+    let flat = flat.as_slice().expect("standard layout");
+    for (b, r) in out.iter().enumerate() {
+        for (i, p) in r.poses.iter().enumerate() {
+            let g = b * n + i;
+            let is_held = held.as_ref().is_some_and(|h| h[g]);
+            let rows = p.to_rows();
+            for row in 0..4 {
+                for c in 0..4 {
+                    matrices[[b, i, row, c]] = if is_held {
+                        flat[16 * g + 4 * row + c]
+                    } else {
+                        rows[row][c]
+                    };
+                }
+            }
+        }
+    }
+    Ok(PyDenoised {
+        results: out,
+        matrices,
+        n,
+        batch,
+    })
+}
+
+/// Adds `denoise` and `Denoised` to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<PyDenoised>()?;
+    m.add_function(wrap_pyfunction!(denoise, m)?)?;
+    Ok(())
+}
