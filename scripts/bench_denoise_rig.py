@@ -29,29 +29,14 @@ import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
-
-BONES, FRAMES = 100, 1000
+from bench_denoise import fcurves  # noqa: E402  (the same curve lookup and Graph Editor context)
+from bench_denoise import graph_context as _graph_context  # noqa: E402
 
 
 def graph_context():
-    win = bpy.context.window_manager.windows[0]
-    area = max(win.screen.areas, key=lambda a: a.width * a.height)
-    area.type = "GRAPH_EDITOR"
-    area.spaces.active.dopesheet.show_only_selected = False
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return dict(window=win, area=area, region=region)
+    return _graph_context(bpy)
 
-
-def fcurves(obj):
-    act = obj.animation_data.action
-    if hasattr(act, "layers") and len(act.layers):
-        slot = obj.animation_data.action_slot
-        for layer in act.layers:
-            for strip in layer.strips:
-                bag = strip.channelbag(slot)
-                if bag:
-                    return list(bag.fcurves)
-    return list(act.fcurves)
+BONES, FRAMES = 100, 1000
 
 
 def rig() -> bpy.types.Object:

@@ -164,21 +164,6 @@ def sample_poses_at(
 def sample_poses(
     owner: owners.Owner | bpy.types.Object, motion: keys.KeyedMotion, frames: np.ndarray, options
 ) -> np.ndarray:
-    """The feature-point motion of `owner` at `frames`: (len(frames), 4, 4) rigid poses.
-
-    `options` is a :class:`bake.Options`. Raises ValueError from `polyscrew`.
-    """
-    # Mean scale over the keys (a static negative scale, a mirrored object, keeps its sign).
-    mean_scale = np.sign(motion.scales[0]) * np.exp(np.log(np.abs(motion.scales)).mean(axis=0))
-    return polyscrew.sample_feature(
-        motion.poses,
-        motion.frames,
-        frames,
-        levels=options.levels,
-        closed=motion.closed,
-        feature_points=feature_points(owner, mean_scale),
-        parametrization=options.parametrization,
-        stiffness=key_stiffness(motion, selected_keys(owner, motion.frames), options.approximate, options.stiffness),
-        period=motion.period,
-        timing=options.timing,
-    )
+    """The feature-point motion of `owner` at `frames`, keys at their own frames with the
+    options' timing: (len(frames), 4, 4) rigid poses (see :func:`sample_poses_at`)."""
+    return sample_poses_at(owner, motion, motion.frames, frames, options, motion.period, options.timing)

@@ -165,6 +165,23 @@ def has_own_keys(obj: bpy.types.Object, fcurves) -> bool:
     return any(fc.data_path in _TRANSFORM_PROPS and len(fc.keyframe_points) for fc in fcurves)
 
 
+def poll_selection(cls, context: bpy.types.Context) -> bool:
+    """An operator's poll for owners: selected bones in Pose Mode, selected objects in
+    Object Mode (the message says which, and what to do)."""
+    if context.mode == "POSE":
+        if not context.selected_pose_bones:
+            cls.poll_message_set("Select one or more keyed bones")
+            return False
+        return True
+    if context.mode != "OBJECT":
+        cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
+        return False
+    if not context.selected_objects:
+        cls.poll_message_set("Select one or more keyed objects")
+        return False
+    return True
+
+
 def selection(context: bpy.types.Context, armature: str = "BOTH", fcurves_of=None) -> list[Owner]:
     """The owners Smooth Motion works on, as the animator expects.
 

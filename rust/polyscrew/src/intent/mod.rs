@@ -38,7 +38,8 @@ pub mod spans;
 mod tests;
 
 pub use pace::{
-    keys_parameters, pace_parameters, screw_pace_poses, travel, KeysTiming, PACE_SAMPLES,
+    keys_parameters, pace_parameters, screw_pace_poses, travel, KeysTiming, DENSE_PACE_SAMPLES,
+    PACE_SAMPLES,
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{

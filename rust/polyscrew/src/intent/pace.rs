@@ -15,6 +15,14 @@ use crate::{check_key_times, Error, Motion, MotionSpec, Pose, Result, Scheme, Ti
 /// motion is measured (the output frames inside a span are measured too).
 pub const PACE_SAMPLES: usize = 16;
 
+/// Blender's playback is measured at every output frame inside a span with at most this many
+/// of them; a span with more (a long bake, subframes) is measured at this many evenly spaced
+/// frames instead and the output frames interpolate between them (their travel fraction is
+/// then exact to the interpolation of a smooth curve over `1 / DENSE_PACE_SAMPLES` of the
+/// span: below 1e-4 of the span for Blender's sharpest ease, EXPO in-out), so the cost of
+/// timing Keys does not grow with the number of frames.
+pub const DENSE_PACE_SAMPLES: usize = 256;
+
 /// How far a body moves from `(ta, ra)` to `(tb, rb)` (translation, rotation matrix): the root
 /// mean square displacement of the six points at `+-size` along its axes,
 /// `sqrt(|tb - ta|^2 + size^2 / 3 |Rb - Ra|_F^2)` (the cross terms cancel).
@@ -211,10 +219,28 @@ pub fn keys_parameters(
     let inside = |tau: f64| tau > 0.0 && tau < 1.0;
     let grid = |j: usize| j as f64 / PACE_SAMPLES as f64;
 
-    // Blender's playback: per span the grid, plus the output frames inside it, in order.
+    // Blender's playback: per span the grid, plus the output frames inside it (or, for a span
+    // with more than DENSE_PACE_SAMPLES of them, a grid that fine instead), in order.
+    let mut inside_count = vec![0usize; spans];
+    for &(s, tau) in &located {
+        if inside(tau) {
+            inside_count[s] += 1;
+        }
+    }
     let mut sampled: Vec<(usize, f64)> = try_vec(samples, "pace samples")?;
     sampled.extend((0..spans).flat_map(|s| (0..per_span).map(move |j| (s, grid(j)))));
-    sampled.extend(located.iter().copied().filter(|&(_, tau)| inside(tau)));
+    sampled.extend(
+        located
+            .iter()
+            .copied()
+            .filter(|&(s, tau)| inside(tau) && inside_count[s] <= DENSE_PACE_SAMPLES),
+    );
+    for (s, &count) in inside_count.iter().enumerate() {
+        if count > DENSE_PACE_SAMPLES {
+            sampled
+                .extend((1..DENSE_PACE_SAMPLES).map(|j| (s, j as f64 / DENSE_PACE_SAMPLES as f64)));
+        }
+    }
     sampled.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let done = playback_fractions(timing.playback, &ends, &sampled, size)?;
     let xp = collected(

@@ -346,6 +346,35 @@ fn keys_timing_of_a_straight_ease_is_the_smoothstep() {
 }
 
 #[test]
+fn keys_timing_of_a_long_bake_interpolates_a_fine_grid() {
+    // 20,000 frames in one span: the playback is measured on DENSE_PACE_SAMPLES steps, and
+    // the frames between them still follow the smoothstep closely.
+    let p = smoothstep_playback();
+    let keys = [
+        Pose::IDENTITY,
+        Pose::from_translation(DVec3::new(10.0, 0.0, 0.0)),
+    ];
+    let smooth = screw_pace_poses(&keys, Scheme::FourPoint, 4, false).unwrap();
+    let frames: Vec<f64> = (0..=20_000).map(|i| 1.0 + 0.001 * i as f64).collect();
+    let timing = KeysTiming {
+        key_frames: &[1.0, 21.0],
+        period: None,
+        size: 1.0,
+        playback: Some(&p),
+    };
+    let u = keys_parameters(&timing, &frames, &smooth).unwrap();
+    let worst = frames
+        .iter()
+        .zip(&u)
+        .map(|(f, u)| {
+            let tau = (f - 1.0) / 20.0;
+            (u - (3.0 * tau * tau - 2.0 * tau * tau * tau)).abs()
+        })
+        .fold(0.0, f64::max);
+    assert!(worst < 2e-5, "{worst}");
+}
+
+#[test]
 fn keys_timing_follows_the_smoothed_motions_own_pace() {
     // The playback goes at constant speed; the smoothed motion, its keys unevenly spread
     // (4-point through 0, 1, 9, 10 at parameters 0..3), is slow in its first and last span:
