@@ -16,6 +16,8 @@ use std::ops::{Mul, Sub};
 pub(crate) struct Band<const W: usize> {
     diag: Vec<f64>,
     off: Vec<[f64; W]>,
+    /// `1 / D[i]` after [`Band::factor`] (the solves multiply by it).
+    dinv: Vec<f64>,
 }
 
 impl<const W: usize> Band<W> {
@@ -77,6 +79,8 @@ impl<const W: usize> Band<W> {
     /// finite (the matrix is not numerically positive definite).
     pub(crate) fn factor(&mut self) -> bool {
         let n = self.len();
+        self.dinv.clear();
+        self.dinv.reserve(n);
         // ld[q] = L[i][k] D[k] for k = i - W + q, the row being factorised.
         let mut ld = [0.0; W];
         // inv[q] = 1 / D[k] for the same k (a window moving with i).
@@ -104,9 +108,11 @@ impl<const W: usize> Band<W> {
             }
             self.off[i] = row;
             self.diag[i] = d;
+            let r = 1.0 / d;
+            self.dinv.push(r);
             if W > 0 {
                 inv.copy_within(1.., 0);
-                inv[W - 1] = 1.0 / d;
+                inv[W - 1] = r;
             }
         }
         true
@@ -126,11 +132,8 @@ impl<const W: usize> Band<W> {
             }
             b[i] = s;
         }
-        for i in 0..n {
-            b[i] = b[i] * (1.0 / self.diag[i]);
-        }
         for i in (0..n).rev() {
-            let mut s = b[i];
+            let mut s = b[i] * self.dinv[i];
             for t in 1..=W.min(n - 1 - i) {
                 s = s - b[i + t] * self.off[i + t][W - t];
             }
@@ -176,7 +179,7 @@ impl<const W: usize> Band<W> {
                 }
                 zi[d] = s;
             }
-            let mut s = 1.0 / self.diag[i];
+            let mut s = self.dinv[i];
             for t in 1..=tmax {
                 s -= l[t] * zi[t];
             }
