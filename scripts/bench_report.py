@@ -665,7 +665,7 @@ def main() -> None:
     rep.other_criterion()
     rep.limits_section()
     rep.later_sections()
-    head = ["# Benchmarks", "", "Written by `scripts/bench.sh` (rerun it to reproduce; about 12 minutes). "
+    head = ["# Benchmarks", "", "Written by `scripts/bench.sh` (rerun it to reproduce; about 18 minutes on 2 cores). "
             "Every figure below was measured in that one run unless marked as a figure from another machine.", ""]
     args.out.write_text("\n".join(head + rep.summary() + rep.lines).rstrip() + "\n")
     print(f"bench_report: wrote {args.out}")
