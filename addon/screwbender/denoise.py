@@ -61,11 +61,12 @@ class Cleaned:
     poses: np.ndarray
     #: The held keys among them.
     held: np.ndarray
-    #: What polyscrew chose and estimated.
+    #: The owner's curves holding the original keys (in the action Remove Noise starts from):
+    #: every key of the result is written from them (a rerun replaces the earlier result).
+    originals: list = field(default_factory=list)
+    #: What polyscrew chose.
     rotation_strength: float = 0.0
     translation_strength: float = 0.0
-    rotation_noise: float = 0.0
-    translation_noise: float = 0.0
 
 
 @dataclass
@@ -80,6 +81,26 @@ class Denoised:
     strengths: list[tuple[float, float]] = field(default_factory=list)
 
 
+def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame of `at`: the index of the nearest frame of `frames` (sorted, not empty), and
+    whether it is the same frame (within :data:`keys.FRAME_TOLERANCE`). Both neighbours are
+    looked at (a key a hair before a frame is that frame's key)."""
+    at = np.asarray(at, dtype=np.float64)
+    last = len(frames) - 1
+    right = np.clip(np.searchsorted(frames, at), 0, last)
+    left = np.clip(right - 1, 0, last)
+    index = np.where(np.abs(frames[left] - at) < np.abs(frames[right] - at), left, right)
+    return index, np.abs(frames[index] - at) < keys.FRAME_TOLERANCE
+
+
+def _points(fc, attr: str = "co") -> np.ndarray:
+    """One keyframe property of every key of `fc`, (n, 2) float32 (one foreach_get)."""
+    points = fc.keyframe_points
+    out = np.empty(2 * len(points), dtype=np.float32)
+    points.foreach_get(attr, out)
+    return out.reshape(-1, 2)
+
+
 def selected_frames(owner: owners.Owner, fcurves: list, frames: np.ndarray) -> np.ndarray:
     """Per key frame of `frames`: whether a key is selected there on the owner's transform
     curves."""
@@ -89,15 +110,12 @@ def selected_frames(owner: owners.Owner, fcurves: list, frames: np.ndarray) -> n
         if owner.prop_of(fc.data_path) not in paths or not len(fc.keyframe_points):
             continue
         points = fc.keyframe_points
-        co = np.empty(2 * len(points), dtype=np.float32)
-        points.foreach_get("co", co)
         flags = np.empty(len(points), dtype=bool)
         points.foreach_get("select_control_point", flags)
-        picked = co[0::2][flags].astype(np.float64)
-        at = np.clip(np.searchsorted(frames, picked), 0, len(frames) - 1)
-        for candidate in (at, np.clip(at - 1, 0, len(frames) - 1)):  # the nearest key frame
-            hit = np.abs(frames[candidate] - picked) < keys.FRAME_TOLERANCE
-            chosen[candidate[hit]] = True
+        if not flags.any():
+            continue
+        index, hit = nearest_rows(frames, _points(fc)[flags, 0])
+        chosen[index[hit]] = True
     return chosen
 
 
@@ -109,34 +127,39 @@ def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.
     return np.flatnonzero((frames >= start - tol) & (frames <= end + tol))
 
 
-def prepare(owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "") -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
-    """The owner's key poses (no analysis), the rows to smooth and which of them are held."""
+def prepare(
+    owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None
+) -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
+    """The owner's key poses (no analysis), the rows to smooth and which of them are held.
+    `fcurves` hold the keys read; `shown` (default `fcurves`) the keys the user sees and
+    selects (the earlier result, on a rerun from the original keys)."""
     motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False)
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
             f"{owner.name}: {len(rows)} key frame(s) in the frame range; Remove Noise needs at least 4: skipped"
         )
-    selected = selected_frames(owner, fcurves, motion.frames)[rows]
+    selected = selected_frames(owner, fcurves if shown is None else shown, motion.frames)[rows]
     held = ~selected if selected.any() else np.zeros(len(rows), dtype=bool)
     if held.all():
         raise SmoothError(f"{owner.name}: every key in the frame range is unselected (held): nothing to smooth: skipped")
     return motion, rows, held
 
 
-def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.ndarray]], options: Options) -> list[Cleaned]:
-    """Denoises prepared owners, batching those keyed on the same frames with the same held
-    keys into one `polyscrew.denoise` call. Raises SmoothError (with polyscrew's message)."""
+def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.ndarray, list]], options: Options) -> list[Cleaned]:
+    """Denoises prepared owners (owner, motion, rows, held, the curves of the original keys),
+    batching those keyed on the same frames with the same held keys into one
+    `polyscrew.denoise` call. Raises SmoothError (with polyscrew's message)."""
     batches: dict[tuple, list] = {}
     for item in prepared:
-        owner, motion, rows, held = item
+        owner, motion, rows, held, _ = item
         key = (motion.frames[rows].tobytes(), held.tobytes())
         batches.setdefault(key, []).append(item)
     out = []
     for items in batches.values():
-        _, motion, rows, held = items[0]
+        _, motion, rows, held, _ = items[0]
         times = motion.frames[rows]
-        stack = np.stack([m.poses[r] for _, m, r, _ in items])
+        stack = np.stack([m.poses[r] for _, m, r, _, _ in items])
         try:
             result = polyscrew.denoise(
                 stack if len(items) > 1 else stack[0], times, strength=options.strength,
@@ -150,64 +173,105 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
             value = np.asarray(value, dtype=np.float64)
             return float(value.reshape(-1)[b] if value.size > 1 else value.reshape(-1)[0])
 
-        for b, (owner, motion, rows, held_b) in enumerate(items):
+        for b, (owner, motion, rows, held_b, originals) in enumerate(items):
             out.append(
                 Cleaned(
-                    owner=owner, motion=motion, rows=rows, poses=poses[b], held=held_b,
+                    owner=owner, motion=motion, rows=rows, poses=poses[b], held=held_b, originals=originals,
                     rotation_strength=per_body(result.rotation_strength, b),
                     translation_strength=per_body(result.translation_strength, b),
-                    rotation_noise=per_body(result.rotation_noise, b),
-                    translation_noise=per_body(result.translation_noise, b),
                 )
             )
     return out
 
 
+TAU = 2.0 * np.pi
+
+
+def _like_original(new: np.ndarray, original: np.ndarray, mode: str) -> np.ndarray:
+    """The rotation channel values `new` (n, k), each row the same rotation written like the
+    original key values `original` (n, k): the quaternion sign of the original, the Euler
+    angles (and axis-angle angle) within half a turn of the original's, so that spins and
+    deliberate sign flips of the keys are kept (not continuity's choice)."""
+    new = np.array(new, dtype=np.float64)
+    if mode == "QUATERNION":
+        new[np.sum(new * original, axis=1) < 0] *= -1.0
+        return new
+    if mode == "AXIS_ANGLE":
+        new[np.sum(new[:, 1:] * original[:, 1:], axis=1) < 0] *= -1.0  # (-angle, -axis): the same
+        new[:, 0] += TAU * np.round((original[:, 0] - new[:, 0]) / TAU)
+        return new
+    # An Euler rotation has two triples (a, b, c) and (a + pi, pi - b, c + pi) in its order's
+    # sequence, each up to whole turns per angle: the one nearest the original.
+    first, middle, last = ("XYZ".index(axis) for axis in mode)
+    other = new.copy()
+    other[:, [first, last]] += np.pi
+    other[:, middle] = np.pi - other[:, middle]
+    near = [c + TAU * np.round((original - c) / TAU) for c in (new, other)]
+    use_other = np.abs(near[1] - original).sum(axis=1) < np.abs(near[0] - original).sum(axis=1)
+    return np.where(use_other[:, None], near[1], near[0])
+
+
+def _original_rotation(motion: keys.KeyedMotion) -> np.ndarray:
+    """The original rotation channel values at every key frame of `motion` (K, k)."""
+    mode = motion.rotation_mode
+    if motion.source is not None:
+        return np.asarray(motion.source.channels(motion.frames)[keys.rotation_path(mode)], dtype=np.float64)
+    # Curves the add-on cannot evaluate: continuity from the first key's values.
+    return polyscrew.rotation_channels(motion.poses, mode, previous=None if mode == "AXIS_ANGLE" else motion.first_rotation)
+
+
 def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
-    """Writes the smoothed values into the keys of the owner's location and rotation curves
-    among `fcurves` (frames in the range), moving each key's handles with it."""
+    """Writes the owner's location and rotation keys among `fcurves` (not muted): every key
+    at a key frame of the motion gets its original key back (value and handles, from
+    `cleaned.originals`), and the smoothed keys (in the range, not held) the smoothed value at
+    their frame, their handles moving with them."""
     motion, owner = cleaned.motion, cleaned.owner
     mode = motion.rotation_mode
-    frames = motion.frames[cleaned.rows]
-    previous = None if mode == "AXIS_ANGLE" else _channels_at(motion, cleaned.rows[0])
-    rotation = polyscrew.rotation_channels(cleaned.poses, mode, previous=previous)
-    values = {keys.rotation_path(mode): rotation}
+    path = keys.rotation_path(mode)
+    smoothed_rows = cleaned.rows[~cleaned.held]
+    smoothed = np.zeros(len(motion.frames), dtype=bool)
+    smoothed[smoothed_rows] = True
+    original = _original_rotation(motion)
+    previous = None if mode == "AXIS_ANGLE" else original[cleaned.rows[0]]
+    rotation = np.zeros((len(motion.frames), original.shape[1]))
+    written = polyscrew.rotation_channels(cleaned.poses, mode, previous=previous)
+    rotation[cleaned.rows] = _like_original(written, original[cleaned.rows], mode)
+    values = {path: rotation}
     if motion.located:
-        values["location"] = cleaned.poses[:, :3, 3]
+        location = np.zeros((len(motion.frames), 3))
+        location[cleaned.rows] = cleaned.poses[:, :3, 3]
+        values["location"] = location
+    euler = mode not in ("QUATERNION", "AXIS_ANGLE")
+    originals = {(fc.data_path, fc.array_index): fc for fc in cleaned.originals}
     for fc in fcurves:
         prop = owner.prop_of(fc.data_path)
-        if prop not in values or fc.array_index >= values[prop].shape[1]:
+        if fc.mute or prop not in values or fc.array_index >= values[prop].shape[1] or not len(fc.keyframe_points):
             continue
         points = fc.keyframe_points
-        n = len(points)
-        co = np.empty(2 * n, dtype=np.float32)
-        points.foreach_get("co", co)
-        co = co.reshape(-1, 2)
-        at = np.searchsorted(frames, co[:, 0].astype(np.float64))
-        at = np.clip(at, 0, len(frames) - 1)
-        near = np.abs(frames[at] - co[:, 0]) < keys.FRAME_TOLERANCE
-        if not near.any():
-            continue
-        delta = np.zeros(n, dtype=np.float64)
-        delta[near] = values[prop][at[near], fc.array_index] - co[near, 1]
-        left = np.empty(2 * n, dtype=np.float32)
-        right = np.empty(2 * n, dtype=np.float32)
-        points.foreach_get("handle_left", left)
-        points.foreach_get("handle_right", right)
-        for array in (co, left.reshape(-1, 2), right.reshape(-1, 2)):
-            array[:, 1] += delta.astype(np.float32)
-        co[near, 1] = values[prop][at[near], fc.array_index]  # exact, not the sum
+        co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
+        source = originals.get((fc.data_path, fc.array_index))
+        if source is not None and source != fc and len(source.keyframe_points):
+            # The original keys back (this curve is a copy of an earlier result).
+            was = _points(source)
+            order = np.argsort(was[:, 0], kind="stable")
+            index, hit = nearest_rows(was[order, 0], co[:, 0])
+            index = order[index[hit]]
+            co[hit, 1] = was[index, 1]
+            left[hit] = _points(source, "handle_left")[index]
+            right[hit] = _points(source, "handle_right")[index]
+        row, near = nearest_rows(motion.frames, co[:, 0])
+        edit = near & smoothed[row]
+        target = values[prop][row[edit], fc.array_index]
+        if euler and prop == path:  # within half a turn of the key's own original value
+            target = target + TAU * np.round((co[edit, 1] - target) / TAU)
+        delta = (target - co[edit, 1]).astype(np.float32)
+        left[edit, 1] += delta
+        right[edit, 1] += delta
+        co[edit, 1] = target  # exact, not the sum
         points.foreach_set("co", co.ravel())
-        points.foreach_set("handle_left", left)
-        points.foreach_set("handle_right", right)
+        points.foreach_set("handle_left", left.ravel())
+        points.foreach_set("handle_right", right.ravel())
         fc.update()
-
-
-def _channels_at(motion: keys.KeyedMotion, row: int) -> np.ndarray:
-    """The rotation channel values the owner has at key `row` (for continuity of the new ones)."""
-    if motion.source is not None:
-        return motion.source.channels(motion.frames[row : row + 1])[keys.rotation_path(motion.rotation_mode)][0]
-    return motion.first_rotation
 
 
 def remove_noise(
@@ -228,7 +292,7 @@ def remove_noise(
             skipped.append(f"{owner.name}: no animation (no active action): skipped")
             continue
         groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
-    prepared, plans = [], []
+    prepared, plans, notes, rerun = [], [], [], []
     for i, members in enumerate(groups.values()):
         first = members[0].obj
         current = first.animation_data.action
@@ -239,21 +303,30 @@ def remove_noise(
             source, slot = found
         listed = channels.action_fcurves(source, slot)
         by_owner = owners.curves_by_owner(listed)
+        # The keys the user sees and selects: those of the action shown (an earlier result).
+        shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         users = bake.users_of(current, identifier)
         done = []
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
-                                             action=None if source is current else source, slot=slot)
+                                             action=None if source is current else source, slot=slot,
+                                             shown=shown.get(owner.bone, []))
             except SmoothError as err:
                 skipped.append(str(err))
                 continue
-            prepared.append((owner, motion, rows, held))
+            prepared.append((owner, motion, rows, held, by_owner.get(owner.bone, [])))
             done.append(owner)
+            if motion.kept:
+                notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
         if done:
             plans.append((users or [first], source, current, identifier, done))
+            if source is not current:
+                rerun.append(first.name)
         if progress is not None:
             progress(i + 1, 2 * len(groups))
+    if rerun:
+        notes.append(f"removed the noise of the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
     cleaned = {(c.owner.obj.as_pointer(), c.owner.bone): c for c in clean(prepared, options)}
     actions = []
     with contextlib.ExitStack() as stack:
@@ -275,5 +348,6 @@ def remove_noise(
         actions=actions,
         owners=[c.owner.name for c in parts],
         skipped=skipped,
+        notes=notes,
         strengths=[(c.rotation_strength, c.translation_strength) for c in parts],
     )

@@ -106,9 +106,11 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         selection = owners.selection(context, self.armature, channels.object_fcurves)
         wm = context.window_manager
-        wm.progress_begin(0, 2 * len(selection))
+        wm.progress_begin(0.0, 1.0)  # remove_noise counts its own steps (two per action)
         try:
-            result = denoise.remove_noise(selection, self.denoise_options(context), lambda done, total: wm.progress_update(done))
+            result = denoise.remove_noise(
+                selection, self.denoise_options(context), lambda done, total: wm.progress_update(done / total)
+            )
         except SmoothError as err:
             self.report({"ERROR"}, str(err))
             return {"CANCELLED"}
@@ -120,6 +122,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             bake_ops.report_skipped(self, result.skipped, "ERROR")
             return {"CANCELLED"}
         bake_ops.report_skipped(self, result.skipped, "WARNING")
+        report_notes(self, result.notes)
         rotation = sorted(s[0] for s in result.strengths)
         translation = sorted(s[1] for s in result.strengths)
         self.rotation_strength = rotation[len(rotation) // 2]
@@ -132,6 +135,18 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             f"{self.rotation_strength:.3g}, translation {self.translation_strength:.3g} frames{spread}",
         )
         return {"FINISHED"}
+
+
+def report_notes(operator: bpy.types.Operator, notes: list[str]) -> None:
+    """The notes of a run (what was kept, a rerun from the original keys), as Smooth Motion
+    reports its own: one line each for a few, else two and the rest in the console."""
+    if len(notes) <= 3:
+        for note in notes:
+            operator.report({"INFO"}, note)
+        return
+    for note in notes:
+        print(f"ScrewBender: {note}")
+    operator.report({"INFO"}, f"{'; '.join(notes[:2])}; and {len(notes) - 2} more notes (in the console)")
 
 
 class VIEW3D_PT_screwbender_denoise(bpy.types.Panel):
