@@ -30,7 +30,7 @@ import polyscrew
 from mathutils import Matrix, Vector
 from mathutils.bvhtree import BVHTree
 
-from . import bake, channels, owners
+from . import bake, channels, owners, transaction
 
 #: Name of the collection that receives swept regions.
 COLLECTION = "Swept Regions"
@@ -233,7 +233,19 @@ def _carrier_frames(driver: BoneDriver) -> list[float]:
         chain.add(bone.name)
         bone = bone.parent
     grouped = owners.curves_by_owner(channels.object_fcurves(rig))
-    return sorted({round(k.co[0], 6) for key in chain for fc in grouped.get(key, []) for k in fc.keyframe_points})
+    return _key_frames([fc for key in chain for fc in grouped.get(key, [])])
+
+
+def _key_frames(fcurves: list) -> list[float]:
+    """The sorted distinct key frames (rounded to 1e-6) of `fcurves`: one foreach_get per curve."""
+    found = []
+    for fc in fcurves:
+        co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
+        fc.keyframe_points.foreach_get("co", co)
+        found.append(co[0::2])
+    if not found:
+        return []
+    return np.unique(np.round(np.concatenate(found).astype(np.float64), 6)).tolist()
 
 
 def motion_frames(obj: bpy.types.Object, scene: bpy.types.Scene, driver: BoneDriver | None = None) -> np.ndarray:
@@ -246,7 +258,7 @@ def motion_frames(obj: bpy.types.Object, scene: bpy.types.Scene, driver: BoneDri
             if len(frames) >= 2:
                 return np.asarray(frames, dtype=np.float64)
     elif bake.source_of(obj) is not None:
-        frames = sorted({round(k.co[0], 6) for fc in channels.object_fcurves(obj) for k in fc.keyframe_points})
+        frames = _key_frames(channels.object_fcurves(obj))
         if len(frames) >= 2:
             return np.asarray(frames, dtype=np.float64)
     return np.arange(scene.frame_start, scene.frame_end + 1, dtype=np.float64)
@@ -300,13 +312,22 @@ def compute(obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps:
     return Swept(obj, v, t, poses, time.perf_counter() - start)
 
 
-def collection(scene: bpy.types.Scene) -> bpy.types.Collection:
-    """The "Swept Regions" collection, created and linked to the scene when missing."""
+def collection(scene: bpy.types.Scene, t: transaction.Transaction | None = None) -> bpy.types.Collection:
+    """The "Swept Regions" collection, created and linked to the scene when missing (the
+    linking undone by `t` when it fails: a new collection goes anyway, an existing one that
+    was not linked is unlinked again)."""
     coll = bpy.data.collections.get(COLLECTION)
     if coll is None:
         coll = bpy.data.collections.new(COLLECTION)
     if coll.name not in scene.collection.children:
         scene.collection.children.link(coll)
+        if t is not None:
+
+            def unlink() -> None:
+                if coll.name in scene.collection.children:
+                    scene.collection.children.unlink(coll)
+
+            t.on_rollback(unlink)
     return coll
 
 
@@ -335,14 +356,15 @@ def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> 
 
 
 def create_object(
-    swept: Swept, context: bpy.types.Context, closed: bool, voxel_size: float
+    swept: Swept, context: bpy.types.Context, closed: bool, voxel_size: float, t: transaction.Transaction | None = None
 ) -> bpy.types.Object:
     """A new object in the "Swept Regions" collection holding the swept mesh (world frame);
-    `closed` turns it into a closed manifold volume with a voxel remesh of `voxel_size`."""
+    `closed` turns it into a closed manifold volume with a voxel remesh of `voxel_size`. `t`
+    undoes the linking of the collection when the operator fails."""
     name = f"{swept.obj.name} swept"
     mesh = mesh_from_arrays(name, swept.vertices, swept.triangles)
     obj = bpy.data.objects.new(name, mesh)
-    collection(context.scene).objects.link(obj)
+    collection(context.scene, t).objects.link(obj)
     obj[SOURCE_KEY] = swept.obj.name
     if closed:
         mod = obj.modifiers.new("Voxel Remesh", "REMESH")

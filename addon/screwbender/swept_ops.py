@@ -70,7 +70,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         try:
             computed = [swept.compute(o, context, self.steps, self.caps) for o in objects]
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
-                created = [swept.create_object(s, context, self.closed, self.voxel_size) for s in computed]
+                created = [swept.create_object(s, context, self.closed, self.voxel_size, t) for s in computed]
                 t.keep_selection(context.view_layer)
                 for obj in context.selected_objects:
                     obj.select_set(False)
