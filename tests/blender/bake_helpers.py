@@ -185,6 +185,7 @@ def snapshot_action(action) -> dict:
                 ("co", 2, np.float32), ("handle_left", 2, np.float32), ("handle_right", 2, np.float32),
                 ("interpolation", 1, np.int32), ("handle_left_type", 1, np.int32),
                 ("handle_right_type", 1, np.int32), ("easing", 1, np.int32), ("type", 1, np.int32),
+                ("select_control_point", 1, bool),
             ):
                 buf = np.empty(width * len(kp), dtype=dtype)
                 kp.foreach_get(attr, buf)

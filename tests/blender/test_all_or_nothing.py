@@ -41,6 +41,28 @@ def fail_on_call(module_name: str, function: str, call: int):
         setattr(module, function, original)
 
 
+@contextlib.contextmanager
+def fail_after_call(module_name: str, function: str, call: int):
+    """Makes `module.function` raise :class:`Injected` right after its `call`-th call has
+    returned (everything that call wrote is there to be undone); yields the counter."""
+    module = addon_module(module_name)
+    original = getattr(module, function)
+    calls = {"n": 0}
+
+    def wrapper(*args, **kwargs):
+        calls["n"] += 1
+        result = original(*args, **kwargs)
+        if calls["n"] == call:
+            raise Injected(f"injected failure after {function}, call {call}")
+        return result
+
+    setattr(module, function, wrapper)
+    try:
+        yield calls
+    finally:
+        setattr(module, function, original)
+
+
 def keyed(name: str, mode: str = "XYZ", offset: float = 0.0, scale: bool = True):
     obj = h.new_object(name, "MESH", mode)
     frames = [1, 9, 17, 30]
@@ -145,6 +167,29 @@ def test_add_angular_velocity_sketch(sb):
     with fail_on_call("angvel", "_set_curve_points", 1) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.add_angular_velocity_sketch())
     assert calls["n"] == 1
+
+
+def test_add_angular_velocity_sketch_after_its_last_write(sb):
+    """A failure once the sketch is made and recorded on the object (t.set_item): the
+    record, the sphere, the sketch and its curves all go."""
+    obj = keyed("Top", mode="QUATERNION", scale=False)
+    h.select_only(obj)
+    with fail_after_call("angvel_ops", "add_sketch", 1) as calls:
+        check_unchanged(lambda: bpy.ops.screwbender.add_angular_velocity_sketch())
+    assert calls["n"] == 1
+    assert addon_module("angvel").SPHERE_KEY not in obj
+
+
+def test_build_swept_region_into_an_unlinked_collection(sb):
+    """An existing "Swept Regions" collection that is not in the scene: the sweep links it,
+    and a failure unlinks it again."""
+    bpy.data.collections.new(addon_module("swept").COLLECTION)
+    a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
+    h.select_only(a, b)
+    with fail_on_call("swept", "mesh_from_arrays", 2) as calls:
+        check_unchanged(lambda: bpy.ops.screwbender.sweep())
+    assert calls["n"] == 2
+    assert addon_module("swept").COLLECTION not in bpy.context.scene.collection.children
 
 
 def test_build_swept_region(sb):
