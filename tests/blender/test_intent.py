@@ -12,6 +12,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import bake_helpers as h
+from conftest import addon_module
 
 SCHEMES = ["four_point", "bspline", "jarek"]
 
@@ -177,7 +178,7 @@ def test_timing_keys_keeps_the_pace_of_blenders_curves(sb, kind):
     frames = np.arange(1.0, 26.0)
     fine = np.arange(1.0, 25.0001, 0.125)
     blender = playback(obj, fine)
-    size = sb.keys.body_size(sb.keys.owners.Owner(obj)) if hasattr(sb.keys, "owners") else 1.0
+    size = sb.keys.body_size(addon_module("owners").Owner(obj))
     assert bpy.ops.screwbender.smooth(timing="keys", scheme="four_point") == {"FINISHED"}
     ours = playback(obj, fine)
     pick = np.isin(fine, frames)
@@ -188,6 +189,10 @@ def test_timing_keys_keeps_the_pace_of_blenders_curves(sb, kind):
     print(f"{kind}: fraction of the span travelled, ours against Blender's: largest difference {100 * off:.2f} % "
           f"(constant pace would be {100 * constant_speed:.1f} % off)")
     assert off < 0.02
+    # The curves are eased: a constant pace is far off theirs (measured 9.6 % for EASE_IN_OUT,
+    # 28.7 % EXPO, 22.3 % HANDLES), well beyond the 2 % allowed above, so matching means
+    # following the easing, not just moving at a steady pace.
+    assert constant_speed > 2.5 * 0.02
     # and the path is the screw between the two keys (at the baked frames: between them
     # Blender interpolates the baked channels linearly)
     keys = playback(obj, [1, 25])

@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+import sys
 import tomllib
 
 import pytest
@@ -22,7 +23,8 @@ def git_status(*paths: str) -> str:
         ["git", "status", "--porcelain", "--untracked-files=all", "--", *paths],
         cwd=ROOT, capture_output=True, text=True,
     )
-    return done.stdout if done.returncode == 0 else ""
+    assert done.returncode == 0, f"git status failed: {done.stderr}"
+    return done.stdout
 
 
 @pytest.mark.skipif(shutil.which("cargo") is None, reason="no cargo")
@@ -79,3 +81,12 @@ def test_changelog_has_the_current_version():
     changelog = (ROOT / "CHANGELOG.md").read_text()
     versions = re.findall(r"^## \[?(\d+\.\d+\.\d+)\]?", changelog, re.M)
     assert versions and versions[0] == extension.cargo_version(), versions
+
+
+def test_git_status_failing_is_an_error(monkeypatch, tmp_path):
+    """Outside a checkout `git status` fails: that is an error, not an empty (clean) status
+    that would let the tree-unchanged check pass whatever happened."""
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    monkeypatch.setenv("GIT_CEILING_DIRECTORIES", str(tmp_path.parent))
+    with pytest.raises(AssertionError, match="git status failed"):
+        git_status()
