@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, owners, transaction
+from . import bake, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: Custom property (on the sphere helper) whose F-curve is the magnitude sketch, rad/s.
@@ -266,17 +266,7 @@ def read_sketch(sphere: bpy.types.Object, timing: str = "POINTS") -> tuple[np.nd
 def selected_keys(obj: bpy.types.Object, motion: keys.KeyedMotion) -> np.ndarray:
     """Mask of the key frames with a selected key on a rotation F-curve (all when none is)."""
     path = keys.rotation_path(motion.rotation_mode)
-    chosen = np.zeros(len(motion.frames), dtype=bool)
-    for fc in channels.object_fcurves(obj):
-        if fc.data_path != path:
-            continue
-        n = len(fc.keyframe_points)
-        co = np.empty(2 * n, dtype=np.float32)
-        fc.keyframe_points.foreach_get("co", co)
-        sel = np.zeros(n, dtype=bool)
-        fc.keyframe_points.foreach_get("select_control_point", sel)
-        for f in co[0::2][sel]:
-            chosen |= np.abs(motion.frames - f) < keys.FRAME_TOLERANCE
+    chosen = feature.selected_frames(owners.as_owner(obj), channels.object_fcurves(obj), motion.frames, props=(path,))
     return chosen if chosen.any() else np.ones(len(motion.frames), dtype=bool)
 
 

@@ -27,7 +27,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, owners, transaction
+from . import bake, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 
@@ -81,16 +81,8 @@ class Denoised:
     strengths: list[tuple[float, float]] = field(default_factory=list)
 
 
-def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per frame of `at`: the index of the nearest frame of `frames` (sorted, not empty), and
-    whether it is the same frame (within :data:`keys.FRAME_TOLERANCE`). Both neighbours are
-    looked at (a key a hair before a frame is that frame's key)."""
-    at = np.asarray(at, dtype=np.float64)
-    last = len(frames) - 1
-    right = np.clip(np.searchsorted(frames, at), 0, last)
-    left = np.clip(right - 1, 0, last)
-    index = np.where(np.abs(frames[left] - at) < np.abs(frames[right] - at), left, right)
-    return index, np.abs(frames[index] - at) < keys.FRAME_TOLERANCE
+#: The nearest key frame of a key (both neighbours), shared with Smooth Motion's selection.
+nearest_rows = feature.nearest_rows
 
 
 def _points(fc, attr: str = "co") -> np.ndarray:
@@ -104,19 +96,7 @@ def _points(fc, attr: str = "co") -> np.ndarray:
 def selected_frames(owner: owners.Owner, fcurves: list, frames: np.ndarray) -> np.ndarray:
     """Per key frame of `frames`: whether a key is selected there on the owner's transform
     curves."""
-    chosen = np.zeros(len(frames), dtype=bool)
-    paths = set(keys.transform_paths(owner.rotation_mode))
-    for fc in fcurves:
-        if owner.prop_of(fc.data_path) not in paths or not len(fc.keyframe_points):
-            continue
-        points = fc.keyframe_points
-        flags = np.empty(len(points), dtype=bool)
-        points.foreach_get("select_control_point", flags)
-        if not flags.any():
-            continue
-        index, hit = nearest_rows(frames, _points(fc)[flags, 0])
-        chosen[index[hit]] = True
-    return chosen
+    return feature.selected_frames(owner, fcurves, frames)
 
 
 def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.ndarray:

@@ -50,24 +50,46 @@ PARAMETRIZATIONS = (
 )
 
 
-def selected_keys(owner: owners.Owner | bpy.types.Object, frames: np.ndarray) -> np.ndarray:
-    """Per key frame: whether a key is selected there on any transform F-curve of `owner`."""
-    owner = owners.as_owner(owner)
-    selected = np.zeros(len(frames), dtype=bool)
-    paths = keys.transform_paths(owner.rotation_mode)
-    for fcurve in channels.object_fcurves(owner.obj):
-        points = fcurve.keyframe_points
-        if owner.prop_of(fcurve.data_path) not in paths or fcurve.mute or len(points) == 0:
+def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame of `at`: the index of the nearest frame of `frames` (sorted, not empty), and
+    whether it is the same frame (within :data:`keys.FRAME_TOLERANCE`). Both neighbours are
+    looked at (a key a hair before or after a frame is that frame's key)."""
+    at = np.asarray(at, dtype=np.float64)
+    last = len(frames) - 1
+    right = np.clip(np.searchsorted(frames, at), 0, last)
+    left = np.clip(right - 1, 0, last)
+    index = np.where(np.abs(frames[left] - at) < np.abs(frames[right] - at), left, right)
+    return index, np.abs(frames[index] - at) < keys.FRAME_TOLERANCE
+
+
+def selected_frames(
+    owner: owners.Owner, fcurves: list, frames: np.ndarray, props: tuple[str, ...] | None = None, skip_muted: bool = False
+) -> np.ndarray:
+    """Per key frame of `frames`: whether a key is selected there on the owner's curves among
+    `fcurves` of the properties `props` (default: its transform properties), muted curves
+    left out with `skip_muted`. One foreach_get per curve, no loop over keys."""
+    chosen = np.zeros(len(frames), dtype=bool)
+    paths = set(keys.transform_paths(owner.rotation_mode) if props is None else props)
+    for fc in fcurves:
+        points = fc.keyframe_points
+        if owner.prop_of(fc.data_path) not in paths or (skip_muted and fc.mute) or not len(points):
+            continue
+        flags = np.empty(len(points), dtype=bool)
+        points.foreach_get("select_control_point", flags)
+        if not flags.any():
             continue
         co = np.empty(2 * len(points), dtype=np.float32)
         points.foreach_get("co", co)
-        flags = np.empty(len(points), dtype=bool)
-        points.foreach_get("select_control_point", flags)
-        for frame in co[0::2][flags].astype(np.float64):
-            nearest = int(np.argmin(np.abs(frames - frame)))
-            if abs(frames[nearest] - frame) < keys.FRAME_TOLERANCE:
-                selected[nearest] = True
-    return selected
+        index, hit = nearest_rows(frames, co[0::2][flags])
+        chosen[index[hit]] = True
+    return chosen
+
+
+def selected_keys(owner: owners.Owner | bpy.types.Object, frames: np.ndarray) -> np.ndarray:
+    """Per key frame: whether a key is selected there on any (not muted) transform F-curve of
+    `owner`."""
+    owner = owners.as_owner(owner)
+    return selected_frames(owner, channels.object_fcurves(owner.obj), frames, skip_muted=True)
 
 
 #: A bone's feature points are those of a box around it, this wide per unit of bone length.

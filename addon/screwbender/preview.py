@@ -33,7 +33,7 @@ from dataclasses import astuple, dataclass, field
 import bpy
 import numpy as np
 
-from . import bake, channels, keys, owners
+from . import bake, channels, feature, keys, owners
 from .keys import SmoothError
 
 #: Default number of stroboscopic instances.
@@ -549,8 +549,8 @@ def object_geometry(obj: bpy.types.Object, heavy_limit: int) -> Geometry:
 
 
 #: A bone's waist (where Blender's octahedral bone is widest) and half its width there, per
-#: unit of bone length.
-BONE_WAIST = 0.1
+#: unit of bone length: the half width of the Feature Points method's bone box.
+BONE_WAIST = feature.BONE_BOX_WIDTH
 #: Edges and triangles of the octahedral bone of :func:`bone_geometry`: head 0, tail 1, the
 #: waist square 2 to 5.
 BONE_EDGES = np.array(
