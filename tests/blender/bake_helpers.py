@@ -169,8 +169,9 @@ def evaluated_basis(obj, frames: Sequence[float]) -> np.ndarray:
     return np.array(out)
 
 
-def snapshot_action(action) -> dict:
-    """Everything about an action's F-curves that smoothing must not change."""
+def snapshot_action(action, key_selection: bool = True) -> dict:
+    """Everything about an action's F-curves that smoothing must not change (with
+    `key_selection`, which keys are selected too)."""
     if action is None:
         return {}
     channels = addon_module("channels")
@@ -185,7 +186,7 @@ def snapshot_action(action) -> dict:
                 ("co", 2, np.float32), ("handle_left", 2, np.float32), ("handle_right", 2, np.float32),
                 ("interpolation", 1, np.int32), ("handle_left_type", 1, np.int32),
                 ("handle_right_type", 1, np.int32), ("easing", 1, np.int32), ("type", 1, np.int32),
-                ("select_control_point", 1, bool),
+                *((("select_control_point", 1, bool),) if key_selection else ()),
             ):
                 buf = np.empty(width * len(kp), dtype=dtype)
                 kp.foreach_get(attr, buf)
@@ -265,10 +266,11 @@ def _id_props(id_block) -> dict:
     return out
 
 
-def snapshot_data() -> dict:
+def snapshot_data(key_selection: bool = False) -> dict:
     """The names and contents of every action, object, mesh, curve, material and collection,
     object selection and the active object: what an operator that fails must leave exactly
-    as it was (compare two snapshots with ==)."""
+    as it was (compare two snapshots with ==). `key_selection` adds which keys are selected
+    (off by default: some tests change it themselves between their snapshots)."""
     scene = bpy.context.scene
     layer = bpy.context.view_layer
     scene.frame_set(scene.frame_current)
@@ -308,7 +310,8 @@ def snapshot_data() -> dict:
         "objects": objects,
         "active": layer.objects.active.name if layer.objects.active else None,
         "actions": {
-            a.name: (a.use_fake_user, a.users, _id_props(a), snapshot_action(a)) for a in bpy.data.actions
+            a.name: (a.use_fake_user, a.users, _id_props(a), snapshot_action(a, key_selection))
+            for a in bpy.data.actions
         },
         "meshes": meshes,
         "curves": curves,

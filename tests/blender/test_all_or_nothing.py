@@ -76,10 +76,10 @@ def keyed(name: str, mode: str = "XYZ", offset: float = 0.0, scale: bool = True)
 
 
 def check_unchanged(run, match="nothing was changed"):
-    before = h.snapshot_data()
+    before = h.snapshot_data(key_selection=True)
     with pytest.raises(RuntimeError, match=match):
         run()
-    after = h.snapshot_data()
+    after = h.snapshot_data(key_selection=True)
     assert after == before
 
 
