@@ -383,7 +383,9 @@ def new_result(
             if _remove_if_unused(current):
                 result.name = name  # the earlier result's name is free again
 
-        t.on_commit(replace_earlier_result)
+        # Objects that shared the earlier result may each get a result of their own now
+        # (they differ in unkeyed channels): it is removed once, and its name goes to the first.
+        t.on_commit(replace_earlier_result, key=("remove", current.as_pointer()))
     return result
 
 
@@ -426,8 +428,12 @@ def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
 
 def _remove_if_unused(action: bpy.types.Action) -> bool:
     """Removes `action` when nothing uses it (a replaced result of Smooth Motion); returns
-    whether it did."""
-    if action.users == 0 and not action.use_fake_user:
+    whether it did (not when it is already removed)."""
+    try:
+        unused = action.users == 0 and not action.use_fake_user
+    except ReferenceError:  # removed already
+        return False
+    if unused:
         bpy.data.actions.remove(action)
         return True
     return False
@@ -681,5 +687,5 @@ def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.
     for other in sharing:
         t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
-    t.on_commit(lambda: _remove_if_unused(smoothed))
+    t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
     return sharing

