@@ -13,6 +13,7 @@ meant for the animator.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import bpy
@@ -206,9 +207,29 @@ def read(
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
     scanning all its curves for each bone).
 
-    Raises :class:`SmoothError` for anything the add-on cannot smooth.
+    Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
+    `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
+    the caller skips that owner and tells why.
     """
     owner = owners.as_owner(owner)
+    try:
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse)
+    except SmoothError:
+        raise
+    except ValueError as err:  # polyscrew refusing the curves or the key poses
+        raise SmoothError(f"{owner.name}: {err}: skipped") from err
+
+
+def _read(
+    owner: owners.Owner,
+    closed: str,
+    action: bpy.types.Action | None,
+    slot: str,
+    extend_to: tuple[float, float] | None,
+    fcurves: list | None,
+    analyse: bool,
+) -> KeyedMotion:
+    """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner)
     obj, target = owner.obj, owner.target
     name = owner.name
@@ -246,6 +267,9 @@ def read(
     except curves.UnsupportedCurve as err:
         source = None
         notes.append(f"{err}: smoothed from the key values alone (spins, holds and easing not read)")
+    except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
+        named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
+        raise SmoothError(f"{name}: {named}: skipped") from err
 
     def evaluate(path: str, size: int) -> np.ndarray:
         """The channels at the key frames (source-less: a loop over keys, not frames)."""
@@ -400,6 +424,17 @@ def read(
         size=body_size(owner),
         kept=kept,
     )
+
+
+def _curves_named(message: str, names: list[str]) -> str:
+    """`message` of `polyscrew`, its "curve N" (an index into the curves passed) as the
+    curve's data path, "location[0]"."""
+
+    def name(match: re.Match) -> str:
+        index = int(match.group(1))
+        return f"curve {names[index]}" if index < len(names) else match.group(0)
+
+    return re.sub(r"\bcurve (\d+)\b", name, message)
 
 
 def _cycle_words(modes: dict) -> str:

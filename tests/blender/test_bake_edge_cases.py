@@ -125,3 +125,29 @@ def test_a_commit_action_registered_once_per_key_runs_once():
         t.on_commit(lambda: ran.append(2), key=("remove", 7))
         t.on_commit(lambda: ran.append(3), key=("remove", 8))
     assert ran == [1, 3]
+
+
+# 2. Curves polyscrew refuses: that owner is skipped and told, the others smoothed --------
+
+
+@pytest.mark.parametrize("where", ["handle", "key", "order"])
+def test_an_owner_whose_curves_polyscrew_refuses_is_skipped_and_the_others_smoothed(sb, capfd, where):
+    good, bad = keyed("Good"), keyed("Bad", offset=1.0)
+    bad_action = bad.animation_data.action
+    fc = curve(bad, "location", 0)
+    points = fc.keyframe_points
+    if where == "handle":
+        points[1].handle_right = (points[1].co[0] + 2.0, float("nan"))
+    elif where == "key":
+        points[2].co = (points[2].co[0], float("nan"))
+    else:  # keys out of order (set through keyframe_points, no update)
+        points[1].co = (25.0, points[1].co[1])
+    h.select_only(good, bad)
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    out = reports(capfd)
+    warnings = [line for line in out if line.startswith("Warning")]
+    assert len(warnings) == 1 and warnings[0].startswith("Warning: Bad: ") and "skipped" in warnings[0], out
+    assert any(line.startswith("Info: Smoothed 1 object(s): Good") for line in out), out
+    assert bad.animation_data.action == bad_action  # unchanged
+    assert good.animation_data.action.get("screwbender_source") is not None
