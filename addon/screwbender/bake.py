@@ -156,9 +156,14 @@ class Baked:
         return self.owner.obj
 
     @property
-    def key_count(self) -> int:
-        """Keys the bake writes."""
-        return len(self.frames) * sum(v.shape[1] for v in self.values.values())
+    def written(self) -> list[tuple[str, int]]:
+        """(property, array index) of every curve the bake writes: each column of `values`
+        (for "scale" the keyed axes)."""
+        out = []
+        for prop, values in self.values.items():
+            indices = np.flatnonzero(self.motion.scale_axes) if prop == "scale" else range(values.shape[1])
+            out += [(prop, int(i)) for i in indices]
+        return out
 
 
 @dataclass
@@ -181,10 +186,6 @@ class ActionBake:
     @property
     def obj(self) -> bpy.types.Object:
         return self.objects[0]
-
-    @property
-    def key_count(self) -> int:
-        return sum(p.key_count for p in self.parts)
 
 
 def sample_poses(
@@ -404,9 +405,10 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
     :func:`new_result`."""
 
     def replace_curves(bag) -> None:
-        # Transform curves the bake replaces; every other curve stays as copied.
-        replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
-        for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced]:
+        # The curves the bake writes replace those of the same (data path, index); every other
+        # curve stays as copied (an unkeyed scale axis's muted or keyless curve too).
+        replaced = {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.written}
+        for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
         for part in bake.parts:
             for prop, values in part.values.items():
@@ -546,18 +548,30 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
             f"{', '.join(o.name for o in group.objects)} share action '{current.name}' but differ in "
             "unkeyed channels or rotation mode: each got its own smoothed action"
         )
+    # Curves of the current action that were not read (muted, keyless): a baked channel
+    # replaces them, which the report tells.
+    unread = {
+        (fc.data_path, fc.array_index): "muted" if fc.mute else "empty"
+        for fc in (listed if read_from is None else channels.action_fcurves(current, identifier))
+        if fc.mute or len(fc.keyframe_points) == 0
+    }
     bakes = []
     for objects, column in units:
         parts = []
         for bone, row in motions.items():
             owner = owners.Owner(objects[0], bone)
             try:
-                parts.append(sample_channels(owner, row[column], options, budget))
+                part = sample_channels(owner, row[column], options, budget)
             except SmoothError as err:
                 skipped.append((owner, str(err)))
                 continue
+            parts.append(part)
             if row[column].kept:
                 notes.append(f"{owner.name}: kept {'; '.join(row[column].kept)}")
+            for prop, index in part.written:
+                what = unread.get((owner.path(prop), index))
+                if what is not None:
+                    notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
         if parts:
             bakes.append(ActionBake(objects, parts, source, current, identifier))
     return bakes, skipped, notes

@@ -151,3 +151,49 @@ def test_an_owner_whose_curves_polyscrew_refuses_is_skipped_and_the_others_smoot
     assert any(line.startswith("Info: Smoothed 1 object(s): Good") for line in out), out
     assert bad.animation_data.action == bad_action  # unchanged
     assert good.animation_data.action.get("screwbender_source") is not None
+
+
+# 3. Curves the bake does not write survive it --------------------------------------------
+
+
+def test_muted_and_keyless_curves_the_bake_does_not_write_survive(sb, capfd):
+    obj = keyed("Box", scale=True)
+    action = obj.animation_data.action
+    bag = sb.channels.container(action, sb.channels.assigned_slot(obj))
+    muted_scale = curve(obj, "scale", 2)
+    muted_scale.keyframe_points[1].co = (9.0, 3.0)
+    muted_scale.mute = True  # the animator switched it off but keeps it
+    keys_before = h.curve_points(muted_scale)
+    muted_location = curve(obj, "location", 1)
+    muted_location.mute = True
+    # a keyless curve of a scale axis (a curve made ready for keys, e.g. by a script)
+    sb.channels.remove_fcurve_at(bag, "scale", 1)
+    obj.scale[1] = 1.25
+    sb.channels.new_fcurve(bag, "scale", 1, "Object Transforms")
+    h.select_only(obj)
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    out = reports(capfd)
+    result = obj.animation_data.action
+    assert result != action
+    kept = curve(obj, "scale", 2)
+    assert kept is not None and kept.mute
+    np.testing.assert_array_equal(h.curve_points(kept), keys_before)
+    keyless = curve(obj, "scale", 1)
+    assert keyless is not None and len(keyless.keyframe_points) == 0
+    baked_x = curve(obj, "scale", 0)
+    assert baked_x is not None and len(baked_x.keyframe_points) == 30 and not baked_x.mute
+    # location is baked on every axis: the muted location Y curve had to give way, and that is told
+    location_y = curve(obj, "location", 1)
+    assert not location_y.mute and len(location_y.keyframe_points) == 30
+    assert any("Box: muted curve location[1] replaced by the baked one" in line for line in out), out
+    # the source keeps all of it
+    assert curve_in(action, obj, "location", 1).mute and curve_in(action, obj, "scale", 2).mute
+
+
+def curve_in(action, obj, path, index):
+    channels = addon_module("channels")
+    return next(
+        fc for fc in channels.action_fcurves(action, channels.slot_identifier(obj))
+        if fc.data_path == path and fc.array_index == index
+    )
