@@ -120,6 +120,15 @@ def transform_paths(mode: str) -> tuple[str, str, str]:
     return ("location", rotation_path(mode), "scale")
 
 
+def baked_channels(mode: str, located: bool, scale_axes: np.ndarray) -> list[tuple[str, int]]:
+    """(property, array index) of every channel a bake writes: location (unless `located` is
+    false), every rotation channel of `mode`, the keyed scale axes."""
+    rotation = rotation_path(mode)
+    out = [("location", i) for i in range(3)] if located else []
+    out += [(rotation, i) for i in range(4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)]
+    return out + [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
+
+
 def rotation_matrices(values: np.ndarray, mode: str) -> np.ndarray:
     """(N, 3, 3) rotation matrices from (N, k) rotation channel values in Blender's `mode`.
 
@@ -398,7 +407,9 @@ def _read(
             held, pops = np.tile(held, len(shifts)), np.tile(pops, len(shifts))
             rotation = rotation[np.arange(len(frames)) % count]
             bake_range = (first, first + period)
-            modes = {key: ("REPEAT", "REPEAT") for key in found} if cyclic else {}
+            # every curve the bake writes repeats, keyed or not (an unkeyed location axis
+            # moves along the screw path too), as every column of a cycle without holds does
+            modes = {key: ("REPEAT", "REPEAT") for key in baked_channels(mode, located, scale_axes)} if cyclic else {}
             is_closed, period = False, None
     start_index = 0
     if bake_range is not None:

@@ -197,3 +197,39 @@ def curve_in(action, obj, path, index):
         fc for fc in channels.action_fcurves(action, channels.slot_identifier(obj))
         if fc.data_path == path and fc.array_index == index
     )
+
+
+# 4. A cycle with holds: every baked channel cycles ---------------------------------------
+
+
+def test_a_cycle_with_a_hold_cycles_every_baked_channel(sb):
+    obj = h.new_object("Turner", "MESH", "XYZ")
+    keys = [(1, 0.0, 0.0), (10, 2.0, 1.5), (20, 2.0, 1.5), (30, 0.0, 0.0)]  # hold 10..20, closes at 30
+    for frame, x, z in keys:
+        obj.location = (x, 0.0, 0.2 * x)
+        obj.rotation_euler = (0.0, 0.0, z)
+        obj.keyframe_insert("location", index=0, frame=frame)  # location Y is not keyed
+        obj.keyframe_insert("location", index=2, frame=frame)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    for fc in h.fcurves(obj):
+        fc.modifiers.new("CYCLES")
+    h.select_only(obj)
+    motion = sb.keys.read(obj)
+    assert motion.held is not None and motion.held.any()  # the hold is found
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+
+    baked = [fc for fc in h.fcurves(obj) if fc.data_path in ("location", "rotation_euler")]
+    assert sorted((fc.data_path, fc.array_index) for fc in baked) == [
+        ("location", 0), ("location", 1), ("location", 2),
+        ("rotation_euler", 0), ("rotation_euler", 1), ("rotation_euler", 2),
+    ]
+    y = curve(obj, "location", 1)
+    first = np.arange(1.0, 30.0, 0.5)
+    assert np.ptp([y.evaluate(f) for f in first]) > 0.05  # the screw path moves the unkeyed Y
+    for fc in baked:
+        assert [m.type for m in fc.modifiers] == ["CYCLES"], (fc.data_path, fc.array_index)
+        now = np.array([fc.evaluate(f) for f in first])
+        later = np.array([fc.evaluate(f + 29.0) for f in first])
+        np.testing.assert_allclose(later, now, atol=1e-5, err_msg=f"{fc.data_path}[{fc.array_index}]")
+    # and Blender plays it so: one period later the object is where it was
+    np.testing.assert_allclose(h.evaluated_basis(obj, first + 29.0), h.evaluated_basis(obj, first), atol=1e-5)
