@@ -381,8 +381,8 @@ def _read(
     if is_closed:
         size = 1.0 + float(np.max(np.abs(location)))
         repeats = np.allclose(poses[-1], poses[0], atol=REPEAT_TOLERANCE * size) and np.allclose(
-            np.log(np.abs(scale[-1])), np.log(np.abs(scale[0])), atol=REPEAT_TOLERANCE
-        )
+            np.log(scale[-1, scale_axes]), np.log(scale[0, scale_axes]), atol=REPEAT_TOLERANCE
+        )  # (keyed scale is positive; an unkeyed axis is the same at every key, maybe 0)
         if repeats:
             if len(frames) < 3:
                 raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")

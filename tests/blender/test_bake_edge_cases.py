@@ -233,3 +233,26 @@ def test_a_cycle_with_a_hold_cycles_every_baked_channel(sb):
         np.testing.assert_allclose(later, now, atol=1e-5, err_msg=f"{fc.data_path}[{fc.array_index}]")
     # and Blender plays it so: one period later the object is where it was
     np.testing.assert_allclose(h.evaluated_basis(obj, first + 29.0), h.evaluated_basis(obj, first), atol=1e-5)
+
+
+# 5. An unkeyed scale axis at zero ---------------------------------------------------------
+
+
+def test_an_unkeyed_scale_axis_at_zero_does_not_stop_smoothing(sb):
+    obj = keyed("Flat", scale=True)
+    bag = sb.channels.container(obj.animation_data.action, sb.channels.assigned_slot(obj))
+    sb.channels.remove_fcurve_at(bag, "scale", 2)
+    obj.scale[2] = 0.0  # flattened, not keyed
+    motion = sb.keys.read(obj)
+    assert bpy.ops.screwbender.smooth(timing="smooth") == {"FINISHED"}
+    assert curve(obj, "scale", 2) is None and obj.scale[2] == 0.0
+    keyed_axes = np.stack([h.curve_points(curve(obj, "scale", i))[:, 1] for i in (0, 1)], axis=1)
+    assert np.all(np.isfinite(keyed_axes)) and np.all(keyed_axes > 0.0)
+    # the keyed axes are the same as with any other unkeyed scale (timing "smooth": the pace
+    # of timing "keys" depends on the body's size, which a zero scale changes)
+    obj_ref = keyed("Reference", scale=True)
+    bag_ref = sb.channels.container(obj_ref.animation_data.action, sb.channels.assigned_slot(obj_ref))
+    sb.channels.remove_fcurve_at(bag_ref, "scale", 2)
+    reference = sb.bake.sample_channels(obj_ref, sb.keys.read(obj_ref), sb.bake.Options(timing="smooth"))
+    np.testing.assert_allclose(keyed_axes, reference.values["scale"], atol=1e-6)
+    assert motion.scale_axes.tolist() == [True, True, False]
