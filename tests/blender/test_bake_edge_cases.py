@@ -65,7 +65,7 @@ def test_resmoothing_a_shared_result_that_splits_replaces_it_once(sb, capfd):
     assert mine != theirs
     # the earlier result is gone, once; the original stays; no other action is left over
     assert sorted(a.name for a in bpy.data.actions) == sorted([original.name, mine.name, theirs.name])
-    assert mine.name == f"{original.name}.smooth"  # the earlier result's name went to a new one
+    assert mine.name == earlier_name == f"{original.name}.smooth"  # the earlier result's name went to a new one
     for action in (mine, theirs):
         assert action["screwbender_source"] == original and action.users == 1
     assert original.use_fake_user
