@@ -210,13 +210,6 @@ def sample_poses(
     return sampled.poses, sampled.scales
 
 
-def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options) -> np.ndarray | None:
-    """Scales (len(frames), 3), the keyed axes smoothed by the same scheme on log-scale and the
-    unkeyed ones constant (the object's own, possibly negative), or None when no scale axis
-    is keyed."""
-    return sampling.sample(motion, frames, options).scales
-
-
 #: Most keys one Smooth Motion may write (all objects together). Blender keeps about 60 bytes
 #: per key (a BezTriple) plus the undo copy of the action: 20 million keys are about 2.5 GB.
 MAX_KEYS = 20_000_000
@@ -255,8 +248,7 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 
 def channel_count(motion: keys.KeyedMotion) -> int:
     """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
-    located = 3 if motion.located else 0
-    return located + (4 if motion.rotation_mode in ("QUATERNION", "AXIS_ANGLE") else 3) + int(motion.scale_axes.sum())
+    return len(keys.baked_channels(motion.rotation_mode, motion.located, motion.scale_axes))
 
 
 def sample_channels(

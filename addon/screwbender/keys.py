@@ -34,9 +34,6 @@ ROTATION_PATHS = {
     "ZYX": "rotation_euler",
 }
 
-#: Every transform property the add-on may read or bake.
-TRANSFORM_PATHS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
-
 #: Two key frames closer than this (in frames) are the same frame.
 FRAME_TOLERANCE = 1e-4
 
@@ -269,9 +266,7 @@ def _read(
     try:
         packed = curves.read([found[c] for c in columns])
         source = intent.Source(
-            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located,
-            cycles_after=[(c or {}).get("mode_after", "") for c in packed.cycles],
-            cycles_before=[(c or {}).get("mode_before", "") for c in packed.cycles],
+            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )
     except curves.UnsupportedCurve as err:
         source = None
