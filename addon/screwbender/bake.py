@@ -156,9 +156,14 @@ class Baked:
         return self.owner.obj
 
     @property
-    def key_count(self) -> int:
-        """Keys the bake writes."""
-        return len(self.frames) * sum(v.shape[1] for v in self.values.values())
+    def written(self) -> list[tuple[str, int]]:
+        """(property, array index) of every curve the bake writes: each column of `values`
+        (for "scale" the keyed axes)."""
+        out = []
+        for prop, values in self.values.items():
+            indices = np.flatnonzero(self.motion.scale_axes) if prop == "scale" else range(values.shape[1])
+            out += [(prop, int(i)) for i in indices]
+        return out
 
 
 @dataclass
@@ -182,10 +187,6 @@ class ActionBake:
     def obj(self) -> bpy.types.Object:
         return self.objects[0]
 
-    @property
-    def key_count(self) -> int:
-        return sum(p.key_count for p in self.parts)
-
 
 def sample_poses(
     motion: keys.KeyedMotion,
@@ -207,13 +208,6 @@ def sample_poses(
     owner = owners.as_owner(owner) if owner is not None else None
     sampled = sampling.sample(motion, frames, options, owner)
     return sampled.poses, sampled.scales
-
-
-def sample_scales(motion: keys.KeyedMotion, frames: np.ndarray, options: Options) -> np.ndarray | None:
-    """Scales (len(frames), 3), the keyed axes smoothed by the same scheme on log-scale and the
-    unkeyed ones constant (the object's own, possibly negative), or None when no scale axis
-    is keyed."""
-    return sampling.sample(motion, frames, options).scales
 
 
 #: Most keys one Smooth Motion may write (all objects together). Blender keeps about 60 bytes
@@ -254,8 +248,7 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
 
 def channel_count(motion: keys.KeyedMotion) -> int:
     """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
-    located = 3 if motion.located else 0
-    return located + (4 if motion.rotation_mode in ("QUATERNION", "AXIS_ANGLE") else 3) + int(motion.scale_axes.sum())
+    return len(keys.baked_channels(motion.rotation_mode, motion.located, motion.scale_axes))
 
 
 def sample_channels(
@@ -383,7 +376,9 @@ def new_result(
             if _remove_if_unused(current):
                 result.name = name  # the earlier result's name is free again
 
-        t.on_commit(replace_earlier_result)
+        # Objects that shared the earlier result may each get a result of their own now
+        # (they differ in unkeyed channels): it is removed once, and its name goes to the first.
+        t.on_commit(replace_earlier_result, key=("remove", current.as_pointer()))
     return result
 
 
@@ -402,9 +397,10 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
     :func:`new_result`."""
 
     def replace_curves(bag) -> None:
-        # Transform curves the bake replaces; every other curve stays as copied.
-        replaced = {part.owner.path(prop) for part in bake.parts for prop in part.values}
-        for fcurve in [fc for fc in channels.fcurves(bag) if fc.data_path in replaced]:
+        # The curves the bake writes replace those of the same (data path, index); every other
+        # curve stays as copied (an unkeyed scale axis's muted or keyless curve too).
+        replaced = {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.written}
+        for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
         for part in bake.parts:
             for prop, values in part.values.items():
@@ -426,8 +422,12 @@ def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
 
 def _remove_if_unused(action: bpy.types.Action) -> bool:
     """Removes `action` when nothing uses it (a replaced result of Smooth Motion); returns
-    whether it did."""
-    if action.users == 0 and not action.use_fake_user:
+    whether it did (not when it is already removed)."""
+    try:
+        unused = action.users == 0 and not action.use_fake_user
+    except ReferenceError:  # removed already
+        return False
+    if unused:
         bpy.data.actions.remove(action)
         return True
     return False
@@ -540,18 +540,30 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
             f"{', '.join(o.name for o in group.objects)} share action '{current.name}' but differ in "
             "unkeyed channels or rotation mode: each got its own smoothed action"
         )
+    # Curves of the current action that were not read (muted, keyless): a baked channel
+    # replaces them, which the report tells.
+    unread = {
+        (fc.data_path, fc.array_index): "muted" if fc.mute else "empty"
+        for fc in (listed if read_from is None else channels.action_fcurves(current, identifier))
+        if fc.mute or len(fc.keyframe_points) == 0
+    }
     bakes = []
     for objects, column in units:
         parts = []
         for bone, row in motions.items():
             owner = owners.Owner(objects[0], bone)
             try:
-                parts.append(sample_channels(owner, row[column], options, budget))
+                part = sample_channels(owner, row[column], options, budget)
             except SmoothError as err:
                 skipped.append((owner, str(err)))
                 continue
+            parts.append(part)
             if row[column].kept:
                 notes.append(f"{owner.name}: kept {'; '.join(row[column].kept)}")
+            for prop, index in part.written:
+                what = unread.get((owner.path(prop), index))
+                if what is not None:
+                    notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
         if parts:
             bakes.append(ActionBake(objects, parts, source, current, identifier))
     return bakes, skipped, notes
@@ -681,5 +693,5 @@ def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.
     for other in sharing:
         t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
-    t.on_commit(lambda: _remove_if_unused(smoothed))
+    t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
     return sharing

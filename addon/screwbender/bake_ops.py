@@ -188,10 +188,11 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         selection = owners.selection(context, self.armature, channels.object_fcurves)
         wm = context.window_manager
-        wm.progress_begin(0, 2 * len(selection))
+        # bake.smooth counts its own steps (two per action): the bar shows their fraction
+        wm.progress_begin(0.0, 1.0)
         try:
             result = bake.smooth(
-                selection, self.smooth_options(context), lambda done, total: wm.progress_update(done)
+                selection, self.smooth_options(context), lambda done, total: wm.progress_update(done / total)
             )
         except SmoothError as err:
             self.report({"ERROR"}, str(err))

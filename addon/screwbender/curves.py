@@ -177,6 +177,19 @@ def _codes(prop: str, raw: np.ndarray) -> np.ndarray:
     return np.where(known, table[np.where(known, raw, 0)], -1)
 
 
+def _unknown(
+    prop: str, codes: np.ndarray, raw: np.ndarray, offsets: np.ndarray, fcurves: Sequence[bpy.types.FCurve]
+) -> list[tuple[bpy.types.FCurve, str]]:
+    """(curve, reason) for every key whose `Keyframe.<prop>` has no `polyscrew` code (-1 in
+    `codes`, from the packed Blender values `raw`; curve c owns keys offsets[c]:offsets[c + 1])."""
+    found = []
+    for i in np.flatnonzero(codes < 0):
+        c = int(np.searchsorted(offsets, i, side="right")) - 1
+        name = _table(prop)[1].get(int(raw[i]), f"value {int(raw[i])}")
+        found.append((fcurves[c], f"has {prop} {name!r}, which this polyscrew does not know"))
+    return found
+
+
 def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.ndarray, width: int = 1) -> None:
     """`foreach_get(name)` of the curves `curves` (indices) straight into their part of `out`."""
     for c in curves:
@@ -205,10 +218,7 @@ def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
     raw = np.zeros(k, dtype=np.uint8)
     _read(points, bounds, every, "interpolation", raw)
     interpolation = _codes("interpolation", raw)
-    for i in np.flatnonzero(interpolation < 0):
-        c = int(np.searchsorted(offsets, i, side="right")) - 1
-        name = _table("interpolation")[1].get(int(raw[i]), f"value {int(raw[i])}")
-        bad.append((fcurves[c], f"has interpolation {name!r}, which this polyscrew does not know"))
+    bad += _unknown("interpolation", interpolation, raw, offsets, fcurves)
     if bad:
         raise UnsupportedCurve(bad)
 
@@ -231,10 +241,7 @@ def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
         raw_easing = np.zeros(k, dtype=np.uint8)
         _read(points, bounds, eased, "easing", raw_easing)
         easing_codes = _codes("easing", raw_easing)
-        for i in np.flatnonzero(easing_codes < 0):
-            c = int(np.searchsorted(offsets, i, side="right")) - 1
-            name = _table("easing")[1].get(int(raw_easing[i]), f"value {int(raw_easing[i])}")
-            bad.append((fcurves[c], f"has easing {name!r}, which this polyscrew does not know"))
+        bad += _unknown("easing", easing_codes, raw_easing, offsets, fcurves)
         if bad:
             raise UnsupportedCurve(bad)
     scalars = {

@@ -95,9 +95,6 @@ class Source:
     rotation_path: str
     #: Whether location moves the owner (not for a connected bone).
     located: bool
-    #: Cycles modifier mode after the keys per curve ("" when none).
-    cycles_after: list[str] = field(default_factory=list)
-    cycles_before: list[str] = field(default_factory=list)
     #: The curves, channels and static values in the core (raises ValueError for curves
     #: `polyscrew` refuses).
     playback: polyscrew.Playback = field(init=False, repr=False)

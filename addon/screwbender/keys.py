@@ -13,6 +13,7 @@ meant for the animator.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 import bpy
@@ -32,9 +33,6 @@ ROTATION_PATHS = {
     "ZXY": "rotation_euler",
     "ZYX": "rotation_euler",
 }
-
-#: Every transform property the add-on may read or bake.
-TRANSFORM_PATHS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
 
 #: Two key frames closer than this (in frames) are the same frame.
 FRAME_TOLERANCE = 1e-4
@@ -117,6 +115,15 @@ def rotation_path(mode: str) -> str:
 def transform_paths(mode: str) -> tuple[str, str, str]:
     """Location, rotation (for `mode`) and scale property names."""
     return ("location", rotation_path(mode), "scale")
+
+
+def baked_channels(mode: str, located: bool, scale_axes: np.ndarray) -> list[tuple[str, int]]:
+    """(property, array index) of every channel a bake writes: location (unless `located` is
+    false), every rotation channel of `mode`, the keyed scale axes."""
+    rotation = rotation_path(mode)
+    out = [("location", i) for i in range(3)] if located else []
+    out += [(rotation, i) for i in range(4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)]
+    return out + [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
 
 
 def rotation_matrices(values: np.ndarray, mode: str) -> np.ndarray:
@@ -206,9 +213,29 @@ def read(
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
     scanning all its curves for each bone).
 
-    Raises :class:`SmoothError` for anything the add-on cannot smooth.
+    Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
+    `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
+    the caller skips that owner and tells why.
     """
     owner = owners.as_owner(owner)
+    try:
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse)
+    except SmoothError:
+        raise
+    except ValueError as err:  # polyscrew refusing the curves or the key poses
+        raise SmoothError(f"{owner.name}: {err}: skipped") from err
+
+
+def _read(
+    owner: owners.Owner,
+    closed: str,
+    action: bpy.types.Action | None,
+    slot: str,
+    extend_to: tuple[float, float] | None,
+    fcurves: list | None,
+    analyse: bool,
+) -> KeyedMotion:
+    """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner)
     obj, target = owner.obj, owner.target
     name = owner.name
@@ -239,13 +266,14 @@ def read(
     try:
         packed = curves.read([found[c] for c in columns])
         source = intent.Source(
-            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located,
-            cycles_after=[(c or {}).get("mode_after", "") for c in packed.cycles],
-            cycles_before=[(c or {}).get("mode_before", "") for c in packed.cycles],
+            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )
     except curves.UnsupportedCurve as err:
         source = None
         notes.append(f"{err}: smoothed from the key values alone (spins, holds and easing not read)")
+    except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
+        named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
+        raise SmoothError(f"{name}: {named}: skipped") from err
 
     def evaluate(path: str, size: int) -> np.ndarray:
         """The channels at the key frames (source-less: a loop over keys, not frames)."""
@@ -348,8 +376,8 @@ def read(
     if is_closed:
         size = 1.0 + float(np.max(np.abs(location)))
         repeats = np.allclose(poses[-1], poses[0], atol=REPEAT_TOLERANCE * size) and np.allclose(
-            np.log(np.abs(scale[-1])), np.log(np.abs(scale[0])), atol=REPEAT_TOLERANCE
-        )
+            np.log(scale[-1, scale_axes]), np.log(scale[0, scale_axes]), atol=REPEAT_TOLERANCE
+        )  # (keyed scale is positive; an unkeyed axis is the same at every key, maybe 0)
         if repeats:
             if len(frames) < 3:
                 raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
@@ -374,7 +402,9 @@ def read(
             held, pops = np.tile(held, len(shifts)), np.tile(pops, len(shifts))
             rotation = rotation[np.arange(len(frames)) % count]
             bake_range = (first, first + period)
-            modes = {key: ("REPEAT", "REPEAT") for key in found} if cyclic else {}
+            # every curve the bake writes repeats, keyed or not (an unkeyed location axis
+            # moves along the screw path too), as every column of a cycle without holds does
+            modes = {key: ("REPEAT", "REPEAT") for key in baked_channels(mode, located, scale_axes)} if cyclic else {}
             is_closed, period = False, None
     start_index = 0
     if bake_range is not None:
@@ -400,6 +430,17 @@ def read(
         size=body_size(owner),
         kept=kept,
     )
+
+
+def _curves_named(message: str, names: list[str]) -> str:
+    """`message` of `polyscrew`, its "curve N" (an index into the curves passed) as the
+    curve's data path, "location[0]"."""
+
+    def name(match: re.Match) -> str:
+        index = int(match.group(1))
+        return f"curve {names[index]}" if index < len(names) else match.group(0)
+
+    return re.sub(r"\bcurve (\d+)\b", name, message)
 
 
 def _cycle_words(modes: dict) -> str:

@@ -17,8 +17,7 @@ from dataclasses import dataclass
 
 import bpy
 
-#: F-curve group names Blender's own keying uses: objects' transforms, and one group per bone.
-OBJECT_GROUP = "Object Transforms"
+from . import channels
 
 
 def _quoted(name: str) -> str:
@@ -55,8 +54,9 @@ class Owner:
 
     @property
     def group(self) -> str:
-        """The F-curve group of the owner's transform curves (Blender's convention)."""
-        return self.bone or OBJECT_GROUP
+        """The F-curve group of the owner's transform curves (Blender's convention: "Object
+        Transforms", one group per bone)."""
+        return self.bone or channels.TRANSFORM_GROUP
 
     def path(self, prop: str) -> str:
         """The full data path of the owner's property `prop` ("location", ...)."""
@@ -86,7 +86,8 @@ ARMATURE_MODES = (
     ("OBJECT", "Object Only", "Smooth only the armature object's own keys, not its bones"),
 )
 
-_TRANSFORM_PROPS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
+#: Every transform property the add-on may read or bake.
+TRANSFORM_PROPS = ("location", "rotation_quaternion", "rotation_axis_angle", "rotation_euler", "scale")
 
 
 def _bone_of(data_path: str) -> tuple[str, str] | None:
@@ -100,7 +101,7 @@ def _bone_of(data_path: str) -> tuple[str, str] | None:
     if end == -1:
         return None
     prop = data_path[end + 3:]
-    if prop not in _TRANSFORM_PROPS:
+    if prop not in TRANSFORM_PROPS:
         return None
     name = data_path[len(head):end].replace('\\"', '"').replace("\\\\", "\\")
     return name, prop
@@ -129,7 +130,7 @@ def curves_by_owner(fcurves) -> dict[str, list]:
     out: dict[str, list] = {}
     for fc in fcurves:
         path = fc.data_path
-        if path in _TRANSFORM_PROPS:
+        if path in TRANSFORM_PROPS:
             out.setdefault("", []).append(fc)
             continue
         found = _bone_of(path)
@@ -162,12 +163,13 @@ def is_selected(obj: bpy.types.Object, bone: str) -> bool:
 
 def has_own_keys(obj: bpy.types.Object, fcurves) -> bool:
     """Whether `obj`'s own transform (not its bones') is keyed among `fcurves`."""
-    return any(fc.data_path in _TRANSFORM_PROPS and len(fc.keyframe_points) for fc in fcurves)
+    return any(fc.data_path in TRANSFORM_PROPS and len(fc.keyframe_points) for fc in fcurves)
 
 
-def poll_selection(cls, context: bpy.types.Context) -> bool:
+def poll_selection(cls, context: bpy.types.Context, objects=None) -> bool:
     """An operator's poll for owners: selected bones in Pose Mode, selected objects in
-    Object Mode (the message says which, and what to do)."""
+    Object Mode (the message says which, and what to do). `objects(context)`, when given,
+    lists the Object Mode objects that count (default: the selected ones)."""
     if context.mode == "POSE":
         if not context.selected_pose_bones:
             cls.poll_message_set("Select one or more keyed bones")
@@ -176,7 +178,7 @@ def poll_selection(cls, context: bpy.types.Context) -> bool:
     if context.mode != "OBJECT":
         cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
         return False
-    if not context.selected_objects:
+    if not (objects(context) if objects is not None else context.selected_objects):
         cls.poll_message_set("Select one or more keyed objects")
         return False
     return True

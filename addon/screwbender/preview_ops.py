@@ -146,18 +146,7 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
-        if context.mode == "POSE":
-            if not context.selected_pose_bones:
-                cls.poll_message_set("Select one or more keyed bones")
-                return False
-            return True
-        if context.mode != "OBJECT":
-            cls.poll_message_set("Switch to Object Mode (objects) or Pose Mode (bones)")
-            return False
-        if not _keyed_selection(context):
-            cls.poll_message_set("Select one or more keyed objects")
-            return False
-        return True
+        return owners.poll_selection(cls, context, _keyed_selection)
 
     def draw(self, context: bpy.types.Context) -> None:
         col = self.layout.column()

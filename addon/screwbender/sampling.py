@@ -181,7 +181,9 @@ def sample(
     rotation = None
     constant = np.zeros(n, dtype=bool)
     scaled = motion.scale_keyed
-    logs = np.log(np.abs(motion.scales)) if scaled else None
+    # log-scale of the keyed axes (positive); an unkeyed axis is not smoothed (it is the owner's
+    # own scale afterwards) and may be 0 or negative: log(1) = 0 stands in for it
+    logs = np.log(np.where(motion.scale_axes, motion.scales, 1.0)) if scaled else None
     log_scales = np.empty((n, 3)) if scaled else None
     last_rotation = previous
     for seg in segments(motion, frames):

@@ -13,7 +13,10 @@ not on others. Every operator that writes runs its writing inside :func:`atomic`
 
 On an exception the journal is replayed backwards, every data-block created since the start
 (objects, meshes, curves, materials, actions, collections) is removed, and the exception propagates to the
-operator, which reports it and cancels. Nothing here is specific to one operator.
+operator, which reports it and cancels. What cannot be undone (removing a replaced data-block)
+is registered with :meth:`Transaction.on_commit` and runs only once the body has succeeded;
+should it fail, the operator says that its changes were made (:class:`CommitIncomplete`).
+Nothing here is specific to one operator.
 """
 
 from __future__ import annotations
@@ -65,7 +68,9 @@ class Transaction:
     def __init__(self, parent: Transaction | None = None) -> None:
         self._parent = parent
         self._undo: list[Callable[[], None]] = []
-        self._on_commit: list[Callable[[], None]] = []
+        #: (key or None, action) of each commit action, in order (see :meth:`on_commit`).
+        self._on_commit: list[tuple[Any, Callable[[], None]]] = []
+        self._commit_keys: set = set()
         self._existing = {kind: {id_.as_pointer() for id_ in getattr(bpy.data, kind)} for kind in CREATED_KINDS}
 
     # Journaled changes of existing data ------------------------------------------------------
@@ -74,10 +79,18 @@ class Transaction:
         """Registers `undo`, run (newest first) when the transaction fails."""
         self._undo.append(undo)
 
-    def on_commit(self, action: Callable[[], None]) -> None:
+    def on_commit(self, action: Callable[[], None], key: Any = None) -> None:
         """Registers `action`, run when the transaction succeeds (for what cannot be undone,
-        such as removing a data-block: it happens only once everything else has worked)."""
-        self._on_commit.append(action)
+        such as removing a data-block: it happens only once everything else has worked).
+
+        With a `key` (hashable, e.g. `("remove", id.as_pointer())`) the action is registered
+        once: a later action with the same key, here or in a nested transaction, is dropped
+        (several results replacing one earlier result remove it once)."""
+        if key is not None:
+            if key in self._commit_keys:
+                return
+            self._commit_keys.add(key)
+        self._on_commit.append((key, action))
 
     def set(self, target: Any, name: str, value: Any) -> None:
         """`setattr(target, name, value)`, undone on failure."""
@@ -195,6 +208,7 @@ class Transaction:
                 problems.append(repr(err))
         self._undo.clear()
         self._on_commit.clear()
+        self._commit_keys.clear()
         for kind in CREATED_KINDS:
             collection = getattr(bpy.data, kind)
             for id_ in [i for i in collection if i.as_pointer() not in self._existing[kind]]:
@@ -206,19 +220,41 @@ class Transaction:
 
     def commit(self) -> None:
         """Ends the transaction: a nested one hands its journal to its parent (which may still
-        fail and undo it); the outermost runs the commit actions."""
+        fail and undo it); the outermost runs the commit actions.
+
+        The changes are done by then and the commit actions cannot be undone, so nothing is
+        rolled back any more: every commit action runs even when an earlier one fails, and
+        failures raise :class:`CommitIncomplete` afterwards (the changes stay, and the operator
+        says so)."""
+        actions, self._on_commit, self._commit_keys = self._on_commit, [], set()
         if self._parent is not None:
             self._parent._undo += self._undo
-            self._parent._on_commit += self._on_commit
-        else:
-            for action in self._on_commit:
-                action()
+            self._undo.clear()
+            for key, action in actions:
+                self._parent.on_commit(action, key)
+            return
         self._undo.clear()
-        self._on_commit.clear()
+        problems = []
+        for _, action in actions:
+            try:
+                action()
+            except Exception as err:  # run the others: the changes are done either way
+                problems.append(f"{type(err).__name__}: {err}")
+        if problems:
+            raise CommitIncomplete(problems)
 
 
 class RolledBack(RuntimeError):
     """An operator failed and its changes were undone; the message says why."""
+
+
+class CommitIncomplete(RuntimeError):
+    """An operator's changes were all made, but some of what it does once they are (removing
+    a replaced data-block) failed; nothing was undone. :attr:`problems` lists the failures."""
+
+    def __init__(self, problems: list[str]):
+        self.problems = problems
+        super().__init__("; ".join(problems))
 
 
 @contextlib.contextmanager
@@ -226,7 +262,9 @@ def atomic(parent: Transaction | None = None) -> Iterator[Transaction]:
     """Runs the body with a :class:`Transaction`; on any exception, rolls everything back and
     re-raises (as :class:`RolledBack` when the undoing itself had problems). Nested in
     `parent`, a failure undoes only the body's own changes, and a success leaves them to the
-    parent's outcome: one object can be skipped while the others go on."""
+    parent's outcome: one object can be skipped while the others go on. A commit action that
+    fails once the body has succeeded raises :class:`CommitIncomplete` (nothing is undone then:
+    the changes are made)."""
     t = Transaction(parent)
     try:
         yield t
@@ -240,9 +278,19 @@ def atomic(parent: Transaction | None = None) -> Iterator[Transaction]:
 
 def report_failure(operator: bpy.types.Operator, err: BaseException, what: str) -> set[str]:
     """Reports an unexpected failure of `operator` (after :func:`atomic` undid its changes)
-    and returns `{'CANCELLED'}`; the traceback goes to the console for a bug report."""
+    and returns `{'CANCELLED'}`; the traceback goes to the console for a bug report. A
+    :class:`CommitIncomplete` is reported as what it is (the changes were made, a clean-up
+    after them failed) and returns `{'FINISHED'}`, so that Blender records an undo step."""
     import traceback
 
     traceback.print_exception(err)
+    if isinstance(err, CommitIncomplete):
+        # The changes are made: finishing lets Blender record them, so Undo takes them back.
+        operator.report(
+            {"ERROR"},
+            f"{what} made its changes, but tidying up after them failed ({err}); the changes were made "
+            "and Undo takes them back",
+        )
+        return {"FINISHED"}
     operator.report({"ERROR"}, f"{what} failed ({type(err).__name__}: {err}); nothing was changed")
     return {"CANCELLED"}
