@@ -23,19 +23,25 @@ def report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str)
     )
 
 
+def report_notes(operator: bpy.types.Operator, notes: list[str]) -> None:
+    """The notes of a run (what was kept, a rerun from the original keys): one line each for
+    a few, else two and how many more (the whole list in the console)."""
+    if len(notes) <= 3:
+        for note in notes:
+            operator.report({"INFO"}, note)
+        return
+    for note in notes:  # many owners: one line, the list in the console
+        print(f"ScrewBender: {note}")
+    operator.report({"INFO"}, f"{'; '.join(notes[:2])}; and {len(notes) - 2} more notes (in the console)")
+
+
 def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: str) -> set[str]:
     """Reports what Smooth Motion did in one readable line (plus skipped objects and notes)."""
     if not result.actions:
         report_skipped(operator, result.skipped, "ERROR")
         return {"CANCELLED"}
     report_skipped(operator, result.skipped, "WARNING")
-    if len(result.notes) <= 3:
-        for note in result.notes:
-            operator.report({"INFO"}, note)
-    else:  # many owners: one line, the list in the console
-        for note in result.notes:
-            print(f"ScrewBender: {note}")
-        operator.report({"INFO"}, f"{'; '.join(result.notes[:2])}; and {len(result.notes) - 2} more notes (in the console)")
+    report_notes(operator, result.notes)
     names = result.owners
     if result.bones == len(names):
         what = "bone(s)"

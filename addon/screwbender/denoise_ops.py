@@ -122,7 +122,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             bake_ops.report_skipped(self, result.skipped, "ERROR")
             return {"CANCELLED"}
         bake_ops.report_skipped(self, result.skipped, "WARNING")
-        report_notes(self, result.notes)
+        bake_ops.report_notes(self, result.notes)
         rotation = sorted(s[0] for s in result.strengths)
         translation = sorted(s[1] for s in result.strengths)
         self.rotation_strength = rotation[len(rotation) // 2]
@@ -135,18 +135,6 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             f"{self.rotation_strength:.3g}, translation {self.translation_strength:.3g} frames{spread}",
         )
         return {"FINISHED"}
-
-
-def report_notes(operator: bpy.types.Operator, notes: list[str]) -> None:
-    """The notes of a run (what was kept, a rerun from the original keys), as Smooth Motion
-    reports its own: one line each for a few, else two and the rest in the console."""
-    if len(notes) <= 3:
-        for note in notes:
-            operator.report({"INFO"}, note)
-        return
-    for note in notes:
-        print(f"ScrewBender: {note}")
-    operator.report({"INFO"}, f"{'; '.join(notes[:2])}; and {len(notes) - 2} more notes (in the console)")
 
 
 class VIEW3D_PT_screwbender_denoise(bpy.types.Panel):
