@@ -172,6 +172,48 @@ fn channels_take_curves_statics_and_ignore_location_when_not_located() {
 }
 
 #[test]
+fn playback_refuses_channels_outside_their_property() {
+    // Built directly (not by `Channel::from_property`): location[3] would read as the
+    // rotation's x and rotation[usize::MAX] overflows its column.
+    let x = curve(&[(1.0, 0.0), (2.0, 1.0)], Interpolation::Linear);
+    for (mode, channel) in [
+        (XYZ, Channel::Location(3)),
+        (XYZ, Channel::Rotation(3)),
+        (XYZ, Channel::Rotation(usize::MAX)),
+        (XYZ, Channel::Scale(3)),
+        (XYZ, Channel::Scale(usize::MAX)),
+        (RotationMode::Quaternion, Channel::Rotation(4)),
+        (RotationMode::AxisAngle, Channel::Location(usize::MAX)),
+    ] {
+        let statics = vec![0.0; 6 + mode.width()];
+        let got = Playback::new(vec![x.clone()], &[channel], statics, mode, true);
+        match got {
+            Err(Error::Invalid {
+                what: "channels",
+                reason,
+            }) => {
+                assert!(
+                    reason.contains("channel 0") && reason.contains("out of range"),
+                    "{reason}"
+                )
+            }
+            other => panic!("{channel:?} in {mode:?}: {other:?}"),
+        }
+    }
+    // The last index of each property is accepted.
+    for (mode, channel) in [
+        (XYZ, Channel::Location(2)),
+        (XYZ, Channel::Rotation(2)),
+        (RotationMode::Quaternion, Channel::Rotation(3)),
+        (RotationMode::Quaternion, Channel::Scale(2)),
+    ] {
+        let statics = vec![1.0; 6 + mode.width()];
+        let p = Playback::new(vec![x.clone()], &[channel], statics, mode, true);
+        assert!(p.is_ok(), "{channel:?} in {mode:?}: {p:?}");
+    }
+}
+
+#[test]
 fn constant_hold_pops_and_equal_keys_hold_without_pop() {
     // x: 0 -> 4 (moving), 4 held CONSTANT to frame 20 where it pops to 8, then 8 -> 8 held.
     let mut keys = vec![
