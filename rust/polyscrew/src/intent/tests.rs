@@ -473,6 +473,48 @@ fn keys_timing_follows_the_smoothed_motions_own_pace() {
 }
 
 #[test]
+fn keys_timing_checks_the_period_as_the_time_map_does() {
+    let keys = [
+        Pose::IDENTITY,
+        Pose::from_translation(DVec3::new(4.0, 0.0, 0.0)),
+    ];
+    let smooth = screw_pace_poses(&keys, Scheme::FourPoint, 3, true).unwrap();
+    // (key frames, period): the cycle's end beyond the time range; the end after the last
+    // key but closer to it than MIN_KEY_SPACING; a period within the keys' span.
+    for (key_frames, period) in [
+        ([0.0, 1e300], 1.5e300),
+        ([-1e-300, 0.0], 1.5e-300),
+        ([1.0, 11.0], 10.0),
+    ] {
+        let timing = KeysTiming {
+            key_frames: &key_frames,
+            period: Some(period),
+            size: 1.0,
+            playback: None,
+        };
+        let got = keys_parameters(&timing, &[key_frames[0]], &smooth);
+        assert!(
+            matches!(got, Err(Error::Period { .. })),
+            "{key_frames:?} period {period}: {got:?}"
+        );
+        let map = crate::TimeMap::new(&key_frames, true, Some(period), crate::Timing::Linear);
+        assert!(
+            matches!(map, Err(Error::Period { .. })),
+            "{key_frames:?} period {period}: {map:?}"
+        );
+    }
+    // Both accept the same period.
+    let ok = KeysTiming {
+        key_frames: &[1.0, 11.0],
+        period: Some(20.0),
+        size: 1.0,
+        playback: None,
+    };
+    assert!(keys_parameters(&ok, &[1.0, 21.0], &smooth).is_ok());
+    assert!(crate::TimeMap::new(&[1.0, 11.0], true, Some(20.0), crate::Timing::Linear).is_ok());
+}
+
+#[test]
 fn keys_timing_of_a_cycle_and_its_errors() {
     let x = curve(
         &[(1.0, 0.0), (11.0, 4.0), (21.0, 0.0)],
