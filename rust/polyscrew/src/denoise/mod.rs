@@ -255,10 +255,12 @@ pub fn denoise_batch(
             });
         }
     }
+    // The times and options are checked even for no bodies: a call is valid or not
+    // whatever the number of bodies.
+    check(n, times, options)?;
     if bodies == 0 {
         return Ok(Vec::new());
     }
-    check(n, times, options)?;
     // More threads than cores gains nothing; the count is bounded so that a huge request
     // cannot exhaust the system.
     let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
