@@ -43,7 +43,7 @@ fn a_batch_over_the_budget_by_its_bezier_segments_is_refused() {
     let times: Vec<f64> = (0..T).map(|i| i as f64 * 0.999).collect();
     // What the check counted before: the keys and the values only.
     let keys_and_values = K * size_of::<Key>() + T * size_of::<f64>();
-    assert!(K <= MAX_KEYS);
+    const { assert!(K <= MAX_KEYS) };
 
     let old = polyscrew::set_memory_budget(keys_and_values);
     let refused = evaluate_packed(&packed, &times);
