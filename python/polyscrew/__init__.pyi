@@ -293,7 +293,8 @@ def fit_angular_velocity(
         target_omega: (M, 3) world-frame target angular velocity. With ``target_speed`` these
             are directions instead (the sketch on the unit sphere): normalised, not
             required to be unit, zero length rejected.
-        constrained: the keys held exactly: None (all), a boolean mask (N,) or key indices.
+        constrained: the keys held exactly: None (all), a boolean mask (N,) or key indices
+            (integers, at most max(4 N, 64) of them; TypeError for anything else).
             The other keys are free: the fit moves them.
         alpha: weight of ``W_T`` (paper: 0.002; 0.001-0.005 works well), >= 0.
         delta: threshold on every fragment error (paper: 0.1), > 0.
@@ -488,10 +489,12 @@ def evaluate_fcurves(
     curves are not evaluated (the add-on's ``curves.py`` refuses them).
 
     The GIL is released. Raises ValueError naming the argument, curve and key: wrong shapes
-    or lengths, bad offsets, codes or names, numbers not finite in float32, keys out of
-    time order, a curve without keys, more than ``MAX_FCURVE_KEYS`` keys or
-    ``MAX_FCURVE_VALUES`` values, or a value that is not finite (where Blender's would be
-    NaN or infinite).
+    or lengths, bad offsets, codes or names, integer codes or offsets that are not whole
+    numbers (``2.7``, NaN), numbers not finite in float32, keys out of time order, a curve
+    without keys, more than ``MAX_FCURVE_KEYS`` keys or ``MAX_FCURVE_VALUES`` values, more
+    memory than the budget (the prepared curves, the values and the copies of the input,
+    checked before anything is copied), or a value that is not finite (where Blender's
+    would be NaN or infinite); TypeError for complex, string or object arrays.
     """
 
 # --- what the animator meant between the keys (polyscrew::intent) ----------------------------
@@ -521,8 +524,9 @@ class Playback:
     angles, or 4: quaternion w, x, y, z / axis-angle angle, x, y, z) and scale (3), used where
     no curve drives a channel. ``located=False``: location is ignored (0), as Blender does
     for a bone connected to its parent. Raises ValueError for bad curves (as
-    ``evaluate_fcurves``), an unknown property or mode, an index out of range, two curves on
-    one channel, or ``unkeyed`` of the wrong length or not finite.
+    ``evaluate_fcurves``), an unknown property or mode, an index out of range, more channels
+    than the owner has (``6 + width``), two curves on one channel, or ``unkeyed`` of the
+    wrong length or not finite.
     """
 
     def __init__(
@@ -681,7 +685,8 @@ def denoise(
     removed, 0 leaves that part as is. ``held``: boolean mask (N,) or (B, N); held poses are
     kept exactly and the motion passes through them. ``kinks``: let abrupt turns (a prop
     stopping against a wall) through instead of rounding them. ``threads``: clips of a batch
-    are spread over this many threads (0: all the machine has).
+    are spread over this many threads (0: all the machine has). A batch of no clips
+    (0, N, 4, 4) is checked like any other and gives an empty result.
 
     Raises ValueError for a wrong shape, fewer than 4 poses, more than 1,000,000 poses per
     clip or 20,000,000 in all, a non-rigid or non-finite pose (naming the index, and the

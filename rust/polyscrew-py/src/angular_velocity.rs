@@ -2,8 +2,6 @@
 //! 2011). Conversion only: quaternions arrive and leave as `(N, 4)` w, x, y, z arrays.
 
 use glam::{DQuat, DVec3};
-#[allow(unused_imports)]
-use numpy::ndarray::ShapeBuilder;
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
@@ -22,7 +20,7 @@ use polyscrew::{
     FitStatus,
 };
 
-use crate::args::{self, FitAngularVelocity, Function};
+use crate::args::{self, FitAngularVelocity, Function, Most};
 use crate::{check_budget, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len};
 use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
 use polyscrew::memory::{try_vec, Footprint};
@@ -44,14 +42,21 @@ fn read_quaternions(what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<DQu
 }
 
 /// `constrained`: `None` (all keys), a boolean mask of length N, or key indices
-/// (negative indices count from the end, as in numpy).
+/// (negative indices count from the end, as in numpy); read through numpy, the length
+/// checked before anything is reserved for it.
 fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResult<Vec<bool>> {
     let Some(c) = constrained.filter(|c| !c.is_none()) else {
-        return Ok(vec![true; n]);
+        return try_vec(n, "constrained mask")
+            .map(|mut mask| {
+                mask.resize(n, true);
+                mask
+            })
+            .map_err(|e| to_py_err(F, e));
     };
-    if let Ok(mask) = c.extract::<Vec<bool>>() {
+    let most_indices = Most::AtMost(n.saturating_mul(4).max(64));
+    if let Some((shape, mask)) = args::bool_array(F, "constrained", c, most_indices)? {
         if !mask.is_empty() {
-            if mask.len() != n {
+            if shape.len() != 1 || mask.len() != n {
                 return Err(PyValueError::new_err(format!(
                     "{F}: constrained: boolean mask has {} entries for {n} keys",
                     mask.len()
@@ -60,18 +65,9 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
             return Ok(mask);
         }
     }
-    let indices: Vec<i64> = c.extract().map_err(|_| {
-        PyValueError::new_err(format!(
-            "{F}: constrained: expected None, a boolean mask of length {n} or key indices"
-        ))
-    })?;
-    if indices.len() > n.saturating_mul(4).max(64) {
-        return Err(PyValueError::new_err(format!(
-            "{F}: constrained: {} indices for {n} keys",
-            indices.len()
-        )));
-    }
-    let mut mask = vec![false; n];
+    let indices = args::int_list(F, "constrained", c, most_indices)?;
+    let mut mask = try_vec(n, "constrained mask").map_err(|e| to_py_err(F, e))?;
+    mask.resize(n, false);
     for i in indices {
         let j = if i < 0 { i + n as i64 } else { i };
         if j < 0 || j >= n as i64 {

@@ -8,11 +8,12 @@
 //! message names the function too while the signature keeps its literal default).
 
 use numpy::ndarray::Dimension;
-use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn};
+use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyFloat, PyString};
 
+use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::sweep::MAX_STEPS;
 use polyscrew::MAX_LEVELS;
 
@@ -111,6 +112,10 @@ pub fn int_array<'py>(
             'f' => {
                 let floats = float_array(function, what, &array)?;
                 let view = floats.as_array();
+                // the int64 copy made below, checked before the entries are even scanned
+                Footprint::of::<i64>(view.len())
+                    .check("the integer conversion", "pass fewer entries")
+                    .map_err(|e| crate::arg_err(function, what, e))?;
                 if let Some((index, value)) = view
                     .indexed_iter()
                     .find(|(_, v)| !(v.fract() == 0.0 && v.abs() < 9.2e18))
@@ -137,6 +142,142 @@ pub fn int_array<'py>(
     }
     obj.extract::<IntArray<'py>>()
         .map_err(|e| named(py, function, what, e))
+}
+
+/// Refuses a sequence (a numpy array: its first axis) of more than `max` entries before
+/// anything reads it: converting or extracting it would reserve room for all of them
+/// first (`range(2**62)`). Objects without a length pass (numpy or the reader judges them).
+fn check_len(function: &str, what: &str, obj: &Bound<'_, PyAny>, max: Most) -> PyResult<()> {
+    if obj.is_instance_of::<PyString>() {
+        return Ok(());
+    }
+    let Ok(len) = obj.call_method0("__len__") else {
+        return Ok(());
+    };
+    match len.extract::<usize>() {
+        Ok(n) if n <= max.count() => Ok(()),
+        _ => Err(too_long(
+            function,
+            what,
+            max,
+            len.str().map_or_else(|_| "?".to_owned(), |s| s.to_string()),
+        )),
+    }
+}
+
+/// How many entries a sequence argument may have.
+#[derive(Debug, Clone, Copy)]
+pub enum Most {
+    /// Exactly this many (fewer are the caller's error).
+    Exactly(usize),
+    /// At most this many.
+    AtMost(usize),
+}
+
+impl Most {
+    fn count(self) -> usize {
+        match self {
+            Self::Exactly(n) | Self::AtMost(n) => n,
+        }
+    }
+}
+
+/// The `ValueError` of a sequence longer than `max`: `"{what}: expected (at most) {max}
+/// entries, got {len}"`.
+fn too_long(function: &str, what: &str, max: Most, len: String) -> PyErr {
+    let expected = match max {
+        Most::Exactly(n) => n.to_string(),
+        Most::AtMost(n) => format!("at most {n}"),
+    };
+    PyValueError::new_err(format!(
+        "{function}: {what}: expected {expected} entries, got {len}"
+    ))
+}
+
+/// Reads a sequence of at most `max` Python objects (a `ValueError` for more, checked before
+/// anything is reserved for them; a `TypeError` for a str or anything that is not a
+/// sequence, the message saying it `expected` ...).
+pub fn sequence<'py>(
+    function: &str,
+    what: &str,
+    obj: &Bound<'py, PyAny>,
+    max: Most,
+    expected: &str,
+) -> PyResult<Vec<Bound<'py, PyAny>>> {
+    let not_a_sequence = || {
+        PyTypeError::new_err(format!(
+            "{function}: {what}: expected {expected}, got {}",
+            type_name(obj)
+        ))
+    };
+    if obj.is_instance_of::<PyString>() {
+        return Err(not_a_sequence());
+    }
+    let seq = obj
+        .cast::<pyo3::types::PySequence>()
+        .map_err(|_| not_a_sequence())?;
+    check_len(function, what, obj, max)?;
+    let n = seq.len().map_err(|e| named(obj.py(), function, what, e))?;
+    let mut out = try_vec(n, "input sequence").map_err(|e| crate::to_py_err(function, e))?;
+    for i in 0..n {
+        out.push(
+            seq.get_item(i)
+                .map_err(|e| named(obj.py(), function, what, e))?,
+        );
+    }
+    Ok(out)
+}
+
+/// Reads a boolean array-like through numpy, copied within the memory budget: its shape and
+/// its entries in row-major order, or `None` when its entries are not booleans (the caller
+/// may read it as something else). A sequence of more than `max_len` entries is refused
+/// before numpy reads it.
+pub fn bool_array(
+    function: &str,
+    what: &str,
+    obj: &Bound<'_, PyAny>,
+    max_len: Most,
+) -> PyResult<Option<(Vec<usize>, Vec<bool>)>> {
+    check_len(function, what, obj, max_len)?;
+    let array = as_numpy(function, what, obj)?;
+    if dtype_kind(&array)? != 'b' {
+        return Ok(None);
+    }
+    let array = array
+        .cast_into::<PyArrayDyn<bool>>()
+        .map_err(|e| named(obj.py(), function, what, e.into()))?;
+    let shape = array.shape().to_vec();
+    let total = array.len();
+    Footprint::of::<bool>(total)
+        .check("the boolean mask", "pass a smaller mask")
+        .map_err(|e| crate::to_py_err(function, e))?;
+    let readonly = array.readonly();
+    let mut out = try_vec(total, "boolean mask").map_err(|e| crate::to_py_err(function, e))?;
+    out.extend(readonly.as_array().iter().copied());
+    Ok(Some((shape, out)))
+}
+
+/// Reads a 1-D integer array-like of at most `max_len` entries ([`int_array`]'s rules),
+/// copied within the memory budget; the length is checked before numpy reads a sequence.
+pub fn int_list(
+    function: &str,
+    what: &str,
+    obj: &Bound<'_, PyAny>,
+    max_len: Most,
+) -> PyResult<Vec<i64>> {
+    check_len(function, what, obj, max_len)?;
+    let array = int_array(function, what, obj)?;
+    let view = array.as_array();
+    if view.ndim() != 1 {
+        return Err(crate::shape_err(function, what, "(N,)", view.shape()));
+    }
+    if view.len() > max_len.count() {
+        return Err(too_long(function, what, max_len, view.len().to_string()));
+    }
+    let mut out =
+        try_vec(view.len(), "input integers").map_err(|e| crate::to_py_err(function, e))?;
+    out.extend(view.iter().copied());
+    Ok(out)
 }
 
 fn as_numpy<'py>(

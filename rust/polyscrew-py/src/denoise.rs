@@ -8,8 +8,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyList;
 
 use polyscrew::denoise::{MAX_DENOISE_BATCH, MAX_DENOISE_POSES, MIN_DENOISE_POSES};
+use polyscrew::memory::try_vec;
 use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
 
+use crate::args::Most;
 use crate::{read_vector, shape_err, to_py_err};
 
 const F: &str = "denoise";
@@ -32,7 +34,7 @@ fn read_clips(array: ArrayViewD<'_, f64>) -> PyResult<(Vec<Pose>, usize, usize, 
             "{F}: poses: {n} poses given, at least {MIN_DENOISE_POSES} needed"
         )));
     }
-    let mut poses = Vec::with_capacity(bodies * n);
+    let mut poses = try_vec(bodies * n, "input poses").map_err(|e| to_py_err(F, e))?;
     let mut m = [[0.0; 4]; 4];
     let mut it = array.iter();
     for g in 0..bodies * n {
@@ -75,7 +77,8 @@ fn read_strength(strength: Option<&Bound<'_, PyAny>>) -> PyResult<Strength> {
     })
 }
 
-/// `held`: None, a boolean mask (N,) for every body or (B, N).
+/// `held`: None, a boolean mask (N,) for every body or (B, N) (read through numpy, its
+/// length checked before anything is reserved for it).
 fn read_held(
     held: Option<&Bound<'_, PyAny>>,
     bodies: usize,
@@ -89,19 +92,21 @@ fn read_held(
             "{F}: held: expected a boolean mask of shape ({n},) or ({bodies}, {n})"
         ))
     };
-    if let Ok(mask) = h.extract::<Vec<bool>>() {
-        if mask.len() != n {
-            return Err(err());
-        }
-        return Ok(Some(
-            mask.iter().copied().cycle().take(bodies * n).collect(),
-        ));
-    }
-    let rows: Vec<Vec<bool>> = h.extract().map_err(|_| err())?;
-    if rows.len() != bodies || rows.iter().any(|r| r.len() != n) {
+    let Some((shape, mask)) = crate::args::bool_array(F, "held", h, Most::AtMost(n.max(bodies)))?
+    else {
         return Err(err());
+    };
+    match shape.as_slice() {
+        [m] if *m == n => {
+            let mut all = try_vec(bodies * n, "held mask").map_err(|e| to_py_err(F, e))?;
+            for _ in 0..bodies {
+                all.extend_from_slice(&mask);
+            }
+            Ok(Some(all))
+        }
+        [b, m] if *b == bodies && *m == n => Ok(Some(mask)),
+        _ => Err(err()),
     }
-    Ok(Some(rows.concat()))
 }
 
 /// The result of `denoise`: the smooth poses and what was chosen.
@@ -214,14 +219,13 @@ impl PyDenoised {
     }
 
     fn __repr__(&self) -> String {
-        let r = &self.results[0];
-        if self.batch {
-            format!("Denoised({} bodies x {} poses)", self.results.len(), self.n)
-        } else {
-            format!(
+        match (&self.results[..], self.batch) {
+            (_, true) => format!("Denoised({} bodies x {} poses)", self.results.len(), self.n),
+            ([r, ..], false) => format!(
                 "Denoised({} poses, rotation_strength={:.4}, translation_strength={:.4}, rotation_noise={:.3e}, translation_noise={:.3e})",
                 self.n, r.rotation_strength, r.translation_strength, r.rotation_noise, r.translation_noise
-            )
+            ),
+            ([], false) => format!("Denoised({} poses)", self.n),
         }
     }
 }

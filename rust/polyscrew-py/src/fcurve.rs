@@ -6,66 +6,93 @@
 //! integer array and its meaning is still fixed by names, never by Blender's internal values.
 
 use numpy::ndarray::{Array2, ArrayViewD};
-use numpy::{AllowTypeChange, IntoPyArray, PyArray2, PyArrayLikeDyn};
+use numpy::{IntoPyArray, PyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 
 use polyscrew::fcurve::{
-    evaluate_packed, key::DEFAULT_AMPLITUDE, key::DEFAULT_BACK, key::DEFAULT_PERIOD, CycleMode,
-    Cycles, Easing, Extrapolation, FrameRange, Interpolation, PackedCurves, MAX_KEYS, MAX_VALUES,
+    check_batch_with, evaluate_packed, key::DEFAULT_AMPLITUDE, key::DEFAULT_BACK,
+    key::DEFAULT_PERIOD, packed_footprint, CycleMode, Cycles, Easing, Extrapolation, FrameRange,
+    Interpolation, PackedCurves, MAX_KEYS, MAX_VALUES,
 };
+use polyscrew::memory::{try_vec, Footprint};
 
-use crate::{read_vector, shape_err, to_py_err, FloatArray};
-
-/// An integer array-like argument converted to int64 on the way in.
-type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+use crate::args::{self, float_array, int_array, FloatArray, IntArray, Most};
+use crate::{read_vector, shape_err, to_py_err, vector_len};
 
 const F: &str = "evaluate_fcurves";
 
-/// Reads `(K, 2)` pairs, flattened.
+/// Reads `(K, 2)` pairs, flattened (allocated fallibly: the caller checked the budget).
 fn read_pairs(f: &str, what: &str, array: ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
     let shape = array.shape();
     if shape.len() != 2 || shape[1] != 2 {
         return Err(shape_err(f, what, "(K, 2)", shape));
     }
-    Ok(array.iter().copied().collect())
+    let mut out = try_vec(array.len(), "input pairs").map_err(|e| to_py_err(f, e))?;
+    out.extend(array.iter().copied());
+    Ok(out)
 }
 
-/// Reads a 1-D integer array.
+/// Reads a 1-D integer array (allocated fallibly: the caller checked the budget).
 fn read_ints(f: &str, what: &str, array: ArrayViewD<'_, i64>) -> PyResult<Vec<i64>> {
     if array.ndim() != 1 {
         return Err(shape_err(f, what, "(N,)", array.shape()));
     }
-    Ok(array.iter().copied().collect())
+    let mut out = try_vec(array.len(), "input integers").map_err(|e| to_py_err(f, e))?;
+    out.extend(array.iter().copied());
+    Ok(out)
+}
+
+/// `n` copies of `value`, allocated fallibly.
+fn filled<T: Clone>(f: &str, value: T, n: usize, what: &'static str) -> PyResult<Vec<T>> {
+    let mut out = try_vec(n, what).map_err(|e| to_py_err(f, e))?;
+    out.resize(n, value);
+    Ok(out)
 }
 
 /// A per-key float array, or `k` copies of `default` when it is not given.
 fn read_per_key(
     f: &str,
     what: &str,
-    array: Option<FloatArray<'_>>,
+    array: Option<&FloatArray<'_>>,
     k: usize,
     default: f32,
 ) -> PyResult<Vec<f64>> {
     match array {
         Some(a) => read_vector(f, what, &a.as_array()),
-        None => Ok(vec![default as f64; k]),
+        None => filled(f, default as f64, k, "per-key values"),
     }
 }
 
-/// One extrapolation name for every curve, or a sequence of `c` names.
+/// An optional float array-like (`None` stays `None`).
+fn optional_floats<'py>(
+    f: &str,
+    what: &str,
+    a: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Option<FloatArray<'py>>> {
+    a.filter(|a| !a.is_none())
+        .map(|a| float_array(f, what, a))
+        .transpose()
+}
+
+/// One extrapolation name for every curve, or a sequence of `c` names (more are refused
+/// before anything is reserved for them).
 fn read_extrapolation(f: &str, arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec<Extrapolation>> {
     let parse = |name: &str| Extrapolation::from_name(name).map_err(|e| to_py_err(f, e));
     if let Ok(name) = arg.cast::<PyString>() {
-        return Ok(vec![parse(name.to_str()?)?; c]);
+        return filled(f, parse(name.to_str()?)?, c, "extrapolations");
     }
-    let names: Vec<String> = arg.extract().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "{f}: extrapolation: expected a name or a sequence of names"
-        ))
-    })?;
-    names.iter().map(|n| parse(n)).collect()
+    let expected = "a name or a sequence of names";
+    let items = args::sequence(f, "extrapolation", arg, Most::Exactly(c), expected)?;
+    let mut out = try_vec(items.len(), "extrapolations").map_err(|e| to_py_err(f, e))?;
+    for item in &items {
+        let name = item.cast::<PyString>().map_err(|_| {
+            PyTypeError::new_err(format!("{f}: extrapolation: expected {expected}"))
+        })?;
+        out.push(parse(name.to_str()?)?);
+    }
+    Ok(out)
 }
 
 /// The keys a Cycles settings dict may hold: the RNA property names of `FModifierCycles`.
@@ -156,11 +183,13 @@ fn read_cycles_list(
     let Some(arg) = arg.filter(|a| !a.is_none()) else {
         return Ok(Vec::new());
     };
-    let items: Vec<Bound<'_, PyAny>> = arg.extract().map_err(|_| {
-        PyTypeError::new_err(format!(
-            "{f}: cycles: expected a sequence of dicts or None, one per curve"
-        ))
-    })?;
+    let items = args::sequence(
+        f,
+        "cycles",
+        arg,
+        Most::Exactly(c),
+        "a sequence of dicts or None, one per curve",
+    )?;
     if items.len() != c {
         return Err(PyValueError::new_err(format!(
             "{f}: cycles: expected {c} entries (one per curve), got {}",
@@ -199,42 +228,82 @@ pub(crate) struct CurveArgs {
 }
 
 impl CurveArgs {
-    /// Reads the arguments (errors name `function` and the argument).
+    /// Reads the arguments (errors name `function` and the argument): every array through
+    /// the module's readers ([`float_array`], [`int_array`]: no silent casts), then the
+    /// batch's sizes and everything the call will hold (the core's [`check_batch_with`]:
+    /// the copies made here, `extra` bytes more the caller holds and the evaluation at
+    /// `times` times) checked before anything is copied.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn read<'py>(
         function: &str,
-        offsets: IntArray<'py>,
-        co: FloatArray<'py>,
-        handle_left: FloatArray<'py>,
-        handle_right: FloatArray<'py>,
-        interpolation: IntArray<'py>,
-        easing: IntArray<'py>,
-        extrapolation: Option<Bound<'py, PyAny>>,
-        back: Option<FloatArray<'py>>,
-        amplitude: Option<FloatArray<'py>>,
-        period: Option<FloatArray<'py>>,
-        cycles: Option<Bound<'py, PyAny>>,
+        times: usize,
+        extra: Footprint,
+        offsets: &Bound<'py, PyAny>,
+        co: &Bound<'py, PyAny>,
+        handle_left: &Bound<'py, PyAny>,
+        handle_right: &Bound<'py, PyAny>,
+        interpolation: &Bound<'py, PyAny>,
+        easing: &Bound<'py, PyAny>,
+        extrapolation: Option<&Bound<'py, PyAny>>,
+        back: Option<&Bound<'py, PyAny>>,
+        amplitude: Option<&Bound<'py, PyAny>>,
+        period: Option<&Bound<'py, PyAny>>,
+        cycles: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         let f = function;
-        let offsets = read_ints(f, "offsets", offsets.as_array())?;
-        let c = offsets.len().saturating_sub(1);
-        let co = read_pairs(f, "co", co.as_array())?;
-        let k = co.len() / 2;
+        let offsets: IntArray<'py> = int_array(f, "offsets", offsets)?;
+        let co = float_array(f, "co", co)?;
+        let handle_left = float_array(f, "handle_left", handle_left)?;
+        let handle_right = float_array(f, "handle_right", handle_right)?;
+        let interpolation = int_array(f, "interpolation", interpolation)?;
+        let easing = int_array(f, "easing", easing)?;
+        let back = optional_floats(f, "back", back)?;
+        let amplitude = optional_floats(f, "amplitude", amplitude)?;
+        let period = optional_floats(f, "period", period)?;
+
+        let offsets_view = offsets.as_array();
+        if offsets_view.ndim() != 1 {
+            return Err(shape_err(f, "offsets", "(N,)", offsets_view.shape()));
+        }
+        let c = offsets_view.len().saturating_sub(1);
+        let co_view = co.as_array();
+        let shape = co_view.shape();
+        if shape.len() != 2 || shape[1] != 2 {
+            return Err(shape_err(f, "co", "(K, 2)", shape));
+        }
+        let k = shape[0];
+        // What is copied here: the packed arrays of `c` curves at the length of the longest
+        // given (a wrong length is the core's error, found after the copy).
+        let pairs = [&co, &handle_left, &handle_right]
+            .into_iter()
+            .map(|a| a.as_array().len().div_ceil(2));
+        let singles = [&interpolation, &easing]
+            .into_iter()
+            .map(|a| a.as_array().len())
+            .chain(
+                [&back, &amplitude, &period]
+                    .into_iter()
+                    .map(|a| a.as_ref().map_or(0, |a| a.as_array().len())),
+            );
+        let rows = pairs.chain(singles).fold(k, usize::max);
+        let copies = packed_footprint(c, rows);
+        check_batch_with(c, k, times, copies + extra).map_err(|e| to_py_err(f, e))?;
+
         Ok(Self {
-            offsets,
-            co,
+            offsets: read_ints(f, "offsets", offsets_view)?,
+            co: read_pairs(f, "co", co_view)?,
             handle_left: read_pairs(f, "handle_left", handle_left.as_array())?,
             handle_right: read_pairs(f, "handle_right", handle_right.as_array())?,
             interpolation: read_ints(f, "interpolation", interpolation.as_array())?,
             easing: read_ints(f, "easing", easing.as_array())?,
-            back: read_per_key(f, "back", back, k, DEFAULT_BACK)?,
-            amplitude: read_per_key(f, "amplitude", amplitude, k, DEFAULT_AMPLITUDE)?,
-            period: read_per_key(f, "period", period, k, DEFAULT_PERIOD)?,
-            extrapolation: match extrapolation.as_ref().filter(|e| !e.is_none()) {
+            back: read_per_key(f, "back", back.as_ref(), k, DEFAULT_BACK)?,
+            amplitude: read_per_key(f, "amplitude", amplitude.as_ref(), k, DEFAULT_AMPLITUDE)?,
+            period: read_per_key(f, "period", period.as_ref(), k, DEFAULT_PERIOD)?,
+            extrapolation: match extrapolation.filter(|e| !e.is_none()) {
                 Some(e) => read_extrapolation(f, e, c)?,
-                None => vec![Extrapolation::Constant; c],
+                None => filled(f, Extrapolation::Constant, c, "extrapolations")?,
             },
-            cycles: read_cycles_list(f, cycles.as_ref(), c)?,
+            cycles: read_cycles_list(f, cycles, c)?,
         })
     }
 
@@ -271,22 +340,25 @@ impl CurveArgs {
 #[allow(clippy::too_many_arguments)]
 fn evaluate_fcurves<'py>(
     py: Python<'py>,
-    times: FloatArray<'py>,
-    offsets: IntArray<'py>,
-    co: FloatArray<'py>,
-    handle_left: FloatArray<'py>,
-    handle_right: FloatArray<'py>,
-    interpolation: IntArray<'py>,
-    easing: IntArray<'py>,
-    extrapolation: Option<Bound<'py, PyAny>>,
-    back: Option<FloatArray<'py>>,
-    amplitude: Option<FloatArray<'py>>,
-    period: Option<FloatArray<'py>>,
-    cycles: Option<Bound<'py, PyAny>>,
+    times: &Bound<'py, PyAny>,
+    offsets: &Bound<'py, PyAny>,
+    co: &Bound<'py, PyAny>,
+    handle_left: &Bound<'py, PyAny>,
+    handle_right: &Bound<'py, PyAny>,
+    interpolation: &Bound<'py, PyAny>,
+    easing: &Bound<'py, PyAny>,
+    extrapolation: Option<&Bound<'py, PyAny>>,
+    back: Option<&Bound<'py, PyAny>>,
+    amplitude: Option<&Bound<'py, PyAny>>,
+    period: Option<&Bound<'py, PyAny>>,
+    cycles: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let times = read_vector(F, "times", &times.as_array())?;
+    let times = float_array(F, "times", times)?;
+    let n = vector_len(F, "times", &times)?;
     let args = CurveArgs::read(
         F,
+        n,
+        Footprint::of::<f64>(n), // the copy of the times
         offsets,
         co,
         handle_left,
@@ -299,9 +371,9 @@ fn evaluate_fcurves<'py>(
         period,
         cycles,
     )?;
+    let times = read_vector(F, "times", &times.as_array())?;
     let packed = args.packed();
     let c = packed.len();
-    let n = times.len();
     let values = py
         .detach(|| evaluate_packed(&packed, &times))
         .map_err(|e| to_py_err(F, e))?;

@@ -8,7 +8,7 @@ use numpy::{IntoPyArray, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use polyscrew::feature::motion::{feature_footprint, FEATURE_HINT};
-use polyscrew::memory::Footprint;
+use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{
     feature_motion as core_feature_motion, register as core_register, CurveScheme, FeatureSpec,
     InertiaFrame, Parametrization, Pose, Stiffness, Timing,
@@ -31,48 +31,97 @@ fn points_len(points: Option<&crate::FloatArray<'_>>) -> usize {
     points.map_or(6, |p| p.as_array().shape().first().copied().unwrap_or(0))
 }
 
-/// Parses the design options shared by `feature_motion` and `sample_feature`.
+/// The `stiffness` argument, read but not yet one value per key (that copy waits for the
+/// memory budget's check).
+enum StiffnessArg<'py> {
+    /// Not given.
+    Absent,
+    /// One value for every key.
+    Scalar(f64),
+    /// One value per key (its length is checked by the core).
+    PerKey(crate::FloatArray<'py>),
+}
+
+impl StiffnessArg<'_> {
+    /// The values the keys' stiffness will hold.
+    fn len(&self, n: usize) -> usize {
+        match self {
+            Self::Absent => 0,
+            Self::Scalar(_) => n,
+            Self::PerKey(a) => a.as_array().len(),
+        }
+    }
+
+    /// The keys' stiffness (`n` copies of a scalar), allocated fallibly: after the budget.
+    fn keys(&self, function: &str, n: usize) -> PyResult<Option<Vec<f64>>> {
+        match self {
+            Self::Absent => Ok(None),
+            Self::Scalar(v) => {
+                let mut out = try_vec(n, "stiffness").map_err(|e| to_py_err(function, e))?;
+                out.resize(n, *v);
+                Ok(Some(out))
+            }
+            Self::PerKey(a) => read_vector(function, "stiffness", &a.as_array()).map(Some),
+        }
+    }
+}
+
+/// Parses the design options shared by `feature_motion` and `sample_feature`; the keys'
+/// stiffness is left to [`StiffnessArg::keys`] (after the budget's check).
 #[allow(clippy::too_many_arguments)]
-fn read_feature_spec(
+fn read_feature_spec<'py>(
     function: &str,
-    n: usize,
     scheme: &str,
     levels: u32,
     closed: bool,
     parametrization: &str,
-    stiffness: Option<&Bound<'_, PyAny>>,
-    inserted_stiffness: Option<&Bound<'_, PyAny>>,
-) -> PyResult<FeatureSpec> {
+    stiffness: Option<&Bound<'py, PyAny>>,
+    inserted_stiffness: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(FeatureSpec, StiffnessArg<'py>)> {
     let scheme = CurveScheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
     let parametrization =
         Parametrization::from_name(parametrization).map_err(|e| to_py_err(function, e))?;
     let keys = match stiffness.filter(|s| !s.is_none()) {
-        None => None,
+        None => StiffnessArg::Absent,
         Some(s) => {
             if s.is_instance_of::<pyo3::types::PyFloat>()
                 || s.is_instance_of::<pyo3::types::PyInt>()
             {
-                Some(vec![args::float_scalar(function, "stiffness", s)?; n])
+                StiffnessArg::Scalar(args::float_scalar(function, "stiffness", s)?)
             } else {
                 let a = float_array(function, "stiffness", s)?;
                 let view = a.as_array();
                 if view.ndim() == 0 {
-                    Some(vec![view.iter().next().copied().unwrap_or(f64::NAN); n])
+                    StiffnessArg::Scalar(view.iter().next().copied().unwrap_or(f64::NAN))
                 } else {
-                    Some(read_vector(function, "stiffness", &view)?)
+                    if view.ndim() != 1 {
+                        return Err(crate::shape_err(
+                            function,
+                            "stiffness",
+                            "(N,)",
+                            view.shape(),
+                        ));
+                    }
+                    StiffnessArg::PerKey(a)
                 }
             }
         }
     };
     let inserted = args::optional_float(function, "inserted_stiffness", inserted_stiffness)?
         .unwrap_or(f64::INFINITY);
-    Ok(FeatureSpec {
-        scheme,
-        levels,
-        closed,
-        parametrization,
-        stiffness: Stiffness { keys, inserted },
-    })
+    Ok((
+        FeatureSpec {
+            scheme,
+            levels,
+            closed,
+            parametrization,
+            stiffness: Stiffness {
+                keys: None,
+                inserted,
+            },
+        },
+        keys,
+    ))
 }
 
 /// register_points(src, dst, weights=None) -> ndarray
@@ -176,9 +225,8 @@ fn feature_motion<'py>(
     const F: &str = FeatureMotion::NAME;
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
-    let spec = read_feature_spec(
+    let (mut spec, stiffness) = read_feature_spec(
         F,
-        n,
         scheme,
         levels,
         closed,
@@ -200,11 +248,13 @@ fn feature_motion<'py>(
         F,
         Footprint::of::<Pose>(n)
             + Footprint::of::<DVec3>(k)
+            + Footprint::of::<f64>(stiffness.len(n))
             + feature_footprint(n, k, &spec)
             + Footprint::of::<[f64; 16]>(out_len),
         "the feature-point motion",
         FEATURE_HINT,
     )?;
+    spec.stiffness.keys = stiffness.keys(F, n)?;
     let views = (poses.as_array(), points.as_ref().map(|p| p.as_array()));
     let out = py.detach(|| -> PyResult<_> {
         let (v, p) = &views;
@@ -248,9 +298,8 @@ fn sample_feature<'py>(
     const F: &str = SampleFeature::NAME;
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
-    let spec = read_feature_spec(
+    let (mut spec, stiffness) = read_feature_spec(
         F,
-        n,
         scheme,
         levels,
         closed,
@@ -274,6 +323,7 @@ fn sample_feature<'py>(
         Footprint::of::<Pose>(n)
             + Footprint::of::<f64>(n_key_times + m)
             + Footprint::of::<DVec3>(k)
+            + Footprint::of::<f64>(stiffness.len(n))
             + feature_footprint(n, k, &spec)
             + Footprint::of::<f64>(n.saturating_add(1)).times(2)
             + Footprint::of::<Pose>(m)
@@ -281,6 +331,7 @@ fn sample_feature<'py>(
         "the sampled feature-point motion",
         FEATURE_HINT,
     )?;
+    spec.stiffness.keys = stiffness.keys(F, n)?;
     let views = (
         poses.as_array(),
         key_times.as_array(),

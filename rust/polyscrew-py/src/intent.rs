@@ -18,11 +18,11 @@ use polyscrew::intent::{
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode};
 
-use crate::args::{self, float_array, Function, IntArray, KeysParameters};
+use crate::args::{self, float_array, Function, KeysParameters, Most};
 use crate::fcurve::CurveArgs;
 use crate::{
-    check_budget, key_count, pose_count, read_poses, read_vector, shape_err, to_py_err, vector_len,
-    FloatArray,
+    check_budget, key_count, pose_count, read_keys, read_poses, read_vector, shape_err, to_py_err,
+    vector_len,
 };
 
 /// How to ask these functions for less memory.
@@ -74,26 +74,38 @@ impl PyPlayback {
         unkeyed: &Bound<'py, PyAny>,
         mode: &Bound<'py, PyAny>,
         #[pyo3(from_py_with = located)] located: bool,
-        offsets: IntArray<'py>,
-        co: FloatArray<'py>,
-        handle_left: FloatArray<'py>,
-        handle_right: FloatArray<'py>,
-        interpolation: IntArray<'py>,
-        easing: IntArray<'py>,
-        extrapolation: Option<Bound<'py, PyAny>>,
-        back: Option<FloatArray<'py>>,
-        amplitude: Option<FloatArray<'py>>,
-        period: Option<FloatArray<'py>>,
-        cycles: Option<Bound<'py, PyAny>>,
+        offsets: &Bound<'py, PyAny>,
+        co: &Bound<'py, PyAny>,
+        handle_left: &Bound<'py, PyAny>,
+        handle_right: &Bound<'py, PyAny>,
+        interpolation: &Bound<'py, PyAny>,
+        easing: &Bound<'py, PyAny>,
+        extrapolation: Option<&Bound<'py, PyAny>>,
+        back: Option<&Bound<'py, PyAny>>,
+        amplitude: Option<&Bound<'py, PyAny>>,
+        period: Option<&Bound<'py, PyAny>>,
+        cycles: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         const F: &str = "Playback";
         let mode = RotationMode::from_name(args::str_arg(F, "mode", mode)?)
             .map_err(|e| to_py_err(F, e))?;
-        let pairs: Vec<(String, i64)> = channels.extract().map_err(|_| {
-            PyTypeError::new_err(format!(
-                "{F}: channels: expected a sequence of (property, index) pairs"
-            ))
-        })?;
+        // One curve per channel of the row at most (more drive a channel twice).
+        let expected = "a sequence of (property, index) pairs";
+        let items = args::sequence(
+            F,
+            "channels",
+            channels,
+            Most::AtMost(6 + mode.width()),
+            expected,
+        )?;
+        let pairs = items
+            .iter()
+            .map(|item| {
+                item.extract::<(String, i64)>().map_err(|_| {
+                    PyTypeError::new_err(format!("{F}: channels: expected {expected}"))
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
         let channels = pairs
             .iter()
             .enumerate()
@@ -111,9 +123,11 @@ impl PyPlayback {
             })
             .collect::<PyResult<Vec<_>>>()?;
         let unkeyed = float_array(F, "unkeyed", unkeyed)?;
-        let unkeyed = read_vector(F, "unkeyed", &unkeyed.as_array())?;
+        let width = vector_len(F, "unkeyed", &unkeyed)?;
         let args = CurveArgs::read(
             F,
+            0,
+            Footprint::of::<f64>(width), // the copy of the owner's values
             offsets,
             co,
             handle_left,
@@ -126,6 +140,7 @@ impl PyPlayback {
             period,
             cycles,
         )?;
+        let unkeyed = read_vector(F, "unkeyed", &unkeyed.as_array())?;
         let packed = args.packed();
         let inner = py
             .detach(|| {
@@ -319,10 +334,7 @@ fn keys_parameters<'py>(
         let key_frames = read_vector(F, "key_frames", &kv)?;
         let frames = read_vector(F, "frames", &fv)?;
         let smoothed = if is_keys {
-            if pv.ndim() != 3 {
-                return Err(shape_err(F, "poses", "(N, 4, 4)", pv.shape()));
-            }
-            Smoothed::Keys(read_poses(F, "poses", &pv)?)
+            Smoothed::Keys(read_keys(F, &pv)?)
         } else {
             Smoothed::Given(read_poses(F, "smooth", &pv)?)
         };

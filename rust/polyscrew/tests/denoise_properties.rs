@@ -399,6 +399,20 @@ fn bad_input_is_an_error() {
         denoise_batch(&poses, 2, &times, None, &o, 1),
         Err(Error::LengthMismatch { what: "poses", .. })
     ));
+    // No bodies: the times and options are checked all the same, and the result is empty.
+    let mut nan = times.clone();
+    nan[3] = f64::NAN;
+    assert!(matches!(
+        denoise_batch(&[], 0, &nan, None, &o, 1),
+        Err(Error::KeyTimes { index: 3 })
+    ));
+    assert!(matches!(
+        denoise_batch(&[], 0, &times, None, &DenoiseOptions { order: 5, ..o }, 1),
+        Err(Error::Invalid { what: "order", .. })
+    ));
+    assert!(denoise_batch(&[], 0, &times, None, &o, 1)
+        .unwrap()
+        .is_empty());
     // Values so large that the computation overflows: an error, not NaN.
     let huge: Vec<Pose> = poses
         .iter()

@@ -73,10 +73,6 @@ pub const MIN_DENOISE_POSES: usize = 4;
 /// refinement still moved it on the hard stop clip, a third did not.
 pub const PIVOT_REFINEMENTS: usize = 2;
 
-/// A refined pivot that lowers the GCV score (at the same strength) by less than this
-/// fraction is kept without searching the strength again.
-pub const PIVOT_GAIN: f64 = 0.0;
-
 /// The most poses of one clip [`denoise`] accepts (about 12 hours at 24 frames per second;
 /// its scratch memory is about 1 kB per pose).
 pub const MAX_DENOISE_POSES: usize = 1_000_000;
@@ -255,10 +251,12 @@ pub fn denoise_batch(
             });
         }
     }
+    // The times and options are checked even for no bodies: a call is valid or not
+    // whatever the number of bodies.
+    check(n, times, options)?;
     if bodies == 0 {
         return Ok(Vec::new());
     }
-    check(n, times, options)?;
     // More threads than cores gains nothing; the count is bounded so that a huge request
     // cannot exhaust the system.
     let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
@@ -520,13 +518,9 @@ fn run<const M: usize>(
         path(next, y_t)?;
         wh.set_data(y_t);
         match wh.gcv_grid(index) {
-            Some(h) if h.score < (1.0 - PIVOT_GAIN) * g.score => {
-                c = next;
-                guess_t = Some(g.tau);
-            }
             Some(h) if h.score < g.score => {
                 c = next;
-                break (h, found);
+                guess_t = Some(g.tau);
             }
             _ => {
                 path(c, y_t)?;

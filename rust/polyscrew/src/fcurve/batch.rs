@@ -7,6 +7,7 @@ use super::cycles::Cycles;
 use super::key::{Easing, Interpolation, Key};
 use super::limits::check_batch;
 use crate::error::{Error, Result};
+use crate::memory::try_vec;
 
 /// The keys of `C` curves packed one curve after the other (`K` keys in all), as numbers and
 /// codes: the layout of `polyscrew.evaluate_fcurves`.
@@ -116,16 +117,17 @@ impl PackedCurves<'_> {
     /// # Errors
     /// [`Error::LengthMismatch`] for an array of the wrong length, [`Error::Invalid`] for bad
     /// offsets, a batch over the size limits ([`check_batch`]), an unknown code, a number that
-    /// is not finite in `float32`, keys out of time order, or a curve without keys.
+    /// is not finite in `float32`, keys out of time order, or a curve without keys;
+    /// [`Error::Memory`] when the curves exceed the memory budget or the allocator refuses.
     pub fn to_curves(&self) -> Result<Vec<FCurve>> {
         let k = self.check_lengths()?;
         check_batch(self.len(), k, 0)?;
         let f = |v: f64| v as f32;
-        let mut curves = Vec::with_capacity(self.len());
+        let mut curves = try_vec(self.len(), "F-curves")?;
         for c in 0..self.len() {
             // Offsets are checked: non-negative, non-decreasing, ending at k.
             let (lo, hi) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
-            let mut keys = Vec::with_capacity(hi - lo);
+            let mut keys = try_vec(hi - lo, "F-curve keys")?;
             for i in lo..hi {
                 let code_err = |e: Error| match e {
                     Error::Invalid { what, reason } => Error::Invalid {
@@ -166,11 +168,12 @@ impl PackedCurves<'_> {
 /// # Errors
 /// [`Error::Invalid`] for a batch over the size limits ([`check_batch`]) or a value that is
 /// not finite (naming the curve and the time), [`Error::NotFinite`] for a time that is not
-/// finite in `float32`.
+/// finite in `float32`, [`Error::Memory`] when the evaluation exceeds the memory budget
+/// ([`check_batch`]: the curves, the times and the values) or the allocator refuses.
 pub fn evaluate_fcurves(curves: &[FCurve], times: &[f64]) -> Result<Vec<f64>> {
     let keys = curves.iter().map(|c| c.keys().len()).sum();
     check_batch(curves.len(), keys, times.len())?;
-    let mut t32 = Vec::with_capacity(times.len());
+    let mut t32 = try_vec(times.len(), "F-curve times")?;
     for (index, &t) in times.iter().enumerate() {
         let t = t as f32;
         if !t.is_finite() {
@@ -181,7 +184,7 @@ pub fn evaluate_fcurves(curves: &[FCurve], times: &[f64]) -> Result<Vec<f64>> {
         }
         t32.push(t);
     }
-    let mut out = Vec::with_capacity(curves.len() * times.len());
+    let mut out = try_vec(curves.len() * times.len(), "F-curve values")?;
     for (c, curve) in curves.iter().enumerate() {
         for (i, &t) in t32.iter().enumerate() {
             let v = curve.evaluate_f32(t);

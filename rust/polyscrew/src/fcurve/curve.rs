@@ -7,6 +7,7 @@ use super::cycles::Cycles;
 use super::easing::ease;
 use super::key::{from_code, from_name, Interpolation, Key};
 use crate::error::{Error, Result};
+use crate::memory::try_vec;
 
 /// Blender's key search threshold in `fcurve_eval_keyframes_interpolate` (`0.0001`): a time
 /// within this of a key (in frames) takes that key's value.
@@ -74,7 +75,7 @@ impl FCurve {
     /// # Errors
     /// [`Error::Invalid`] when `keys` is empty, a key has a non-finite number (naming the key
     /// and the field), a key's frame is before the previous key's, or the modifier has a
-    /// non-finite number.
+    /// non-finite number; [`Error::Memory`] when the allocator refuses the Bezier segments.
     pub fn new(
         keys: Vec<Key>,
         extrapolation: Extrapolation,
@@ -133,14 +134,11 @@ impl FCurve {
                 e => e,
             })?;
         }
-        let bezier = keys
-            .windows(2)
-            .map(|w| {
-                (w[0].interpolation == Interpolation::Bezier).then(|| {
-                    BezierSegment::new(w[0].co, w[0].handle_right, w[1].handle_left, w[1].co)
-                })
-            })
-            .collect();
+        let mut bezier = try_vec(keys.len() - 1, "Bezier segments")?;
+        bezier.extend(keys.windows(2).map(|w| {
+            (w[0].interpolation == Interpolation::Bezier)
+                .then(|| BezierSegment::new(w[0].co, w[0].handle_right, w[1].handle_left, w[1].co))
+        }));
         Ok(Self {
             keys,
             extrapolation,

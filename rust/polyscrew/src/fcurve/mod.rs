@@ -64,4 +64,6 @@ pub use batch::{evaluate_fcurves, evaluate_packed, PackedCurves};
 pub use curve::{Extrapolation, FCurve};
 pub use cycles::{CycleMode, Cycles, FrameRange};
 pub use key::{Easing, Interpolation, Key};
-pub use limits::{check_batch, MAX_KEYS, MAX_VALUES};
+pub use limits::{
+    batch_footprint, check_batch, check_batch_with, packed_footprint, MAX_KEYS, MAX_VALUES,
+};

@@ -8,7 +8,7 @@ use super::limits::{check_footprint, collected};
 use super::playback::Playback;
 use crate::memory::try_vec;
 use crate::motion::pose::MAX_COORDINATE;
-use crate::motion::timing::check_time;
+use crate::motion::timing::{check_period, check_time};
 use crate::{check_key_times, Error, Motion, MotionSpec, Pose, Result, Scheme, Timing};
 
 /// Steps per key span along which the travel of Blender's playback and of the smoothed
@@ -139,7 +139,7 @@ pub struct KeysTiming<'a> {
 /// # Errors
 /// [`Error::TooFew`] for fewer than two keys, the errors of
 /// [`check_key_times`] for the key frames (strictly increasing,
-/// within the time range), [`Error::Period`] for a period not beyond the keys,
+/// within the time range), [`Error::Period`] for a period [`check_period`] refuses,
 /// [`Error::Invalid`] for a size outside `(0, 1e150]` or a frame so far outside the keys that
 /// its parameter is not finite, [`Error::NotFinite`] or [`Error::OutOfRange`] for a frame
 /// outside the time range, [`Error::LengthMismatch`] when `smooth` does not hold
@@ -157,18 +157,9 @@ pub fn keys_parameters(
         return Err(Error::TooFew { got: k, need: 2 });
     }
     check_key_times(key_frames)?;
-    let first = key_frames[0];
-    let last = key_frames[k - 1];
     let mut ends = collected(k + 1, key_frames.iter().copied(), "span ends")?;
     if let Some(period) = timing.period {
-        let end = first + period;
-        if !(end.is_finite() && end > last) {
-            return Err(Error::Period {
-                period,
-                span: last - first,
-            });
-        }
-        ends.push(end);
+        ends.push(check_period(key_frames, period)?);
     }
     let spans = ends.len() - 1;
     let size = timing.size;

@@ -55,13 +55,37 @@ impl Channel {
         Ok(channel)
     }
 
-    /// Its place in a channel row of `mode`.
+    /// Its place in a channel row of `mode`, for an index within its property
+    /// ([`Channel::check`]; past it the column is another channel's, or saturates at
+    /// `usize::MAX`).
     pub fn column(self, mode: RotationMode) -> usize {
         match self {
             Self::Location(i) => i,
-            Self::Rotation(i) => 3 + i,
-            Self::Scale(i) => 3 + mode.width() + i,
+            Self::Rotation(i) => i.saturating_add(3),
+            Self::Scale(i) => i.saturating_add(3 + mode.width()),
         }
+    }
+
+    /// Checks that the index is within its property in `mode`: `0..3` for location and
+    /// scale, `0..mode.width()` for the rotation.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] (`"channels"`) naming the channel and the range.
+    pub fn check(self, mode: RotationMode) -> Result<()> {
+        let (index, size) = match self {
+            Self::Location(i) | Self::Scale(i) => (i, 3),
+            Self::Rotation(i) => (i, mode.width()),
+        };
+        if index >= size {
+            return Err(Error::Invalid {
+                what: "channels",
+                reason: format!(
+                    "{self:?}: index out of range 0..{size} (rotation mode {})",
+                    mode_name(mode)
+                ),
+            });
+        }
+        Ok(())
     }
 }
 
@@ -196,8 +220,9 @@ impl Playback {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `channels` and `curves`, or `statics` and the row
-    /// width `6 + mode.width()`, differ in length; [`Error::Invalid`] when two curves drive
-    /// one channel; [`Error::NotFinite`] for a static value that is not finite.
+    /// width `6 + mode.width()`, differ in length; [`Error::Invalid`] for a channel whose
+    /// index is outside its property ([`Channel::check`]) or when two curves drive one
+    /// channel; [`Error::NotFinite`] for a static value that is not finite.
     pub fn new(
         curves: Vec<FCurve>,
         channels: &[Channel],
@@ -225,6 +250,15 @@ impl Playback {
                 what: "static value",
                 index,
             });
+        }
+        for (c, channel) in channels.iter().enumerate() {
+            channel.check(mode).map_err(|e| match e {
+                Error::Invalid { what, reason } => Error::Invalid {
+                    what,
+                    reason: format!("channel {c}: {reason}"),
+                },
+                e => e,
+            })?;
         }
         let columns: Vec<usize> = channels.iter().map(|c| c.column(mode)).collect();
         for (c, column) in columns.iter().enumerate() {

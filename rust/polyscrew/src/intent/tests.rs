@@ -172,6 +172,48 @@ fn channels_take_curves_statics_and_ignore_location_when_not_located() {
 }
 
 #[test]
+fn playback_refuses_channels_outside_their_property() {
+    // Built directly (not by `Channel::from_property`): location[3] would read as the
+    // rotation's x and rotation[usize::MAX] overflows its column.
+    let x = curve(&[(1.0, 0.0), (2.0, 1.0)], Interpolation::Linear);
+    for (mode, channel) in [
+        (XYZ, Channel::Location(3)),
+        (XYZ, Channel::Rotation(3)),
+        (XYZ, Channel::Rotation(usize::MAX)),
+        (XYZ, Channel::Scale(3)),
+        (XYZ, Channel::Scale(usize::MAX)),
+        (RotationMode::Quaternion, Channel::Rotation(4)),
+        (RotationMode::AxisAngle, Channel::Location(usize::MAX)),
+    ] {
+        let statics = vec![0.0; 6 + mode.width()];
+        let got = Playback::new(vec![x.clone()], &[channel], statics, mode, true);
+        match got {
+            Err(Error::Invalid {
+                what: "channels",
+                reason,
+            }) => {
+                assert!(
+                    reason.contains("channel 0") && reason.contains("out of range"),
+                    "{reason}"
+                )
+            }
+            other => panic!("{channel:?} in {mode:?}: {other:?}"),
+        }
+    }
+    // The last index of each property is accepted.
+    for (mode, channel) in [
+        (XYZ, Channel::Location(2)),
+        (XYZ, Channel::Rotation(2)),
+        (RotationMode::Quaternion, Channel::Rotation(3)),
+        (RotationMode::Quaternion, Channel::Scale(2)),
+    ] {
+        let statics = vec![1.0; 6 + mode.width()];
+        let p = Playback::new(vec![x.clone()], &[channel], statics, mode, true);
+        assert!(p.is_ok(), "{channel:?} in {mode:?}: {p:?}");
+    }
+}
+
+#[test]
 fn constant_hold_pops_and_equal_keys_hold_without_pop() {
     // x: 0 -> 4 (moving), 4 held CONSTANT to frame 20 where it pops to 8, then 8 -> 8 held.
     let mut keys = vec![
@@ -428,6 +470,48 @@ fn keys_timing_follows_the_smoothed_motions_own_pace() {
             "frame {f}: u {u}, travel fraction {fraction}, time {tau}"
         );
     }
+}
+
+#[test]
+fn keys_timing_checks_the_period_as_the_time_map_does() {
+    let keys = [
+        Pose::IDENTITY,
+        Pose::from_translation(DVec3::new(4.0, 0.0, 0.0)),
+    ];
+    let smooth = screw_pace_poses(&keys, Scheme::FourPoint, 3, true).unwrap();
+    // (key frames, period): the cycle's end beyond the time range; the end after the last
+    // key but closer to it than MIN_KEY_SPACING; a period within the keys' span.
+    for (key_frames, period) in [
+        ([0.0, 1e300], 1.5e300),
+        ([-1e-300, 0.0], 1.5e-300),
+        ([1.0, 11.0], 10.0),
+    ] {
+        let timing = KeysTiming {
+            key_frames: &key_frames,
+            period: Some(period),
+            size: 1.0,
+            playback: None,
+        };
+        let got = keys_parameters(&timing, &[key_frames[0]], &smooth);
+        assert!(
+            matches!(got, Err(Error::Period { .. })),
+            "{key_frames:?} period {period}: {got:?}"
+        );
+        let map = crate::TimeMap::new(&key_frames, true, Some(period), crate::Timing::Linear);
+        assert!(
+            matches!(map, Err(Error::Period { .. })),
+            "{key_frames:?} period {period}: {map:?}"
+        );
+    }
+    // Both accept the same period.
+    let ok = KeysTiming {
+        key_frames: &[1.0, 11.0],
+        period: Some(20.0),
+        size: 1.0,
+        playback: None,
+    };
+    assert!(keys_parameters(&ok, &[1.0, 21.0], &smooth).is_ok());
+    assert!(crate::TimeMap::new(&[1.0, 11.0], true, Some(20.0), crate::Timing::Linear).is_ok());
 }
 
 #[test]

@@ -114,7 +114,9 @@ impl<T: Interpolant> Motion<T> {
     ///
     /// # Errors
     /// [`Error::Levels`] for levels above [`crate::MAX_LEVELS`], [`Error::LengthMismatch`]
-    /// when `dense` has the wrong length, then the errors of [`TimeMap::new`].
+    /// when `dense` has the wrong length, an element outside the working range (as
+    /// [`subdivide`] refuses its keys: [`Interpolant::check_range`], naming the element),
+    /// then the errors of [`TimeMap::new`].
     pub fn from_dense(
         dense: Vec<T>,
         key_times: &[f64],
@@ -132,6 +134,7 @@ impl<T: Interpolant> Motion<T> {
                 got: dense.len(),
             });
         }
+        check_range(&dense)?;
         let map = TimeMap::new(key_times, closed, period, timing)?;
         Ok(Self {
             dense,
@@ -404,6 +407,38 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn dense_poses_outside_the_working_range_are_refused() {
+        use crate::error::PoseDefect;
+        use crate::motion::pose::{Pose, MAX_COORDINATE};
+        let key_times = [0.0, 1.0, 2.0];
+        let good = vec![Pose::IDENTITY; subdivided_len(3, 2, false)];
+        let motion = Motion::from_dense(good.clone(), &key_times, 2, false, None, Timing::Smooth);
+        assert!(motion.is_ok());
+        for (index, translation) in [
+            (0, DVec3::new(2.0 * MAX_COORDINATE, 0.0, 0.0)),
+            (5, DVec3::new(0.0, f64::NAN, 0.0)),
+            (8, DVec3::new(0.0, 0.0, f64::NEG_INFINITY)),
+        ] {
+            let mut dense = good.clone();
+            dense[index] = Pose::from_translation(translation);
+            let got = Motion::from_dense(dense, &key_times, 2, false, None, Timing::Smooth);
+            match got {
+                Err(Error::BadPose { index: i, defect }) => {
+                    assert_eq!(i, index);
+                    assert!(
+                        matches!(
+                            defect,
+                            PoseDefect::NotFinite | PoseDefect::OutOfRange { .. }
+                        ),
+                        "{defect:?}"
+                    );
+                }
+                other => panic!("dense pose {index} at {translation}: {:?}", other.err()),
             }
         }
     }

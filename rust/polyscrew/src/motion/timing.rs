@@ -99,6 +99,30 @@ pub fn check_key_times(times: &[f64]) -> Result<()> {
     Ok(())
 }
 
+/// Checks the period of a closed motion whose keys sit at `key_times` (at least two, checked
+/// by [`check_key_times`]) and returns the cycle's end `t_0 + period`, a knot like the key
+/// times: the period finite and longer than the keys' span `t_(n-1) - t_0`, the end within
+/// [`MAX_TIME`] and at least [`MIN_KEY_SPACING`] after the last key.
+///
+/// # Errors
+/// [`Error::Period`] for any other period (or fewer than two key times).
+pub fn check_period(key_times: &[f64], period: f64) -> Result<f64> {
+    let (first, last) = match key_times {
+        [first, .., last] => (*first, *last),
+        _ => return Err(Error::Period { period, span: 0.0 }),
+    };
+    let span = last - first;
+    let end = first + period;
+    if !period.is_finite()
+        || period <= span
+        || end.abs() > MAX_TIME
+        || !(end - last >= MIN_KEY_SPACING)
+    {
+        return Err(Error::Period { period, span });
+    }
+    Ok(end)
+}
+
 /// Checks one sample time: finite and within [`MAX_TIME`].
 ///
 /// # Errors
@@ -128,7 +152,7 @@ impl TimeMap {
     ///
     /// # Errors
     /// [`Error::TooFew`] for fewer than 2 keys, [`Error::KeyTimes`] for times that are not
-    /// strictly increasing, [`Error::Period`] for a period not exceeding the keys' span.
+    /// strictly increasing, [`Error::Period`] for a period [`check_period`] refuses.
     pub fn new(
         key_times: &[f64],
         closed: bool,
@@ -145,15 +169,7 @@ impl TimeMap {
         let period = if closed {
             let period = period.unwrap_or(span * n as f64 / (n - 1) as f64);
             // The cycle's end, a knot like the others: in range and far enough from the last key.
-            let end = key_times[0] + period;
-            if !period.is_finite()
-                || period <= span
-                || end.abs() > MAX_TIME
-                || !(end - key_times[n - 1] >= MIN_KEY_SPACING)
-            {
-                return Err(Error::Period { period, span });
-            }
-            knots.push(end);
+            knots.push(check_period(key_times, period)?);
             Some(period)
         } else {
             None
