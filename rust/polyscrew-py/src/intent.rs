@@ -250,8 +250,14 @@ impl PyPlayback {
             (frames.as_array(), location.as_array(), rotation.as_array());
         let out = py.detach(|| -> PyResult<_> {
             let frames = read_vector(F, "frames", &frames)?;
-            let location = read_vector(F, "location", &location)?;
-            let rotation = read_vector(F, "rotation", &rotation)?;
+            // (shapes checked above) row-major values
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| -> PyResult<Vec<f64>> {
+                let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(F, e))?;
+                out.extend(view.iter().copied());
+                Ok(out)
+            };
+            let location = flat(&location)?;
+            let rotation = flat(&rotation)?;
             core_departure(inner, &frames, &location, &rotation).map_err(|e| to_py_err(F, e))
         })?;
         Ok((out.distance.into_pyarray(py), out.angle.into_pyarray(py)))
@@ -264,11 +270,10 @@ fn spans_of(
     function: &str,
     playback: &Bound<'_, PyAny>,
     frames: &Bound<'_, PyAny>,
-    turns: &Bound<'_, PyAny>,
+    turns: &str,
 ) -> PyResult<Spans> {
     let playback = playback_arg(function, "playback", playback)?;
-    let turns = Turns::from_name(args::str_arg(function, "turns", turns)?)
-        .map_err(|e| to_py_err(function, e))?;
+    let turns = Turns::from_name(turns).map_err(|e| to_py_err(function, e))?;
     let frames = float_array(function, "frames", frames)?;
     let k = vector_len(function, "frames", &frames)?;
     check_budget(function, Footprint::of::<f64>(k), "the frames", HINT)?;
@@ -289,27 +294,20 @@ fn spans_of(
 /// no screw span of a spin `turns` follows turns more than `WIND_STEP` (`analyse_turns`).
 /// GIL released.
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns=None))]
+#[pyo3(signature = (playback, frames, turns="AUTO"))]
 #[allow(clippy::type_complexity)]
 fn analyse_spans<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: Option<&Bound<'py, PyAny>>,
+    turns: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 )> {
-    let auto = pyo3::types::PyString::new(py, "AUTO");
-    let spans = spans_of(
-        py,
-        "analyse_spans",
-        playback,
-        frames,
-        turns.unwrap_or(&auto),
-    )?;
+    let spans = spans_of(py, "analyse_spans", playback, frames, turns)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
@@ -327,13 +325,13 @@ fn analyse_spans<'py>(
 /// takes flips (and quaternions) the short way; "BLENDER" follows every span as Blender
 /// plays it; "SHORTEST" follows none (nothing inserted). GIL released.
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns=None))]
+#[pyo3(signature = (playback, frames, turns="AUTO"))]
 #[allow(clippy::type_complexity)]
 fn analyse_turns<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: Option<&Bound<'py, PyAny>>,
+    turns: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
@@ -341,14 +339,7 @@ fn analyse_turns<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
 )> {
-    let auto = pyo3::types::PyString::new(py, "AUTO");
-    let spans = spans_of(
-        py,
-        "analyse_turns",
-        playback,
-        frames,
-        turns.unwrap_or(&auto),
-    )?;
+    let spans = spans_of(py, "analyse_turns", playback, frames, turns)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),

@@ -65,11 +65,13 @@ fn span_samples(start: f64, end: f64, count: usize, out: &mut Vec<f64>) {
 
 /// Samples for a span whose rotation channels change from `a` to `b` (channel rows' rotation
 /// parts): one per [`DEGREES_PER_SAMPLE`] of change, within
-/// [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]. For quaternions the change is the angle between
-/// the keys' 4-vectors, doubled (`2 acos(a . b / |a| |b|)`, up to 360 degrees for a sign flip
-/// that Blender plays the long way).
-fn sample_count(mode: RotationMode, a: &[f64], b: &[f64]) -> usize {
+/// [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]. Quaternions: [`SPAN_SAMPLES`], unless their
+/// turns are followed (`follow_quaternions`, [`Turns::AsPlayed`]): then the change is the
+/// angle between the keys' 4-vectors, doubled (`2 acos(a . b / |a| |b|)`, up to 360 degrees
+/// for a sign flip that Blender plays the long way).
+fn sample_count(mode: RotationMode, a: &[f64], b: &[f64], follow_quaternions: bool) -> usize {
     let change = match mode {
+        RotationMode::Quaternion if !follow_quaternions => return SPAN_SAMPLES,
         RotationMode::Quaternion => {
             let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
             let norms = a.iter().map(|x| x * x).sum::<f64>().sqrt()
@@ -167,6 +169,7 @@ pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Resul
                 mode,
                 &key_row(s)[rotation.clone()],
                 &key_row(s + 1)[rotation.clone()],
+                turns == Turns::AsPlayed,
             )
         }),
         "spans",
