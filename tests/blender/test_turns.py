@@ -318,3 +318,27 @@ def addon_size(obj) -> float:
     from conftest import addon_module
 
     return addon_module("keys").body_size(addon_module("owners").as_owner(obj))
+
+
+def test_smooth_blend_script_takes_turns(sb, tmp_path):
+    """scripts/smooth_blend.py --turns: the same choice for a pipeline."""
+    import os
+    import subprocess
+    import sys
+
+    from conftest import ROOT
+
+    keyed_turns()
+    source = tmp_path / "turns.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(source))
+    env = dict(os.environ)
+    env.pop("BLENDER_USER_RESOURCES", None)  # a plain bpy session, as a farm would start it
+    for turns, want in (("shortest", [-90.0, -170.0, 110.0, 130.0]), ("blender", [270.0, -170.0, -250.0, 130.0])):
+        out = tmp_path / f"{turns}.blend"
+        done = subprocess.run([sys.executable, str(ROOT / "scripts" / "smooth_blend.py"), str(source), "--turns", turns,
+                               "--out", str(out)], env=env, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 0, done.stderr
+        bpy.ops.wm.open_mainfile(filepath=str(out))
+        got = z_turns(bpy.data.objects["Turner"], SPANS)
+        print(f"\nsmooth_blend --turns {turns}: {np.round(got, 1).tolist()}")
+        np.testing.assert_allclose(got, want, atol=2.0)
