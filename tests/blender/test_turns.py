@@ -342,3 +342,40 @@ def test_smooth_blend_script_takes_turns(sb, tmp_path):
         got = z_turns(bpy.data.objects["Turner"], SPANS)
         print(f"\nsmooth_blend --turns {turns}: {np.round(got, 1).tolist()}")
         np.testing.assert_allclose(got, want, atol=2.0)
+
+
+@pytest.mark.parametrize("turns", ["AUTO", "BLENDER", "SHORTEST"])
+def test_panel_setting_preview_and_bake_agree(sb, turns):
+    """The panel's Turns setting is the operator's (same items, default and tooltip, which
+    states the rule); the live preview draws what Smooth Motion then bakes with it."""
+    from conftest import addon_module
+
+    pd = addon_module("preview_draw")
+    prop = bpy.ops.screwbender.smooth.get_rna_type().properties["turns"]
+    setting = bpy.types.Scene.bl_rna.properties["screwbender"].fixed_type.properties["turns"]
+    assert [i.identifier for i in prop.enum_items] == [i.identifier for i in setting.enum_items] == ["AUTO", "BLENDER", "SHORTEST"]
+    assert prop.default == setting.default == "AUTO" and prop.description == setting.description
+    assert "-180..180" in prop.description and "45 degrees" in prop.description
+    obj = keyed_turns()
+    scene = bpy.context.scene
+    scene.screwbender.turns = turns
+    # timing Smooth: the pace of timing Keys is measured along the frames sampled together
+    # (the preview's instances and trajectory), which moves it by up to 1e-3
+    scene.screwbender.timing = "smooth"
+    assert sb.bake.options_from(scene.screwbender, scene).turns == turns
+    scene.frame_set(1)
+    scene.screwbender_preview.instances = 51
+    obj.screwbender_preview = True
+    try:
+        pd.refresh(scene)
+        previewed = pd.CACHE.entries[obj.session_uid].batches.instances
+    finally:
+        obj.screwbender_preview = False
+        pd.sync()
+    h.select_only(obj)
+    assert bpy.ops.screwbender.smooth(turns=scene.screwbender.turns, timing="smooth") == {"FINISHED"}
+    baked = h.evaluated_basis(obj, np.arange(1.0, 52.0))
+    # (max abs matrix entry: Blender's matrix_basis is float32, the baked keys too)
+    off = np.abs(previewed - baked).max()
+    print(f"\nTurns {turns}: preview against the bake {off:.1e}")
+    assert off < 1e-5
