@@ -252,6 +252,36 @@ def departure_from_blender(obj, frames) -> tuple[float, float]:
     return float(angle.max()), float(np.linalg.norm(ours[:, :3, 3] - theirs[:, :3, 3], axis=1).max())
 
 
+def per_frame_departure(obj, frames) -> tuple[np.ndarray, np.ndarray]:
+    """Per frame: angle (degrees) and distance between the object's playback now and its
+    source's (Blender's own evaluation of both actions)."""
+    result = obj.animation_data.action
+    ours = h.evaluated_basis(obj, frames)
+    obj.animation_data.action = result["screwbender_source"]
+    theirs = h.evaluated_basis(obj, frames)
+    obj.animation_data.action = result
+    r = np.einsum("nji,njk->nik", theirs[:, :3, :3], ours[:, :3, :3])
+    angle = np.degrees(np.arccos(np.clip((np.trace(r, axis1=1, axis2=2) - 1) / 2, -1, 1)))
+    return angle, np.linalg.norm(ours[:, :3, 3] - theirs[:, :3, 3], axis=1)
+
+
+def check_frames(obj, line: str, frames: np.ndarray) -> None:
+    """The frames the report names are those where Blender's playback of the result departs
+    from the source's by more than 5 degrees or 5 % of the size (within float32 rounding), and
+    the frame of the largest departure is among them."""
+    named = set()
+    for run in line.split(" at frames ")[1].split(" (")[0].split(", "):
+        a, _, b = run.partition("-")
+        named.update(np.arange(float(a), float(b or a) + 0.5))
+    angle, distance = per_frame_departure(obj, frames)
+    size = addon_size(obj)
+    over = {float(f) for f, a, d in zip(frames, angle, distance) if a > 5.05 or d > 0.0505 * size}
+    within = {float(f) for f, a, d in zip(frames, angle, distance) if a < 4.95 and d < 0.0495 * size}
+    print(f"  named frames {sorted(named)}")
+    assert over <= named and not (named & within), (sorted(over - named), sorted(named & within))
+    assert float(frames[np.argmax(angle)]) in named
+
+
 def reported_departure(report: str, name: str) -> tuple[float, float, str]:
     line = next(line for line in report.splitlines() if f"{name}: departs" in line)
     degrees = float(line.split("by up to ")[1].split(" degrees")[0])
@@ -286,7 +316,7 @@ def test_departure_report_on_quaternion_keys(sb, kind, capfd):
     assert degrees > 5.0
     # the report's figure is Blender's (float32 keys: a hundredth of a degree)
     assert said_degrees == pytest.approx(degrees, abs=0.06)
-    assert "at frames" in line
+    check_frames(obj, line, frames)
     if kind == "flipped":
         assert "quaternion sign flip(s)" in report and "flips removed" in line
     else:
@@ -379,3 +409,23 @@ def test_panel_setting_preview_and_bake_agree(sb, turns):
     off = np.abs(previewed - baked).max()
     print(f"\nTurns {turns}: preview against the bake {off:.1e}")
     assert off < 1e-5
+
+
+def test_departure_report_names_an_approximating_scheme(sb, capfd):
+    """B-Spline cuts inside the keys: the report says where and by how much, and why."""
+    rng = np.random.default_rng(3)
+    obj = h.new_object("Blocky", "MESH", "XYZ")
+    frames = [1, 9, 20, 26, 37, 45]
+    rot = Rotation.from_rotvec(np.cumsum(rng.normal(0, 0.6, (6, 3)), axis=0)).as_matrix()
+    h.key_poses(obj, frames, h.rigid(rng.uniform(-3, 3, (6, 3)), rot))
+    h.select_only(obj)
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth(scheme="bspline") == {"FINISHED"}
+    report = capfd.readouterr().out
+    every = np.arange(1.0, 46.0)
+    degrees, units = departure_from_blender(obj, every)
+    said_degrees, said_units, line = reported_departure(report, "Blocky")
+    print(f"\nB-Spline on random keys: {degrees:.1f} degrees, {units:.3f} units; report: {line.strip()}")
+    assert "the B-Spline scheme cuts inside the keys" in line
+    assert said_degrees == pytest.approx(degrees, abs=0.06) and said_units == pytest.approx(units, rel=1e-3, abs=1e-4)
+    check_frames(obj, line, every)
