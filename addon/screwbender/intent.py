@@ -14,7 +14,7 @@ for the following, each one `polyscrew` call per owner (`polyscrew.analyse_spans
   spin that turn more than :data:`WIND_STEP`), until every screw span there turns at most
   :data:`WIND_STEP`: the motion turns as far and the same way as the channels say.
   Quaternion keys keep the shortest arc (no sign flips), which is what quaternion users
-  expect.
+  expect (unless Turns is As Blender Plays).
 - **Flips** are not spins. Keys set from matrices (a script setting `matrix_basis`, an
   importer, a visual-keyed bake) have Euler values inside -180..180 degrees; where a channel
   wraps (111.5 -> -141.1) Blender's playback turns the long way round. The option *Turns*
