@@ -226,17 +226,20 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         reverted: dict[str, bpy.types.Object] = {}
+        kept: list[str] = []
         try:
             with transaction.atomic() as t:
                 for obj in sorted(context.selected_objects, key=lambda o: o.name):
                     if obj.name not in reverted and bake.source_of(obj) is not None:
-                        reverted.update((o.name, o) for o in bake.revert(obj, t))
+                        reverted.update((o.name, o) for o in bake.revert(obj, t, kept))
         except Exception as err:
             return transaction.report_failure(self, err, "Revert Smoothing")
         selected = {o.name for o in context.selected_objects}
         others = sorted(set(reverted) - selected)
         also = f" (and {bake.summary(others)}, which shared its action)" if others else ""
         self.report({"INFO"}, f"Restored the original action of {bake.summary(sorted(set(reverted) & selected))}{also}")
+        if kept:
+            self.report({"INFO"}, f"kept the edited result {bake.summary(kept)} (fake user): it was edited after it was made")
         return {"FINISHED"}
 
 
