@@ -49,7 +49,8 @@ def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: s
         what = "bone(s) and object(s)"
     else:
         what = "object(s)"
-    shared = f" ({len(result.actions)} new actions)" if len(result.actions) != len(names) else ""
+    count = len(result.actions)
+    shared = f" ({count} new action{'s' if count != 1 else ''})" if count != len(names) else ""
     operator.report({"INFO"}, f"{verb} {len(names)} {what}: {bake.summary(names)}{shared}")
     return {"FINISHED"}
 

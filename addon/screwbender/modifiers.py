@@ -107,9 +107,15 @@ def copy_onto(modifiers: list[bpy.types.FModifier], fcurve: bpy.types.FCurve) ->
         if mod.type == "GENERATOR":
             new.poly_order = mod.poly_order
         if mod.type == "ENVELOPE":
-            for point in mod.control_points:
-                added = new.control_points.add(point.frame)
-                added.min, added.max = point.min, point.max
+            # the points' bounds through foreach_set: setting a point's min/max one by one runs
+            # an update meant for modifiers on the point (crashes Blender now and then)
+            points = mod.control_points
+            for point in points:
+                new.control_points.add(point.frame)
+            for name in ("min", "max"):
+                values = [0.0] * len(points)
+                points.foreach_get(name, values)
+                new.control_points.foreach_set(name, values)
         # twice: a restricted range's start and end clamp each other as they are set
         _copy_properties(mod, new)
         _copy_properties(mod, new)
