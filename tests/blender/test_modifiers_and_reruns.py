@@ -104,10 +104,7 @@ def test_noise_keeps_shaking_the_smoothed_motion_and_stays_out_of_the_key_poses(
     capfd.readouterr()
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     out = reports(capfd)
-    assert "Info: Shaky: kept the Noise modifier on location" in out, out
-
     fcs = [curve(shaky, "location", i) for i in range(3)]
-    assert [properties(m) for fc in fcs for m in fc.modifiers] == originals  # every property, in order
     result = np.stack([played(fc, frames) for fc in fcs], axis=1)
     result_keys = np.stack([keys_only(fc, frames) for fc in fcs], axis=1)
     twin = np.stack([played(curve(clean, "location", i), frames) for i in range(3)], axis=1)
@@ -122,8 +119,10 @@ def test_noise_keeps_shaking_the_smoothed_motion_and_stays_out_of_the_key_poses(
     print(
         f"\nNoise: RMS second difference source {1000 * rms_source:.1f} mm/frame^2, result "
         f"{1000 * rms_result:.1f} ({100 * (rms_result / rms_source - 1):+.2f} %); key poses off the keyed "
-        f"values by {1000 * key_poses:.3g} mm; keys-only vs twin {keys_gap:.2g}; noise vs source's {noise_gap:.2g}"
+        f"values by {1000 * key_poses:.3g} mm; keys-only vs twin {keys_gap:.2g}; noise vs source's {noise_gap:.2g}; {out}"
     )
+    assert "Info: Shaky: kept the Noise modifier on location" in out, out
+    assert [properties(m) for fc in fcs for m in fc.modifiers] == originals  # every property, in order
     assert keys_gap < 1e-5 and noise_gap < 1e-5 and key_poses < 1e-5
     assert abs(rms_result / rms_source - 1) < 0.05
 
@@ -144,10 +143,6 @@ def test_stepped_stays_stepped(sb, capfd):
     capfd.readouterr()
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     out = reports(capfd)
-    assert (
-        "Info: Blocky: kept the Stepped Interpolation modifier on location; the Stepped Interpolation modifier "
-        "on rotation" in out
-    ), out
     result = np.stack([played(curve(obj, p, i), frames) for p, i in paths], axis=1)
     # Blender's Stepped: the keys read at the start of each 3-frame block after the offset
     snapped = np.floor((frames - 1.0) / 3.0) * 3.0 + 1.0
@@ -161,6 +156,10 @@ def test_stepped_stays_stepped(sb, capfd):
         f"{blocks} blocks ({len(frames)} frames); result vs source playback: {1000 * change[:, :3].max():.0f} mm, "
         f"{np.degrees(change[:, 3:].max()):.1f} deg (the smoothing)"
     )
+    assert (
+        "Info: Blocky: kept the Stepped Interpolation modifier on location; the Stepped Interpolation modifier "
+        "on rotation" in out
+    ), out
     assert gap < 1e-5 and distinct == blocks
 
 
@@ -342,21 +341,22 @@ def test_a_rerun_smooths_the_edited_result_and_keeps_it(sb, capfd):
     fc = curve(obj, "location", 0)
     unedited = float(played(fc, [10.0])[0])
     moved = move_key(fc, 10.0, 1.0)  # the animator moves a key of the result 1 m
-    assert sb.bake.was_edited(first, sb.channels.slot_identifier(obj))
     capfd.readouterr()
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}  # default options: not Smooth Result
     out = reports(capfd)
-    assert any("'EditedAction.smooth' was edited after Smooth Motion made it" in line for line in out), out
     second = obj.animation_data.action
-    assert second != first and first_name in bpy.data.actions  # the edit is kept
-    assert second["screwbender_source"] == first
+    # the original, the edited result and the new one (a name alone could be reused)
+    others = sorted(a.name for a in bpy.data.actions if a != second and a != original)
     now = float(played(curve(obj, "location", 0), [10.0])[0])
     basis = h.evaluated_basis(obj, [10.0])[0]
     print(
         f"\nEdit then re-run: the moved key (frame 10, +1 m) is in the new result to {abs(now - moved):.2g} "
         f"(the unedited result had {unedited:.4f}, {1000 * abs(now - unedited):.0f} mm away); Blender plays "
-        f"{basis[0, 3]:.6f}"
+        f"{basis[0, 3]:.6f}; the edited action is {'kept' if others else 'deleted'}; {out}"
     )
+    assert any("'EditedAction.smooth' was edited after Smooth Motion made it" in line for line in out), out
+    assert others == [first_name] and second != first  # the edit is kept
+    assert second["screwbender_source"] == first and sb.bake.was_edited(first, sb.channels.slot_identifier(obj))
     assert abs(now - moved) < 1e-5 and abs(basis[0, 3] - moved) < 1e-5
     # Revert returns to the edited result, a second Revert to the original; nothing is deleted
     assert bpy.ops.screwbender.revert() == {"FINISHED"}
