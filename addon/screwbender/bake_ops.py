@@ -175,7 +175,8 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         default=False,
         description="On an object whose action is already a result of Smooth Motion, smooth that "
         "result itself (Revert then returns to it). Off: smooth the original keys again with these "
-        "options, replacing the earlier result (one Revert returns to the original)",
+        "options, replacing the earlier result (one Revert returns to the original); a result edited "
+        "since it was made (keys moved, added or deleted) is smoothed as it is and kept, never deleted",
     )
 
     @classmethod

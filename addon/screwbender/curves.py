@@ -18,6 +18,8 @@ not play; a driver; baked sample points; no keys; an interpolation this `polyscr
 know), and :func:`read` / :func:`evaluate` raise :class:`UnsupportedCurve` naming every such
 curve and reason. Muted modifiers are ignored, as Blender ignores them. The caller decides
 what to do (report it to the animator, or fall back to key values only for that object).
+With `keys_only`, the other modifiers are left out: what the keys make is evaluated (Smooth
+Motion smooths that and copies those modifiers onto its result, :mod:`modifiers`).
 
 Enumerations are passed to `polyscrew` by name: Blender's RNA identifiers, mapped through
 tables read from RNA (`bl_rna.properties[...].enum_items`), never Blender's internal values.
