@@ -314,12 +314,15 @@ def _write_curves(
     cycle_modes: dict | None = None,
     prop: str = "",
     stacks: dict | None = None,
+    digests: dict | None = None,
 ) -> None:
     """One dense linear F-curve per column of `values` (array index `indices[column]`, by
     default the column), keyed at `frames`, in F-curve group `group`; keys where `constant`
     is set are CONSTANT (a held span that pops at its end). `cycle_modes` gives the Cycles
     modifier (before, after) per (`prop`, index) of a motion baked over one extended cycle;
-    `stacks` the source curve's other F-curve modifiers per (`prop`, index), copied on top."""
+    `stacks` the source curve's other F-curve modifiers per (`prop`, index), copied on top;
+    `digests` gets each written curve's :func:`curve_digest` per (path, index), from the arrays
+    written (no read back)."""
     co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
     co[:, 0] = frames
     # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
@@ -328,6 +331,7 @@ def _write_curves(
         interpolation = (_LINEAR,) * len(frames)
     else:
         interpolation = tuple(np.where(constant, _CONSTANT, _LINEAR).tolist())
+    kinds = np.array(interpolation, dtype=np.uint8) if digests is not None else None
     for column in range(values.shape[1]):
         index = int(indices[column]) if indices is not None else column
         fcurve = channels.new_fcurve(bag, path, index, group)
@@ -336,6 +340,8 @@ def _write_curves(
         co[:, 1] = values[:, column]
         points.foreach_set("co", co.ravel())
         points.foreach_set("interpolation", interpolation)
+        if digests is not None:
+            digests[path, index] = curve_digest(co, kinds)
         if cyclic:
             fcurve.modifiers.new("CYCLES")
         elif cycle_modes and (prop, index) in cycle_modes:
@@ -355,19 +361,22 @@ def new_result(
     t: transaction.Transaction,
     edit,
     made_by: str = "smooth",
+    digests: dict | None = None,
 ) -> bpy.types.Action:
     """A copy of `current` (the action `objects` have now) edited by `edit(bag)` (the copy's
     F-curve container for slot `identifier`), named after `source` (the action holding the
     original keys) and assigned to every object of `objects`; `source` keeps a fake user and
     is recorded on the copy for :func:`revert`. When `current` is an earlier result of the same
     operator (`made_by`: "smooth", "denoise") it is replaced: removed once everything has
-    worked, if nothing uses it any more. Everything goes through the transaction `t`."""
+    worked, if nothing uses it any more. The copy records a digest of its keys
+    (:func:`keys_digest`; `digests`: those of the curves `edit` wrote, filled by `edit`), so
+    that a later edit is seen. Everything goes through the transaction `t`."""
     suffix = f".{made_by}" if made_by != "smooth" else ".smooth"
     result = current.copy()
     result.name = f"{source.name}{suffix}"
     result.use_fake_user = False
     edit(channels.ensure_container(result, channels.find_slot(result, identifier)))
-    result[WRITTEN_KEY] = keys_digest(result, identifier)
+    result[WRITTEN_KEY] = keys_digest(result, identifier, digests)
     result[SOURCE_KEY] = source
     result[MADE_BY_KEY] = made_by
     if current is source:
@@ -390,20 +399,33 @@ def new_result(
     return result
 
 
-def keys_digest(action: bpy.types.Action, identifier: str) -> str:
+def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> bytes:
+    """A digest of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
+    interpolations (Blender's enum values, as `foreach_get` gives them)."""
+    digest = hashlib.sha256(f"{len(interpolation)}:".encode())
+    digest.update(np.ascontiguousarray(co, dtype=np.float32).tobytes())
+    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes())
+    return digest.digest()
+
+
+def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
     """A digest of the keys of `action` for slot `identifier`: every curve's data path, index,
-    key frames, values and interpolations (one `foreach_get` each). A key moved, added or
-    deleted, a curve added or removed, changes it."""
+    key frames, values and interpolations (one `foreach_get` each, but for the curves whose
+    :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
+    added or deleted, its interpolation changed, a curve added or removed, changes it."""
     digest = hashlib.sha256()
     for fcurve in sorted(channels.action_fcurves(action, identifier), key=lambda fc: (fc.data_path, fc.array_index)):
-        points = fcurve.keyframe_points
-        co = np.empty(2 * len(points), dtype=np.float32)
-        points.foreach_get("co", co)
-        interpolation = np.empty(len(points), dtype=np.uint8)
-        points.foreach_get("interpolation", interpolation)
-        digest.update(f"{fcurve.data_path}[{fcurve.array_index}]:{len(points)}:".encode())
-        digest.update(co.tobytes())
-        digest.update(interpolation.tobytes())
+        key = (fcurve.data_path, fcurve.array_index)
+        sub = known.get(key) if known else None
+        if sub is None:
+            points = fcurve.keyframe_points
+            co = np.empty(2 * len(points), dtype=np.float32)
+            points.foreach_get("co", co)
+            interpolation = np.empty(len(points), dtype=np.uint8)
+            points.foreach_get("interpolation", interpolation)
+            sub = curve_digest(co, interpolation)
+        digest.update(f"{key[0]}[{key[1]}]:".encode())
+        digest.update(sub)
     return digest.hexdigest()
 
 
@@ -439,10 +461,11 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
                 indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
                 _write_curves(
                     bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group,
-                    part.constant, part.cycle_modes, prop, part.motion.modifiers,
+                    part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
                 )
 
-    return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves)
+    digests: dict = {}
+    return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves, digests=digests)
 
 
 def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
