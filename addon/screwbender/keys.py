@@ -166,13 +166,11 @@ def _union(frames: list[np.ndarray]) -> np.ndarray:
 
 
 def playing_strips(adt) -> list:
-    """The NLA strips Blender plays for `adt` (an AnimData): none when the NLA is off, only
-    those of solo tracks when a track is solo, never those of muted tracks or muted strips."""
+    """The NLA strips Blender plays under the action of `adt` (an AnimData): none when the
+    NLA is off, never those of muted tracks or muted strips."""
     if adt is None or not getattr(adt, "use_nla", True):
         return []
-    tracks = list(adt.nla_tracks)
-    solo = [track for track in tracks if track.is_solo]
-    return [strip for track in (solo or tracks) if not track.mute for strip in track.strips if not strip.mute]
+    return [strip for track in adt.nla_tracks if not track.mute for strip in track.strips if not strip.mute]
 
 
 def no_action(name: str, adt) -> str:
@@ -209,6 +207,12 @@ def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
     if getattr(adt, "use_tweak_mode", False):
         raise SmoothError(
             f"{name}: is in NLA tweak mode (editing a strip's action): exit it first (NLA Editor, Tab): skipped"
+        )
+    solo = [track.name for track in adt.nla_tracks if track.is_solo]
+    if solo and getattr(adt, "use_nla", True):
+        raise SmoothError(
+            f"{name}: NLA track '{solo[0]}' is Solo, so Blender plays that track alone and not the action: "
+            "turn Solo off to smooth the action: skipped"
         )
     strips = len(playing_strips(adt))
     if strips:

@@ -248,6 +248,7 @@ CASES = {
     "cycles_repeat_noise": (cycles("REPEAT"), ranged_noise, True),
     "cycles_offset_generator": (cycles("REPEAT_OFFSET"), generator, False),
     "cycles_mirror_envelope": (cycles("MIRROR"), envelope, False),
+    "cycles_none_before_limits": (cycles("NONE"), stack, False),
 }
 
 
@@ -433,6 +434,64 @@ def test_an_edited_rerun_is_all_or_nothing(sb):
         check_unchanged(lambda: bpy.ops.screwbender.revert())
 
 
+def test_a_solo_nla_track_is_refused_with_the_reason(sb):
+    """With a Solo track Blender plays that track alone, not the action (measured: the
+    action's keys and Blender's playback then differ by units): the reason is said."""
+    obj = keyed("Soloed")
+    solo = obj.animation_data.nla_tracks.new()
+    solo.name = "Listen"
+    solo.is_solo = True
+    h.select_only(obj)
+    gap = np.linalg.norm(h.evaluated_basis(obj, [9.0])[0, :3, 3] - LOCATIONS[1])
+    with pytest.raises(RuntimeError) as error:
+        bpy.ops.screwbender.smooth()
+    print(f"\nSolo NLA track: Blender plays {gap:.3f} away from the action's key at frame 9; {error.value}")
+    assert gap > 0.5
+    assert str(error.value).startswith("Error: Soloed: NLA track 'Listen' is Solo, so Blender plays that track alone")
+
+
+def test_nla_tweak_mode_is_refused_with_the_reason(sb):
+    obj = keyed("Tweaked")
+    adt = obj.animation_data
+    track = adt.nla_tracks.new()
+    strip = track.strips.new("Walk", 1, adt.action)
+    adt.action = None
+    track.select = strip.select = True
+    adt.use_tweak_mode = True
+    assert adt.use_tweak_mode and adt.action is not None
+    h.select_only(obj)
+    with pytest.raises(RuntimeError) as error:
+        bpy.ops.screwbender.smooth()
+    print(f"\nNLA tweak mode: {error.value}")
+    assert str(error.value).startswith("Error: Tweaked: is in NLA tweak mode")
+    adt.use_tweak_mode = False
+
+
+def test_modifiers_on_bones_are_kept(sb, capfd):
+    rig = bh.armature(holder=False)
+    poses = bh.random_poses(4, seed=5, gentle=True)
+    bh.key_bone(rig, "Upper", FRAMES, poses)
+    bh.key_bone(rig, "Hand", FRAMES, poses)
+    path = 'pose.bones["Upper"].location'
+    for i in range(3):
+        mod = curve(rig, path, i).modifiers.new("NOISE")
+        mod.strength, mod.phase = 0.3, 1.0 + i
+    frames = np.arange(1.0, 30.5, 0.5)
+    shake = [played(curve(rig, path, i), frames) - keys_only(curve(rig, path, i), frames) for i in range(3)]
+    h.select_only(rig)
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    out = reports(capfd)
+    assert "Info: Rig: Upper: kept the Noise modifier on location" in out, out
+    gap = max(
+        np.abs(played(curve(rig, path, i), frames) - keys_only(curve(rig, path, i), frames) - shake[i]).max()
+        for i in range(3)
+    )
+    hand = [len(curve(rig, 'pose.bones["Hand"].location', i).modifiers) for i in range(3)]
+    print(f"\nBone Noise: the result's shake vs the source's {gap:.2g}; {out}")
+    assert gap < 1e-5 and hand == [0, 0, 0]
+
+
 # 9. Reports tell the truth ----------------------------------------------------------------
 
 
@@ -479,7 +538,7 @@ def test_motion_only_in_nla_strips_is_refused_with_the_reason(sb, capfd):
     assert result.skipped[0].startswith("Pushed: its motion is in NLA strips")
 
 
-@pytest.mark.parametrize("muted", ["track", "strip"])
+@pytest.mark.parametrize("muted", ["track", "strip", "nla off"])
 def test_muted_nla_below_the_action_does_not_block(sb, capfd, muted):
     obj = keyed("Layered")
     other = keyed("Other")
@@ -491,11 +550,13 @@ def test_muted_nla_below_the_action_does_not_block(sb, capfd, muted):
         bpy.ops.screwbender.smooth()  # a playing strip still blocks
     if muted == "track":
         track.mute = True
-    else:
+    elif muted == "strip":
         strip.mute = True
+    else:
+        obj.animation_data.use_nla = False
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     assert obj.animation_data.action.get("screwbender_source") is not None
-    assert len(obj.animation_data.nla_tracks) == 1 and len(track.strips) == 1  # the NLA is left alone
+    assert len(track.strips) == 1  # the NLA is left alone
     # Blender plays the smoothed action alone (the muted NLA adds nothing)
     frames, baked = h.baked_matrices(obj)
     played_basis = h.evaluated_basis(obj, frames[::5])
