@@ -178,7 +178,9 @@ def test_limits_hold(sb, capfd):
     free_z = played(curve(clean, "rotation_euler", 2), frames)
     print(
         f"\nLimits: location Y max {y.max():.4f} (limit 1.5; without the modifier {free_y.max():.4f}); rotation Z "
-        f"{z.min():.4f}..{z.max():.4f} (limits 0.2..2.5; without {free_z.min():.4f}..{free_z.max():.4f})"
+        f"{z.min():.4f}..{z.max():.4f} (limits 0.2..2.5; without {free_z.min():.4f}..{free_z.max():.4f}); result "
+        f"vs the smoothed keys clamped: {1000 * np.abs(y - np.minimum(free_y, 1.5)).max():.3g} mm, "
+        f"{np.degrees(np.abs(z - np.clip(free_z, 0.2, 2.5)).max()):.3g} deg"
     )
     assert free_y.max() > 1.6 and free_z.max() > 2.6  # the limits bite
     assert y.max() <= 1.5 + 1e-6 and z.min() >= 0.2 - 1e-6 and z.max() <= 2.5 + 1e-6
