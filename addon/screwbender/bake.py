@@ -19,13 +19,14 @@ leaves the scene as it was.
 from __future__ import annotations
 
 import contextlib
+import hashlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 import bpy
 import numpy as np
 
-from . import channels, feature, intent, keys, owners, sampling, transaction
+from . import channels, feature, intent, keys, modifiers, owners, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -78,6 +79,8 @@ SOURCE_SLOT_KEY = "screwbender_source_slot"
 SOURCE_FAKE_USER_KEY = "screwbender_source_fake_user"
 #: Which operator made a result ("smooth", "denoise"; absent: Smooth Motion).
 MADE_BY_KEY = "screwbender_made_by"
+#: A digest of the keys a result was written with (:func:`keys_digest`): an edit changes it.
+WRITTEN_KEY = "screwbender_written"
 
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
@@ -314,11 +317,16 @@ def _write_curves(
     constant: np.ndarray | None = None,
     cycle_modes: dict | None = None,
     prop: str = "",
+    stacks: dict | None = None,
+    digests: dict | None = None,
 ) -> None:
     """One dense linear F-curve per column of `values` (array index `indices[column]`, by
     default the column), keyed at `frames`, in F-curve group `group`; keys where `constant`
     is set are CONSTANT (a held span that pops at its end). `cycle_modes` gives the Cycles
-    modifier (before, after) per (`prop`, index) of a motion baked over one extended cycle."""
+    modifier (before, after) per (`prop`, index) of a motion baked over one extended cycle;
+    `stacks` the source curve's other F-curve modifiers per (`prop`, index), copied on top;
+    `digests` gets each written curve's :func:`curve_digest` per (path, index), from the arrays
+    written (no read back)."""
     co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
     co[:, 0] = frames
     # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
@@ -327,6 +335,7 @@ def _write_curves(
         interpolation = (_LINEAR,) * len(frames)
     else:
         interpolation = tuple(np.where(constant, _CONSTANT, _LINEAR).tolist())
+    kinds = np.array(interpolation, dtype=np.uint8) if digests is not None else None
     for column in range(values.shape[1]):
         index = int(indices[column]) if indices is not None else column
         fcurve = channels.new_fcurve(bag, path, index, group)
@@ -335,12 +344,16 @@ def _write_curves(
         co[:, 1] = values[:, column]
         points.foreach_set("co", co.ravel())
         points.foreach_set("interpolation", interpolation)
+        if digests is not None:
+            digests[path, index] = curve_digest(co, kinds)
         if cyclic:
             fcurve.modifiers.new("CYCLES")
         elif cycle_modes and (prop, index) in cycle_modes:
             before, after = cycle_modes[prop, index]
             modifier = fcurve.modifiers.new("CYCLES")
             modifier.mode_before, modifier.mode_after = before, after
+        if stacks and (prop, index) in stacks:
+            modifiers.copy_onto(stacks[prop, index], fcurve)
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
@@ -352,18 +365,25 @@ def new_result(
     t: transaction.Transaction,
     edit,
     made_by: str = "smooth",
+    digests: dict | None = None,
 ) -> bpy.types.Action:
     """A copy of `current` (the action `objects` have now) edited by `edit(bag)` (the copy's
     F-curve container for slot `identifier`), named after `source` (the action holding the
     original keys) and assigned to every object of `objects`; `source` keeps a fake user and
     is recorded on the copy for :func:`revert`. When `current` is an earlier result of the same
     operator (`made_by`: "smooth", "denoise") it is replaced: removed once everything has
-    worked, if nothing uses it any more. Everything goes through the transaction `t`."""
+    worked, if nothing uses it any more. A result of Smooth Motion records a digest of its
+    keys (:func:`keys_digest`; `digests`: those of the curves `edit` wrote, filled by `edit`),
+    so that a later edit is seen. Everything goes through the transaction `t`."""
     suffix = f".{made_by}" if made_by != "smooth" else ".smooth"
     result = current.copy()
     result.name = f"{source.name}{suffix}"
     result.use_fake_user = False
     edit(channels.ensure_container(result, channels.find_slot(result, identifier)))
+    if made_by == "smooth":  # (what its re-runs and Revert compare with)
+        result[WRITTEN_KEY] = keys_digest(result, identifier, digests)
+    elif WRITTEN_KEY in result:  # copied from an earlier Smooth Motion result: not this one's
+        del result[WRITTEN_KEY]
     result[SOURCE_KEY] = source
     result[MADE_BY_KEY] = made_by
     if current is source:
@@ -384,6 +404,43 @@ def new_result(
         # (they differ in unkeyed channels): it is removed once, and its name goes to the first.
         t.on_commit(replace_earlier_result, key=("remove", current.as_pointer()))
     return result
+
+
+def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> bytes:
+    """A digest of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
+    interpolations (Blender's enum values, as `foreach_get` gives them)."""
+    digest = hashlib.sha256(f"{len(interpolation)}:".encode())
+    digest.update(np.ascontiguousarray(co, dtype=np.float32).tobytes())
+    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes())
+    return digest.digest()
+
+
+def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
+    """A digest of the keys of `action` for slot `identifier`: every curve's data path, index,
+    key frames, values and interpolations (one `foreach_get` each, but for the curves whose
+    :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
+    added or deleted, its interpolation changed, a curve added or removed, changes it."""
+    digest = hashlib.sha256()
+    for fcurve in sorted(channels.action_fcurves(action, identifier), key=lambda fc: (fc.data_path, fc.array_index)):
+        key = (fcurve.data_path, fcurve.array_index)
+        sub = known.get(key) if known else None
+        if sub is None:
+            points = fcurve.keyframe_points
+            co = np.empty(2 * len(points), dtype=np.float32)
+            points.foreach_get("co", co)
+            interpolation = np.empty(len(points), dtype=np.uint8)
+            points.foreach_get("interpolation", interpolation)
+            sub = curve_digest(co, interpolation)
+        digest.update(f"{key[0]}[{key[1]}]:".encode())
+        digest.update(sub)
+    return digest.hexdigest()
+
+
+def was_edited(action: bpy.types.Action, identifier: str) -> bool:
+    """Whether the keys of `action` (a result, slot `identifier`) changed after it was
+    written (False for a result written before digests were kept: nothing to compare)."""
+    written = action.get(WRITTEN_KEY)
+    return isinstance(written, str) and written != keys_digest(action, identifier)
 
 
 def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Action, str] | None:
@@ -411,10 +468,11 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
                 indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
                 _write_curves(
                     bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group,
-                    part.constant, part.cycle_modes, prop,
+                    part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
                 )
 
-    return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves)
+    digests: dict = {}
+    return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves, digests=digests)
 
 
 def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
@@ -466,7 +524,7 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
         owner = owners.as_owner(item)
         adt = owner.obj.animation_data
         if adt is None or adt.action is None:
-            skipped.append((owner, f"{owner.name}: no animation (no active action): skipped"))
+            skipped.append((owner, keys.no_action(owner.name, adt)))
             continue
         group = groups.setdefault(
             (adt.action.as_pointer(), channels.slot_identifier(owner.obj)), _Group([], [])
@@ -506,9 +564,18 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     identifier = channels.slot_identifier(first)
     source, source_slot = current, identifier
     found = original_of(current, "smooth")
+    notes = []
     if found is not None and not options.smooth_result:
-        # A result of Smooth Motion: smooth the original keys again with the new options.
-        source, source_slot = found
+        if was_edited(current, identifier):
+            # The animator changed the result: the edit is the new source, never thrown away.
+            notes.append(
+                f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
+                "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
+                "them, a second Revert to the original)"
+            )
+        else:
+            # A result of Smooth Motion: smooth the original keys again with the new options.
+            source, source_slot = found
     read_from = None if source is current else source
     # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
@@ -534,7 +601,6 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
             motions[bone] = row
     if not motions:
         return [], skipped, []
-    notes = []
     shared = all(_same_motion(row[0], m) for row in motions.values() for m in row[1:])
     if shared:
         units = [(group.objects, 0)]
@@ -606,7 +672,8 @@ class Smoothed:
     actions: list[bpy.types.Action]
     #: The objects given a new action.
     objects: list[bpy.types.Object]
-    #: The owners smoothed (objects and bones), by name.
+    #: The owners whose motion changed (objects and bones), by name: every object given a new
+    #: action, selected or not (a linked duplicate sharing the action changes too).
     owners: list[str]
     #: How many of them are bones.
     bones: int
@@ -668,6 +735,13 @@ def smooth(
     skipped = _in_order(selection, skipped)
     if strict and skipped:
         raise SmoothError("; ".join(skipped))
+    selected = {owners.as_owner(item).obj.name for item in selection}
+    sharing = sorted({obj.name for b in bakes for obj in b.objects} - selected)
+    if sharing:
+        notes.append(
+            f"{_names(sharing)} share{'s' if len(sharing) == 1 else ''} the smoothed action (linked "
+            "duplicates): their motion changed too"
+        )
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
@@ -682,8 +756,8 @@ def smooth(
     return Smoothed(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],
-        owners=[p.owner.name for b in bakes for p in b.parts],
-        bones=sum(1 for b in bakes for p in b.parts if p.owner.bone),
+        owners=[owners.Owner(obj, p.owner.bone).name for b in bakes for p in b.parts for obj in b.objects],
+        bones=sum(len(b.objects) for b in bakes for p in b.parts if p.owner.bone),
         skipped=skipped,
         notes=notes,
     )
@@ -710,10 +784,13 @@ def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
     return source if isinstance(source, bpy.types.Action) else None
 
 
-def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.Object]:
+def revert(
+    obj: bpy.types.Object, t: transaction.Transaction, kept: list[str] | None = None
+) -> list[bpy.types.Object]:
     """Gives `obj`, and every object sharing its smoothed action, back the action they had
     before smoothing (bones included: the whole action); drops the smoothed copy once nothing
-    uses it. Returns the objects."""
+    uses it, unless the animator edited it since it was made: that one is kept with a fake
+    user and its name appended to `kept`. Returns the objects."""
     source = source_of(obj)
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
@@ -722,5 +799,10 @@ def revert(obj: bpy.types.Object, t: transaction.Transaction) -> list[bpy.types.
     for other in sharing:
         t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
-    t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
+    if was_edited(smoothed, channels.slot_identifier(obj)):
+        t.set(smoothed, "use_fake_user", True)  # an edit is never thrown away
+        if kept is not None:
+            kept.append(smoothed.name)
+    else:
+        t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
     return sharing

@@ -49,7 +49,8 @@ def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: s
         what = "bone(s) and object(s)"
     else:
         what = "object(s)"
-    shared = f" ({len(result.actions)} new actions)" if len(result.actions) != len(names) else ""
+    count = len(result.actions)
+    shared = f" ({count} new action{'s' if count != 1 else ''})" if count != len(names) else ""
     operator.report({"INFO"}, f"{verb} {len(names)} {what}: {bake.summary(names)}{shared}")
     return {"FINISHED"}
 
@@ -185,7 +186,8 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         default=False,
         description="On an object whose action is already a result of Smooth Motion, smooth that "
         "result itself (Revert then returns to it). Off: smooth the original keys again with these "
-        "options, replacing the earlier result (one Revert returns to the original)",
+        "options, replacing the earlier result (one Revert returns to the original); a result edited "
+        "since it was made (keys moved, added or deleted) is smoothed as it is and kept, never deleted",
     )
 
     @classmethod
@@ -237,17 +239,20 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         reverted: dict[str, bpy.types.Object] = {}
+        kept: list[str] = []
         try:
             with transaction.atomic() as t:
                 for obj in sorted(context.selected_objects, key=lambda o: o.name):
                     if obj.name not in reverted and bake.source_of(obj) is not None:
-                        reverted.update((o.name, o) for o in bake.revert(obj, t))
+                        reverted.update((o.name, o) for o in bake.revert(obj, t, kept))
         except Exception as err:
             return transaction.report_failure(self, err, "Revert Smoothing")
         selected = {o.name for o in context.selected_objects}
         others = sorted(set(reverted) - selected)
         also = f" (and {bake.summary(others)}, which shared its action)" if others else ""
         self.report({"INFO"}, f"Restored the original action of {bake.summary(sorted(set(reverted) & selected))}{also}")
+        if kept:
+            self.report({"INFO"}, f"kept the edited result {bake.summary(kept)} (fake user): it was edited after it was made")
         return {"FINISHED"}
 
 

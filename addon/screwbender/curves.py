@@ -18,6 +18,8 @@ not play; a driver; baked sample points; no keys; an interpolation this `polyscr
 know), and :func:`read` / :func:`evaluate` raise :class:`UnsupportedCurve` naming every such
 curve and reason. Muted modifiers are ignored, as Blender ignores them. The caller decides
 what to do (report it to the animator, or fall back to key values only for that object).
+With `keys_only`, the other modifiers are left out: what the keys make is evaluated (Smooth
+Motion smooths that and copies those modifiers onto its result, :mod:`modifiers`).
 
 Enumerations are passed to `polyscrew` by name: Blender's RNA identifiers, mapped through
 tables read from RNA (`bl_rna.properties[...].enum_items`), never Blender's internal values.
@@ -80,8 +82,10 @@ def _active_modifiers(fcurve: bpy.types.FCurve) -> list[tuple[int, bpy.types.FMo
     return [(i, m) for i, m in enumerate(fcurve.modifiers) if not m.mute]
 
 
-def problems(fcurve: bpy.types.FCurve) -> list[str]:
-    """Why `fcurve` cannot be evaluated here as Blender plays it (empty when it can)."""
+def problems(fcurve: bpy.types.FCurve, keys_only: bool = False) -> list[str]:
+    """Why `fcurve` cannot be evaluated here as Blender plays it (empty when it can).
+    `keys_only`: what the keys make (with a first Cycles modifier) is wanted, before Blender
+    applies the other modifiers (Noise, Limits, ...): those are then no problem."""
     found = []
     if getattr(fcurve, "driver", None) is not None:
         found.append("is a driver (its input is not time)")
@@ -96,6 +100,8 @@ def problems(fcurve: bpy.types.FCurve) -> list[str]:
         found.append("has no keyframes")
     for index, mod in _active_modifiers(fcurve):
         if mod.type == "CYCLES" and index == 0:
+            continue
+        if keys_only and mod.type != "CYCLES":
             continue
         kind = bpy.types.FModifier.bl_rna.properties["type"].enum_items[mod.type].name
         where = "" if mod.type != "CYCLES" else " not first in the stack"
@@ -198,7 +204,7 @@ def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.
             points[c].foreach_get(name, out[width * lo : width * hi])
 
 
-def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
+def read(fcurves: Sequence[bpy.types.FCurve], keys_only: bool = False) -> Packed:
     """The keys, extrapolation and Cycles modifier of every curve in `fcurves`, packed.
 
     One `foreach_get` per property and curve, straight into the packed arrays (float32 and,
@@ -207,9 +213,11 @@ def read(fcurves: Sequence[bpy.types.FCurve]) -> Packed:
     interpolation, `back` only with BACK, `amplitude` and `period` only with ELASTIC (the
     others keep Blender's defaults, which nothing reads). Raises :class:`UnsupportedCurve`
     naming every curve that cannot be evaluated as Blender plays it (see :func:`problems`).
+    `keys_only` packs what the keys make (with a first Cycles modifier), leaving the other
+    modifiers out: Smooth Motion smooths that and keeps those modifiers (:mod:`modifiers`).
     """
     fcurves = list(fcurves)
-    bad = [(fc, reason) for fc in fcurves for reason in problems(fc)]
+    bad = [(fc, reason) for fc in fcurves for reason in problems(fc, keys_only)]
     points = [fc.keyframe_points for fc in fcurves]
     offsets = np.zeros(len(fcurves) + 1, dtype=np.int64)
     np.cumsum([len(p) for p in points], out=offsets[1:])

@@ -20,7 +20,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, curves, intent, owners
+from . import channels, curves, intent, modifiers, owners
 
 #: Rotation modes and the property holding the rotation in each.
 ROTATION_PATHS = {
@@ -96,6 +96,9 @@ class KeyedMotion:
     #: Why the result may depart from Blender's playback (flips removed, non-normalised
     #: quaternion keys), for the departure report.
     causes: list[str] = field(default_factory=list)
+    #: F-curve modifiers copied onto the baked curves, per (property, index): every modifier
+    #: of the source curve but a first Cycles one (:mod:`modifiers`).
+    modifiers: dict = field(default_factory=dict)
 
     @property
     def scale_keyed(self) -> bool:
@@ -167,6 +170,29 @@ def _union(frames: list[np.ndarray]) -> np.ndarray:
     return merged[keep]
 
 
+def playing_strips(adt) -> list:
+    """The NLA strips Blender plays under the action of `adt` (an AnimData): none when the
+    NLA is off, never those of muted tracks or muted strips."""
+    if adt is None or not getattr(adt, "use_nla", True):
+        return []
+    return [strip for track in adt.nla_tracks if not track.mute for strip in track.strips if not strip.mute]
+
+
+def no_action(name: str, adt) -> str:
+    """Why `name` (with the AnimData `adt`, maybe None) has nothing to smooth: no active
+    action; when its motion lives in NLA strips, that, and what to do."""
+    strips = [(track, strip) for track in adt.nla_tracks for strip in track.strips] if adt is not None else []
+    if not strips:
+        return f"{name}: no animation (no active action): skipped"
+    track, strip = strips[0]
+    more = f" and {len(strips) - 1} more" if len(strips) > 1 else ""
+    return (
+        f"{name}: its motion is in NLA strips ('{strip.name}' on track '{track.name}'{more}), not in an active "
+        "action, and Smooth Motion smooths the active action: make the strip's action the active one "
+        "(Action Editor), mute or delete the strip, smooth, then Push Down again: skipped"
+    )
+
+
 def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
     """Raises :class:`SmoothError` unless `owner` (an object or a pose bone, see
     :mod:`owners`) has an editable action driving its transform."""
@@ -179,14 +205,25 @@ def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
         raise SmoothError(f"{name}: object is linked from a library and cannot be edited: skipped")
     adt = obj.animation_data
     if adt is None or adt.action is None:
-        raise SmoothError(f"{name}: no animation (no active action): skipped")
+        raise SmoothError(no_action(name, adt))
     action = adt.action
     if action.library is not None or not getattr(action, "is_editable", True):
         raise SmoothError(f"{name}: action '{action.name}' is linked from a library and cannot be edited: skipped")
-    strips = sum(len(track.strips) for track in adt.nla_tracks)
+    if getattr(adt, "use_tweak_mode", False):
+        raise SmoothError(
+            f"{name}: is in NLA tweak mode (editing a strip's action): exit it first (NLA Editor, Tab): skipped"
+        )
+    solo = [track.name for track in adt.nla_tracks if track.is_solo]
+    if solo and getattr(adt, "use_nla", True):
+        raise SmoothError(
+            f"{name}: NLA track '{solo[0]}' is Solo, so Blender plays that track alone and not the action: "
+            "turn Solo off to smooth the action: skipped"
+        )
+    strips = len(playing_strips(adt))
     if strips:
         raise SmoothError(
-            f"{name}: has {strips} NLA strip(s); the baked action would not be what the NLA plays: skipped"
+            f"{name}: has {strips} NLA strip(s) that play under the action; the baked action would not be "
+            "what the NLA plays (mute their tracks to smooth the action alone): skipped"
         )
     paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
     driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
@@ -268,12 +305,19 @@ def _read(
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
+    # F-curve modifiers: smoothing works on what the keys make, the modifiers are kept on top
+    key_range = (float(frames[0]), float(frames[-1]))
+    for (prop, index), fc in found.items():
+        reason = modifiers.refusal(fc, key_range)
+        if reason is not None:
+            raise SmoothError(f"{name}: {owner.path(prop)}[{index}]: {reason}: skipped")
+    stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
     columns = list(found)
     notes = []
     try:
-        packed = curves.read([found[c] for c in columns])
+        packed = curves.read([found[c] for c in columns], keys_only=True)
         source = intent.Source(
             packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )
@@ -331,7 +375,7 @@ def _read(
         and any(mode_ in intent.EXTENDED_CYCLES for pair in modes.values() for mode_ in pair)
     )
     is_closed = (cyclic and not extended) if closed == "AUTO" else closed == "ON"
-    kept = list(notes)
+    kept = list(notes) + modifiers.describe({key: found[key] for key in stacked})
     bake_range = None
     if extended:
         # Blender plays the keys on, shifted (offset) or mirrored, beyond their range: take
@@ -465,6 +509,7 @@ def _read(
         kept=kept,
         removed=removed,
         causes=causes,
+        modifiers=stacked,
     )
 
 

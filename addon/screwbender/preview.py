@@ -312,7 +312,8 @@ def key_hash(
         action = adt.action
         digest.update(
             f"|{action.name_full if action else ''}|{channels.slot_identifier(obj)}"
-            f"|{sum(len(t.strips) for t in adt.nla_tracks)}"
+            f"|{[(t.mute, t.is_solo, [s.mute for s in t.strips]) for t in adt.nla_tracks]}|{adt.use_nla}"
+            f"|{adt.use_tweak_mode}"
             f"|{sorted((d.data_path, d.array_index) for d in adt.drivers if d.data_path in paths)}".encode()
         )
     feature_method = options.smooth.method == "FEATURE"
