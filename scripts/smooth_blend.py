@@ -49,6 +49,9 @@ def parse(argv: list[str]) -> argparse.Namespace:
     parser.add_argument("--levels", type=int, default=4, choices=range(0, 11), metavar="0..10")
     parser.add_argument("--timing", choices=("keys", "smooth", "linear"), default="keys")
     parser.add_argument("--closed", choices=("AUTO", "ON", "OFF"), default="AUTO", type=str.upper)
+    parser.add_argument("--turns", choices=("AUTO", "BLENDER", "SHORTEST"), default="AUTO", type=str.upper,
+                        help="flips the short way, typed spins as Blender plays them (AUTO); every span as "
+                        "Blender plays it (BLENDER); the short screw everywhere (SHORTEST)")
     parser.add_argument("--step", type=float, default=1.0, help="frames between baked keys (default 1)")
     parser.add_argument("--frame-range", nargs=2, type=float, metavar=("START", "END"), help="default: the keys' range")
     parser.add_argument("--method", choices=("SCREW", "FEATURE"), default="SCREW", type=str.upper,
@@ -110,6 +113,7 @@ def run(args: argparse.Namespace) -> str:
         levels=args.levels,
         timing=args.timing,
         closed=args.closed,
+        turns=args.turns,
         frame_range=tuple(args.frame_range) if args.frame_range else None,
         step=args.step,
         method=args.method,

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels, feature, keys, modifiers, owners, sampling, transaction
+from . import channels, feature, intent, keys, modifiers, owners, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -109,6 +109,9 @@ class Options:
     #: Smooth the current action even when it is a result of Smooth Motion (else such an
     #: object's original keys are smoothed again, replacing the earlier result).
     smooth_result: bool = False
+    #: Turns (:data:`intent.TURNS`): "AUTO" (typed spins as Blender plays them, flips the
+    #: short way), "BLENDER" (every span as Blender plays it) or "SHORTEST".
+    turns: str = "AUTO"
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -132,6 +135,7 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
         approximate=settings.approximate,
         stiffness=settings.stiffness,
         smooth_result=getattr(settings, "smooth_result", False),
+        turns=getattr(settings, "turns", "AUTO"),
     )
 
 
@@ -587,7 +591,7 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
                 row.append(
                     keys.read(
                         owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range,
-                        fcurves=by_owner.get(bone, []),
+                        fcurves=by_owner.get(bone, []), turns=options.turns,
                     )
                 )
             except SmoothError as err:
@@ -626,6 +630,11 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
             parts.append(part)
             if row[column].kept:
                 notes.append(f"{owner.name}: kept {'; '.join(row[column].kept)}")
+            if row[column].removed:
+                notes.append(f"{owner.name}: removed {'; '.join(row[column].removed)}")
+            departed = _departure_note(owner, row[column], part, options)
+            if departed is not None:
+                notes.append(departed)
             for prop, index in part.written:
                 what = unread.get((owner.path(prop), index))
                 if what is not None:
@@ -633,6 +642,26 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
         if parts:
             bakes.append(ActionBake(objects, parts, source, current, identifier))
     return bakes, skipped, notes
+
+
+def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, options: Options) -> str | None:
+    """The report's line when the bake of `owner` departs from Blender's playback of its
+    source by more than :data:`intent.DEPARTURE_DEGREES` or :data:`intent.DEPARTURE_FRACTION`
+    of its size at its baked frames (one `polyscrew` call); None when it does not, or when
+    the source's curves cannot be played (:attr:`keys.KeyedMotion.source` is None)."""
+    if motion.source is None:
+        return None
+    mode = motion.rotation_mode
+    found = intent.departure(
+        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)]
+    )
+    causes = list(motion.causes)
+    if options.method == "FEATURE" and options.approximate:
+        causes.append("Approximate Keys passes near the selected keys")
+    elif options.method != "FEATURE" and options.scheme != "four_point":
+        label = {identifier: name for identifier, name, _ in SCHEMES}.get(options.scheme, options.scheme)
+        causes.append(f"the {label} scheme cuts inside the keys")
+    return intent.departure_note(owner.name, found, motion.size, causes)
 
 
 @dataclass

@@ -6,7 +6,7 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, channels, feature, owners, transaction
+from . import bake, channels, feature, intent, owners, transaction
 from .keys import SmoothError
 
 
@@ -69,7 +69,7 @@ def draw_method(layout: bpy.types.UILayout, settings) -> None:
 def draw_options(layout: bpy.types.UILayout, settings) -> None:
     """Every Smooth Motion option (the operator's redo panel and the sidebar panel)."""
     draw_method(layout, settings)
-    for name in ("scheme", "levels", "timing", "closed", "range_mode"):
+    for name in ("scheme", "levels", "timing", "turns", "closed", "range_mode"):
         layout.prop(settings, name)
     if settings.range_mode == "CUSTOM":
         col = layout.column(align=True)
@@ -136,6 +136,17 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         items=bake.TIMINGS,
         default="keys",
         description="How time runs between keys at uneven frames",
+    )
+    turns: EnumProperty(
+        name="Turns",
+        items=intent.TURNS,
+        default="AUTO",
+        description="Where Blender's playback of the keys turns the long way round: Auto keeps the "
+        "spins you typed (a key value beyond -180..180 degrees, 0 to 270, 0/360/720) and takes flips "
+        "the short way (Euler wraps of keys set from matrices: both keys inside -180..180 and the same "
+        "rotation, 360 degrees off or the twin Euler triple, at least 45 degrees closer; quaternion "
+        "keys of opposite sign), and reports them; As Blender Plays follows every span as Blender "
+        "plays it; Shortest takes the short screw between every two key poses",
     )
     closed: EnumProperty(
         name="Cycle",
@@ -248,7 +259,7 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 _OPTION_NAMES = (
     "method", "parametrization", "approximate", "stiffness",
     "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
-    "armature", "smooth_result",
+    "armature", "smooth_result", "turns",
 )
 
 
@@ -275,6 +286,7 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
     step: _same_property("step")
     armature: _same_property("armature")
     smooth_result: _same_property("smooth_result")
+    turns: _same_property("turns")
 
 
 class _SmoothPanel:

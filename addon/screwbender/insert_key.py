@@ -88,7 +88,7 @@ def insert_key(
     """
     owner = owners.as_owner(owner)
     name = owner.name
-    before = keys.read(owner, options.closed)
+    before = keys.read(owner, options.closed, turns=options.turns)
     frames = check_frames(before, frame)
     try:
         poses_before, _ = bake.sample_poses(before, frames, options, owner)
@@ -127,7 +127,7 @@ def insert_key(
                 t.keep_keys(fcurve)
             channels.insert_key(fcurve, frame, float(value))
 
-    after = keys.read(owner, options.closed)
+    after = keys.read(owner, options.closed, turns=options.turns)
     try:
         poses_after, _ = bake.sample_poses(after, frames, options, owner)
     except ValueError as err:

@@ -14,7 +14,22 @@ for the following, each one `polyscrew` call per owner (`polyscrew.analyse_spans
   spin that turn more than :data:`WIND_STEP`), until every screw span there turns at most
   :data:`WIND_STEP`: the motion turns as far and the same way as the channels say.
   Quaternion keys keep the shortest arc (no sign flips), which is what quaternion users
-  expect.
+  expect (unless Turns is As Blender Plays).
+- **Flips** are not spins. Keys set from matrices (a script setting `matrix_basis`, an
+  importer, a visual-keyed bake) have Euler values inside -180..180 degrees; where a channel
+  wraps (111.5 -> -141.1) Blender's playback turns the long way round. The option *Turns*
+  (:data:`TURNS`) decides: Auto (the default) takes such a span the short way when both keys
+  lie inside -180..180 and an equivalent triple (360 added, or the twin triple) is at least
+  :data:`WRAP_MARGIN` closer to the previous key, and quaternion keys with opposite signs
+  the short way, while spins the animator typed (a value beyond the range, 0 -> 270, 0 / 360
+  / 720, or a jump no equivalent triple explains) turn as Blender plays them; As Blender
+  Plays follows every span as Blender plays it (flips and quaternion sign flips too);
+  Shortest takes the short screw between every two key poses. The removed flips are
+  reported with their frames.
+- **Departure.** After a bake the result is measured against Blender's playback of the
+  source at every baked frame (`polyscrew.Playback.departure`, one call per owner): where it
+  departs by more than :data:`DEPARTURE_DEGREES` or :data:`DEPARTURE_FRACTION` of the
+  owner's size, the report names the owner, the frames and the size (:func:`departure_note`).
 - **Holds and pops.** A span where every channel stays still (CONSTANT interpolation, or
   equal keys with flat handles) is held: its frames keep the key pose exactly, the motion is
   cut there into pieces smoothed as open sequences (each keeps its end poses), and when the
@@ -66,6 +81,39 @@ MAX_SPAN_SAMPLES = polyscrew.MAX_SPAN_SAMPLES
 #: A channel that moves by less than this (relative to its size, plus an absolute floor of the
 #: same size) over a span is still.
 HOLD_TOLERANCE = polyscrew.HOLD_TOLERANCE
+
+#: Turns (the option): how spans that Blender's playback turns the long way round are
+#: smoothed. (identifier, label, description)
+TURNS = (
+    (
+        "AUTO",
+        "Auto",
+        "Spins you typed turn as Blender plays them (a key value beyond -180..180, 0 to 270, "
+        "0/360/720); flips take the short way: Euler wraps (both keys inside -180..180 and the same "
+        "rotation 360 degrees off, or its twin Euler triple, at least 45 degrees closer to the "
+        "previous key, as keys set from matrices have) and quaternion keys of opposite sign. "
+        "The report says how many flips were removed and where",
+    ),
+    (
+        "BLENDER",
+        "As Blender Plays",
+        "Every span turns as Blender plays its curves: spins, Euler wraps and quaternion sign "
+        "flips alike",
+    ),
+    ("SHORTEST", "Shortest", "The short screw (at most half a turn) between every two key poses, spins included"),
+)
+
+#: An Euler span is a wrap when an equivalent triple of its second key is at least this much
+#: closer (radians, 45 degrees, sum over the three angles) to the first key: `polyscrew.WRAP_MARGIN`.
+WRAP_MARGIN = polyscrew.WRAP_MARGIN
+
+#: The report names an owner whose result departs from Blender's playback of the source by
+#: more than this angle (degrees) ...
+DEPARTURE_DEGREES = 5.0
+
+#: ... or more than this fraction of the owner's size (:func:`keys.body_size`, half its
+#: largest dimension) in location.
+DEPARTURE_FRACTION = 0.05
 
 #: Cycles modifier modes whose playback beyond the keys is not the keys repeated: the
 #: motion is extended by Blender's playback and baked with the same modifier.
@@ -126,3 +174,73 @@ def analyse_spans(
     converts rotations itself); they stay so that callers need not change.
     """
     return polyscrew.analyse_spans(source.playback, np.asarray(frames, dtype=np.float64))
+
+
+def analyse_turns(
+    source: Source, frames: np.ndarray, turns: str = "AUTO"
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`analyse_spans` under the option Turns (:data:`TURNS`), and per span whether it
+    is a flip (an Euler wrap or a quaternion sign flip, by its key values). One
+    `polyscrew.analyse_turns` call."""
+    return polyscrew.analyse_turns(source.playback, np.asarray(frames, dtype=np.float64), turns)
+
+
+def frame_runs(frames: np.ndarray, limit: int = 4) -> str:
+    """"12-18, 30-37 and 2 more": the runs of consecutive entries of `frames` (sorted frames
+    of one grid, or (start, end) pairs when 2-D), the first `limit` of them."""
+    frames = np.asarray(frames, dtype=np.float64)
+    if frames.ndim == 2:
+        starts, ends = frames[:, 0], frames[:, 1]
+    else:
+        if not len(frames):
+            return ""
+        gaps = np.diff(frames)
+        step = np.min(gaps) if len(gaps) else 1.0
+        cut = np.flatnonzero(gaps > 1.5 * step) + 1
+        starts, ends = frames[np.r_[0, cut]], frames[np.r_[cut - 1, len(frames) - 1]]
+    words = [f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in zip(starts[:limit], ends[:limit])]
+    more = f" and {len(starts) - limit} more" if len(starts) > limit else ""
+    return ", ".join(words) + more
+
+
+@dataclass
+class Departure:
+    """How far a result departs from Blender's playback of the source, at its baked frames."""
+
+    #: Largest angle (degrees) and distance (units) over the frames.
+    degrees: float
+    distance: float
+    #: The frames where it departs by more than the thresholds.
+    frames: np.ndarray
+
+
+def departure(
+    source: Source, size: float, frames: np.ndarray, location: np.ndarray | None, rotation: np.ndarray
+) -> Departure:
+    """The departure of the channels `location` (T, 3; None for a connected bone) and
+    `rotation` (T, k) at `frames` (T,) from Blender's playback of `source`: one
+    `polyscrew.Playback.departure` call; frames above :data:`DEPARTURE_DEGREES` or
+    :data:`DEPARTURE_FRACTION` of `size`."""
+    frames = np.asarray(frames, dtype=np.float64)
+    if location is None:
+        location = np.zeros((len(frames), 3))
+    distance, angle = source.playback.departure(frames, location, rotation)
+    degrees = np.degrees(angle)
+    over = (degrees > DEPARTURE_DEGREES) | (distance > DEPARTURE_FRACTION * size)
+    return Departure(
+        degrees=float(degrees.max(initial=0.0)), distance=float(distance.max(initial=0.0)), frames=frames[over]
+    )
+
+
+def departure_note(name: str, found: Departure, size: float, causes: list[str]) -> str | None:
+    """The report's line for an owner whose result departs from Blender's playback (None when
+    it stays within the thresholds): the owner, the largest angle and distance (and the
+    distance as a percentage of its size), the frames, and what may cause it."""
+    if not len(found.frames):
+        return None
+    why = f" ({'; '.join(causes)})" if causes else ""
+    return (
+        f"{name}: departs from what Blender played by up to {found.degrees:.1f} degrees and "
+        f"{found.distance:.3g} units ({100.0 * found.distance / size:.0f} % of its size) at frames "
+        f"{frame_runs(found.frames)}{why}"
+    )

@@ -91,6 +91,11 @@ class KeyedMotion:
     size: float = 1.0
     #: What was found and kept, for the report ("2 holds", "a spin", ...).
     kept: list[str] = field(default_factory=list)
+    #: What was taken out, for the report ("2 flip(s) ... at frames 11-21, 31-41").
+    removed: list[str] = field(default_factory=list)
+    #: Why the result may depart from Blender's playback (flips removed, non-normalised
+    #: quaternion keys), for the departure report.
+    causes: list[str] = field(default_factory=list)
     #: F-curve modifiers copied onto the baked curves, per (property, index): every modifier
     #: of the source curve but a first Cycles one (:mod:`modifiers`).
     modifiers: dict = field(default_factory=dict)
@@ -234,6 +239,7 @@ def read(
     extend_to: tuple[float, float] | None = None,
     fcurves: list | None = None,
     analyse: bool = True,
+    turns: str = "AUTO",
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -248,7 +254,9 @@ def read(
     extended by Blender's playback over it, plus :data:`intent.EXTRA_CYCLES` on each side.
     `fcurves`, when given, are the F-curves to read from instead (the caller's grouping by
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
-    scanning all its curves for each bone).
+    scanning all its curves for each bone). `turns` is the option Turns (:data:`intent.TURNS`):
+    which spans Blender's playback turns the long way round are followed (spins) and which
+    are taken the short way (flips, reported in `removed`).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
     `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
@@ -256,7 +264,7 @@ def read(
     """
     owner = owners.as_owner(owner)
     try:
-        return _read(owner, closed, action, slot, extend_to, fcurves, analyse)
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns)
     except SmoothError:
         raise
     except ValueError as err:  # polyscrew refusing the curves or the key poses
@@ -271,6 +279,7 @@ def _read(
     extend_to: tuple[float, float] | None,
     fcurves: list | None,
     analyse: bool,
+    turns: str = "AUTO",
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner)
@@ -393,10 +402,35 @@ def _read(
 
     held = pops = None
     is_key = np.ones(len(frames), dtype=bool)
+    removed, causes = [], []
+    if mode == "QUATERNION" and np.abs(np.linalg.norm(rotation, axis=1) - 1.0).max() > 1e-3:
+        causes.append("non-normalised quaternion keys: Blender's playback interpolates their components")
     if source is not None and analyse:
-        held, pops, turn, inserted = intent.analyse_spans(source, frames, rotation_matrices, compose)
+        held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
+        followed = ~held & ((~flips & (mode != "QUATERNION")) if turns == "AUTO" else (turns == "BLENDER"))
+        # Shortest: typed turns whose short screw turns less far than Blender's playback
+        relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
+        short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
+        shortened = ~held & longer & ~flips & (turns == "SHORTEST")
+        spans = np.stack([frames[:-1], frames[1:]], axis=1)
+        if bake_range is not None:  # an extended cycle: report the keys' own period once
+            once = (spans[:, 0] >= bake_range[0]) & (spans[:, 0] < bake_range[1])
+            flips, shortened = flips & once, shortened & once
+        if flips.any():
+            where = intent.frame_runs(spans[flips])
+            if turns == "BLENDER":
+                kept.append(f"{int(flips.sum())} flip(s) as Blender plays them (Turns: As Blender Plays) at frames {where}")
+            else:
+                what = "Euler wrap(s)" if mode != "QUATERNION" else "quaternion sign flip(s)"
+                removed.append(f"{int(flips.sum())} flip(s) ({what} taken the short way) at frames {where}")
+                causes.append("flips removed")
+        if shortened.any():
+            removed.append(f"{int(shortened.sum())} spin(s) taken the short way (Turns: Shortest) at frames "
+                           f"{intent.frame_runs(spans[shortened])}")
+            causes.append("spins taken the short way")
         if len(inserted):
-            spins = int(np.sum((turn > intent.WIND_LIMIT) & ~held))
+            spins = int(np.sum((turn > intent.WIND_LIMIT) & followed))
             played = source.channels(inserted)
             order = np.argsort(np.concatenate([frames, inserted]), kind="stable")
             parent = np.clip(np.searchsorted(frames, np.concatenate([frames, inserted])[order][:-1], side="right") - 1, 0, len(frames) - 2)
@@ -473,6 +507,8 @@ def _read(
         cycle_modes=modes if bake_range is not None else None,
         size=body_size(owner),
         kept=kept,
+        removed=removed,
+        causes=causes,
         modifiers=stacked,
     )
 

@@ -464,7 +464,9 @@ class PreviewCache:
             return entry, False
         name = owner.name
         try:
-            motion = keys.read(owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves)
+            motion = keys.read(
+                owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves, turns=options.smooth.turns
+            )
             if live is not None:
                 motion = with_live_key(motion, live)
             entry = PreviewEntry(digest, compute(motion, options, owner))

@@ -512,6 +512,11 @@ HOLD_TOLERANCE: float
 """A channel moving less than this times (its size + 1) over a span is still (1e-6)."""
 PACE_SAMPLES: int
 """Steps per span along which ``keys_parameters`` measures travel (16)."""
+WRAP_MARGIN: float
+"""An Euler span is a wrap when an equivalent triple of its second key is at least this much
+closer (radians, 45 degrees, sum over the three angles) to its first key (``analyse_turns``)."""
+RANGE_TOLERANCE: float
+"""How far beyond -pi..pi an Euler key may lie and still be inside the range (1e-6 radians)."""
 
 class Playback:
     """An owner's transform channels as Blender plays them.
@@ -554,9 +559,33 @@ class Playback:
         others ``unkeyed``. GIL released."""
     def __len__(self) -> int:
         """The number of curves."""
+    def departure(
+        self, frames: ArrayLike, location: ArrayLike, rotation: ArrayLike
+    ) -> tuple[FloatArray, FloatArray]:
+        """How far a result's ``location`` (T, 3) and ``rotation`` (T, 3 or 4, in the owner's
+        mode) at ``frames`` (T,) are from this playback: per frame the distance between the
+        locations (0 when ``located`` is false) and the angle (radians, in [0, pi]) between
+        the rotations, both (T,). GIL released. Raises ValueError for shapes that do not
+        match or values that are not finite."""
+
+def analyse_turns(
+    playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """``analyse_spans`` and, per span, ``flips`` (K - 1,): not held, and its key values are
+    an Euler wrap (every value of both keys inside -pi..pi, and an equivalent triple of the
+    second key, 2 pi added or the twin triple, at least ``WRAP_MARGIN`` closer to the first,
+    sum of absolute differences) or a quaternion sign flip (q0 . q1 < 0): what Blender plays
+    the long way round although the animator did not type a spin.
+
+    ``turns`` picks the spans whose playback is followed (poses added, the rule of
+    ``analyse_spans``): "AUTO", Euler and axis-angle spans that are not flips (typed spins
+    turn as Blender plays them; flips and quaternion keys take the short screw); "BLENDER",
+    every span (flips and quaternion sign flips too, as Blender plays them); "SHORTEST",
+    none (the short screw between every two key poses; nothing inserted).
+    """
 
 def analyse_spans(
-    playback: Playback, frames: ArrayLike
+    playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
 ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:
     """What each key span of ``frames`` (K,) (strictly increasing, K >= 2) does along the
     playback: ``(held, pops, turn, inserted)``.
@@ -567,10 +596,11 @@ def analyse_spans(
     from the span's start by more than ``HOLD_TOLERANCE`` (relative to the value + 1);
     ``pops`` (K - 1,): held, and a channel differs between its keys; ``turn`` (K - 1,):
     radians the rotation turns through, the sum of the angles between consecutive samples
-    and the span's end. ``inserted`` (M,), ascending: for Euler and axis-angle rotation, the
-    frames where poses of the playback must be added: a span turning more than
-    ``WIND_LIMIT`` (not held), and the runs of its neighbours turning more than
-    ``WIND_STEP``, get ``ceil(turn / WIND_STEP) - 1`` frames where the accumulated turn
+    and the span's end. ``inserted`` (M,), ascending: the frames where poses of the playback
+    must be added: a span that ``turns`` follows (``analyse_turns``; by default Euler and
+    axis-angle spans that are not Euler wraps) turning more than ``WIND_LIMIT`` (not held),
+    and the runs of its followed neighbours turning more than ``WIND_STEP``, get
+    ``ceil(turn / WIND_STEP) - 1`` frames where the accumulated turn
     reaches equal fractions of the span's (linear between samples). GIL released. Raises
     ValueError for fewer than two frames or frames that do not increase.
     """

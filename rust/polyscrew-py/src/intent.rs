@@ -10,10 +10,11 @@ use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use polyscrew::intent::{
-    analyse_spans as core_analyse_spans, keys_parameters as core_keys_parameters,
-    pace_parameters as core_pace_parameters, rotation_matrices as core_rotation_matrices,
-    screw_pace_poses, Channel, KeysTiming, Playback, HOLD_TOLERANCE, MAX_SPAN_SAMPLES,
-    PACE_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
+    analyse_turns as core_analyse_turns, departure as core_departure,
+    keys_parameters as core_keys_parameters, pace_parameters as core_pace_parameters,
+    rotation_matrices as core_rotation_matrices, screw_pace_poses, Channel, KeysTiming, Playback,
+    Spans, Turns, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES,
+    WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode};
@@ -209,44 +210,142 @@ impl PyPlayback {
     fn __len__(&self) -> usize {
         self.inner.curves().len()
     }
+
+    /// departure(frames, location, rotation) -> (distance, angle)
+    ///
+    /// How far a result's channels, `location` (T, 3) and `rotation` (T, 3 or 4, in the
+    /// owner's mode) at `frames` (T,), are from this playback: per frame the distance between
+    /// the locations (0 when `located` is false) and the angle (radians, in [0, pi]) between
+    /// the rotations, both (T,). GIL released.
+    #[allow(clippy::type_complexity)]
+    fn departure<'py>(
+        &self,
+        py: Python<'py>,
+        frames: &Bound<'py, PyAny>,
+        location: &Bound<'py, PyAny>,
+        rotation: &Bound<'py, PyAny>,
+    ) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)> {
+        const F: &str = "Playback.departure";
+        let inner = &self.inner;
+        let frames = float_array(F, "frames", frames)?;
+        let t = vector_len(F, "frames", &frames)?;
+        let w = inner.mode().width();
+        let location = float_array(F, "location", location)?;
+        let rotation = float_array(F, "rotation", rotation)?;
+        for (array, what, width) in [(&location, "location", 3), (&rotation, "rotation", w)] {
+            let view = array.as_array();
+            let shape = view.shape();
+            if shape.len() != 2 || shape[1] != width || shape[0] != t {
+                return Err(shape_err(F, what, &format!("({t}, {width})"), shape));
+            }
+        }
+        // the values read, the playback's rows, the two outputs
+        check_budget(
+            F,
+            Footprint::of::<f64>(t.saturating_mul(3 + w + 3)).and::<f64>(4096 * inner.width()),
+            "the departure",
+            HINT,
+        )?;
+        let (frames, location, rotation) =
+            (frames.as_array(), location.as_array(), rotation.as_array());
+        let out = py.detach(|| -> PyResult<_> {
+            let frames = read_vector(F, "frames", &frames)?;
+            // (shapes checked above) row-major values
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| -> PyResult<Vec<f64>> {
+                let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(F, e))?;
+                out.extend(view.iter().copied());
+                Ok(out)
+            };
+            let location = flat(&location)?;
+            let rotation = flat(&rotation)?;
+            core_departure(inner, &frames, &location, &rotation).map_err(|e| to_py_err(F, e))
+        })?;
+        Ok((out.distance.into_pyarray(py), out.angle.into_pyarray(py)))
+    }
 }
 
-/// analyse_spans(playback, frames) -> (held, pops, turn, inserted)
+/// Reads the arguments of `analyse_spans` / `analyse_turns` and runs the core, GIL released.
+fn spans_of(
+    py: Python<'_>,
+    function: &str,
+    playback: &Bound<'_, PyAny>,
+    frames: &Bound<'_, PyAny>,
+    turns: &str,
+) -> PyResult<Spans> {
+    let playback = playback_arg(function, "playback", playback)?;
+    let turns = Turns::from_name(turns).map_err(|e| to_py_err(function, e))?;
+    let frames = float_array(function, "frames", frames)?;
+    let k = vector_len(function, "frames", &frames)?;
+    check_budget(function, Footprint::of::<f64>(k), "the frames", HINT)?;
+    let inner = &playback.get().inner;
+    let view = frames.as_array();
+    py.detach(|| -> PyResult<_> {
+        let frames = read_vector(function, "frames", &view)?;
+        core_analyse_turns(inner, &frames, turns).map_err(|e| to_py_err(function, e))
+    })
+}
+
+/// analyse_spans(playback, frames, turns="AUTO") -> (held, pops, turn, inserted)
 ///
 /// Per key span of `frames` (K,) (strictly increasing, K >= 2): `held` (K - 1,) bool, every
 /// channel still over the span; `pops` (K - 1,) bool, held and jumping at its end; `turn`
 /// (K - 1,) radians the rotation turns through over the span (along Blender's playback);
 /// `inserted` (M,) the frames (ascending) where poses of the playback must be added so that
-/// no screw span of a spin turns more than `WIND_STEP` (Euler and axis-angle only). GIL
-/// released.
+/// no screw span of a spin `turns` follows turns more than `WIND_STEP` (`analyse_turns`).
+/// GIL released.
 #[pyfunction]
+#[pyo3(signature = (playback, frames, turns="AUTO"))]
 #[allow(clippy::type_complexity)]
 fn analyse_spans<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
+    turns: &str,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 )> {
-    const F: &str = "analyse_spans";
-    let playback = playback_arg(F, "playback", playback)?;
-    let frames = float_array(F, "frames", frames)?;
-    let k = vector_len(F, "frames", &frames)?;
-    check_budget(F, Footprint::of::<f64>(k), "the frames", HINT)?;
-    let inner = &playback.get().inner;
-    let view = frames.as_array();
-    let spans = py.detach(|| -> PyResult<_> {
-        let frames = read_vector(F, "frames", &view)?;
-        core_analyse_spans(inner, &frames).map_err(|e| to_py_err(F, e))
-    })?;
+    let spans = spans_of(py, "analyse_spans", playback, frames, turns)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
         spans.turn.into_pyarray(py),
         spans.inserted.into_pyarray(py),
+    ))
+}
+
+/// analyse_turns(playback, frames, turns="AUTO") -> (held, pops, turn, inserted, flips)
+///
+/// `analyse_spans` and, per span, `flips` (K - 1,) bool: not held, and its key values are an
+/// Euler wrap (both keys inside -pi..pi and an equivalent triple, 2 pi added or the twin
+/// triple, at least `WRAP_MARGIN` closer to the first) or a quaternion sign flip (q0 . q1 <
+/// 0). `turns`: "AUTO" follows Blender's playback for typed Euler and axis-angle spins and
+/// takes flips (and quaternions) the short way; "BLENDER" follows every span as Blender
+/// plays it; "SHORTEST" follows none (nothing inserted). GIL released.
+#[pyfunction]
+#[pyo3(signature = (playback, frames, turns="AUTO"))]
+#[allow(clippy::type_complexity)]
+fn analyse_turns<'py>(
+    py: Python<'py>,
+    playback: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
+    turns: &str,
+) -> PyResult<(
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+)> {
+    let spans = spans_of(py, "analyse_turns", playback, frames, turns)?;
+    Ok((
+        spans.held.into_pyarray(py),
+        spans.pops.into_pyarray(py),
+        spans.turn.into_pyarray(py),
+        spans.inserted.into_pyarray(py),
+        spans.flips.into_pyarray(py),
     ))
 }
 
@@ -422,6 +521,7 @@ fn rotation_matrices<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyPlayback>()?;
     m.add_function(wrap_pyfunction!(analyse_spans, m)?)?;
+    m.add_function(wrap_pyfunction!(analyse_turns, m)?)?;
     m.add_function(wrap_pyfunction!(keys_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(pace_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_matrices, m)?)?;
@@ -431,5 +531,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_SPAN_SAMPLES", MAX_SPAN_SAMPLES)?;
     m.add("HOLD_TOLERANCE", HOLD_TOLERANCE)?;
     m.add("PACE_SAMPLES", PACE_SAMPLES)?;
+    m.add("WRAP_MARGIN", WRAP_MARGIN)?;
+    m.add("RANGE_TOLERANCE", RANGE_TOLERANCE)?;
     Ok(())
 }

@@ -17,7 +17,12 @@
 //!   turning more than [`WIND_LIMIT`], and its neighbours turning more than [`WIND_STEP`])
 //!   turns more than [`WIND_STEP`]. A screw between two key poses turns at most half a
 //!   turn; with the added poses the smoothed motion turns as far and the same way as the
-//!   channels. Quaternion channels keep the shortest arc (nothing is added).
+//!   channels. Quaternion channels keep the shortest arc (nothing is added). [`analyse_turns`]
+//!   does the same under a [`Turns`] choice and tells the **flips** ([`turns`]: Euler wraps
+//!   and quaternion sign flips, which Blender plays the long way round and [`Turns::Auto`]
+//!   takes the short way) from the spins the animator typed.
+//! - [`departure`]: per frame, how far a smoothed result's channels are from the playback
+//!   (distance of the origins, rotation angle), for the report.
 //! - [`keys_parameters`]: timing "Keys". Within each span, the motion parameter of an output
 //!   frame is the one at which the smoothed motion has travelled the same fraction of the
 //!   span as Blender's playback has at that frame. Travel is the root mean square
@@ -28,20 +33,27 @@
 //! Every size input can drive is checked in one place ([`limits`]) before it is allocated;
 //! bad input is an [`Error`](crate::Error), never a panic.
 
+pub mod departure;
 pub(crate) mod interp;
 pub mod limits;
 pub mod pace;
 pub mod playback;
 pub mod spans;
+pub mod turns;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod turns_tests;
 
+pub use departure::{departure, Departure};
 pub use pace::{
     keys_parameters, pace_parameters, screw_pace_poses, travel, KeysTiming, DENSE_PACE_SAMPLES,
     PACE_SAMPLES,
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{
-    analyse_spans, Spans, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
+    analyse_spans, analyse_turns, Spans, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, SPAN_SAMPLES,
+    WIND_LIMIT, WIND_STEP,
 };
+pub use turns::{is_euler_wrap, is_flip, is_sign_flip, Turns, RANGE_TOLERANCE, WRAP_MARGIN};

@@ -7,6 +7,7 @@ use glam::DMat3;
 use super::interp::interp;
 use super::limits::{check_footprint, collected, filled};
 use super::playback::Playback;
+use super::turns::{is_flip, Turns};
 use crate::memory::try_vec;
 use crate::{check_key_times, Error, Result, RotationMode};
 
@@ -46,9 +47,12 @@ pub struct Spans {
     /// rotation angles between consecutive samples of the playback and the span's end.
     pub turn: Vec<f64>,
     /// Frames where poses of the playback must be added (ascending): inside the spans of
-    /// spins, so that each screw span of a spin turns at most [`WIND_STEP`]. Empty for
-    /// quaternion rotation.
+    /// spins, so that each screw span of a spin turns at most [`WIND_STEP`]. Which spans
+    /// are followed depends on [`Turns`] (quaternion rotation: none with [`Turns::Auto`]).
     pub inserted: Vec<f64>,
+    /// Not held, and a flip by the key values ([`is_flip`]: an Euler wrap or a quaternion sign
+    /// flip), whatever [`Turns`] does with it.
+    pub flips: Vec<bool>,
 }
 
 /// The samples of a span from `start` (included) to `end` (excluded), `count` of them:
@@ -61,10 +65,22 @@ fn span_samples(start: f64, end: f64, count: usize, out: &mut Vec<f64>) {
 
 /// Samples for a span whose rotation channels change from `a` to `b` (channel rows' rotation
 /// parts): one per [`DEGREES_PER_SAMPLE`] of change, within
-/// [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]; always [`SPAN_SAMPLES`] for quaternions.
-fn sample_count(mode: RotationMode, a: &[f64], b: &[f64]) -> usize {
+/// [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]. Quaternions: [`SPAN_SAMPLES`], unless their
+/// turns are followed (`follow_quaternions`, [`Turns::AsPlayed`]): then the change is the
+/// angle between the keys' 4-vectors, doubled (`2 acos(a . b / |a| |b|)`, up to 360 degrees
+/// for a sign flip that Blender plays the long way).
+fn sample_count(mode: RotationMode, a: &[f64], b: &[f64], follow_quaternions: bool) -> usize {
     let change = match mode {
-        RotationMode::Quaternion => return SPAN_SAMPLES,
+        RotationMode::Quaternion if !follow_quaternions => return SPAN_SAMPLES,
+        RotationMode::Quaternion => {
+            let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+            let norms = a.iter().map(|x| x * x).sum::<f64>().sqrt()
+                * b.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norms <= 0.0 || norms.is_nan() {
+                return SPAN_SAMPLES;
+            }
+            2.0 * (dot / norms).clamp(-1.0, 1.0).acos()
+        }
         RotationMode::AxisAngle => (b[0] - a[0]).abs(),
         RotationMode::Euler(_) => a.iter().zip(b).map(|(x, y)| (y - x).abs()).sum(),
     };
@@ -93,8 +109,17 @@ fn moves(v0: &[f64], v: &[f64]) -> bool {
         .any(|(a, b)| (b - a).abs() > HOLD_TOLERANCE * (a.abs() + 1.0))
 }
 
+/// [`analyse_turns`] with [`Turns::Auto`].
+///
+/// # Errors
+/// Those of [`analyse_turns`].
+pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
+    analyse_turns(playback, frames, Turns::Auto)
+}
+
 /// Per key span of `frames` (`K >= 2`, strictly increasing): whether it is held, whether the
-/// pose pops at its end, its turn, and the frames where poses must be added for spins.
+/// pose pops at its end, its turn, whether it is a flip, and the frames where poses must be
+/// added for the spins `turns` follows.
 ///
 /// Each span is sampled at [`SPAN_SAMPLES`] evenly spaced frames from its start (included)
 /// to its end (excluded), more where the rotation channels change a lot between its keys
@@ -102,17 +127,20 @@ fn moves(v0: &[f64], v: &[f64]) -> bool {
 /// channel of any sample moves from the span's start by more than [`HOLD_TOLERANCE`]; it
 /// pops when it is held and a channel differs between its keys. Its turn is the sum of
 /// [`rotation_angle`]s between consecutive samples and from the last sample to the span's
-/// end. Spins (Euler and axis-angle only): a span that is not held and turns more than
-/// [`WIND_LIMIT`], together with the runs of neighbouring spans that are not held and turn
-/// more than [`WIND_STEP`], gets `ceil(turn / WIND_STEP) - 1` frames where the accumulated
-/// turn along its samples reaches equal fractions of the span's turn (linear between
-/// samples).
+/// end. A span is a flip when it is not held and its key values are an Euler wrap or a
+/// quaternion sign flip ([`is_flip`]). A span is *followed* when `turns` is
+/// [`Turns::AsPlayed`]; with [`Turns::Auto`] when it is not a flip and the mode is Euler or
+/// axis-angle (quaternion keys keep the shortest arc); never with [`Turns::Shortest`]. Spins:
+/// a followed span that is not held and turns more than [`WIND_LIMIT`], together with the
+/// runs of neighbouring followed spans that are not held and turn more than [`WIND_STEP`],
+/// gets `ceil(turn / WIND_STEP) - 1` frames where the accumulated turn along its samples
+/// reaches equal fractions of the span's turn (linear between samples).
 ///
 /// # Errors
 /// [`Error::TooFew`] for fewer than two frames, [`Error::KeyTimes`] for frames that are not
 /// finite and strictly increasing, the errors of [`Playback::channels`], and a request over
 /// the size limit ([`check_footprint`]).
-pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
+pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Result<Spans> {
     let k = frames.len();
     if k < 2 {
         return Err(Error::TooFew { got: k, need: 2 });
@@ -125,7 +153,7 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
     // The key rows, per-span results, one span's samples (frames, rows, steps).
     let f64s = k
         .saturating_mul(width)
-        .saturating_add(spans.saturating_mul(3))
+        .saturating_add(spans.saturating_mul(4))
         .saturating_add(MAX_SPAN_SAMPLES.saturating_mul(width + 2));
     check_footprint(
         f64s.saturating_mul(std::mem::size_of::<f64>()),
@@ -141,6 +169,7 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
                 mode,
                 &key_row(s)[rotation.clone()],
                 &key_row(s + 1)[rotation.clone()],
+                turns == Turns::AsPlayed,
             )
         }),
         "spans",
@@ -177,12 +206,29 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
         pops[s] = held[s] && moves(key_row(s), key_row(s + 1));
     }
 
+    let mut flips = filled(spans, false, "spans")?;
+    for s in 0..spans {
+        flips[s] = !held[s]
+            && is_flip(
+                mode,
+                &key_row(s)[rotation.clone()],
+                &key_row(s + 1)[rotation.clone()],
+            );
+    }
+    let follows = |s: usize| {
+        !held[s]
+            && match turns {
+                Turns::AsPlayed => true,
+                Turns::Auto => mode != RotationMode::Quaternion && !flips[s],
+                Turns::Shortest => false,
+            }
+    };
     let mut inserted = Vec::new();
-    if mode != RotationMode::Quaternion {
+    if turns != Turns::Shortest {
         let mut spinning = filled(spans, false, "spans")?;
-        let turning = |s: usize| turn[s] > WIND_STEP && !held[s];
+        let turning = |s: usize| turn[s] > WIND_STEP && follows(s);
         for s in 0..spans {
-            let spin = turn[s] > WIND_LIMIT && !held[s];
+            let spin = turn[s] > WIND_LIMIT && follows(s);
             if !spin {
                 continue; // the runs of neighbours are found from the spins
             }
@@ -234,5 +280,6 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
         pops,
         turn,
         inserted,
+        flips,
     })
 }
