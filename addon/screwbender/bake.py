@@ -303,7 +303,7 @@ def sample_channels(
     if join is not None:  # (an end moved off an eased span: baked from there)
         start, end = (join.start if join.before else start), (join.end if join.after else end)
     if budget is not None and end > start and options.step > 0.0:
-        keys_needed = ((end - start) / options.step + 2 + len(motion.frames)) * channel_count(motion)
+        keys_needed = ((end - start) / options.step + 2) * channel_count(motion)
         if keys_needed > budget[0]:
             raise SmoothError(
                 f"{owner.name}: baking frames {start:g} to {end:g} every {options.step:g} frames would write "

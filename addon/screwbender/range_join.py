@@ -111,9 +111,9 @@ def cut(
     start, end = float(frame_range[0]), float(frame_range[1])
     frames = motion.frames
     before, after = start > frames[0] + tol, end < frames[-1] - tol
-    if not (before or after):
+    if not (before or after) or not end > start:  # (an empty range is refused by the bake)
         return motion, None
-    if not end > start + tol or end <= frames[0] + tol or start >= frames[-1] - tol:
+    if end <= frames[0] + tol or start >= frames[-1] - tol:
         raise keys.SmoothError(
             f"{owner.name}: the frame range {start:g} to {end:g} holds none of its motion (keys "
             f"{frames[0]:g} to {frames[-1]:g}): skipped"
