@@ -252,6 +252,8 @@ def test_remove_noise_keeps_the_keys_outside_and_joins_at_the_ends(capsys):
     assert bpy.ops.screwbender.denoise(range_mode="CUSTOM", frame_start=20, frame_end=60) == {"FINISHED"}
     now = played(obj, frames)
     loc, ang = difference(played(obj, fine[fine_outside]), was_fine)
+    with capsys.disabled():
+        print(f"\n[remove noise 20..60] outside (every quarter frame): {loc:.4f} mm, {ang:.5f} deg off the source")
     after = {key: key_table(fc) for key, fc in curves_of(obj).items()}
     for key, table in before.items():
         rows = (table["co"][:, 0] < 20) | (table["co"][:, 0] > 60)
@@ -266,7 +268,7 @@ def test_remove_noise_keeps_the_keys_outside_and_joins_at_the_ends(capsys):
     across = step[[18, 59]]  # frames 19 -> 20 and 60 -> 61
     with capsys.disabled():
         print(
-            f"\n[remove noise 20..60] outside (every quarter frame): {loc:.4f} mm, {ang:.5f} deg off the source; step across the ends "
+            f"\n[remove noise 20..60] step across the ends "
             f"{across[0]:.1f} / {across[1]:.1f} mm (the source's largest step {source_step.max():.1f} mm)"
         )
     assert loc == 0.0 and ang < 1e-4
