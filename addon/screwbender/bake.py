@@ -502,7 +502,7 @@ def _write_joined(bag, part: Baked, prop: str, columns: list[tuple[int, int]]) -
     for column, index in columns:
         fcurve = channels.new_fcurve(bag, part.owner.path(prop), index, part.owner.group)
         range_join.write(
-            bag, fcurve, part.join, part.frames, part.values[prop][:, column], interpolation, prop, index, column,
+            fcurve, part.join, part.frames, part.values[prop][:, column], interpolation, prop, index, column,
             part.end_maps or {},
         )
 

@@ -300,7 +300,7 @@ def _map(table: dict[str, np.ndarray], a: float, c: float) -> None:
         table[name][:, 1] = (a * table[name][:, 1].astype(np.float64) + c).astype(np.float32)
 
 
-def write(bag, fcurve: bpy.types.FCurve, join: Join, frames: np.ndarray, values: np.ndarray,
+def write(fcurve: bpy.types.FCurve, join: Join, frames: np.ndarray, values: np.ndarray,
           interpolation: np.ndarray, prop: str, index: int, column: int, source_ends: dict) -> None:
     """Keys `fcurve` (new, empty) with the baked keys (`frames`, `values` of one channel,
     `interpolation` codes) and, outside the range, the source keys of that channel kept.
