@@ -16,10 +16,11 @@ without a jump. Per curve (:func:`write`), the source span the range's end cuts 
   the range inside such a span moves to the span's key inside the range (:func:`cut`), the
   whole span is kept, and the report says so.
 
-Rotation channels: the baked values are continuous from the source's value at the start, and
-a quaternion (the axis of an axis-angle) is scaled along the range so that it has the source's
-length at both ends (Blender normalises them: the poses are unchanged). Where the baked values
-end on another triple of the same rotation (an Euler channel a whole turn away, the twin Euler
+Rotation channels: the baked values are continuous from the source's value at the start
+(written as the same rotation the source's channels hold there: an axis-angle of the other
+sign, an Euler angle a turn away), and a quaternion (the axis of an axis-angle) is scaled
+along the range so that it has the source's length at both ends (Blender normalises them: the
+poses are unchanged). Where the baked values end on another triple of the same rotation (an Euler channel a whole turn away, the twin Euler
 triple, a quaternion of the other sign), the source keys after the range are written as that
 same rotation (each channel mapped by `a * value + c`, which keeps every pose Blender plays):
 no channel jumps at the join.
@@ -276,7 +277,7 @@ def equivalence(source: np.ndarray, baked: np.ndarray, mode: str, prop: str) -> 
         axis = float(source[1:] @ source[1:])
         for sign in (1.0, -1.0):
             if axis > 0.0:
-                scale = sign * float(baked[1:] @ source[1:]) / axis
+                scale = float(baked[1:] @ source[1:]) / axis  # the axis: sign times a positive length
                 if scale * sign > 0.0:
                     a = np.array([sign, scale, scale, scale])
                     c = np.array([TAU * np.round((baked[0] - sign * source[0]) / TAU), 0.0, 0.0, 0.0])
@@ -427,10 +428,21 @@ def end_maps(join: Join, motion: keys.KeyedMotion, played: dict, values: dict, f
             if not getattr(join, "before" if side == "start" else "after"):
                 continue
             src = played[prop][src_row] if prop != "scale" else played["scale"][src_row, motion.scale_axes]
+            identity = (np.ones_like(src), np.zeros_like(src))
+            if side == "start":
+                # the baked values written like the source's at the start (the whole bake mapped:
+                # the same rotations), so that the keys before the range are kept as they are
+                found = equivalence(baked[0], src, motion.rotation_mode, prop)
+                if found is None:
+                    baked[0] = src
+                else:
+                    baked[:] = found[0] * baked + found[1]
+                maps[side] = identity
+                continue
             found = equivalence(src, baked[row], motion.rotation_mode, prop)
             if found is None:  # no rotation-keeping map: the baked end takes the source's value
                 baked[row] = src
-                found = (np.ones_like(src), np.zeros_like(src))
+                found = identity
             maps[side] = found
         out[prop] = maps
     return out

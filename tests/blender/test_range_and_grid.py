@@ -113,6 +113,8 @@ RANGES = [
     ("CUSTOM", 10.0, 30.0, "CONSTANT", "XYZ"),
     ("CUSTOM", 10.0, 30.0, "SINE", "YZX"),
     ("CUSTOM", 13.0, 31.0, "BEZIER", "XYZ"),  # the range's ends on keys
+    ("CUSTOM", -5.0, 30.0, "BEZIER", "AXIS_ANGLE"),  # from before the first key: only the end cuts
+    ("CUSTOM", 10.0, 30.0, "BEZIER", "AXIS_ANGLE"),
 ]
 
 
@@ -173,6 +175,26 @@ def test_frame_range_smooths_a_part_and_keeps_the_rest(capsys, range_mode, start
     # the source action itself is untouched
     for key, table in before_keys.items():
         np.testing.assert_array_equal(key_table(curves_of(obj, source)[key])["co"], table["co"])
+
+
+def test_a_channel_keyed_only_outside_the_range_is_split_exactly(capsys):
+    """Scale keyed at frames 1 and 40 only: its one Bezier span is cut at both ends of the range."""
+    obj, _ = keyed()
+    for frame, value in ((1, (1.0, 1.5, 0.8)), (40, (2.0, 0.7, 1.1))):
+        obj.scale = value
+        obj.keyframe_insert("scale", frame=frame)
+    frames = grid(-2, 44)
+    was = played(obj, frames)
+    assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30) == {"FINISHED"}
+    now = played(obj, frames)
+    outside = (frames < 10) | (frames > 30)
+    scale_off = float(np.abs(np.linalg.norm(now[:, :3, :3], axis=1) - np.linalg.norm(was[:, :3, :3], axis=1))[outside].max())
+    loc, ang = difference(now[outside], was[outside])
+    with capsys.disabled():
+        print(f"\n[range, scale keyed at 1 and 40 only] outside: {loc:.4f} mm, {ang:.5f} deg, scale {scale_off:.1e}")
+    assert scale_off < 1e-6 and loc < 0.01 and ang < 1e-3
+    scale_frames = sorted(kp.co[0] for fc in h.fcurves(obj) if fc.data_path == "scale" for kp in fc.keyframe_points)
+    assert scale_frames[0] == 1.0 and scale_frames[-1] == 40.0
 
 
 def test_the_report_says_the_range_was_smoothed_and_the_rest_kept(capfd):
