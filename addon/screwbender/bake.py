@@ -298,7 +298,12 @@ def sample_channels(
     owner = owners.as_owner(owner)
     join = None
     if source_curves is not None:
-        motion, join = range_join.cut(motion, options.frame_range, source_curves, owner)
+        try:
+            motion, join = range_join.cut(motion, options.frame_range, source_curves, owner)
+        except SmoothError:
+            raise
+        except ValueError as err:  # polyscrew playing the curves at the range's ends
+            raise SmoothError(f"{owner.name}: {err}") from err
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
     if join is not None:  # (an end moved off an eased span: baked from there)
         start, end = (join.start if join.before else start), (join.end if join.after else end)
