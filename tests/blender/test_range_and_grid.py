@@ -411,3 +411,38 @@ def test_unkeyed_bone_channels_stay_unkeyed(capsys):
         np.testing.assert_allclose(location, (0.3 * i, np.sin(i), 0.1 * i * i), atol=F32)
         np.testing.assert_allclose(rotation, (0.2, 0.1, -0.3), atol=F32)
     bpy.ops.object.mode_set(mode="OBJECT")
+
+
+def test_a_range_bake_failing_halfway_changes_nothing_and_undo_restores():
+    """The joined write runs in Smooth Motion's transaction: a failure after some of its curves
+    are written leaves `bpy.data` as it was; a finished run is one undo step."""
+    a, _ = keyed("A")
+    b_obj, _ = keyed("B", seed=4)
+    h.select_only(a, b_obj)
+    module = addon_module("range_join")
+    original = module.write
+    calls = {"n": 0}
+
+    def failing(*args, **kwargs):
+        original(*args, **kwargs)
+        calls["n"] += 1
+        if calls["n"] == 8:  # A's six curves written, then two of B's
+            raise RuntimeError("injected failure in range_join.write")
+
+    before = h.snapshot_data(key_selection=True)
+    module.write = failing
+    try:
+        with pytest.raises(RuntimeError, match="nothing was changed"):
+            bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30)
+    finally:
+        module.write = original
+    assert calls["n"] == 8
+    assert h.snapshot_data(key_selection=True) == before
+    source_name = a.animation_data.action.name
+    bpy.ops.ed.undo_push(message="before")
+    assert bpy.ops.screwbender.smooth(
+        "EXEC_DEFAULT", True, range_mode="CUSTOM", frame_start=10, frame_end=30
+    ) == {"FINISHED"}
+    assert a.animation_data.action.name.endswith(".smooth")
+    assert bpy.ops.ed.undo() == {"FINISHED"}
+    assert bpy.data.objects["A"].animation_data.action.name == source_name
