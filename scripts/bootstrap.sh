@@ -8,11 +8,25 @@
 # When that CPython is missing, the version is left out with a message and scripts/test.sh
 # fails on it; the demo and benchmarks (bpy 5.0) still work.
 # Idempotent: a stamp per part skips what is already there. Downloads are cached in
-# .venv/pip-cache.
+# .venv/pip-cache (SCREWBENDER_PIP_CACHE: another folder, e.g. a cache another clone filled).
+#
+#   scripts/bootstrap.sh           everything (the tests, the demo, the benchmarks)
+#   scripts/bootstrap.sh --build   only what building the extension needs (what
+#                                  scripts/build_extension.sh runs when it misses it): maturin and
+#                                  ziglang in .venv, and Blender's extension tool (blender_ext.py
+#                                  and its tags.py) taken out of the newest CPython 3.11 bpy wheel
+#                                  into .venv/bpy-tools/<major.minor>, without installing Blender
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 venv="$root/.venv"
 source "$root/scripts/blender_matrix.sh"
+build_only=false
+case "${1:-}" in
+  "") ;;
+  --build) build_only=true ;;
+  *) echo "usage: scripts/bootstrap.sh [--build]" >&2; exit 2 ;;
+esac
+pip_cache=${SCREWBENDER_PIP_CACHE:-$venv/pip-cache}
 
 python=$(find_cpython 3.11) ||
   { echo "bootstrap: CPython 3.11 is needed (the project venv and the bpy 4.2-5.0 wheels); set PYTHON=" >&2; exit 1; }
@@ -20,8 +34,44 @@ python=$(find_cpython 3.11) ||
 [ -x "$venv/bin/python" ] || "$python" -m venv "$venv"
 pip_in() { # pip of the venv $1, with the shared download cache
   local env=$1; shift
-  "$env/bin/python" -m pip --disable-pip-version-check --cache-dir "$venv/pip-cache" "$@"
+  "$env/bin/python" -m pip --disable-pip-version-check --cache-dir "$pip_cache" "$@"
 }
+
+if $build_only; then
+  # maturin and ziglang as tests/requirements.txt pins them
+  build_reqs=$(grep -E '^(maturin|ziglang)\b' "$root/tests/requirements.txt" | sed -E 's/ *#.*//')
+  stamp="$venv/.stamp-build-$(echo "$build_reqs" | sha256sum | cut -c1-16)"
+  if [ ! -f "$stamp" ] && ! ls "$venv"/.stamp-requirements-* >/dev/null 2>&1; then
+    echo "bootstrap: installing $(echo $build_reqs) into .venv (building only)"
+    # shellcheck disable=SC2086
+    pip_in "$venv" install -q $(echo "$build_reqs" | tr '\n' ' ')
+    touch "$stamp"
+  fi
+  if ! "$venv/bin/python" "$root/scripts/extension.py" tools >/dev/null 2>&1; then
+    # the newest Blender on CPython 3.11: its wheel holds the tool (plain Python 3.11)
+    for row in "${BLENDER_MATRIX[@]}"; do
+      read -r version cpython _ <<<"$row"
+      [ "$cpython" = 3.11 ] && tool_version=$version
+    done
+    minor=${tool_version%.*}
+    echo "bootstrap: taking Blender $minor's extension tool out of the bpy $tool_version wheel (about 350 MB download, cached)"
+    download=$(mktemp -d)
+    pip_in "$venv" download -q --no-deps --only-binary :all: --python-version 3.11 -d "$download" "bpy==$tool_version"
+    rm -rf "$venv/bpy-tools/$minor"
+    "$venv/bin/python" - "$download"/bpy-*.whl "$venv/bpy-tools/$minor" "$minor" <<'PY'
+import sys, zipfile
+wheel, into, minor = sys.argv[1:]
+inside = [f"bpy/{minor}/scripts/addons_core/bl_pkg/cli/blender_ext.py",
+          f"bpy/{minor}/scripts/modules/_bpy_internal/extensions/tags.py"]
+with zipfile.ZipFile(wheel) as archive:
+    for name in inside:
+        archive.extract(name, into)
+PY
+    rm -rf "$download"
+  fi
+  echo "bootstrap: .venv ready for building ($("$venv/bin/python" --version); $("$venv/bin/maturin" --version))"
+  exit 0
+fi
 
 req_hash=$(sha256sum "$root/tests/requirements.txt" | cut -c1-16)
 if [ ! -f "$venv/.stamp-requirements-$req_hash" ]; then

@@ -18,7 +18,10 @@
 # validated by the tool of each Blender in .venv/bpy and checked by `extension.py check`
 # (the wheels it lists are the wheels it holds, which Blender's validate does not look at).
 # Prints the zips' paths, this machine's platform's last.
-# Env: PYTHON (default .venv/bin/python), BLENDER_EXT (a blender_ext.py instead of .venv/bpy's)
+# On a fresh clone (no .venv) it first runs scripts/bootstrap.sh --build: maturin, ziglang and
+# Blender's extension tool alone, not the Blender wheels the tests need.
+# Env: PYTHON (default .venv/bin/python), BLENDER_EXT (a blender_ext.py instead of .venv/bpy's),
+#      SCREWBENDER_PIP_CACHE (bootstrap's pip download cache, default .venv/pip-cache)
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -34,6 +37,19 @@ while [ $# -gt 0 ]; do
     *) echo "usage: scripts/build_extension.sh [--wheels DIR] [--out DIR]" >&2; exit 2 ;;
   esac
 done
+# A fresh clone has no .venv: take what building needs first (maturin and zig for the wheel,
+# Blender's extension tool for the zip), and only that: scripts/bootstrap.sh --build.
+builds_wheel=false
+[ -z "$wheels" ] && [ -z "${SCREWBENDER_WHEEL:-}" ] && builds_wheel=true
+has_build_tools() {
+  [ -x "$root/.venv/bin/maturin" ] || [ -n "${MATURIN:-}" ] || return 1
+  [ "$(uname -s)-$(uname -m)" != Linux-x86_64 ] || "$root/.venv/bin/python" -c "import ziglang" 2>/dev/null
+}
+if { $builds_wheel && ! has_build_tools; } || ! ext tools >/dev/null 2>&1; then
+  echo "build_extension: .venv lacks what building needs: running scripts/bootstrap.sh --build" >&2
+  scripts/bootstrap.sh --build >&2
+  python=$root/.venv/bin/python
+fi
 if [ -z "$wheels" ]; then
   wheels="$root/dist/wheels"
   mkdir -p "$wheels"

@@ -8,7 +8,8 @@ which wheels a build produced, nor what our version is, and its `validate` does 
 inside the wheel list: a zip whose manifest names a wheel it does not hold validates, and
 fails only on the animator's machine. So this script does three things, and nothing else:
 
-    tools               the Blender tools in .venv/bpy/*: "<blender_ext.py> <tags.py>" per
+    tools               the Blender tools in .venv/bpy/* (and .venv/bpy-tools/*, see
+                        scripts/bootstrap.sh --build): "<blender_ext.py> <tags.py>" per
                         line, newest Blender first (BLENDER_EXT=<blender_ext.py> overrides)
     version, platform   the workspace version; this machine's Blender platform (linux-x64, ...)
     stage --wheels DIR --into DIR
@@ -63,7 +64,8 @@ def cargo_version() -> str:
 
 
 def blender_tools() -> list[tuple[Path, Path]]:
-    """(blender_ext.py, tags.py) of every bpy tree under .venv/bpy, newest Blender first."""
+    """(blender_ext.py, tags.py) of every bpy tree under .venv/bpy (and of the tools alone under
+    .venv/bpy-tools), newest Blender first."""
     override = os.environ.get("BLENDER_EXT")
     if override:
         tool = Path(override).resolve()
@@ -73,6 +75,13 @@ def blender_tools() -> list[tuple[Path, Path]]:
         return tuple(int(part) for part in tree.name.split(".") if part.isdigit())
 
     trees = [tool.parents[4] for tool in (ROOT / ".venv" / "bpy").glob(f"*/bpy/*/{TOOL_IN_BPY}")]
+    # the tool alone, out of a bpy wheel (scripts/bootstrap.sh --build), for a Blender not installed
+    installed = {tree.name for tree in trees}
+    trees += [
+        tool.parents[4]
+        for tool in (ROOT / ".venv" / "bpy-tools").glob(f"*/bpy/*/{TOOL_IN_BPY}")
+        if tool.parents[4].name not in installed
+    ]
     found = []
     for tree in sorted(trees, key=version_key, reverse=True):
         tool = tree / TOOL_IN_BPY

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels, feature, intent, keys, modifiers, owners, sampling, transaction
+from . import channels, feature, intent, keys, modifiers, owners, range_join, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -156,21 +156,30 @@ class Baked:
     #: Cycles modifier modes (before, after) per (property, index) for a motion extended by
     #: its Cycles modifier and baked over one period (Repeat with Offset, Mirror).
     cycle_modes: dict | None = None
+    #: A Frame Range narrower than the keys: where the bake joins the source keys kept outside
+    #: it (:mod:`range_join`), and the per-property maps of the source's channels at its ends.
+    join: range_join.Join | None = None
+    end_maps: dict | None = None
+    #: (property, array index) of channels the source did not key and the smoothed motion
+    #: leaves constant (to float32): not written, they stay unkeyed.
+    unkeyed: frozenset = frozenset()
 
     @property
     def obj(self) -> bpy.types.Object:
         """The owner's object."""
         return self.owner.obj
 
+    def columns(self, prop: str) -> list[tuple[int, int]]:
+        """(column of `values[prop]`, array index) of every curve of `prop` the bake writes."""
+        values = self.values[prop]
+        indices = np.flatnonzero(self.motion.scale_axes) if prop == "scale" else range(values.shape[1])
+        return [(c, int(i)) for c, i in enumerate(indices) if (prop, int(i)) not in self.unkeyed]
+
     @property
     def written(self) -> list[tuple[str, int]]:
         """(property, array index) of every curve the bake writes: each column of `values`
-        (for "scale" the keyed axes)."""
-        out = []
-        for prop, values in self.values.items():
-            indices = np.flatnonzero(self.motion.scale_axes) if prop == "scale" else range(values.shape[1])
-            out += [(prop, int(i)) for i in indices]
-        return out
+        (for "scale" the keyed axes), but the channels left unkeyed."""
+        return [(prop, i) for prop in self.values for _, i in self.columns(prop)]
 
 
 @dataclass
@@ -253,6 +262,25 @@ def bake_frames(start: float, end: float, step: float) -> np.ndarray:
     return np.concatenate(([start], grid, [end]))
 
 
+def with_key_frames(grid: np.ndarray, key_frames: np.ndarray) -> np.ndarray:
+    """The baked frames `grid` (sorted, from :func:`bake_frames`) with every key frame of
+    `key_frames` inside their range added: every key pose is a baked key, also at a subframe
+    (a key at 12.5, keys every half frame of a 60 fps capture in a 30 fps scene). A grid frame
+    closer than :data:`keys.FRAME_TOLERANCE` to a key frame gives way to the key frame."""
+    tol = keys.FRAME_TOLERANCE
+    key_frames = np.asarray(key_frames, dtype=np.float64)
+    inside = key_frames[(key_frames > grid[0] + tol) & (key_frames < grid[-1] - tol)]
+    if not len(inside):
+        return grid
+    inside = np.unique(inside)
+    # grid frames near a key frame are that key frame
+    at = np.clip(np.searchsorted(inside, grid), 1, len(inside)) - 1
+    near = np.minimum(np.abs(grid - inside[at]), np.abs(grid - inside[np.minimum(at + 1, len(inside) - 1)]))
+    keep = near > tol
+    keep[0] = keep[-1] = True  # the range's ends stay exact
+    return np.unique(np.concatenate((grid[keep], inside)))
+
+
 def channel_count(motion: keys.KeyedMotion) -> int:
     """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
     return len(keys.baked_channels(motion.rotation_mode, motion.located, motion.scale_axes))
@@ -263,14 +291,29 @@ def sample_channels(
     motion: keys.KeyedMotion,
     options: Options,
     budget: list[int] | None = None,
+    source_curves: list | None = None,
 ) -> Baked:
     """Samples the smoothed motion of `owner` at every baked frame (no Blender data changes).
 
     `budget` holds the keys still allowed (all owners of one Smooth Motion together, at most
     :data:`MAX_KEYS`); a bake that would exceed it is refused before anything is sampled.
+    `source_curves`, the owner's curves the keys were read from, when given: a Frame Range
+    narrower than the keys smooths that part and keeps the source keys outside it
+    (:mod:`range_join`), and channels they do not key stay unkeyed where the smoothed motion
+    leaves them constant.
     """
     owner = owners.as_owner(owner)
+    join = None
+    if source_curves is not None:
+        try:
+            motion, join = range_join.cut(motion, options.frame_range, source_curves, owner)
+        except SmoothError:
+            raise
+        except ValueError as err:  # polyscrew playing the curves at the range's ends
+            raise SmoothError(f"{owner.name}: {err}") from err
     start, end = options.frame_range if options.frame_range is not None else motion.frame_range
+    if join is not None:  # (an end moved off an eased span: baked from there)
+        start, end = (join.start if join.before else start), (join.end if join.after else end)
     if budget is not None and end > start and options.step > 0.0:
         keys_needed = ((end - start) / options.step + 2) * channel_count(motion)
         if keys_needed > budget[0]:
@@ -284,6 +327,14 @@ def sample_channels(
         feature.check_approximate(owner, motion, options.stiffness)
     try:
         frames = bake_frames(start, end, options.step)
+        # every key frame of the source is a baked frame (spin poses taken from the playback
+        # inside a span are not keys)
+        key_frames = motion.frames if motion.is_key is None else motion.frames[motion.is_key]
+        if motion.period is not None:  # a cycle: its keys in every period of the range
+            first = int(np.floor((start - key_frames[0]) / motion.period))
+            last = int(np.ceil((end - key_frames[0]) / motion.period))
+            key_frames = (key_frames[None] + motion.period * np.arange(first, last + 1)[:, None]).ravel()
+        frames = with_key_frames(frames, key_frames)
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
@@ -296,14 +347,42 @@ def sample_channels(
             values["scale"] = scales[:, motion.scale_axes]
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{owner.name}: {err}") from err
+    end_maps = range_join.end_maps(join, motion, join.played, values, frames) if join is not None else None
+    unkeyed = frozenset()
+    if source_curves is not None:
+        unkeyed = _left_unkeyed(owner, source_curves, values, motion)
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
     # that was cyclic in the source.
     whole_period = options.frame_range is None and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
     cyclic = motion.cyclic and motion.closed and whole_period
     modes = motion.cycle_modes if whole_period and motion.cycle_modes else None
     return Baked(
-        owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes
+        owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes,
+        join=join, end_maps=end_maps, unkeyed=unkeyed,
     )
+
+
+def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion: keys.KeyedMotion) -> frozenset:
+    """(property, index) of the baked channels the source did not key (no curve with keys,
+    or a muted one) whose baked values all equal the owner's own value in float32: the
+    smoothed motion leaves them where they are, so they are not keyed."""
+    keyed = set()
+    for fc in source_curves:
+        prop = owner.prop_of(fc.data_path)
+        if prop is not None and not fc.mute and len(fc.keyframe_points):
+            keyed.add((prop, fc.array_index))
+    out = set()
+    for prop, baked in values.items():
+        if prop == "scale":
+            continue  # only keyed scale axes are baked
+        own = np.array(getattr(owner.target, prop), dtype=np.float64)
+        for column in range(baked.shape[1]):
+            if (prop, column) in keyed:
+                continue
+            value = np.float32(own[column])
+            if np.all(np.abs(baked[:, column].astype(np.float32) - value) <= 2 * np.spacing(np.abs(value) + np.float32(1))):
+                out.add((prop, column))
+    return frozenset(out)
 
 
 def _write_curves(
@@ -461,18 +540,42 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
         # The curves the bake writes replace those of the same (data path, index); every other
         # curve stays as copied (an unkeyed scale axis's muted or keyless curve too).
         replaced = {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.written}
+        if bake.current is not bake.source:  # a channel left unkeyed loses an earlier result's curve
+            replaced |= {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.unkeyed}
         for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
         for part in bake.parts:
             for prop, values in part.values.items():
-                indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
+                columns = part.columns(prop)
+                if not columns:
+                    continue
+                if part.join is not None:
+                    _write_joined(bag, part, prop, columns)
+                    continue
                 _write_curves(
-                    bag, part.owner.path(prop), part.frames, values, part.cyclic, indices, part.owner.group,
-                    part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
+                    bag, part.owner.path(prop), part.frames, values[:, [c for c, _ in columns]], part.cyclic,
+                    np.array([i for _, i in columns]), part.owner.group, part.constant, part.cycle_modes, prop,
+                    part.motion.modifiers, digests,
                 )
 
     digests: dict = {}
     return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves, digests=digests)
+
+
+def _write_joined(bag, part: Baked, prop: str, columns: list[tuple[int, int]]) -> None:
+    """The curves of `prop` of a bake over a Frame Range narrower than the keys: the baked
+    keys inside it, the source keys outside it (:func:`range_join.write`)."""
+    constant = part.constant if part.constant is not None else np.zeros(len(part.frames), dtype=bool)
+    interpolation = np.where(constant, _CONSTANT, _LINEAR)
+    for column, index in columns:
+        fcurve = channels.new_fcurve(bag, part.owner.path(prop), index, part.owner.group)
+        range_join.write(
+            fcurve, part.join, part.frames, part.values[prop][:, column], interpolation, prop, index, column,
+            part.end_maps or {},
+        )
+        stack = part.motion.modifiers.get((prop, index)) if part.motion.modifiers else None
+        if stack:
+            modifiers.copy_onto(stack, fcurve)
 
 
 def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
@@ -623,7 +726,7 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
         for bone, row in motions.items():
             owner = owners.Owner(objects[0], bone)
             try:
-                part = sample_channels(owner, row[column], options, budget)
+                part = sample_channels(owner, row[column], options, budget, source_curves=by_owner.get(bone, []))
             except SmoothError as err:
                 skipped.append((owner, str(err)))
                 continue
@@ -743,6 +846,16 @@ def smooth(
             "duplicates): their motion changed too"
         )
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
+    joined = [p for b in bakes for p in b.parts if p.join is not None]
+    if joined:
+        first = joined[0].join
+        start = first.start if first.before else options.frame_range[0]
+        end = first.end if first.after else options.frame_range[1]
+        moved = f" (moved its {' and '.join(first.moved)}: a span eased by a Blender preset cannot be cut)"
+        notes.append(
+            f"smoothed frames {start:g} to {end:g} of {_names([p.owner.name for p in joined])}"
+            f"{moved if first.moved else ''}; the keys outside the range kept as they were"
+        )
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
     with contextlib.ExitStack() as stack:

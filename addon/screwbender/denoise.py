@@ -211,6 +211,8 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
     smoothed_rows = cleaned.rows[~cleaned.held]
     smoothed = np.zeros(len(motion.frames), dtype=bool)
     smoothed[smoothed_rows] = True
+    in_range = np.zeros(len(motion.frames), dtype=bool)
+    in_range[cleaned.rows] = True
     original = _original_rotation(motion)
     previous = None if mode == "AXIS_ANGLE" else original[cleaned.rows[0]]
     rotation = np.zeros((len(motion.frames), original.shape[1]))
@@ -252,6 +254,29 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         points.foreach_set("handle_left", left.ravel())
         points.foreach_set("handle_right", right.ravel())
         fc.update()
+        _keep_handles_outside(fc, ~(near & in_range[row]), left, right)
+
+
+_FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
+
+
+def _keep_handles_outside(fc, outside: np.ndarray, left: np.ndarray, right: np.ndarray) -> None:
+    """Gives the keys `outside` the frame range back the handles `left`, `right` they had
+    when `fc.update()` recomputed automatic ones from their moved neighbours (the key next to
+    the range), as FREE handles: outside the range the curve plays exactly what it played."""
+    now_left, now_right = _points(fc, "handle_left"), _points(fc, "handle_right")
+    changed = outside & (np.any(now_left != left, axis=1) | np.any(now_right != right, axis=1))
+    if not changed.any():
+        return
+    points = fc.keyframe_points
+    now_left[changed], now_right[changed] = left[changed], right[changed]
+    for side in ("handle_left_type", "handle_right_type"):
+        kinds = np.zeros(len(points), dtype=np.uint8)
+        points.foreach_get(side, kinds)
+        kinds[changed] = _FREE
+        points.foreach_set(side, tuple(kinds.tolist()))
+    points.foreach_set("handle_left", now_left.ravel())
+    points.foreach_set("handle_right", now_right.ravel())
 
 
 def remove_noise(

@@ -36,17 +36,20 @@ def keyed(mode: str, seed: int, name: str = "Body", parent: bool = True):
     return obj
 
 
-def grid(start: float, end: float, step: float) -> np.ndarray:
-    """The frames a bake must have: the ends, and the multiples of `step` strictly between."""
+def grid(start: float, end: float, step: float, key_frames=()) -> np.ndarray:
+    """The frames a bake must have: the ends, and the multiples of `step` strictly between,
+    and every key frame in between (issue 24: every key is a baked frame)."""
     multiples = [k * step for k in range(int(np.floor(start / step)) - 1, int(np.ceil(end / step)) + 2)]
-    inner = [f for f in multiples if start + 1e-4 < f < end - 1e-4]
-    return np.array([start, *inner, end])
+    keys_inside = [f for f in key_frames if start + 1e-4 < f < end - 1e-4]
+    inner = [f for f in multiples if start + 1e-4 < f < end - 1e-4 and all(abs(f - k) > 1e-4 for k in keys_inside)]
+    return np.array([start, *sorted(inner + keys_inside), end])
 
 
 def check_against_sample(sb, obj, motion, scheme, levels, timing, step):
     frames, baked = h.baked_matrices(obj, with_scale=False)
     start, end = motion.frame_range
-    np.testing.assert_allclose(frames, grid(start, end, step), atol=1e-4)
+    key_frames = motion.frames if motion.is_key is None else motion.frames[motion.is_key]
+    np.testing.assert_allclose(frames, grid(start, end, step, key_frames), atol=1e-4)
     spec = dict(scheme=scheme, levels=levels, closed=motion.closed, period=motion.period, timing=timing)
     expected = polyscrew.sample(motion.poses, motion.frames, frames, **spec)
     error = np.abs(baked - expected).max()
@@ -108,7 +111,10 @@ def test_custom_and_scene_frame_ranges(sb, factory_scene):
     factory_scene.frame_start, factory_scene.frame_end = 3, 12
     assert bpy.ops.screwbender.smooth(range_mode="SCENE", scheme="jarek", timing="smooth") == {"FINISHED"}
     frames, _ = h.baked_matrices(obj)
-    np.testing.assert_allclose(frames, np.arange(3, 13))
+    # issue 24: frames 3 to 12 baked, the source keys outside the range kept (1; 17, 21, 40)
+    inside = (frames >= 3) & (frames <= 12)
+    np.testing.assert_allclose(frames[inside], np.arange(3, 13))
+    np.testing.assert_allclose(frames[~inside], [f for f in FRAMES if f < 3 or f > 12])
 
 
 def test_cyclic_motion_bakes_one_period_with_cycles_modifier(sb):

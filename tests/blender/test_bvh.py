@@ -135,9 +135,10 @@ def test_a_bvh_clip_is_smoothed_on_all_its_bones_in_one_call(tmp_path, capfd):
         key_frames, key_angles = bone_curves(source, slot, bone, "rotation_euler", 3)
         has_location = any(fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("channels").action_fcurves(source, slot))
         # A connected bone's location is ignored by Blender: not read, not baked. Any other
-        # bone's location is baked (constant where only its rotation is keyed: a screw through
-        # poses sharing their origin turns about an axis through it).
-        located = bone not in connected
+        # bone's location is baked where it is keyed; where only its rotation is keyed, the
+        # location stays constant (a screw through poses sharing their origin turns about an axis
+        # through it) and stays unkeyed (issue 24, item 7).
+        located = bone not in connected and has_location
         key_location = bone_curves(source, slot, bone, "location", 3)[1] if has_location else np.zeros((len(key_frames), 3))
         key_poses = h.compose(key_location, h.rotation_to_matrices(key_angles, mode))
         frames, angles = bone_curves(smoothed, slot, bone, "rotation_euler", 3)
@@ -158,6 +159,11 @@ def test_a_bvh_clip_is_smoothed_on_all_its_bones_in_one_call(tmp_path, capfd):
             ulps = np.abs(location.astype(np.float32).view(np.int32).astype(np.int64)
                           - expected.astype(np.float32).view(np.int32).astype(np.int64))
             assert ulps.max() <= 1, (bone, ulps.max())
+        elif bone not in connected:  # location not keyed: constant, so left unkeyed
+            assert np.abs(reference[:, :3, 3]).max() < 1e-9
+            assert not any(
+                fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("channels").action_fcurves(smoothed, slot)
+            )
         else:  # no location was baked for a connected bone
             assert not any(
                 fc.data_path == f'pose.bones["{bone}"].location' and len(fc.keyframe_points) > len(key_frames)
