@@ -81,6 +81,8 @@ class Cleaned:
     #: back to within the noise estimated.
     sparse_spacing: float = 0.0
     limited: int = 0
+    #: Why the owner is refused after all (sparse keys that are blocked poses), else None.
+    refused: str | None = None
 
 
 @dataclass
@@ -133,7 +135,7 @@ def prepare(
         raise SmoothError(
             f"{owner.name}: {len(rows)} key frame(s) in the frame range; Remove Noise needs at least 4: skipped"
         )
-    refused = denoise_data.refusal(owner.name, len(rows), options.strength is None)
+    refused = denoise_data.refusal(owner.name, motion.frames[rows], options.strength is None)
     if refused is not None:
         raise SmoothError(refused)
     selected = selected_frames(owner, fcurves if shown is None else shown, motion.frames)[rows]
@@ -184,6 +186,7 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
             )
             if spacing > denoise_data.SPARSE_SPACING:  # sparse: no key moves more than the noise
                 c.sparse_spacing = spacing
+                c.refused = denoise_data.blocked(owner.name, spacing, c.rotation_noise, c.translation_noise, stack[b])
                 c.poses, c.limited = denoise_data.limit_moves(
                     stack[b], c.poses, c.pivot, np.sqrt(3.0) * c.rotation_noise, np.sqrt(3.0) * c.translation_noise
                 )
@@ -207,7 +210,7 @@ def data_notes(c: Cleaned) -> list[str]:
         notes.append(
             f"{c.owner.name}: keys {c.sparse_spacing:g} frames apart are sparse for Remove Noise: no key moved more "
             f"than the noise estimated ({np.degrees(np.sqrt(3.0) * c.rotation_noise):.3g} deg, "
-            f"{np.sqrt(3.0) * c.translation_noise:.3g} units); {c.limited} key(s) held back to it. Smooth Motion "
+            f"{np.sqrt(3.0) * c.translation_noise:.3g} units); {c.limited} key(s) drawn back to it. Smooth Motion "
             "(Approximate Keys) fits sparse keys"
         )
     return notes
@@ -357,6 +360,15 @@ def remove_noise(
     if rerun:
         notes.append(f"removed the noise of the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
     cleaned = {(c.owner.obj.as_pointer(), c.owner.bone): c for c in clean(prepared, options)}
+    for key, c in list(cleaned.items()):  # blocked poses after all: skipped, nothing written
+        if c.refused is not None:
+            skipped.append(c.refused)
+            del cleaned[key]
+    plans = [
+        (objects, source, current, identifier, kept)
+        for objects, source, current, identifier, done in plans
+        if (kept := [o for o in done if (o.obj.as_pointer(), o.bone) in cleaned])
+    ]
     actions = []
     with contextlib.ExitStack() as stack:
         if t is None:
