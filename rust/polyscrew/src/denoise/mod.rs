@@ -807,3 +807,138 @@ struct Chosen {
     index: Option<usize>,
     kinks: Vec<usize>,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A noisy tumbling flight of `n` poses, one per frame; with `pop`, teleported by 5 m and
+    /// turned 90 degrees from pose `n / 2` on.
+    fn flight(n: usize, pop: bool) -> (Vec<Pose>, Vec<f64>) {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut noise = || smoother_noise(&mut state);
+        let times: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let jump = Pose::from_rotation_translation(
+            DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2),
+            DVec3::new(5.0, 0.0, 0.0),
+        );
+        let poses = times
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let t = t / 24.0;
+                let wobble = DVec3::new(noise(), noise(), noise()) * 0.01;
+                let q = DQuat::from_scaled_axis(DVec3::new(0.3, 0.2, 1.1) * t + wobble);
+                let p = DVec3::new((0.5 * t).cos() * 2.0, (0.3 * t).sin(), 0.3 * t)
+                    + DVec3::new(noise(), noise(), noise()) * 0.02;
+                let pose = Pose::from_rotation_translation(q, p);
+                if pop && i >= n / 2 {
+                    Pose::from_rotation_translation(
+                        jump.rotation * pose.rotation,
+                        jump.rotation * pose.translation + jump.translation,
+                    )
+                } else {
+                    pose
+                }
+            })
+            .collect();
+        (poses, times)
+    }
+
+    fn smoother_noise(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// A pop cuts the clip: each piece is what denoising it alone gives, and the jump across
+    /// the pop is the input's.
+    #[test]
+    fn a_pop_cuts_the_clip_into_pieces_smoothed_apart() {
+        let (poses, times) = flight(120, true);
+        let o = DenoiseOptions::default();
+        let d = denoise(&poses, &times, None, &o).unwrap();
+        assert_eq!(d.pops, vec![60]);
+        let first = denoise(&poses[..60], &times[..60], None, &o).unwrap();
+        let second = denoise(&poses[60..], &times[60..], None, &o).unwrap();
+        assert!(first.pops.is_empty() && second.pops.is_empty());
+        assert_eq!(d.poses[..60], first.poses[..]);
+        assert_eq!(d.poses[60..], second.poses[..]);
+        // No pop without the jump; with kinks off, no cut either.
+        let (smooth, _) = flight(120, false);
+        assert!(denoise(&smooth, &times, None, &o).unwrap().pops.is_empty());
+        let off = DenoiseOptions { kinks: false, ..o };
+        assert!(denoise(&poses, &times, None, &off).unwrap().pops.is_empty());
+    }
+
+    /// Every strength is served: tiny ones leave the clip as it is, huge ones act as
+    /// MAX_STRENGTH_SPACINGS spacings (and say so), in any unit of time.
+    #[test]
+    fn every_strength_in_any_unit_is_served() {
+        let (poses, times) = flight(250, false);
+        let fixed = |s: f64| DenoiseOptions {
+            strength: Strength::Fixed {
+                rotation: s,
+                translation: s,
+            },
+            ..DenoiseOptions::default()
+        };
+        for s in [1e-300, 0.0005, 0.001, 316.0, 1000.0, 1e300] {
+            let d = denoise(&poses, &times, None, &fixed(s)).unwrap();
+            let used = s.min(MAX_STRENGTH_SPACINGS);
+            assert!(
+                (d.rotation_strength - used).abs() <= 1e-12 * used,
+                "{s}: {d:?}"
+            );
+            assert!(d.poses.iter().all(|p| p.rotation.is_finite()
+                && p.translation.is_finite()
+                && (p.rotation.length() - 1.0).abs() < 1e-12));
+        }
+        let at = |s: f64, k: f64| {
+            let t: Vec<f64> = times.iter().map(|t| t * k).collect();
+            denoise(&poses, &t, None, &fixed(s * k)).unwrap()
+        };
+        assert_eq!(at(1000.0, 1.0).poses, at(100.0, 1.0).poses);
+        for k in [1e-100, 1e50, 0.001] {
+            let (a, b) = (at(4.0, k), at(4.0, 1.0));
+            let diff = a
+                .poses
+                .iter()
+                .zip(&b.poses)
+                .map(|(p, q)| (p.translation - q.translation).length())
+                .fold(0.0, f64::max);
+            assert!(diff < 1e-9, "x{k}: {diff}");
+        }
+    }
+
+    /// Held poses come back as the matrices given, bit for bit; the others as their poses.
+    #[test]
+    fn held_rows_are_the_source_matrices() {
+        let (poses, times) = flight(20, false);
+        let held: Vec<bool> = (0..20).map(|i| i % 3 == 0).collect();
+        let d = denoise(&poses, &times, Some(&held), &DenoiseOptions::default()).unwrap();
+        let source: Vec<[[f64; 4]; 4]> = (0..7)
+            .map(|k| {
+                let mut m = poses[3 * k].to_rows();
+                m[0][3] += 1e-17 * k as f64; // not what the pose would give back
+                m
+            })
+            .collect();
+        let mut out = vec![0.0; 16 * 20];
+        assert_eq!(d.write_rows(Some(&held), &source, &mut out), 7);
+        for i in 0..20 {
+            let want = if held[i] {
+                source[i / 3]
+            } else {
+                d.poses[i].to_rows()
+            };
+            let got: Vec<f64> = out[16 * i..16 * i + 16].to_vec();
+            assert_eq!(
+                got,
+                want.iter().flatten().copied().collect::<Vec<_>>(),
+                "{i}"
+            );
+        }
+    }
+}
