@@ -176,7 +176,7 @@ def test_a_pop_is_kept_and_the_pieces_smoothed_apart(sb, capfd, n):
     (the rotation strength collapsing to 0.25 frames)."""
     pop = n // 2
     away = np.abs(np.arange(n) - (pop - 0.5)) > 10
-    ratios = []
+    ratios, lines = [], []  # (printed at the end: capfd takes what is printed before a run)
     for seed in SEEDS:
         truth, noisy = capture(True, seed, n)
         clean_truth, clean_noisy = capture(False, seed, n)
@@ -186,7 +186,7 @@ def test_a_pop_is_kept_and_the_pieces_smoothed_apart(sb, capfd, n):
                 "smoothed apart") in out
         e_in, e_pop, e_clean = errors(noisy, truth, away), errors(result, truth, away), errors(clean, clean_truth, away)
         ratios.append((e_pop[0] / e_clean[0], e_pop[1] / e_clean[1]))
-        print(f"{n} frames, seed {seed}: away from the pop, location / rotation RMS: input {e_in[0]:.1f} mm / "
+        lines.append(f"{n} frames, seed {seed}: away from the pop, location / rotation RMS: input {e_in[0]:.1f} mm / "
               f"{e_in[1]:.3f} deg, with the pop {e_pop[0]:.1f} mm / {e_pop[1]:.3f} deg, the same clip without it "
               f"{e_clean[0]:.1f} mm / {e_clean[1]:.3f} deg: ratios {ratios[-1][0]:.2f}, {ratios[-1][1]:.2f}")
         assert e_pop[0] < 0.6 * e_in[0] and e_pop[1] < 0.6 * e_in[1]  # smoothed on both sides, rotation too
@@ -196,6 +196,7 @@ def test_a_pop_is_kept_and_the_pieces_smoothed_apart(sb, capfd, n):
         assert np.linalg.norm(jump(result) - jump(truth)) < 0.1
         assert abs(math.degrees(turn(result) - turn(truth))) < 2.0
     mean = np.mean(ratios, axis=0)
+    print("\n".join(lines))
     print(f"{n} frames: mean ratios over {len(ratios)} seeds: location {mean[0]:.3f}, rotation {mean[1]:.3f}")
     if n == 240:
         assert mean[0] <= 1.10 and mean[1] <= 1.10

@@ -7,8 +7,10 @@
   250-frame clip, and four keys 0.001 frames apart at 2 or 20, raised "poses: values too
   large: the computation overflowed".
 - The unit of time: times multiplied by 1e50, 1e-100 or 0.1 give the same poses (to the
-  rounding of the times) and the strengths in the new unit. Before: poses moved by 0.0059
-  and the strength by 75 % at 1e50; 1e-100 was refused as "overflowed".
+  rounding of the times) and the strengths in the new unit. Before: 1e-100 was refused
+  ("times 0 to 3 are too close together or too far apart for f64"; the issue saw
+  "overflowed", and at 1e50 poses moved by 0.0059 on its clip; on this clip 1e50 and 0.1
+  already agreed to 1.5e-11).
 - Held poses are read once: a thread writing NaN (or a scale) into the held rows of the
   input while `denoise` works cannot reach the result. Before: every held output pose NaN
   (3 of 3 runs).
