@@ -443,7 +443,8 @@ fn denoise_with(
         Vec::new()
     };
     if pops.is_empty() {
-        return denoise_piece(ws, poses, times, held, options);
+        // (the rotations are normalised in `ws` already)
+        return denoise_piece(ws, poses, times, held, options, false);
     }
     // Each piece between pops apart; a piece too short to smooth is kept as it is.
     let mut out = Denoised {
@@ -476,6 +477,7 @@ fn denoise_with(
             &times[a..b],
             held.map(|h| &h[a..b]),
             options,
+            true,
         )?;
         out.poses.extend_from_slice(&d.poses);
         out.rotation_kinks
@@ -498,13 +500,15 @@ fn denoise_with(
 
 /// One clip without pops (at least [`MIN_DENOISE_POSES`] finite poses), in normalised time:
 /// the times shifted to start at 0 and divided by their median spacing, a given strength
-/// likewise (at most [`MAX_STRENGTH_SPACINGS`]); the strengths found are scaled back.
+/// likewise (at most [`MAX_STRENGTH_SPACINGS`]); the strengths found are scaled back. The
+/// normalised rotations are in `ws` unless `part` (a piece of the clip they were made for).
 fn denoise_piece(
     ws: &mut Workspace,
     poses: &[Pose],
     times: &[f64],
     held: Option<&[bool]>,
     options: &DenoiseOptions,
+    part: bool,
 ) -> Result<Denoised> {
     let n = poses.len();
     let cm = &mut ws.common;
@@ -515,9 +519,11 @@ fn denoise_piece(
     cm.times.clear();
     cm.times.extend(times.iter().map(|t| (t - times[0]) / unit));
     crate::check_key_times(&cm.times)?;
-    cm.quats.clear();
-    cm.quats
-        .extend(poses.iter().map(|p| p.rotation / p.rotation.length()));
+    if part {
+        cm.quats.clear();
+        cm.quats
+            .extend(poses.iter().map(|p| p.rotation / p.rotation.length()));
+    }
     let scale = |tau: f64| (tau / unit).min(MAX_STRENGTH_SPACINGS);
     let options = DenoiseOptions {
         strength: match options.strength {
