@@ -7,16 +7,15 @@
 //! its own strengths (`super::denoise`); the pop itself stays as it was captured.
 //!
 //! Step `j` (between samples `j` and `j + 1`) is a pop when its speed, in rotation
-//! (`|log(Q_{j+1} Q_j^-1)| / (t_{j+1} - t_j)`, a norm of a rotation vector: the same in any
-//! coordinate frame) or in translation (`|o_{j+1} - o_j| / (t_{j+1} - t_j)`, world distances),
+//! (`sin(theta_j / 2) / (t_{j+1} - t_j)` with `theta_j` the angle of `Q_{j+1} Q_j^-1`, the
+//! same in any coordinate frame; the sine keeps it cheap and is monotone in the angle) or in
+//! translation (`|o_{j+1} - o_j| / (t_{j+1} - t_j)`, world distances),
 //! is more than [`POP_RATIO`] times the fastest of the [`POP_WINDOW`] steps on either side.
 //! Noise, and motion that speeds up over a few samples, raise the neighbours with it; a
 //! kink (a stop) changes the speed but never makes one step stand out; a single sample off
 //! and back (two fast steps side by side) is not a pop either.
 
 use glam::{DQuat, DVec3};
-
-use super::so3;
 
 /// A pop's step is this many times faster than any step within [`POP_WINDOW`] of it: far
 /// above what noise or a change of pace makes. Measured on the orbit-and-dolly capture of
@@ -38,38 +37,39 @@ pub(crate) fn find(quats: &[DQuat], origins: &[DVec3], times: &[f64]) -> Vec<usi
     if n < 2 {
         return Vec::new();
     }
-    let dt = |j: usize| times[j + 1] - times[j];
-    let rotation: Vec<f64> = (0..n - 1)
-        .map(|j| so3::log(quats[j + 1] * quats[j].conjugate()).length() / dt(j))
-        .collect();
-    let translation: Vec<f64> = (0..n - 1)
-        .map(|j| (origins[j + 1] - origins[j]).length() / dt(j))
-        .collect();
-    let mut out = Vec::new();
+    let mut rotation = Vec::with_capacity(n - 1);
+    let mut translation = Vec::with_capacity(n - 1);
     for j in 0..n - 1 {
-        if stands_out(&rotation, j) || stands_out(&translation, j) {
-            out.push(j + 1);
-        }
+        let per = 1.0 / (times[j + 1] - times[j]);
+        rotation.push((quats[j + 1] * quats[j].conjugate()).xyz().length() * per);
+        translation.push((origins[j + 1] - origins[j]).length() * per);
     }
-    out
+    (0..n - 1)
+        .filter(|j| stands_out(&rotation, *j) || stands_out(&translation, *j))
+        .map(|j| j + 1)
+        .collect()
 }
 
 /// Whether step `j` of `speed` is more than [`POP_RATIO`] times its neighbours' fastest.
 fn stands_out(speed: &[f64], j: usize) -> bool {
     let v = speed[j];
-    if !(v.is_finite() && v > 0.0) {
+    let last = speed.len() - 1;
+    // Most steps are no faster than POP_RATIO times a direct neighbour: decided at once.
+    let near = |k: usize| speed[k] * POP_RATIO >= v;
+    if !(v.is_finite() && v > 0.0)
+        || last == 0
+        || (j > 0 && near(j - 1))
+        || (j < last && near(j + 1))
+    {
         return false;
     }
     let lo = j.saturating_sub(POP_WINDOW);
-    let hi = (j + POP_WINDOW).min(speed.len() - 1);
-    let near = (lo..=hi)
-        .filter(|k| *k != j)
-        .map(|k| speed[k])
-        .fold(0.0, f64::max);
-    if lo == hi {
-        return false;
-    }
-    v > POP_RATIO * near.max(ROUNDING_FLOOR * v)
+    let hi = (j + POP_WINDOW).min(last);
+    let fastest = speed[lo..j]
+        .iter()
+        .chain(&speed[j + 1..=hi])
+        .fold(0.0, |a: f64, b| a.max(*b));
+    v > POP_RATIO * fastest.max(ROUNDING_FLOOR * v)
 }
 
 #[cfg(test)]
