@@ -21,7 +21,7 @@ use glam::{DQuat, DVec3};
 /// above what noise or a change of pace makes. Measured on the orbit-and-dolly capture of
 /// `tests/blender/test_denoise_data.py` (20 noise seeds; 2 cm / 0.5 degrees, 5 mm / 0.1
 /// degrees and no noise): no step without a pop stands out by more than 2.4; the 5 m / 90
-/// degree teleport by at least 35.
+/// degree teleport by at least 31.
 pub(crate) const POP_RATIO: f64 = 10.0;
 
 /// The steps compared on either side of a candidate pop.
