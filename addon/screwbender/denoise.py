@@ -14,7 +14,11 @@ and every other curve are left as they were. Like Smooth Motion the result is a 
 
 Held keys: when the user selects keys on an owner's transform curves (Graph Editor, Dope
 Sheet), the selected ones are smoothed and the unselected ones held exactly, as Blender's
-Smooth Keys works on the selection; with nothing selected every key is smoothed.
+Smooth Keys works on the selection; with nothing selected every key is smoothed. The report
+says how many keys were held.
+
+What it refuses (too few keys for Auto), where it limits itself (sparse keys move no more
+than the noise estimated) and how pops are kept: :mod:`denoise_data`.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, feature, keys, owners, transaction
+from . import bake, channels, denoise_data, feature, keys, owners, transaction
 from .keys import SmoothError
 
 
@@ -67,6 +71,18 @@ class Cleaned:
     #: What polyscrew chose.
     rotation_strength: float = 0.0
     translation_strength: float = 0.0
+    #: The noise it estimated (per axis: radians, pose units) and the pivot (body coordinates).
+    rotation_noise: float = 0.0
+    translation_noise: float = 0.0
+    pivot: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    #: Indices (into rows) of the first key after each pop the clip was cut at.
+    pops: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    #: Sparse keys: their median spacing (frames; 0 when dense) and how many keys were drawn
+    #: back to within the noise estimated.
+    sparse_spacing: float = 0.0
+    limited: int = 0
+    #: Why the owner is refused after all (sparse keys that are blocked poses), else None.
+    refused: str | None = None
 
 
 @dataclass
@@ -119,6 +135,9 @@ def prepare(
         raise SmoothError(
             f"{owner.name}: {len(rows)} key frame(s) in the frame range; Remove Noise needs at least 4: skipped"
         )
+    refused = denoise_data.refusal(owner.name, motion.frames[rows], options.strength is None)
+    if refused is not None:
+        raise SmoothError(refused)
     selected = selected_frames(owner, fcurves if shown is None else shown, motion.frames)[rows]
     held = ~selected if selected.any() else np.zeros(len(rows), dtype=bool)
     if held.all():
@@ -153,15 +172,48 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
             value = np.asarray(value, dtype=np.float64)
             return float(value.reshape(-1)[b] if value.size > 1 else value.reshape(-1)[0])
 
+        pivots = np.asarray(result.pivot, dtype=np.float64).reshape(-1, 3)
+        pops = result.pops if len(items) > 1 else [result.pops]
+        spacing = denoise_data.median_spacing(times)
         for b, (owner, motion, rows, held_b, originals) in enumerate(items):
-            out.append(
-                Cleaned(
-                    owner=owner, motion=motion, rows=rows, poses=poses[b], held=held_b, originals=originals,
-                    rotation_strength=per_body(result.rotation_strength, b),
-                    translation_strength=per_body(result.translation_strength, b),
-                )
+            c = Cleaned(
+                owner=owner, motion=motion, rows=rows, poses=poses[b], held=held_b, originals=originals,
+                rotation_strength=per_body(result.rotation_strength, b),
+                translation_strength=per_body(result.translation_strength, b),
+                rotation_noise=per_body(result.rotation_noise, b),
+                translation_noise=per_body(result.translation_noise, b),
+                pivot=pivots[b], pops=np.asarray(pops[b], dtype=np.int64),
             )
+            if spacing > denoise_data.SPARSE_SPACING:  # sparse: no key moves more than the noise
+                c.sparse_spacing = spacing
+                c.refused = denoise_data.blocked(owner.name, spacing, c.rotation_noise, c.translation_noise, stack[b])
+                c.poses, c.limited = denoise_data.limit_moves(
+                    stack[b], c.poses, c.pivot, np.sqrt(3.0) * c.rotation_noise, np.sqrt(3.0) * c.translation_noise
+                )
+            out.append(c)
     return out
+
+
+def data_notes(c: Cleaned) -> list[str]:
+    """What the report says about one owner's data: keys held by the selection, pops kept,
+    sparse keys limited."""
+    notes = []
+    frames = c.motion.frames[c.rows]
+    if c.held.any():
+        notes.append(f"{c.owner.name}: {int(c.held.sum())} of {len(c.held)} keys held (not selected), "
+                     f"{int((~c.held).sum())} smoothed")
+    if len(c.pops):
+        at = ", ".join(f"{frames[i]:g}" for i in c.pops[:5]) + (", ..." if len(c.pops) > 5 else "")
+        notes.append(f"{c.owner.name}: {len(c.pops)} pop(s) kept (a jump far above the noise, at frame {at}): "
+                     "the pieces between were smoothed apart")
+    if c.sparse_spacing:
+        notes.append(
+            f"{c.owner.name}: keys {c.sparse_spacing:g} frames apart are sparse for Remove Noise: no key moved more "
+            f"than the noise estimated ({np.degrees(np.sqrt(3.0) * c.rotation_noise):.3g} deg, "
+            f"{np.sqrt(3.0) * c.translation_noise:.3g} units); {c.limited} key(s) drawn back to it. Smooth Motion "
+            "(Approximate Keys) fits sparse keys"
+        )
+    return notes
 
 
 TAU = 2.0 * np.pi
@@ -333,6 +385,15 @@ def remove_noise(
     if rerun:
         notes.append(f"removed the noise of the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
     cleaned = {(c.owner.obj.as_pointer(), c.owner.bone): c for c in clean(prepared, options)}
+    for key, c in list(cleaned.items()):  # blocked poses after all: skipped, nothing written
+        if c.refused is not None:
+            skipped.append(c.refused)
+            del cleaned[key]
+    plans = [
+        (objects, source, current, identifier, kept)
+        for objects, source, current, identifier, done in plans
+        if (kept := [o for o in done if (o.obj.as_pointer(), o.bone) in cleaned])
+    ]
     actions = []
     with contextlib.ExitStack() as stack:
         if t is None:
@@ -349,6 +410,8 @@ def remove_noise(
             if progress is not None:
                 progress(len(groups) + i + 1, 2 * len(groups))
     parts = list(cleaned.values())
+    for c in parts:
+        notes.extend(data_notes(c))
     return Denoised(
         actions=actions,
         owners=[c.owner.name for c in parts],

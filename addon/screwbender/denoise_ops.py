@@ -31,7 +31,8 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         soft_max=20.0,
         subtype="TIME_ABSOLUTE",
         description="Smoothing time in frames: motion faster than about 6 times this per cycle is "
-        "removed (0 leaves the keys as they are). Used when Auto Strength is off",
+        "removed (0 leaves the keys as they are). Used when Auto Strength is off. Every value is served; "
+        "above 100 key spacings it acts as 100 spacings (the strength used is shown below)",
     )
     range_mode: EnumProperty(
         name="Frame Range",

@@ -683,6 +683,11 @@ class Denoised:
     def translation_kinks(self) -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]:
         """Indices of the poses where an abrupt turn of the path was let through."""
     @property
+    def pops(self) -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]:
+        """Indices of the first pose after each pop (a jump far faster than the motion
+        around it) the clip was cut at; the pieces between are smoothed apart, each with its
+        own strengths (those reported are the longest piece's), and the jump is kept."""
+    @property
     def iterations(self) -> int | npt.NDArray[np.int64]:
         """Gauss-Newton iterations of the rotation solve."""
     @property
@@ -712,9 +717,13 @@ def denoise(
     ``strength``: None chooses the strengths from the data (generalised cross-validation,
     rotation and translation apart, reported back); a time tau (in the units of ``times``)
     or (rotation, translation) times: motion faster than about ``2 pi tau`` per cycle is
-    removed, 0 leaves that part as is. ``held``: boolean mask (N,) or (B, N); held poses are
-    kept exactly and the motion passes through them. ``kinks``: let abrupt turns (a prop
-    stopping against a wall) through instead of rounding them. ``threads``: clips of a batch
+    removed, 0 leaves that part as is; any finite tau >= 0 is served, one above 100 median
+    spacings of ``times`` acts as 100 spacings (the strength reported). The work is done in
+    a normalised time: scaling ``times`` changes nothing but the strengths' unit. ``held``:
+    boolean mask (N,) or (B, N); held poses are kept exactly (their matrices as given, read
+    once) and the motion passes through them. ``kinks``: let abrupt turns (a prop stopping
+    against a wall) through instead of rounding them, and cut the clip at pops (see
+    ``Denoised.pops``). ``threads``: clips of a batch
     are spread over this many threads (0: all the machine has). A batch of no clips
     (0, N, 4, 4) is checked like any other and gives an empty result.
 

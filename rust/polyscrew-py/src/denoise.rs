@@ -16,8 +16,12 @@ use crate::{read_vector, shape_err, to_py_err};
 
 const F: &str = "denoise";
 
-/// Reads `(N, 4, 4)` or `(B, N, 4, 4)` poses: (poses body-major, bodies, frames, batch?).
-fn read_clips(array: ArrayViewD<'_, f64>) -> PyResult<(Vec<Pose>, usize, usize, bool)> {
+/// The poses of a clip and the matrices of its held poses, as read (once) from the input.
+type Clips = (Vec<Pose>, Vec<[[f64; 4]; 4]>);
+
+/// The shape of `(N, 4, 4)` or `(B, N, 4, 4)` poses: (bodies, frames, batch?), within the
+/// limits.
+fn clip_shape(array: &ArrayViewD<'_, f64>) -> PyResult<(usize, usize, bool)> {
     let shape = array.shape().to_vec();
     let (bodies, n, batch) = match shape.as_slice() {
         [n, 4, 4] => (1, *n, false),
@@ -34,7 +38,19 @@ fn read_clips(array: ArrayViewD<'_, f64>) -> PyResult<(Vec<Pose>, usize, usize, 
             "{F}: poses: {n} poses given, at least {MIN_DENOISE_POSES} needed"
         )));
     }
+    Ok((bodies, n, batch))
+}
+
+/// Reads the poses (body-major) of a `clip_shape` array in one pass, keeping the matrices
+/// of the held ones as they were read: nothing is read from the caller's array again.
+fn read_clips(
+    array: ArrayViewD<'_, f64>,
+    (bodies, n, batch): (usize, usize, bool),
+    held: Option<&[bool]>,
+) -> PyResult<Clips> {
     let mut poses = try_vec(bodies * n, "input poses").map_err(|e| to_py_err(F, e))?;
+    let kept = held.map_or(0, |h| h.iter().filter(|h| **h).count());
+    let mut held_rows = try_vec(kept, "held poses").map_err(|e| to_py_err(F, e))?;
     let mut m = [[0.0; 4]; 4];
     let mut it = array.iter();
     for g in 0..bodies * n {
@@ -51,8 +67,11 @@ fn read_clips(array: ArrayViewD<'_, f64>) -> PyResult<(Vec<Pose>, usize, usize, 
                 to_py_err(F, e)
             }
         })?);
+        if held.is_some_and(|h| h[g]) {
+            held_rows.push(m);
+        }
     }
-    Ok((poses, bodies, n, batch))
+    Ok((poses, held_rows))
 }
 
 /// `strength`: None (automatic), one time for both, or (rotation, translation).
@@ -113,8 +132,8 @@ fn read_held(
 #[pyclass(frozen, module = "polyscrew", name = "Denoised")]
 pub struct PyDenoised {
     results: Vec<Denoised>,
-    /// The smooth poses as (B, N, 4, 4), held ones copied from the input bit for bit (a
-    /// matrix read into a quaternion and written back may differ in the last bit).
+    /// The smooth poses as (B, N, 4, 4), held ones the input's matrices as read, bit for bit
+    /// (`Denoised::write_rows`).
     matrices: Array4<f64>,
     n: usize,
     batch: bool,
@@ -199,6 +218,13 @@ impl PyDenoised {
     #[getter]
     fn translation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.translation_kinks)
+    }
+
+    /// Pops the clip was cut at (the first pose after each jump; the pieces between are
+    /// smoothed apart): int array, or a list of them.
+    #[getter]
+    fn pops<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        self.kinks(py, |r| &r.pops)
     }
 
     /// Gauss-Newton iterations of the rotation solve: int, or (B,).
@@ -294,7 +320,12 @@ fn denoise(
         "the noise removal",
         "denoise fewer frames or fewer bodies in one call",
     )?;
-    let (poses, bodies, n, batch) = read_clips(input.view())?;
+    let shape = clip_shape(&input)?;
+    let (bodies, n, batch) = shape;
+    // The mask first, so that the one pass over the poses keeps the held ones' matrices:
+    // the caller's arrays are not read again once the work leaves the GIL.
+    let held = read_held(held, bodies, n)?;
+    let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
     let times = read_vector(F, "times", &times.as_array())?;
     if times.len() != n {
         return Err(PyValueError::new_err(format!(
@@ -303,7 +334,6 @@ fn denoise(
         )));
     }
     let strength = read_strength(strength)?;
-    let held = read_held(held, bodies, n)?;
     let options = DenoiseOptions {
         strength,
         order,
@@ -312,6 +342,7 @@ fn denoise(
     let results = py
         .detach(|| denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads))
         .map_err(|e| to_py_err(F, e))?;
+    drop(poses);
     let mut out = Vec::with_capacity(bodies);
     for (b, r) in results.into_iter().enumerate() {
         match r {
@@ -323,23 +354,11 @@ fn denoise(
         }
     }
     let mut matrices = Array4::<f64>::zeros((bodies, n, 4, 4));
-    let flat = input.as_standard_layout();
-    let flat = flat.as_slice().expect("standard layout");
-    for (b, r) in out.iter().enumerate() {
-        for (i, p) in r.poses.iter().enumerate() {
-            let g = b * n + i;
-            let is_held = held.as_ref().is_some_and(|h| h[g]);
-            let rows = p.to_rows();
-            for row in 0..4 {
-                for c in 0..4 {
-                    matrices[[b, i, row, c]] = if is_held {
-                        flat[16 * g + 4 * row + c]
-                    } else {
-                        rows[row][c]
-                    };
-                }
-            }
-        }
+    let flat = matrices.as_slice_mut().expect("a new array is contiguous");
+    let mut used = 0;
+    for (b, (r, dst)) in out.iter().zip(flat.chunks_exact_mut(16 * n)).enumerate() {
+        let h = held.as_ref().map(|h| &h[b * n..(b + 1) * n]);
+        used += r.write_rows(h, &held_rows[used..], dst);
     }
     Ok(PyDenoised {
         results: out,

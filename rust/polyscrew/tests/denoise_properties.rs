@@ -422,11 +422,21 @@ fn bad_input_is_an_error() {
         denoise(&huge, &times, None, &o),
         Err(Error::Invalid { what: "poses", .. })
     ));
+    // Times in any unit (issue 28: these were refused, the work is now in a normalised
+    // time): spaced 1e-120 apart, the result of times spaced 1 apart, strengths scaled.
     let tiny: Vec<f64> = (0..50).map(|i| i as f64 * 1e-120).collect();
-    assert!(matches!(
-        denoise(&poses, &tiny, None, &o),
-        Err(Error::Invalid { what: "times", .. })
-    ));
+    let unit: Vec<f64> = (0..50).map(|i| i as f64).collect();
+    let (a, b) = (
+        denoise(&poses, &tiny, None, &o).unwrap(),
+        denoise(&poses, &unit, None, &o).unwrap(),
+    );
+    // (a time rounded to the last bit moves the poses by about 1e-7 here, noise 0.01)
+    assert!(
+        max_diff(&a.poses, &b.poses) < 1e-6,
+        "{}",
+        max_diff(&a.poses, &b.poses)
+    );
+    assert!((a.rotation_strength / 1e-120 / b.rotation_strength - 1.0).abs() < 1e-12);
     // Zero strength leaves the part as it is.
     let off = DenoiseOptions {
         strength: Strength::Fixed {

@@ -40,7 +40,15 @@
 //! - Kinks (a prop that stops dead, a foot that plants) are found in a pilot fit and the
 //!   penalty is released there (`kinks.rs`), so a hard stop stays sharp instead of being
 //!   rounded over the spline's time scale.
+//! - Pops (a jump far faster than the motion around it: a tracker re-acquiring its target,
+//!   a teleport) cut the clip into pieces that are smoothed apart, each with its own
+//!   strengths (`pops.rs`); the jump stays as captured. Pieces of fewer than
+//!   [`MIN_DENOISE_POSES`] poses are kept as they are.
 //! - Held poses (`held[i]`) are kept exactly; the smooth motion passes through them.
+//! - The work is done in a normalised time (the median spacing of a piece's times is 1):
+//!   the result does not depend on the unit of the times beyond rounding, and keys as
+//!   close as `1e-300` apart are served like keys one frame apart. A given strength above
+//!   [`MAX_STRENGTH_SPACINGS`] spacings acts as that many (the one the result reports).
 //!
 //! What was measured to choose this (`scripts/bench_denoise.py`, the tables in
 //! BENCHMARKS.md, the alternatives in `docs/denoise.md`): the SE(3) spline on logarithms
@@ -54,6 +62,7 @@ mod band;
 mod blockband;
 pub(crate) mod kinks;
 pub(crate) mod pivot;
+pub(crate) mod pops;
 pub(crate) mod rotation;
 pub(crate) mod smoother;
 mod so3;
@@ -86,6 +95,15 @@ pub const AUTO_MIN_SPACINGS: f64 = 0.25;
 
 /// ... and this many times the median spacing (or the clip's span, if shorter).
 pub const AUTO_MAX_SPACINGS: f64 = 100.0;
+
+/// The largest strength used, in median spacings of the times: a larger given strength
+/// acts as this one (and the result reports it). Beyond it the band system
+/// `H + tau^6 M` (with `M` of size about 20 per spacing) loses every digit: measured, it
+/// fails from about 300 spacings on an even clip. At 100 spacings the spline's frequency
+/// response already removes every period shorter than about 600 spacings: on a clip
+/// shorter than that the result is within rounding of the least-squares polynomial of
+/// degree `m - 1` that an infinite strength gives.
+pub const MAX_STRENGTH_SPACINGS: f64 = 100.0;
 
 /// How strongly to smooth.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -152,6 +170,42 @@ pub struct Denoised {
     pub iterations: usize,
     /// Whether the rotation solve converged (its last step below `1e-10` rad).
     pub converged: bool,
+    /// Pops (see the module documentation): the index of the first pose after each jump
+    /// the clip was cut at, increasing. The strengths, noise and pivot above are those of
+    /// the longest piece; kinks and iterations are those of every piece.
+    pub pops: Vec<usize>,
+}
+
+impl Denoised {
+    /// The smooth poses as 4x4 matrices row by row (Blender's layout), 16 values per pose,
+    /// into `out`: a held pose (`held[i]`) is the next matrix of `source` bit for bit (the
+    /// held poses' matrices as they were read, in order: a matrix read into a quaternion
+    /// and written back may differ in the last bit), the others [`Pose::to_rows`]. Returns
+    /// how many matrices of `source` were used.
+    ///
+    /// # Panics
+    /// If `out` holds fewer than 16 values per pose, or `source` fewer matrices than there
+    /// are held poses (a caller's bug, not user data).
+    pub fn write_rows(
+        &self,
+        held: Option<&[bool]>,
+        source: &[[[f64; 4]; 4]],
+        out: &mut [f64],
+    ) -> usize {
+        let mut used = 0;
+        for (i, (p, dst)) in self.poses.iter().zip(out.chunks_exact_mut(16)).enumerate() {
+            let rows = if held.is_some_and(|h| h[i]) {
+                used += 1;
+                source[used - 1]
+            } else {
+                p.to_rows()
+            };
+            for (d, v) in dst.iter_mut().zip(rows.iter().flatten()) {
+                *d = *v;
+            }
+        }
+        used
+    }
 }
 
 /// Scratch memory, reused between clips (one per thread in [`denoise_batch`]).
@@ -174,6 +228,8 @@ struct Common {
     u_t: Vec<f64>,
     u_r: Vec<f64>,
     quats: Vec<DQuat>,
+    origins: Vec<DVec3>,
+    times: Vec<f64>,
     r: Vec<DQuat>,
     scratch: Vec<f64>,
     paths: [Vec<DVec3>; 4],
@@ -369,6 +425,7 @@ fn denoise_with(
     }
     let cm = &mut ws.common;
     cm.quats.clear();
+    cm.origins.clear();
     for (index, p) in poses.iter().enumerate() {
         let len = p.rotation.length();
         if !(p.rotation.is_finite() && p.translation.is_finite() && len > 0.0) {
@@ -378,11 +435,121 @@ fn denoise_with(
             });
         }
         cm.quats.push(p.rotation / len);
+        cm.origins.push(p.translation);
     }
-    match options.order {
-        2 => run(&mut ws.w2, &mut ws.rot2, cm, poses, times, held, options),
-        _ => run(&mut ws.w3, &mut ws.rot3, cm, poses, times, held, options),
+    let pops = if options.kinks {
+        pops::find(&cm.quats, &cm.origins, times)
+    } else {
+        Vec::new()
+    };
+    if pops.is_empty() {
+        // (the rotations are normalised in `ws` already)
+        return denoise_piece(ws, poses, times, held, options, false);
     }
+    // Each piece between pops apart; a piece too short to smooth is kept as it is.
+    let mut out = Denoised {
+        poses: Vec::with_capacity(n),
+        rotation_strength: 0.0,
+        translation_strength: 0.0,
+        pivot: DVec3::ZERO,
+        rotation_noise: 0.0,
+        translation_noise: 0.0,
+        rotation_kinks: Vec::new(),
+        translation_kinks: Vec::new(),
+        iterations: 0,
+        converged: true,
+        pops: pops.clone(),
+    };
+    let mut longest = 0;
+    let bounds: Vec<usize> = std::iter::once(0)
+        .chain(pops.iter().copied())
+        .chain(std::iter::once(n))
+        .collect();
+    for w in bounds.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if b - a < MIN_DENOISE_POSES {
+            out.poses.extend_from_slice(&poses[a..b]);
+            continue;
+        }
+        let d = denoise_piece(
+            ws,
+            &poses[a..b],
+            &times[a..b],
+            held.map(|h| &h[a..b]),
+            options,
+            true,
+        )?;
+        out.poses.extend_from_slice(&d.poses);
+        out.rotation_kinks
+            .extend(d.rotation_kinks.iter().map(|k| k + a));
+        out.translation_kinks
+            .extend(d.translation_kinks.iter().map(|k| k + a));
+        out.iterations += d.iterations;
+        out.converged &= d.converged;
+        if b - a > longest {
+            longest = b - a;
+            out.rotation_strength = d.rotation_strength;
+            out.translation_strength = d.translation_strength;
+            out.pivot = d.pivot;
+            out.rotation_noise = d.rotation_noise;
+            out.translation_noise = d.translation_noise;
+        }
+    }
+    Ok(out)
+}
+
+/// One clip without pops (at least [`MIN_DENOISE_POSES`] finite poses), in normalised time:
+/// the times shifted to start at 0 and divided by their median spacing, a given strength
+/// likewise (at most [`MAX_STRENGTH_SPACINGS`]); the strengths found are scaled back. The
+/// normalised rotations are in `ws` unless `part` (a piece of the clip they were made for).
+fn denoise_piece(
+    ws: &mut Workspace,
+    poses: &[Pose],
+    times: &[f64],
+    held: Option<&[bool]>,
+    options: &DenoiseOptions,
+    part: bool,
+) -> Result<Denoised> {
+    let n = poses.len();
+    let cm = &mut ws.common;
+    cm.scratch.clear();
+    cm.scratch.extend(times.windows(2).map(|w| w[1] - w[0]));
+    let mid = cm.scratch.len() / 2;
+    let unit = *cm.scratch.select_nth_unstable_by(mid, f64::total_cmp).1;
+    cm.times.clear();
+    cm.times.extend(times.iter().map(|t| (t - times[0]) / unit));
+    crate::check_key_times(&cm.times)?;
+    if part {
+        cm.quats.clear();
+        cm.quats
+            .extend(poses.iter().map(|p| p.rotation / p.rotation.length()));
+    }
+    let scale = |tau: f64| (tau / unit).min(MAX_STRENGTH_SPACINGS);
+    let options = DenoiseOptions {
+        strength: match options.strength {
+            Strength::Auto => Strength::Auto,
+            Strength::Fixed {
+                rotation,
+                translation,
+            } => Strength::Fixed {
+                rotation: scale(rotation),
+                translation: scale(translation),
+            },
+        },
+        ..*options
+    };
+    let times = std::mem::take(&mut cm.times);
+    let result = match options.order {
+        2 => run(&mut ws.w2, &mut ws.rot2, cm, poses, &times, held, &options),
+        _ => run(&mut ws.w3, &mut ws.rot3, cm, poses, &times, held, &options),
+    };
+    ws.common.times = times;
+    debug_assert!(result.as_ref().map_or(true, |d| d.poses.len() == n));
+    result.map(|mut d| {
+        d.rotation_strength *= unit;
+        d.translation_strength *= unit;
+        d
+    })
 }
 
 /// The pipeline for order `M`.
@@ -405,6 +572,8 @@ fn run<const M: usize>(
         u_r,
         quats,
         r,
+        origins: _,
+        times: _,
         scratch,
         paths,
         zs,
@@ -572,6 +741,7 @@ fn run<const M: usize>(
         translation_kinks: kinks_t,
         iterations: solve.iterations,
         converged: solve.converged,
+        pops: Vec::new(),
     })
 }
 
@@ -642,4 +812,139 @@ struct Chosen {
     gcv: Gcv,
     index: Option<usize>,
     kinks: Vec<usize>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A noisy tumbling flight of `n` poses, one per frame; with `pop`, teleported by 5 m and
+    /// turned 90 degrees from pose `n / 2` on.
+    fn flight(n: usize, pop: bool) -> (Vec<Pose>, Vec<f64>) {
+        let mut state = 0x2545_F491_4F6C_DD1D_u64;
+        let mut noise = || smoother_noise(&mut state);
+        let times: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        let jump = Pose::from_rotation_translation(
+            DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2),
+            DVec3::new(5.0, 0.0, 0.0),
+        );
+        let poses = times
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let t = t / 24.0;
+                let wobble = DVec3::new(noise(), noise(), noise()) * 0.01;
+                let q = DQuat::from_scaled_axis(DVec3::new(0.3, 0.2, 1.1) * t + wobble);
+                let p = DVec3::new((0.5 * t).cos() * 2.0, (0.3 * t).sin(), 0.3 * t)
+                    + DVec3::new(noise(), noise(), noise()) * 0.02;
+                let pose = Pose::from_rotation_translation(q, p);
+                if pop && i >= n / 2 {
+                    Pose::from_rotation_translation(
+                        jump.rotation * pose.rotation,
+                        jump.rotation * pose.translation + jump.translation,
+                    )
+                } else {
+                    pose
+                }
+            })
+            .collect();
+        (poses, times)
+    }
+
+    fn smoother_noise(state: &mut u64) -> f64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 11) as f64 / (1u64 << 52) as f64 - 1.0
+    }
+
+    /// A pop cuts the clip: each piece is what denoising it alone gives, and the jump across
+    /// the pop is the input's.
+    #[test]
+    fn a_pop_cuts_the_clip_into_pieces_smoothed_apart() {
+        let (poses, times) = flight(120, true);
+        let o = DenoiseOptions::default();
+        let d = denoise(&poses, &times, None, &o).unwrap();
+        assert_eq!(d.pops, vec![60]);
+        let first = denoise(&poses[..60], &times[..60], None, &o).unwrap();
+        let second = denoise(&poses[60..], &times[60..], None, &o).unwrap();
+        assert!(first.pops.is_empty() && second.pops.is_empty());
+        assert_eq!(d.poses[..60], first.poses[..]);
+        assert_eq!(d.poses[60..], second.poses[..]);
+        // No pop without the jump; with kinks off, no cut either.
+        let (smooth, _) = flight(120, false);
+        assert!(denoise(&smooth, &times, None, &o).unwrap().pops.is_empty());
+        let off = DenoiseOptions { kinks: false, ..o };
+        assert!(denoise(&poses, &times, None, &off).unwrap().pops.is_empty());
+    }
+
+    /// Every strength is served: tiny ones leave the clip as it is, huge ones act as
+    /// MAX_STRENGTH_SPACINGS spacings (and say so), in any unit of time.
+    #[test]
+    fn every_strength_in_any_unit_is_served() {
+        let (poses, times) = flight(250, false);
+        let fixed = |s: f64| DenoiseOptions {
+            strength: Strength::Fixed {
+                rotation: s,
+                translation: s,
+            },
+            ..DenoiseOptions::default()
+        };
+        for s in [1e-300, 0.0005, 0.001, 316.0, 1000.0, 1e300] {
+            let d = denoise(&poses, &times, None, &fixed(s)).unwrap();
+            let used = s.min(MAX_STRENGTH_SPACINGS);
+            assert!(
+                (d.rotation_strength - used).abs() <= 1e-12 * used,
+                "{s}: {d:?}"
+            );
+            assert!(d.poses.iter().all(|p| p.rotation.is_finite()
+                && p.translation.is_finite()
+                && (p.rotation.length() - 1.0).abs() < 1e-12));
+        }
+        let at = |s: f64, k: f64| {
+            let t: Vec<f64> = times.iter().map(|t| t * k).collect();
+            denoise(&poses, &t, None, &fixed(s * k)).unwrap()
+        };
+        assert_eq!(at(1000.0, 1.0).poses, at(100.0, 1.0).poses);
+        for k in [1e-100, 1e50, 0.001] {
+            let (a, b) = (at(4.0, k), at(4.0, 1.0));
+            let diff = a
+                .poses
+                .iter()
+                .zip(&b.poses)
+                .map(|(p, q)| (p.translation - q.translation).length())
+                .fold(0.0, f64::max);
+            assert!(diff < 1e-9, "x{k}: {diff}");
+        }
+    }
+
+    /// Held poses come back as the matrices given, bit for bit; the others as their poses.
+    #[test]
+    fn held_rows_are_the_source_matrices() {
+        let (poses, times) = flight(20, false);
+        let held: Vec<bool> = (0..20).map(|i| i % 3 == 0).collect();
+        let d = denoise(&poses, &times, Some(&held), &DenoiseOptions::default()).unwrap();
+        let source: Vec<[[f64; 4]; 4]> = (0..7)
+            .map(|k| {
+                let mut m = poses[3 * k].to_rows();
+                m[0][3] += 1e-17 * k as f64; // not what the pose would give back
+                m
+            })
+            .collect();
+        let mut out = vec![0.0; 16 * 20];
+        assert_eq!(d.write_rows(Some(&held), &source, &mut out), 7);
+        for i in 0..20 {
+            let want = if held[i] {
+                source[i / 3]
+            } else {
+                d.poses[i].to_rows()
+            };
+            let got: Vec<f64> = out[16 * i..16 * i + 16].to_vec();
+            assert_eq!(
+                got,
+                want.iter().flatten().copied().collect::<Vec<_>>(),
+                "{i}"
+            );
+        }
+    }
 }

@@ -295,7 +295,8 @@ impl<const W: usize> Whittaker<W> {
         true
     }
 
-    /// The GCV statistics of the current `z`, with trace `trace`.
+    /// The GCV statistics of the current `z`, with trace `trace` (the score infinite when
+    /// the fit leaves no degree of freedom); None if they overflow.
     fn score(&self, tau: f64, trace: f64) -> Option<Gcv> {
         let n = self.y.len();
         let (mut rss, mut hsum) = (0.0, 0.0);
@@ -304,9 +305,18 @@ impl<const W: usize> Whittaker<W> {
             rss += h * self.z[i].length_squared();
             hsum += h;
         }
+        if !(rss.is_finite() && trace.is_finite()) {
+            return None;
+        }
+        // At a tiny strength the fit is the data (tr(A) = n to rounding): GCV cannot rank
+        // it (an infinite score), but the fit itself is fine.
         let free = 1.0 - trace / n as f64;
-        let score = (rss / hsum) / (free * free);
-        score.is_finite().then_some(Gcv {
+        let score = if free > 0.0 {
+            (rss / hsum) / (free * free)
+        } else {
+            f64::INFINITY
+        };
+        (!score.is_nan()).then_some(Gcv {
             tau,
             score,
             rss,

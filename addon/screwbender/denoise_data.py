@@ -1,0 +1,151 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Remove Noise knows its data (issue 24): what it refuses, where it limits itself, and what
+it reports. Pure (numpy, no bpy).
+
+Remove Noise is for dense keys (a capture: a key every frame or so). The rules, per owner:
+
+- **Too few keys.** With fewer than :data:`MIN_AUTO_KEYS` keys in the frame range the noise
+  cannot be told from the motion (generalised cross-validation on a handful of keys takes
+  the motion itself for noise: on four blocked keys it chose 20 frames and moved them by up
+  to 1,114 mm / 65.8 degrees). With Auto Strength such an owner is refused, and the message
+  points to Smooth Motion (Approximate Keys) or a given Strength; sparse keys are refused
+  whatever the strength (the limit below needs a noise estimate); dense keys with a given
+  Strength are smoothed.
+- **Sparse keys** (the median spacing of the keys in the range above
+  :data:`SPARSE_SPACING` frames): smoothed, but no key moves more than the noise estimated
+  (``polyscrew.denoise``'s ``rotation_noise`` and ``translation_noise``, per axis: a key's
+  rotation moves at most ``sqrt(3)`` times the first, its pivot point at most ``sqrt(3)``
+  times the second, the size of one noise vector): a key beyond is drawn back towards its
+  original pose (:func:`limit_moves`), and the report says how many. On sparse keys the noise
+  is estimated from the keys themselves: blocked poses of a fast motion look like huge
+  noise (twelve keys 90 to 270 degrees apart: 40 degrees per axis), so sparse keys whose
+  estimated noise exceeds :data:`MAX_SPARSE_ROTATION_NOISE` or
+  :data:`MAX_SPARSE_TRANSLATION_NOISE` of their path's extent are refused as blocked poses
+  (:func:`blocked`), pointing to Smooth Motion.
+- **Pops** are cut by ``polyscrew.denoise`` itself (``Denoised.pops``); the report names their
+  frames.
+- **Held keys**: the report says how many keys the selection held.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+#: Auto Strength (and sparse keys, whatever the strength) need at least this many keys in
+#: the frame range (GCV of a third-order spline has n - 3 degrees of freedom to tell noise
+#: from motion).
+MIN_AUTO_KEYS = 7
+
+#: Keys further apart than this (median spacing, frames) are sparse for Remove Noise.
+SPARSE_SPACING = 2.0
+
+#: Sparse keys whose rotation noise is estimated above this (radians per axis: 10 degrees,
+#: far above any capture's) are blocked poses, not noisy samples...
+MAX_SPARSE_ROTATION_NOISE = np.radians(10.0)
+
+#: ... and so are sparse keys whose position noise is estimated above this fraction of the
+#: extent of their path.
+MAX_SPARSE_TRANSLATION_NOISE = 0.1
+
+
+def median_spacing(frames: np.ndarray) -> float:
+    """The median spacing of increasing key frames (0 for fewer than two)."""
+    frames = np.asarray(frames, dtype=np.float64)
+    return float(np.median(np.diff(frames))) if len(frames) > 1 else 0.0
+
+
+def refusal(name: str, frames: np.ndarray, auto: bool) -> str | None:
+    """Why Remove Noise refuses the keys at `frames` (in the frame range) of owner `name`
+    (None: it does not)."""
+    count = len(frames)
+    if count >= MIN_AUTO_KEYS:
+        return None
+    spacing = median_spacing(frames)
+    if spacing > SPARSE_SPACING:
+        return (
+            f"{name}: {count} keys {spacing:g} frames apart are too few and too sparse to tell noise from motion "
+            f"(Remove Noise needs {MIN_AUTO_KEYS} keys, a frame or two apart); it is for dense captured keys: use "
+            "Smooth Motion (Approximate Keys to pass near noisy keys): skipped"
+        )
+    if auto:
+        return (
+            f"{name}: {count} keys in the frame range are too few to choose a strength from the data "
+            f"(Auto Strength needs {MIN_AUTO_KEYS}); Remove Noise is for dense captured keys: use Smooth Motion "
+            "(Approximate Keys to pass near noisy keys), or turn Auto Strength off and give a Strength: skipped"
+        )
+    return None
+
+
+def blocked(name: str, spacing: float, rotation_noise: float, translation_noise: float, poses: np.ndarray) -> str | None:
+    """Why sparse keys (`poses`, (n, 4, 4), `spacing` frames apart) with the noise estimated
+    are refused as blocked poses (None: they are not)."""
+    extent = float(np.linalg.norm(poses[:, :3, 3] - poses[0, :3, 3], axis=1).max())
+    if rotation_noise > MAX_SPARSE_ROTATION_NOISE or translation_noise > MAX_SPARSE_TRANSLATION_NOISE * extent:
+        return (
+            f"{name}: keys {spacing:g} frames apart that differ by far more than noise (estimated "
+            f"{np.degrees(rotation_noise):.3g} deg, {translation_noise:.3g} units per axis) are blocked poses, not a "
+            "capture; Remove Noise is for dense captured keys: use Smooth Motion (Approximate Keys to pass near noisy "
+            "keys): skipped"
+        )
+    return None
+
+
+def _log(r: np.ndarray) -> np.ndarray:
+    """Rotation vectors of rotation matrices (n, 3, 3) -> (n, 3)."""
+    cos = np.clip((np.trace(r, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
+    angle = np.arccos(cos)
+    w = np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1)
+    sin = np.sin(angle)
+    scale = np.where(sin > 1e-12, angle / (2.0 * np.where(sin > 1e-12, sin, 1.0)), 0.5)
+    return w * scale[:, None]
+
+
+def _exp(v: np.ndarray) -> np.ndarray:
+    """Rotation matrices of rotation vectors (n, 3) (Rodrigues)."""
+    angle = np.linalg.norm(v, axis=1)
+    safe = np.where(angle > 0.0, angle, 1.0)
+    k = v / safe[:, None]
+    kx = np.zeros((len(v), 3, 3))
+    kx[:, 0, 1], kx[:, 0, 2], kx[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
+    kx -= kx.transpose(0, 2, 1)
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
+
+
+def moves(source: np.ndarray, smoothed: np.ndarray, pivot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How far each pose moved: the rotation angle (radians) and the distance of the pivot
+    point (body coordinates) between `source` and `smoothed` (n, 4, 4)."""
+    rel = smoothed[:, :3, :3] @ source[:, :3, :3].transpose(0, 2, 1)
+    angle = np.linalg.norm(_log(rel), axis=1)
+    at = lambda m: m[:, :3, :3] @ pivot + m[:, :3, 3]  # noqa: E731
+    return angle, np.linalg.norm(at(smoothed) - at(source), axis=1)
+
+
+def limit_moves(
+    source: np.ndarray, smoothed: np.ndarray, pivot: np.ndarray, rotation_bound: float, translation_bound: float
+) -> tuple[np.ndarray, int]:
+    """`smoothed` (n, 4, 4) with every pose that moved from `source` by more than the bounds
+    (a rotation angle, radians; a distance of the pivot point) drawn back towards its source
+    pose by the fraction a that brings both within them: the rotation by a of its turn
+    (about the same axis), the pivot a of the way along its straight move. Returns the poses
+    and how many were drawn back."""
+    angle, distance = moves(source, smoothed, pivot)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = np.minimum.reduce([
+            np.ones(len(angle)),
+            np.where(angle > rotation_bound, rotation_bound / angle, 1.0),
+            np.where(distance > translation_bound, translation_bound / distance, 1.0),
+        ])
+    limited = a < 1.0
+    out = smoothed.copy()
+    if not limited.any():
+        return out, 0
+    s, m = source[limited], smoothed[limited]
+    k = a[limited]
+    turn = _log(m[:, :3, :3] @ s[:, :3, :3].transpose(0, 2, 1))
+    rot = _exp(turn * k[:, None]) @ s[:, :3, :3]
+    p0 = s[:, :3, :3] @ pivot + s[:, :3, 3]
+    p1 = m[:, :3, :3] @ pivot + m[:, :3, 3]
+    out[limited, :3, :3] = rot
+    out[limited, :3, 3] = p0 + k[:, None] * (p1 - p0) - rot @ pivot
+    return out, int(limited.sum())
