@@ -88,12 +88,13 @@ def keeps_map(fcurve: bpy.types.FCurve, a: float, c: float) -> bool:
     turn, or the twin Euler triple, away: :mod:`range_join`). Stepped and Cycles change only
     the time, an additive Noise or Generator only adds (a shift `c` passes through them);
     Limits, Envelope, a Generator that replaces the keys, a multiplying Noise do not."""
-    if a == 1.0 and c == 0.0:
+    same = abs(a - 1.0) <= 1e-6  # (a quaternion's map: its length matched, to rounding)
+    if same and abs(c) <= 1e-9:
         return True
     for _, mod in active(fcurve):
         if mod.type in ("STEPPED", "CYCLES"):
             continue
-        if a == 1.0 and (
+        if same and (
             (mod.type == "NOISE" and mod.blend_type != "MULTIPLY")
             or (mod.type in ("GENERATOR", "FNGENERATOR") and mod.use_additive)
         ):

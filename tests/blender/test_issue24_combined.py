@@ -434,3 +434,25 @@ def test_range_modifiers_rerun_failing_midway_changes_nothing(sb):
     assert calls["n"] == 5
     assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30) == {"FINISHED"}
     assert all(len(fc.modifiers) == 1 for key, fc in curves_of(obj).items() if key[0] == "location")
+
+
+def test_range_on_quaternion_keys_with_noise_and_limits_on_rotation(sb, capfd):
+    """Quaternion keys (a sign flip inside the range) under Noise and Limits on the rotation:
+    not refused (the join's map is the identity), the source plays outside the range."""
+    obj, _ = keyed(name="Spun", mode="QUATERNION")
+    fcs = curves_of(obj)
+    for i in range(4):
+        noise(fcs["rotation_quaternion", i], i)
+        mod = fcs["rotation_quaternion", i].modifiers.new("LIMITS")
+        mod.use_min_y, mod.min_y = True, -0.9
+    frames = fine(-2, 44)
+    before = played(obj, frames)
+    capfd.readouterr()
+    assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30) == {"FINISHED"}
+    out = reports(capfd)
+    after = played(obj, frames)
+    outside = (frames < 10) | (frames > 30)
+    loc, ang = difference(after[outside], before[outside])
+    print(f"\n[quaternion range 10..30, Noise + Limits on rotation] outside {loc:.4f} mm {ang:.5f} deg; {out}")
+    assert loc < 0.01 and ang < 1e-3
+    assert all(len(fc.modifiers) == 2 for key, fc in curves_of(obj).items() if key[0] == "rotation_quaternion")
