@@ -156,9 +156,14 @@ def test_range_over_a_flip_on_a_bone_in_pose_mode(sb, capfd):
     loc, ang = difference(after[outside], before[outside])
     steps = [largest_step(rig, at, world) for at in (start, end)]
     moved = difference(after[~outside], before[~outside])
-    print(f"\n[bone range {start:g}..{end:g} over a flip] outside {loc:.4f} mm {ang:.5f} deg; steps {steps}; "
-          f"inside moved {moved}; {report.strip()}")
-    assert loc < 0.01 and ang < 1e-3
+    per = [difference(after[i : i + 1], before[i : i + 1]) for i in np.flatnonzero(outside)]
+    worst = np.flatnonzero(outside)[int(np.argmax([a for _, a in per]))]
+    # (the matrices' own float32 rounding: the largest entry difference, in radians)
+    entries = float(np.abs(after[outside][:, :3, :3] - before[outside][:, :3, :3]).max())
+    print(f"\n[bone range {start:g}..{end:g} over a flip] outside {loc:.4f} mm {ang:.5f} deg (rotation matrix "
+          f"entries {entries:.2g}, worst at frame {frames[worst]:g}); steps {steps}; inside moved {moved}; {report.strip()}")
+    # (arccos of a float32 matrix's trace reads 1e-6 of rounding as 0.03 degrees: the entries are the measure)
+    assert loc < 0.01 and entries < 1e-5
     assert all(a < 5.0 for _, a in steps), steps
     assert moved[1] > 10.0  # the flip inside is gone: the inside is not the source
     assert flip_count(report) >= 1 and "Hand" in report
