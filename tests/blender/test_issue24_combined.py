@@ -58,6 +58,12 @@ def largest_step(obj, at: float, world) -> tuple[float, float]:
     return float(loc), float(ang)
 
 
+def named_frames(line: str) -> list[float]:
+    """The frames a departure line names ("at frames 11-15, 19-23 (...)"): each run's ends."""
+    runs = line.split(" at frames ")[1].split(" (")[0].replace(" and", ",").split(", ")
+    return [float(x) for run in runs if "more" not in run for x in run.split("-")]
+
+
 def subframe_world(obj, bone=None):
     scene = bpy.context.scene
 
@@ -301,7 +307,10 @@ def test_range_with_only_location_keyed(sb, capfd):
     assert paths == ["location"]
     assert loc < 0.01 and ang < 1e-6
     assert inside[0] > 1.0 and inside[1] < 1e-4  # the rotation stays the owner's own
-    assert "departs" not in report or "Slide: departs" in report
+    # the departure report: measured where the result differs (inside), the unkeyed rotation not at all
+    deg, units, line = reported_departure(report, "Slide")
+    assert deg == 0.0 and abs(units - inside[0] / 1000) < 0.002, (line, inside)
+    assert all(10 <= f <= 30 for f in named_frames(line)), line
 
 
 # --- re-runs of a range result ---------------------------------------------------------------
@@ -365,6 +374,10 @@ def test_rerun_of_an_edited_result_with_modifiers_does_not_double_them(sb):
         now = {key: [properties(m) for m in fc.modifiers] for key, fc in curves_of(obj).items()}
         print(f"\nrun {run + 1}: modifiers per curve {[len(v) for v in now.values()]}")
         assert now == originals
+    for run in range(2):  # Smooth Result on, with a range: the result itself, twice
+        assert bpy.ops.screwbender.smooth(smooth_result=True, range_mode="CUSTOM", frame_start=8, frame_end=25) == {"FINISHED"}
+        now = {key: [properties(m) for m in fc.modifiers] for key, fc in curves_of(obj).items()}
+        assert now == originals
 
 
 # --- linked duplicates, the departure report ---------------------------------------------------
@@ -418,6 +431,7 @@ def test_departure_report_with_a_range_is_measured_inside_it(sb, capfd):
           f"outside {per_frame[~inside].max():.4f}; {line}")
     assert per_frame[~inside].max() < 1e-3
     assert abs(deg - per_frame[inside].max()) < 0.5
+    assert all(9 <= f <= 25 for f in named_frames(line)), line
 
 
 # --- all or nothing ----------------------------------------------------------------------------
