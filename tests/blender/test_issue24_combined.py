@@ -475,3 +475,32 @@ def test_range_on_quaternion_keys_with_noise_and_limits_on_rotation(sb, capfd):
     print(f"\n[quaternion range 10..30, Noise + Limits on rotation] outside {loc:.4f} mm {ang:.5f} deg; {out}")
     assert loc < 0.01 and ang < 1e-3
     assert all(len(fc.modifiers) == 2 for key, fc in curves_of(obj).items() if key[0] == "rotation_quaternion")
+
+
+def test_range_ending_a_turn_away_keeps_noise_on_rotation(sb, capfd):
+    """A Noise on the rotation only adds: keys after the range written a whole turn away play
+    the same poses under it (or, for the twin Euler triple, the owner is refused with the reason)."""
+    obj, _, _ = keyed_object()
+    for i, fc in enumerate(fc for fc in h.fcurves(obj) if fc.data_path == "rotation_euler"):
+        noise(fc, i)
+    source = obj.animation_data.action
+    world = subframe_world(obj)
+    frames = fine(HELIX_FRAMES[0] - 2, HELIX_FRAMES[-1] + 2)
+    before = world(frames)
+    try:
+        result = bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=14, frame_end=44)
+    except RuntimeError as err:  # the twin triple: refused, with the Noise named
+        print(f"\n[range 14..44, Noise on rotation] refused: {err}")
+        assert "Noise modifier" in str(err) and "twin" in str(err)
+        return
+    assert result == {"FINISHED"}
+    after = world(frames)
+    outside = (frames < 14) | (frames > 44)
+    entries = float(np.abs(after[outside][:, :3, :] - before[outside][:, :3, :]).max())
+    last = {key: fc.keyframe_points[-1].co[1] for key, fc in curves_of(obj).items()}
+    was = {key: fc.keyframe_points[-1].co[1] for key, fc in curves_of(obj, source).items()}
+    shift = [round(float(last[k] - was[k]) / (2 * math.pi), 4) for k in sorted(last) if k[0] == "rotation_euler"]
+    print(f"\n[range 14..44, Noise on rotation] outside: matrix entries {entries:.2g} off the source; the last "
+          f"key of each rotation channel moved by {shift} turns")
+    assert any(abs(t) > 0.5 for t in shift)  # the keys after the range are written a turn away
+    assert entries < 1e-4
