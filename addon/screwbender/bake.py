@@ -348,6 +348,8 @@ def sample_channels(
     except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
         raise SmoothError(f"{owner.name}: {err}") from err
     end_maps = range_join.end_maps(join, motion, join.played, values, frames) if join is not None else None
+    if join is not None:
+        _check_mapped_modifiers(owner, join, end_maps)
     unkeyed = frozenset()
     if source_curves is not None:
         unkeyed = _left_unkeyed(owner, source_curves, values, motion)
@@ -360,6 +362,25 @@ def sample_channels(
         owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes,
         join=join, end_maps=end_maps, unkeyed=unkeyed,
     )
+
+
+def _check_mapped_modifiers(owner: owners.Owner, join: range_join.Join, end_maps: dict) -> None:
+    """Refuses an owner whose keys after a Frame Range are written as the same rotation in
+    other values (:func:`range_join.end_maps`) on a curve whose modifiers would then play
+    something else (:func:`modifiers.keeps_map`: a Limits, an Envelope)."""
+    for prop, maps in end_maps.items():
+        if "end" not in maps:
+            continue
+        for index, (a, c) in enumerate(zip(*maps["end"])):
+            fcurve = join.curves.get((prop, index))
+            if fcurve is not None and not modifiers.keeps_map(fcurve, float(a), float(c)):
+                names = ", ".join(f"{modifiers.kind(m)} modifier {m.name!r}" for _, m in modifiers.active(fcurve))
+                raise SmoothError(
+                    f"{owner.name}: {owner.path(prop)}[{index}]: the smoothed motion ends the Frame Range a turn "
+                    "(or on the twin Euler angles) away from the keys after it, which would be written as the same "
+                    f"rotation in other values, and its {names} would act on them differently: extend the Frame "
+                    "Range to the last key, or use Turns: As Blender Plays: skipped"
+                )
 
 
 def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion: keys.KeyedMotion) -> frozenset:
@@ -847,13 +868,15 @@ def smooth(
         )
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
     joined = [p for b in bakes for p in b.parts if p.join is not None]
+    # every owner the range changed: linked duplicates sharing the action too
+    joined_names = [owners.Owner(obj, p.owner.bone).name for b in bakes for p in b.parts if p.join for obj in b.objects]
     if joined:
         first = joined[0].join
         start = first.start if first.before else options.frame_range[0]
         end = first.end if first.after else options.frame_range[1]
         moved = f" (moved its {' and '.join(first.moved)}: a span eased by a Blender preset cannot be cut)"
         notes.append(
-            f"smoothed frames {start:g} to {end:g} of {_names([p.owner.name for p in joined])}"
+            f"smoothed frames {start:g} to {end:g} of {_names(joined_names)}"
             f"{moved if first.moved else ''}; the keys outside the range kept as they were"
         )
     if resmoothed:

@@ -417,6 +417,11 @@ def _read(
         if bake_range is not None:  # an extended cycle: report the keys' own period once
             once = (spans[:, 0] >= bake_range[0]) & (spans[:, 0] < bake_range[1])
             flips, shortened = flips & once, shortened & once
+        elif extend_to is not None and not is_closed:
+            # a Frame Range narrower than the keys smooths the spans it reaches; the source keys
+            # outside it are kept as they are (range_join), their flips too: not reported
+            inside = (spans[:, 1] > extend_to[0] + FRAME_TOLERANCE) & (spans[:, 0] < extend_to[1] - FRAME_TOLERANCE)
+            flips, shortened = flips & inside, shortened & inside
         if flips.any():
             where = intent.frame_runs(spans[flips])
             if turns == "BLENDER":

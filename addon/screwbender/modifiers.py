@@ -82,6 +82,27 @@ def refusal(fcurve: bpy.types.FCurve, key_range: tuple[float, float]) -> str | N
     return None
 
 
+def keeps_map(fcurve: bpy.types.FCurve, a: float, c: float) -> bool:
+    """Whether the modifiers of `fcurve` play its keys mapped by `a * value + c` as that same
+    map of what they played before (a Frame Range's join writes the keys after the range a
+    turn, or the twin Euler triple, away: :mod:`range_join`). Stepped and Cycles change only
+    the time, an additive Noise or Generator only adds (a shift `c` passes through them);
+    Limits, Envelope, a Generator that replaces the keys, a multiplying Noise do not."""
+    same = abs(a - 1.0) <= 1e-6  # (a quaternion's map: its length matched, to rounding)
+    if same and abs(c) <= 1e-9:
+        return True
+    for _, mod in active(fcurve):
+        if mod.type in ("STEPPED", "CYCLES"):
+            continue
+        if same and (
+            (mod.type == "NOISE" and mod.blend_type != "MULTIPLY")
+            or (mod.type in ("GENERATOR", "FNGENERATOR") and mod.use_additive)
+        ):
+            continue
+        return False
+    return True
+
+
 def _copy_properties(source, target) -> None:
     """Every writable RNA property of `source` onto `target` (same type), in RNA order;
     arrays as arrays; pointers and collections are left to the caller."""
