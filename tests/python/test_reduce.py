@@ -496,6 +496,61 @@ def test_fallback_when_a_frame_is_not_enough():
     assert r["keys"][0] >= n
 
 
+def neville_reference(poses, frames, per=4):
+    """The "cubic" dense motion at `sample_times(frames, per)`, independently: Aitken-Neville
+    over the two poses each side of a span with pytransform3d's screw for straight lines."""
+    n = len(frames)
+    out = []
+    for f in range(n - 1):
+        lo, hi = max(f - 1, 0), min(f + 2, n - 1)
+        for k in range(per):
+            t = frames[f] + (frames[f + 1] - frames[f]) * k / per
+            if k == 0:
+                out.append(poses[f])
+                continue
+            p = [poses[i] for i in range(lo, hi + 1)]
+            for level in range(1, len(p)):
+                for i in range(len(p) - level):
+                    ti, tj = frames[lo + i], frames[lo + i + level]
+                    p[i] = reference_s(p[i], (t - ti) / (tj - ti), p[i + 1])
+            out.append(p[0])
+    out.append(poses[-1])
+    return np.array(out)
+
+
+def test_between_cubic(rng):
+    """between="cubic": the tolerance holds against the cubic through the frames (built here
+    with pytransform3d's screw), and a smooth clip needs fewer keys than against the screw's
+    corners; a screw motion is still reproduced with two keys."""
+    n = 300
+    frames = np.arange(n, dtype=float)
+    t = frames / 30.0
+    limb = np.zeros((n, 4, 4))
+    limb[:, :3, :3] = Rotation.from_rotvec(np.stack([0.5 * np.sin(2 * np.pi * t), 0.05 * np.sin(4 * np.pi * t),
+                                                     np.zeros(n)], -1)).as_matrix()
+    limb[:, 3, 3] = 1
+    clips = np.array([limb, smooth_motion(n, rng), smooth_motion(n, rng)])
+    radius = np.array([0.45, 0.3, 0.3])
+    times = sample_times(frames)
+    counts = {}
+    for between in ("screw", "cubic"):
+        r = polyscrew.reduce_keys(clips, frames, "XYZ", radius, MM, 0.5 * DEG, between=between)
+        dense = np.array([(dense_reference if between == "screw" else neville_reference)(p, frames) for p in clips])
+        played = play(r, times, ["XYZ"] * 3, dense)
+        d, a = pose_errors(played, dense, radius)
+        assert d.max() <= MM and a.max() <= 0.5 * DEG, (between, d.max(), a.max())
+        np.testing.assert_allclose(r["distance_error"], d.max(axis=1), rtol=1e-3, atol=1e-9)
+        counts[between] = r["keys"]
+    print(f"\nkeys against the screw {counts['screw'].tolist()}, against the cubic {counts['cubic'].tolist()} "
+          f"of {n} frames (limb swing, two tumbles)")
+    assert (counts["cubic"] < counts["screw"]).all()
+    helix = screw_motion(61, [0.2, 0.3, 1.0], np.radians(100), 1.0, np.array([0.5, 0.0, 0.0]))[None]
+    r = polyscrew.reduce_keys(helix, np.arange(61.0), "QUATERNION", 0.3, MM, 0.5 * DEG, between="cubic")
+    assert r["keys"][0] <= 4
+    with pytest.raises(ValueError, match="reduce_keys: between"):
+        polyscrew.reduce_keys(helix, np.arange(61.0), "XYZ", 0.3, MM, DEG, between="linear")
+
+
 # --- the result's form -------------------------------------------------------------------
 
 
