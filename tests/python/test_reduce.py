@@ -447,6 +447,8 @@ def test_scales_and_channels(rng):
     channels = np.array([[True, True, True], [False, True, False]])
     r = polyscrew.reduce_keys(poses, frames, "XYZ", 0.5, MM, 0.5 * DEG, scales=scales, channels=channels)
     assert [p for o, p in zip(r["owner"], r["path"]) if o == 1] == ["rotation_euler"] * 3
+    nothing = polyscrew.reduce_keys(poses[:1], frames, "XYZ", 0.5, MM, DEG, channels=[[False, False, False]])
+    assert nothing["path"] == [] and nothing["keys"].tolist() == [0]
     assert sorted(set(p for o, p in zip(r["owner"], r["path"]) if o == 0)) == ["location", "rotation_euler", "scale"]
     times = sample_times(frames)
     dense = np.array([dense_reference(p, frames) for p in poses])

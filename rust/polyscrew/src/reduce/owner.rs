@@ -315,7 +315,9 @@ impl<'a> Context<'a> {
                 .iter()
                 .map(|&c| curve_of(&fitter, o, c, &spans))
                 .collect::<Result<Vec<_>>>()?;
-            (curves, spans.len() + 1, d, a)
+            // An owner that keys nothing has no key frames.
+            let keys = if cols.is_empty() { 0 } else { spans.len() + 1 };
+            (curves, keys, d, a)
         };
         let world = if keep_world {
             let mut reduced = try_vec(m, "world poses")?;
