@@ -720,7 +720,7 @@ def reduce_keys(
     per_channel: bool = False,
     start: ArrayLike | None = None,
     threads: int = 0,
-    between: Literal["screw", "cubic"] = "screw",
+    between: Literal["screw", "cubic", "linear"] = "screw",
 ) -> dict[str, Any]:
     """The fewest Bezier keys whose playback by Blender stays within a world-space tolerance
     of B owners' dense rigid motions.
@@ -770,7 +770,10 @@ def reduce_keys(
       what a source keyed on every frame with Bezier keys plays (smooth: an ``nla.bake``, an
       imported capture); a smooth reduction can follow it much more closely than the
       screw's corners at every frame, so it needs fewer keys at tight tolerances. Both
-      reproduce screw motions exactly and are coordinate-free.
+      reproduce screw motions exactly and are coordinate-free. "linear": the owner's channels
+      interpolated linearly between two frames, exactly what a source keyed on every frame
+      with LINEAR keys plays (a Smooth Motion bake); not coordinate-free (Euler channels are
+      not).
 
     Keys sit on the dense values (first and last frame always keyed); rotation channels are
     unwrapped along the dense samples (quaternion signs continuous, Euler triples compatible,

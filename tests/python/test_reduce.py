@@ -550,7 +550,31 @@ def test_between_cubic(rng):
     r = polyscrew.reduce_keys(helix, np.arange(61.0), "QUATERNION", 0.3, MM, 0.5 * DEG, between="cubic")
     assert r["keys"][0] <= 4
     with pytest.raises(ValueError, match="reduce_keys: between"):
-        polyscrew.reduce_keys(helix, np.arange(61.0), "XYZ", 0.3, MM, DEG, between="linear")
+        polyscrew.reduce_keys(helix, np.arange(61.0), "XYZ", 0.3, MM, DEG, between="bezier")
+
+
+def test_between_linear(rng):
+    """between="linear": the tolerance holds against the channels interpolated linearly
+    between frames (what LINEAR keys on every frame play), built here from scipy's Euler
+    angles unwrapped by numpy and composed by scipy."""
+    n = 200
+    frames = np.arange(n, dtype=float)
+    clips = np.array([smooth_motion(n, rng) for _ in range(2)])
+    r = polyscrew.reduce_keys(clips, frames, "ZXY", 0.4, MM, 0.5 * DEG, between="linear")
+    times = sample_times(frames)
+    u = np.tile(np.arange(4) / 4, n - 1)
+    dense = np.zeros((2, len(times), 4, 4))
+    dense[:, :, 3, 3] = 1
+    for o, p in enumerate(clips):
+        e = np.unwrap(Rotation.from_matrix(p[:, :3, :3]).as_euler("zxy"), axis=0)[:, [1, 2, 0]]  # x, y, z
+        lerp = lambda v: np.r_[v[:-1].repeat(4, 0) + np.diff(v, axis=0).repeat(4, 0) * u[:, None], v[-1:]]  # noqa: E731
+        dense[o, :, :3, :3] = rotation_of("ZXY", lerp(e))
+        dense[o, :, :3, 3] = lerp(p[:, :3, 3])
+    played = play(r, times, ["ZXY"] * 2, dense)
+    d, a = pose_errors(played, dense, np.full(2, 0.4))
+    print(f"\nlinear: keys {r['keys'].tolist()} of {n}, errors {d.max() / MM:.3f} mm {np.degrees(a.max()):.3f} deg")
+    assert d.max() <= MM and a.max() <= 0.5 * DEG, (d.max(), a.max())
+    np.testing.assert_allclose(r["distance_error"], d.max(axis=1), rtol=1e-3, atol=1e-9)
 
 
 # --- the result's form -------------------------------------------------------------------

@@ -166,11 +166,16 @@ pub enum Between {
     /// keys (an `nla.bake`, an imported capture); screws are reproduced exactly and it is
     /// coordinate-free like the screw.
     Cubic,
+    /// The owner's channels (location, the rotation channels of its mode, unwrapped from
+    /// `start`) interpolated linearly between the two frames: exactly what the source plays
+    /// when it is keyed on every frame with LINEAR keys (a Smooth Motion bake). Not
+    /// coordinate-free (Euler channels are not).
+    Linear,
 }
 
 impl Between {
     /// The names, in the order of the variants.
-    pub const NAMES: [&'static str; 2] = ["screw", "cubic"];
+    pub const NAMES: [&'static str; 3] = ["screw", "cubic", "linear"];
 
     /// The variant named `name`.
     ///
@@ -180,9 +185,10 @@ impl Between {
         match name {
             "screw" => Ok(Self::Screw),
             "cubic" => Ok(Self::Cubic),
+            "linear" => Ok(Self::Linear),
             _ => Err(invalid(
                 "between",
-                format!("{name:?} is not one of screw, cubic"),
+                format!("{name:?} is not one of screw, cubic, linear"),
             )),
         }
     }

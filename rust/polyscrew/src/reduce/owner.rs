@@ -159,10 +159,36 @@ impl<'a> Context<'a> {
         ws.local.clear();
         ws.local.reserve(m);
         ws.scale.clear();
+        let width = mode.width();
+        let start = self.input.start.map(|s| &s[o][..width]);
+        // LINEAR keys on every frame: the channels at the frames, interpolated.
+        let frame_channels = if self.between == Between::Linear {
+            ws.quats.clear();
+            ws.quats.extend(poses.iter().map(|p| p.rotation));
+            Some(rotation_channels(&ws.quats, mode, start)?)
+        } else {
+            None
+        };
         for f in 0..n - 1 {
             ws.local.push(poses[f]);
             if self.constant(o, f) {
                 ws.local.extend([poses[f]; SUBSAMPLES - 1]);
+            } else if let Some(ch) = &frame_channels {
+                let (a, b) = (
+                    &ch[f * width..(f + 1) * width],
+                    &ch[(f + 1) * width..(f + 2) * width],
+                );
+                for k in 1..SUBSAMPLES {
+                    let u = k as f64 / SUBSAMPLES as f64;
+                    let mut r = [0.0; 4];
+                    for i in 0..width {
+                        r[i] = a[i] + (b[i] - a[i]) * u;
+                    }
+                    ws.local.push(Pose {
+                        rotation: rotation(mode, &r),
+                        translation: poses[f].translation.lerp(poses[f + 1].translation, u),
+                    });
+                }
             } else if self.between == Between::Cubic {
                 // Up to two poses each side, not across CONSTANT spans or the clip's ends.
                 let lo = if f > 0 && !self.constant(o, f - 1) {
@@ -245,8 +271,6 @@ impl<'a> Context<'a> {
         // Channels, continuous along the samples.
         ws.quats.clear();
         ws.quats.extend(ws.target.iter().map(|p| p.rotation));
-        let width = mode.width();
-        let start = self.input.start.map(|s| &s[o][..width]);
         let rot = rotation_channels(&ws.quats, mode, start)?;
         ws.v.clear();
         ws.v.reserve(m);
