@@ -1,0 +1,291 @@
+//! Poses from channel values as Blender builds them, and the error of one pose against
+//! another on a body of a given radius.
+//!
+//! A channel row here has [`STRIDE`] numbers: location `x, y, z` (columns 0..3), the rotation
+//! channels of the owner's mode (columns 3..3 + w: quaternion `w, x, y, z`, axis-angle
+//! `angle, x, y, z`, Euler `x, y, z`) and scale `x, y, z` (columns 7..10).
+
+use glam::{DQuat, DVec3};
+
+use crate::motion::channels::{EulerOrder, RotationMode};
+
+/// Numbers per channel row: 3 location, up to 4 rotation, 3 scale.
+pub const STRIDE: usize = 10;
+/// First rotation column.
+pub const ROT: usize = 3;
+/// First scale column.
+pub const SCALE: usize = 7;
+
+/// The rotation Blender builds from rotation channels `r` (the mode's first
+/// [`RotationMode::width`] numbers), as a unit quaternion:
+///
+/// - quaternion `(w, x, y, z)` normalised (all zero: the identity);
+/// - axis-angle `(angle, x, y, z)`: `angle` about the normalised axis (zero axis: the
+///   identity);
+/// - Euler `(x, y, z)` in order `"XYZ"`: `Rz(z) Ry(y) Rx(x)`, X applied first (the other
+///   orders alike).
+#[inline]
+pub fn rotation(mode: RotationMode, r: &[f64]) -> DQuat {
+    match mode {
+        RotationMode::Quaternion => {
+            let q = DQuat::from_xyzw(r[1], r[2], r[3], r[0]);
+            let len = q.length();
+            if len > 0.0 && len.is_finite() {
+                q / len
+            } else {
+                DQuat::IDENTITY
+            }
+        }
+        RotationMode::AxisAngle => {
+            let axis = DVec3::new(r[1], r[2], r[3]);
+            match axis.try_normalize() {
+                Some(a) => DQuat::from_axis_angle(a, r[0]),
+                None => DQuat::IDENTITY,
+            }
+        }
+        RotationMode::Euler(order) => {
+            let x = DQuat::from_rotation_x(r[0]);
+            let y = DQuat::from_rotation_y(r[1]);
+            let z = DQuat::from_rotation_z(r[2]);
+            match order {
+                EulerOrder::Xyz => z * y * x,
+                EulerOrder::Xzy => y * z * x,
+                EulerOrder::Yxz => z * x * y,
+                EulerOrder::Yzx => x * z * y,
+                EulerOrder::Zxy => y * x * z,
+                EulerOrder::Zyx => x * y * z,
+            }
+        }
+    }
+}
+
+/// `sin(theta / 2)` and `theta` (in `[0, pi]`) of the rotation taking unit `a` to unit `b`:
+/// with `q = a^-1 b`, `theta = 2 atan2(|q.xyz|, |q.w|)` (no cancellation at small angles).
+#[inline]
+pub fn relative_angle(a: DQuat, b: DQuat) -> (f64, f64) {
+    let q = a.conjugate() * b;
+    let s = q.xyz().length();
+    let c = q.w.abs();
+    let norm = (s * s + c * c).sqrt();
+    let sin_half = if norm > 0.0 { s / norm } else { 0.0 };
+    (sin_half, 2.0 * s.atan2(c))
+}
+
+/// The rotation channels' Jacobian at channel values `r` whose rotation is the unit `q`:
+/// `J` (3 x 4, by rows; unused columns zero) with `omega = J dr` the rotation vector of
+/// `R(r)^-1 R(r + dr)` to first order (its angle `|omega|`), for the search's `f64` model:
+///
+/// - quaternion `(w, v)`: `omega = 2 Im(q^* dq) = 2 (w dv - dw v - v x dv)`;
+/// - Euler, axes applied `a1, a2, a3`: `omega = R3 R2 u1 de1 + R3 u2 de2 + u3 de3` (world
+///   frame; its length is the angle in any frame);
+/// - axis-angle: `None` (the model composes it exactly).
+pub fn jacobian(mode: RotationMode, r: &[f64], q: DQuat) -> Option<[[f64; 4]; 3]> {
+    match mode {
+        RotationMode::Quaternion => {
+            let (w, v) = (q.w, q.xyz());
+            // Signs of the stored channels may be the opposite of q's.
+            let s = if q.dot(DQuat::from_xyzw(r[1], r[2], r[3], r[0])) < 0.0 {
+                -2.0
+            } else {
+                2.0
+            };
+            // d(Im) / d(dw) = -v; d(Im) / d(dv) = w I - [v]x.
+            Some([
+                [-s * v.x, s * w, s * v.z, -s * v.y],
+                [-s * v.y, -s * v.z, s * w, s * v.x],
+                [-s * v.z, s * v.y, -s * v.x, s * w],
+            ])
+        }
+        RotationMode::AxisAngle => None,
+        RotationMode::Euler(order) => {
+            let [a1, a2, a3] = euler_axes(order);
+            let unit = |a: usize| match a {
+                0 => DVec3::X,
+                1 => DVec3::Y,
+                _ => DVec3::Z,
+            };
+            let c3 = unit(a3);
+            // R3 R2 u1 = R u1 (R1 keeps u1); R3 u2 is perpendicular to both: c3 x c1 =
+            // cos(e2) R3 u2 for an even order, -cos(e2) R3 u2 for an odd one.
+            let c1 = q * unit(a1);
+            let cross = c3.cross(c1);
+            let len = cross.length();
+            let c2 = if len > GIMBAL_JACOBIAN {
+                // The sign of cos(e2) from e2 itself: even half-turn count -> positive.
+                let turns = (r[a2] / std::f64::consts::PI + 0.5).floor();
+                let even_order = (a2 + 3 - a1) % 3 == 1;
+                let positive = (turns.rem_euclid(2.0) == 0.0) == even_order;
+                if positive {
+                    cross / len
+                } else {
+                    -cross / len
+                }
+            } else {
+                DQuat::from_axis_angle(c3, r[a3]) * unit(a2)
+            };
+            let mut j = [[0.0; 4]; 3];
+            for (axis, col) in [(a1, c1), (a2, c2), (a3, c3)] {
+                j[0][axis] = col.x;
+                j[1][axis] = col.y;
+                j[2][axis] = col.z;
+            }
+            Some(j)
+        }
+    }
+}
+
+/// Below this `|cos(e2)|` the Euler Jacobian's middle column is built with trigonometry.
+const GIMBAL_JACOBIAN: f64 = 1e-3;
+
+/// The axes of an Euler order in the order they are applied (`"XYZ"`: X first).
+fn euler_axes(order: EulerOrder) -> [usize; 3] {
+    match order {
+        EulerOrder::Xyz => [0, 1, 2],
+        EulerOrder::Xzy => [0, 2, 1],
+        EulerOrder::Yxz => [1, 0, 2],
+        EulerOrder::Yzx => [1, 2, 0],
+        EulerOrder::Zxy => [2, 0, 1],
+        EulerOrder::Zyx => [2, 1, 0],
+    }
+}
+
+/// What an owner keys: location, rotation, scale.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Keyed {
+    /// Location channels are keyed.
+    pub location: bool,
+    /// Rotation channels are keyed.
+    pub rotation: bool,
+    /// Scale channels are keyed.
+    pub scale: bool,
+}
+
+/// The distance and angle error of channel row `y` against the target pose
+/// (`rotation`, `translation`) and scale on a body of radius `radius`:
+///
+/// `distance = |dt| + 2 r sin(theta / 2) + r |ds|`, `angle = theta`,
+///
+/// the largest distance any point within `r` of the body's origin can be from its place
+/// (`|(R1 - R2) p| = 2 sin(theta / 2) |p|` for the rotation, `|dS p| <= |ds| |p|` for the
+/// scale). Groups that are not keyed count as exact.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub fn row_error(
+    mode: RotationMode,
+    keyed: Keyed,
+    radius: f64,
+    y: &[f64; STRIDE],
+    rotation_target: DQuat,
+    translation_target: DVec3,
+    scale_target: DVec3,
+) -> (f64, f64, DQuat, DVec3) {
+    let mut distance = 0.0;
+    let mut angle = 0.0;
+    let t = DVec3::new(y[0], y[1], y[2]);
+    let (q, t) = {
+        let q = if keyed.rotation {
+            rotation(mode, &y[ROT..ROT + 4])
+        } else {
+            rotation_target
+        };
+        let t = if keyed.location {
+            t
+        } else {
+            translation_target
+        };
+        (q, t)
+    };
+    if keyed.location {
+        distance += (t - translation_target).length();
+    }
+    if keyed.rotation {
+        let (sin_half, theta) = relative_angle(rotation_target, q);
+        distance += 2.0 * radius * sin_half;
+        angle = theta;
+    }
+    if keyed.scale {
+        let s = DVec3::new(y[SCALE], y[SCALE + 1], y[SCALE + 2]);
+        distance += radius * (s - scale_target).length();
+    }
+    (distance, angle, q, t)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DMat3;
+
+    #[test]
+    fn euler_rotation_matches_the_channel_matrices() {
+        let e = DVec3::new(0.3, -1.2, 2.2);
+        for order in [
+            EulerOrder::Xyz,
+            EulerOrder::Xzy,
+            EulerOrder::Yxz,
+            EulerOrder::Yzx,
+            EulerOrder::Zxy,
+            EulerOrder::Zyx,
+        ] {
+            let q = rotation(RotationMode::Euler(order), &e.to_array());
+            let m = order.to_mat3(e);
+            let d = (DMat3::from_quat(q) - m)
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(d < 1e-14, "{order:?}: {d}");
+        }
+    }
+
+    #[test]
+    fn jacobian_gives_the_small_turns() {
+        let mut cases = vec![];
+        for order in [
+            EulerOrder::Xyz,
+            EulerOrder::Xzy,
+            EulerOrder::Yxz,
+            EulerOrder::Yzx,
+            EulerOrder::Zxy,
+            EulerOrder::Zyx,
+        ] {
+            for r in [
+                [0.4, -0.9, 2.1],
+                [3.0, 2.5, -7.0],
+                [-1.0, 7.5, 0.3],
+                [0.2, 1.5707, 0.1],
+            ] {
+                cases.push((RotationMode::Euler(order), vec![r[0], r[1], r[2], 0.0]));
+            }
+        }
+        let q = DQuat::from_scaled_axis(DVec3::new(0.3, -1.0, 0.7));
+        cases.push((RotationMode::Quaternion, vec![-q.w, -q.x, -q.y, -q.z]));
+        for (mode, r) in cases {
+            let q = rotation(mode, &r);
+            let j = jacobian(mode, &r, q).unwrap();
+            for k in 0..mode.width() {
+                let mut d = r.clone();
+                d[k] += 1e-6;
+                let (_, angle) = relative_angle(q, rotation(mode, &d));
+                let col = DVec3::new(j[0][k], j[1][k], j[2][k]);
+                let want = col.length() * 1e-6;
+                assert!(
+                    (angle - want).abs() < 1e-11,
+                    "{mode:?} {k}: {angle} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn relative_angle_is_the_turn() {
+        let a = DQuat::from_rotation_y(0.4);
+        let b = a * DQuat::from_rotation_x(1e-7);
+        let (s, t) = relative_angle(a, b);
+        assert!((t - 1e-7).abs() < 1e-20, "{t}");
+        assert!((s - (0.5e-7f64).sin()).abs() < 1e-20);
+        let (_, t) = relative_angle(a, -b);
+        assert!(
+            (t - 1e-7).abs() < 1e-20,
+            "sign of the quaternion does not matter"
+        );
+    }
+}
