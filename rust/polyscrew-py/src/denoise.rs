@@ -284,16 +284,20 @@ fn denoise(
     };
     let poses = crate::args::float_array(F, "poses", poses)?;
     let times = crate::args::float_array(F, "times", times)?;
-    let input = poses.as_array();
-    // Before anything is copied: the input copy, the scratch of the solves (about 1 kB per
-    // pose, see polyscrew::denoise) and the output, against the memory budget.
-    let count: usize = input.shape().iter().rev().skip(2).product();
+    // Before anything is copied: the conversions of the arguments, the input copy, the
+    // scratch of the solves (about 1 kB per pose, see polyscrew::denoise) and the output,
+    // against the memory budget.
+    let count: usize = poses.shape().iter().rev().skip(2).product();
     crate::check_budget(
         F,
-        polyscrew::Footprint::bytes(count.saturating_mul(16 * 8 * 2 + 1024)),
+        poses.copy()
+            + times.copy()
+            + polyscrew::Footprint::bytes(count.saturating_mul(16 * 8 * 2 + 1024)),
         "the noise removal",
         "denoise fewer frames or fewer bodies in one call",
     )?;
+    let (poses, times) = (poses.read()?, times.read()?);
+    let input = poses.as_array();
     let (poses, bodies, n, batch) = read_clips(input.view())?;
     let times = read_vector(F, "times", &times.as_array())?;
     if times.len() != n {

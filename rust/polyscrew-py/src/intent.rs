@@ -127,7 +127,7 @@ impl PyPlayback {
         let args = CurveArgs::read(
             F,
             0,
-            Footprint::of::<f64>(width), // the copy of the owner's values
+            unkeyed.copy() + Footprint::of::<f64>(width), // the owner's values and their copy
             offsets,
             co,
             handle_left,
@@ -140,7 +140,7 @@ impl PyPlayback {
             period,
             cycles,
         )?;
-        let unkeyed = read_vector(F, "unkeyed", &unkeyed.as_array())?;
+        let unkeyed = read_vector(F, "unkeyed", &unkeyed.read()?.as_array())?;
         let packed = args.packed();
         let inner = py
             .detach(|| {
@@ -175,10 +175,11 @@ impl PyPlayback {
         // the frames, the rows, the three outputs
         check_budget(
             F,
-            Footprint::of::<f64>(t).and::<f64>(t.saturating_mul(2 * width)),
+            frames.copy() + Footprint::of::<f64>(t).and::<f64>(t.saturating_mul(2 * width)),
             "the channel values",
             HINT,
         )?;
+        let frames = frames.read()?;
         let view = frames.as_array();
         let (location, rotation, scale) = py.detach(|| -> PyResult<_> {
             let frames = read_vector(F, "frames", &view)?;
@@ -235,8 +236,14 @@ fn analyse_spans<'py>(
     let playback = playback_arg(F, "playback", playback)?;
     let frames = float_array(F, "frames", frames)?;
     let k = vector_len(F, "frames", &frames)?;
-    check_budget(F, Footprint::of::<f64>(k), "the frames", HINT)?;
+    check_budget(
+        F,
+        frames.copy() + Footprint::of::<f64>(k),
+        "the frames",
+        HINT,
+    )?;
     let inner = &playback.get().inner;
+    let frames = frames.read()?;
     let view = frames.as_array();
     let spans = py.detach(|| -> PyResult<_> {
         let frames = read_vector(F, "frames", &view)?;
@@ -319,15 +326,19 @@ fn keys_parameters<'py>(
     let n = if is_keys {
         key_count(F, &array)?
     } else {
-        pose_count(F, "smooth", array.as_array().shape())?.0
+        pose_count(F, "smooth", array.shape())?.0
     };
     // the copies of the input and the output (the core checks its own working memory)
     check_budget(
         F,
-        Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
+        key_frames.copy()
+            + frames.copy()
+            + array.copy()
+            + Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
         "timing Keys",
         HINT,
     )?;
+    let (key_frames, frames, array) = (key_frames.read()?, frames.read()?, array.read()?);
     let inner = playback.map(|p| &p.get().inner);
     let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
     let out = py.detach(|| -> PyResult<Vec<f64>> {
@@ -386,9 +397,8 @@ fn rotation_matrices<'py>(
     let mode =
         RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
     let values = float_array(F, "values", values)?;
-    let view = values.as_array();
     let width = mode.width();
-    let shape = view.shape();
+    let shape = values.shape();
     if shape.len() != 2 || shape[1] != width {
         return Err(shape_err(F, "values", &format!("(N, {width})"), shape));
     }
@@ -396,10 +406,13 @@ fn rotation_matrices<'py>(
     // the values read, the matrices, the output
     check_budget(
         F,
-        Footprint::of::<f64>(n.saturating_mul(width)).and::<[f64; 9]>(n.saturating_mul(2)),
+        values.copy()
+            + Footprint::of::<f64>(n.saturating_mul(width)).and::<[f64; 9]>(n.saturating_mul(2)),
         "the rotation matrices",
         HINT,
     )?;
+    let values = values.read()?;
+    let view = values.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let run = || -> Result<Array3<f64>, Error> {
             let mut values = try_vec(n.saturating_mul(width), "input values")?;

@@ -26,7 +26,7 @@ use polyscrew::{
 use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 
-pub use args::{float_array, FloatArray};
+pub use args::{copy_of, float_array, FloatArg, FloatArray};
 use args::{Function, Sample, SampleChannels, SampleVectors, Subdivide, SubdivideVectors};
 
 /// The one place a core error becomes a Python exception, with the function's name:
@@ -113,8 +113,8 @@ pub fn read_keys(function: &str, poses: &ArrayViewD<'_, f64>) -> PyResult<Vec<Po
 }
 
 /// The key count of an `(N, 4, 4)` argument (checked again when read).
-pub fn key_count(function: &str, poses: &FloatArray<'_>) -> PyResult<usize> {
-    pose_count(function, "poses", poses.as_array().shape()).map(|(n, _)| n)
+pub fn key_count(function: &str, poses: &FloatArg<'_>) -> PyResult<usize> {
+    pose_count(function, "poses", poses.shape()).map(|(n, _)| n)
 }
 
 /// Poses as an `(N, 4, 4)` array in Blender's layout (allocated fallibly).
@@ -137,12 +137,11 @@ pub fn read_vector(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> P
 }
 
 /// The length of a 1-D array (checked again when read).
-pub fn vector_len(function: &str, what: &str, array: &FloatArray<'_>) -> PyResult<usize> {
-    let a = array.as_array();
-    if a.ndim() != 1 {
-        return Err(shape_err(function, what, "(N,)", a.shape()));
+pub fn vector_len(function: &str, what: &str, array: &FloatArg<'_>) -> PyResult<usize> {
+    if array.ndim() != 1 {
+        return Err(shape_err(function, what, "(N,)", array.shape()));
     }
-    Ok(a.len())
+    Ok(array.len())
 }
 
 /// Reads `(N, 3)` rows without judging their values (no GIL needed).
@@ -164,8 +163,8 @@ pub fn read_rows3(
 }
 
 /// The row count of an `(N, 3)` argument (checked again when read).
-pub fn rows3_len(array: &FloatArray<'_>) -> usize {
-    array.as_array().shape().first().copied().unwrap_or(0)
+pub fn rows3_len(array: &FloatArg<'_>) -> usize {
+    array.shape().first().copied().unwrap_or(0)
 }
 
 /// Reads `(N, 3)` vectors, finite and within the working range (no GIL needed).
@@ -254,11 +253,12 @@ impl PyScrew {
 /// Reads exactly one pose.
 fn read_one_pose(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Pose> {
     let array = float_array(function, what, obj)?;
-    let view = array.as_array();
-    let (_, single) = pose_count(function, what, view.shape())?;
+    let (_, single) = pose_count(function, what, array.shape())?;
     if !single {
-        return Err(shape_err(function, what, "(4, 4)", view.shape()));
+        return Err(shape_err(function, what, "(4, 4)", array.shape()));
     }
+    let array = array.read()?;
+    let view = array.as_array();
     Ok(read_poses(function, what, &view)?[0])
 }
 
@@ -321,9 +321,14 @@ fn interpolate<'py>(
             .into_any());
     }
     let ts = float_array(F, "t", t)?;
-    let view = ts.as_array();
-    if view.ndim() == 0 {
-        let t = view.iter().next().copied().unwrap_or(f64::NAN);
+    if ts.ndim() == 0 {
+        let t = ts
+            .read()?
+            .as_array()
+            .iter()
+            .next()
+            .copied()
+            .unwrap_or(f64::NAN);
         check_t(0, t)?;
         let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
         return Ok(out
@@ -334,10 +339,12 @@ fn interpolate<'py>(
     let m = vector_len(F, "t", &ts)?;
     check_budget(
         F,
-        Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
+        ts.copy() + Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
         "the interpolated poses",
         "pass fewer t at once",
     )?;
+    let ts = ts.read()?;
+    let view = ts.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let ts = read_vector(F, "t", &view)?;
         for (index, t) in ts.iter().enumerate() {
@@ -382,12 +389,14 @@ fn subdivide<'py>(
     };
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + keys_footprint(n)
             + subdivision_footprint::<Pose>(n, levels, closed)
             + Footprint::of::<[f64; 16]>(out_len),
         "the subdivided poses",
         SUBDIVISION_HINT,
     )?;
+    let poses = poses.read()?;
     let view = poses.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let keys = read_keys(F, &view)?;
@@ -400,8 +409,8 @@ fn subdivide<'py>(
 
 /// The inputs of the sampling functions: key count, key times and times arrays.
 struct TimedInput<'py> {
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
+    key_times: FloatArg<'py>,
+    times: FloatArg<'py>,
     n_times: usize,
     n_key_times: usize,
 }
@@ -421,6 +430,18 @@ fn read_timed<'py>(
         n_times,
         n_key_times,
     })
+}
+
+impl<'py> TimedInput<'py> {
+    /// What reading the two arrays copies.
+    fn copy(&self) -> Footprint {
+        self.key_times.copy() + self.times.copy()
+    }
+
+    /// The two arrays read (after the budget's check).
+    fn read(&self) -> PyResult<(FloatArray<'py>, FloatArray<'py>)> {
+        Ok((self.key_times.read()?, self.times.read()?))
+    }
 }
 
 /// sample(poses, key_times, times, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> ndarray
@@ -454,18 +475,17 @@ fn sample<'py>(
     let m = input.n_times;
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + input.copy()
+            + keys_footprint(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<Pose>(n, m, &spec)
             + Footprint::of::<[f64; 16]>(m),
         "the sampled poses",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        poses.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (poses, (key_times, times)) = (poses.read()?, input.read()?);
+    let (view, kt, tt) = (poses.as_array(), key_times.as_array(), times.as_array());
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let keys = read_keys(F, &view)?;
         let key_times = read_vector(F, "key_times", &kt)?;
@@ -515,7 +535,10 @@ fn sample_channels<'py>(
     let width = mode.width();
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + input.copy()
+            + copy_of(previous.as_ref())
+            + keys_footprint(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<Pose>(n, m, &spec)
             + Footprint::of::<(DQuat, DVec3)>(m)
@@ -524,11 +547,9 @@ fn sample_channels<'py>(
         "the sampled channels",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        poses.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (poses, (key_times, times)) = (poses.read()?, input.read()?);
+    let previous = previous.as_ref().map(|p| p.read()).transpose()?;
+    let (view, kt, tt) = (poses.as_array(), key_times.as_array(), times.as_array());
     let pv = previous.as_ref().map(|p| p.as_array());
     let (locations, rotations) = py.detach(|| -> PyResult<(Array2<f64>, Array2<f64>)> {
         let keys = read_keys(F, &view)?;
@@ -580,12 +601,14 @@ fn subdivide_vectors<'py>(
     };
     check_budget(
         F,
-        Footprint::of::<DVec3>(n)
+        values.copy()
+            + Footprint::of::<DVec3>(n)
             + subdivision_footprint::<DVec3>(n, levels, closed)
             + Footprint::of::<[f64; 3]>(out_len),
         "the subdivided vectors",
         SUBDIVISION_HINT,
     )?;
+    let values = values.read()?;
     let view = values.as_array();
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let keys = read_vec3s(F, "values", &view)?;
@@ -623,18 +646,17 @@ fn sample_vectors<'py>(
     let m = input.n_times;
     check_budget(
         F,
-        Footprint::of::<DVec3>(n)
+        values.copy()
+            + input.copy()
+            + Footprint::of::<DVec3>(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<DVec3>(n, m, &spec)
             + Footprint::of::<[f64; 3]>(m),
         "the sampled vectors",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        values.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (values, (key_times, times)) = (values.read()?, input.read()?);
+    let (view, kt, tt) = (values.as_array(), key_times.as_array(), times.as_array());
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let keys = read_vec3s(F, "values", &view)?;
         let key_times = read_vector(F, "key_times", &kt)?;
@@ -709,15 +731,20 @@ fn rotation_channels<'py>(
         .filter(|p| !p.is_none())
         .map(|p| float_array(F, "previous", p))
         .transpose()?;
-    let view = rotations.as_array();
-    let n = view.shape().first().copied().unwrap_or(0);
+    let n = rotations.shape().first().copied().unwrap_or(0);
     let width = mode.width();
     check_budget(
         F,
-        Footprint::of::<DQuat>(n) + Footprint::of::<f64>(n.saturating_mul(width)),
+        rotations.copy()
+            + copy_of(previous.as_ref())
+            + Footprint::of::<DQuat>(n)
+            + Footprint::of::<f64>(n.saturating_mul(width)),
         "the rotation channels",
         polyscrew::motion::channels::CHANNELS_HINT,
     )?;
+    let rotations = rotations.read()?;
+    let view = rotations.as_array();
+    let previous = previous.as_ref().map(|p| p.read()).transpose()?;
     let pv = previous.as_ref().map(|p| p.as_array());
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let quats = read_rotations(F, &view)?;
