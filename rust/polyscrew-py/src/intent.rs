@@ -12,8 +12,8 @@ use pyo3::prelude::*;
 use polyscrew::intent::{
     analyse_spans as core_analyse_spans, keys_parameters as core_keys_parameters,
     pace_parameters as core_pace_parameters, rotation_matrices as core_rotation_matrices,
-    screw_pace_poses, Channel, KeysTiming, Playback, HOLD_TOLERANCE, MAX_SPAN_SAMPLES,
-    PACE_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
+    screw_pace_poses, Channel, KeysTiming, Playback, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES,
+    MAX_SPAN_SAMPLES, PACE_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
 };
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode};
@@ -442,6 +442,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WIND_STEP", WIND_STEP)?;
     m.add("SPAN_SAMPLES", SPAN_SAMPLES)?;
     m.add("MAX_SPAN_SAMPLES", MAX_SPAN_SAMPLES)?;
+    m.add("MAX_ANALYSIS_SAMPLES", MAX_ANALYSIS_SAMPLES)?;
     m.add("HOLD_TOLERANCE", HOLD_TOLERANCE)?;
     m.add("PACE_SAMPLES", PACE_SAMPLES)?;
     Ok(())

@@ -714,7 +714,7 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
 /// "AXIS_ANGLE" -> (N, 4) angle, x, y, z, unwrapped; "XYZ", "XZY", "YXZ", "YZX", "ZXY",
 /// "ZYX" -> (N, 3) Euler angles (radians, per axis x, y, z) each compatible with the
 /// previous frame as `Euler.make_compatible` does. `previous`: the channel values just
-/// before the first frame, to continue from.
+/// before the first frame, to continue from (its angles within +-`MAX_PREVIOUS_ANGLE`).
 #[pyfunction]
 #[pyo3(signature = (rotations, mode, previous=None))]
 fn rotation_channels<'py>(
@@ -798,6 +798,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_MEMORY_BUDGET", polyscrew::DEFAULT_MEMORY_BUDGET)?;
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
+    m.add("MAX_PREVIOUS_ANGLE", polyscrew::MAX_PREVIOUS_ANGLE)?;
     angular_velocity::register(m)?;
     sweep::register(m)?;
     feature::register(m)?;

@@ -43,5 +43,6 @@ pub use pace::{
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{
-    analyse_spans, Spans, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
+    analyse_spans, Spans, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES, SPAN_SAMPLES,
+    WIND_LIMIT, WIND_STEP,
 };

@@ -27,6 +27,13 @@ pub const SPAN_SAMPLES: usize = 8;
 /// At most this many samples per span.
 pub const MAX_SPAN_SAMPLES: usize = 4096;
 
+/// At most this many samples of the playback in one [`analyse_spans`] call, all spans
+/// together (2**22; spins are walked a second time to place their added frames, so the
+/// playback is evaluated at most twice this often). The work is not bounded by memory (a
+/// span's samples are reused): this bounds its time, about a second per million samples of
+/// a playback of ten curves on one core.
+pub const MAX_ANALYSIS_SAMPLES: usize = 1 << 22;
+
 /// Degrees of rotation-channel change (the sum over the Euler angles, or the axis-angle
 /// angle) per sample of a span.
 pub const DEGREES_PER_SAMPLE: f64 = 10.0;
@@ -102,7 +109,8 @@ fn moves(v0: &[f64], v: &[f64]) -> bool {
 /// channel of any sample moves from the span's start by more than [`HOLD_TOLERANCE`]; it
 /// pops when it is held and a channel differs between its keys. Its turn is the sum of
 /// [`rotation_angle`]s between consecutive samples and from the last sample to the span's
-/// end. Spins (Euler and axis-angle only): a span that is not held and turns more than
+/// end. All spans together take at most [`MAX_ANALYSIS_SAMPLES`] samples. Spins (Euler and
+/// axis-angle only): a span that is not held and turns more than
 /// [`WIND_LIMIT`], together with the runs of neighbouring spans that are not held and turn
 /// more than [`WIND_STEP`], gets `ceil(turn / WIND_STEP) - 1` frames where the accumulated
 /// turn along its samples reaches equal fractions of the span's turn (linear between
@@ -111,7 +119,8 @@ fn moves(v0: &[f64], v: &[f64]) -> bool {
 /// # Errors
 /// [`Error::TooFew`] for fewer than two frames, [`Error::KeyTimes`] for frames that are not
 /// finite and strictly increasing, the errors of [`Playback::channels`], and a request over
-/// the size limit ([`check_footprint`]).
+/// the size limit ([`check_footprint`]), [`Error::Invalid`] (`frames`) for spans that would
+/// take more than [`MAX_ANALYSIS_SAMPLES`] samples in all (before any is taken).
 pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
     let k = frames.len();
     if k < 2 {
@@ -145,6 +154,18 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
         }),
         "spans",
     )?;
+    let total = counts.iter().fold(0usize, |a, &c| a.saturating_add(c));
+    if total > MAX_ANALYSIS_SAMPLES {
+        return Err(Error::Invalid {
+            what: "frames",
+            reason: format!(
+                "the {spans} key spans would take {total} samples of the playback, more than \
+                 {MAX_ANALYSIS_SAMPLES} (a span whose rotation channels change by d degrees \
+                 takes d / {DEGREES_PER_SAMPLE} of them, {SPAN_SAMPLES} to {MAX_SPAN_SAMPLES}): \
+                 analyse fewer key frames at once"
+            ),
+        });
+    }
 
     let mut held = filled(spans, true, "spans")?;
     let mut pops = filled(spans, false, "spans")?;

@@ -199,6 +199,13 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
     }
 }
 
+/// The largest `previous` angle (radians, either sign) [`rotation_channels`] continues from:
+/// Euler angles and the axis-angle angle. A continued angle is `previous` plus less than
+/// half a turn; within this range a double holds it to about 1e-7 radians (its spacing at
+/// 1e9 is 1.2e-7), beyond it the spacing grows until no double near `previous` stands for
+/// the rotation at all (at 1e17 the doubles are 16 radians apart).
+pub const MAX_PREVIOUS_ANGLE: f64 = 1e9;
+
 /// How to ask [`rotation_channels`] for less memory.
 pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 
@@ -211,7 +218,9 @@ pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
-/// it holds NaN or infinity, [`Error::Memory`] when the channels exceed the memory budget.
+/// it holds NaN or infinity, [`Error::OutOfRange`] when one of its angles (Euler, or the
+/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Memory`] when the channels
+/// exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
     mode: RotationMode,
@@ -230,6 +239,22 @@ pub fn rotation_channels(
             return Err(Error::NotFinite {
                 what: "previous value",
                 index,
+            });
+        }
+        let angles = match mode {
+            RotationMode::Quaternion => 0,
+            RotationMode::AxisAngle => 1,
+            RotationMode::Euler(_) => 3,
+        };
+        if let Some(index) = p[..angles]
+            .iter()
+            .position(|v| v.abs() > MAX_PREVIOUS_ANGLE)
+        {
+            return Err(Error::OutOfRange {
+                what: "previous value",
+                index,
+                value: p[index],
+                range: "+-1e9",
             });
         }
     }
