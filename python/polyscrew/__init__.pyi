@@ -46,7 +46,8 @@ beyond which the motion is subdivided in windows of key spans (memory independen
 key count, the same result to the bit); ``subdivide`` 212 per output pose;
 ``rotation_channels`` 56 per rotation (Euler); ``sweep`` 48 per output vertex and 36 per
 output triangle (checked before each screw's quads are added) plus 320 per body triangle;
-``feature_motion`` 640 per output pose. ``scripts/memory_footprints.py`` prints the
+``feature_motion`` 640 per output pose; ``denoise`` 1,792 per pose (its scratch measured at
+1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/memory_footprints.py`` prints the
 estimates beside the peaks measured for the largest uses (all below 160 MB).
 
 The module releases the GIL while it reads its input, computes and builds its output.
@@ -75,6 +76,12 @@ MAX_TIME: float
 MAX_PREVIOUS_ANGLE: float
 """The largest ``previous`` angle (radians, either sign) the rotation channels continue
 from: 1e9 (see the module documentation); beyond it ``ValueError``."""
+
+MAX_ROTATIONS: int
+"""The most rotations one ``rotation_channels`` call converts: 2**24 (16,777,216), the most
+the default memory budget accepts in quaternion and axis-angle modes. It bounds the call's
+time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
+is read."""
 
 DEFAULT_MEMORY_BUDGET: int
 """The default memory budget per call, 1 GiB (1073741824 bytes): about 5 times the largest
@@ -200,7 +207,7 @@ def rotation_channels(
     unwrapped; Euler orders: (N, 3) angles per axis (x, y, z), each frame compatible with the
     previous one (no jump above 180 degrees). ``previous`` continues from earlier values;
     its angles (Euler, the axis-angle angle) within ``+-MAX_PREVIOUS_ANGLE`` (1e9), else
-    ``ValueError``.
+    ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
     """
 
 # --- Angular-velocity editing (Xie et al. 2011, "Sketch-based rotation editing") ---
@@ -522,8 +529,9 @@ SPAN_SAMPLES: int
 MAX_SPAN_SAMPLES: int
 """At most this many samples per span in ``analyse_spans`` (4096; one per 10 degrees)."""
 MAX_ANALYSIS_SAMPLES: int
-"""At most this many samples in one ``analyse_spans`` call, all spans together (4,194,304):
-its work is not bounded by memory, this bounds its time (a few seconds on one core)."""
+"""At most this many samples in one ``analyse_spans`` call, all spans together (2,097,152):
+its work is not bounded by memory, this bounds its time (about 2 s of one core at the
+limit: 512 spans of 4,096 samples, each a spin)."""
 HOLD_TOLERANCE: float
 """A channel moving less than this times (its size + 1) over a span is still (1e-6)."""
 PACE_SAMPLES: int

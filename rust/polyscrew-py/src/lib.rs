@@ -12,7 +12,7 @@ mod intent;
 mod sweep;
 
 use glam::{DQuat, DVec3};
-use numpy::ndarray::{Array2, Array3, ArrayViewD};
+use numpy::ndarray::{Array2, Array3, ArrayViewD, Ix3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::motion::sample::sample_footprint;
@@ -79,12 +79,11 @@ pub fn pose_count(function: &str, what: &str, shape: &[usize]) -> PyResult<(usiz
 pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<Pose>> {
     let (n, single) = pose_count(function, what, array.shape())?;
     let mut poses = try_vec(n, "input poses").map_err(|e| to_py_err(function, e))?;
-    let mut values = array.iter();
-    for i in 0..n {
+    // read through a view of fixed dimensions: ndarray iterates a broadcast or strided view
+    // of dynamic dimensions about twice as slowly
+    let mut push = |values: &mut dyn FnMut(&mut [f64; 16]), i: usize| -> PyResult<()> {
         let mut m = [0.0; 16];
-        for (slot, v) in m.iter_mut().zip(&mut values) {
-            *slot = *v;
-        }
+        values(&mut m);
         let row = |r: usize| [m[4 * r], m[4 * r + 1], m[4 * r + 2], m[4 * r + 3]];
         let pose = Pose::from_rows(&[row(0), row(1), row(2), row(3)], i).map_err(|e| {
             if single {
@@ -99,8 +98,24 @@ pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> Py
             }
         })?;
         poses.push(pose);
+        Ok(())
+    };
+    if let Ok(fixed) = array.view().into_dimensionality::<Ix3>() {
+        for (i, matrix) in fixed.outer_iter().enumerate() {
+            push(&mut |m| fill(m, matrix.iter()), i)?;
+        }
+    } else {
+        push(&mut |m| fill(m, array.iter()), 0)?;
     }
     Ok(poses)
+}
+
+/// `m` filled from `values` (as many as it holds).
+#[inline]
+fn fill<'a, const K: usize>(m: &mut [f64; K], values: impl Iterator<Item = &'a f64>) {
+    for (slot, v) in m.iter_mut().zip(values) {
+        *slot = *v;
+    }
 }
 
 /// Reads `(N, 4, 4)` key poses (a single matrix is refused), no GIL needed.
@@ -680,12 +695,13 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
         }
         [n, 3, 3] => {
             let mut out = try_vec(*n, "rotations").map_err(|e| to_py_err(function, e))?;
-            let mut values = array.iter();
-            for i in 0..*n {
+            let fixed = array
+                .view()
+                .into_dimensionality::<Ix3>()
+                .map_err(|e| PyValueError::new_err(format!("{function}: rotations: {e}")))?;
+            for (i, matrix) in fixed.outer_iter().enumerate() {
                 let mut m = [0.0; 9];
-                for (slot, v) in m.iter_mut().zip(&mut values) {
-                    *slot = *v;
-                }
+                fill(&mut m, matrix.iter());
                 let rows = [
                     [m[0], m[1], m[2], 0.0],
                     [m[3], m[4], m[5], 0.0],
@@ -715,6 +731,7 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
 /// "ZYX" -> (N, 3) Euler angles (radians, per axis x, y, z) each compatible with the
 /// previous frame as `Euler.make_compatible` does. `previous`: the channel values just
 /// before the first frame, to continue from (its angles within +-`MAX_PREVIOUS_ANGLE`).
+/// At most `MAX_ROTATIONS` rotations per call.
 #[pyfunction]
 #[pyo3(signature = (rotations, mode, previous=None))]
 fn rotation_channels<'py>(
@@ -742,6 +759,7 @@ fn rotation_channels<'py>(
         "the rotation channels",
         polyscrew::motion::channels::CHANNELS_HINT,
     )?;
+    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(F, e))?;
     let rotations = rotations.read()?;
     let view = rotations.as_array();
     let previous = previous.as_ref().map(|p| p.read()).transpose()?;
@@ -799,6 +817,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
     m.add("MAX_PREVIOUS_ANGLE", polyscrew::MAX_PREVIOUS_ANGLE)?;
+    m.add("MAX_ROTATIONS", polyscrew::MAX_ROTATIONS)?;
     angular_velocity::register(m)?;
     sweep::register(m)?;
     feature::register(m)?;

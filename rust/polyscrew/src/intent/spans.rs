@@ -28,11 +28,11 @@ pub const SPAN_SAMPLES: usize = 8;
 pub const MAX_SPAN_SAMPLES: usize = 4096;
 
 /// At most this many samples of the playback in one [`analyse_spans`] call, all spans
-/// together (2**22; spins are walked a second time to place their added frames, so the
+/// together (2**21; spins are walked a second time to place their added frames, so the
 /// playback is evaluated at most twice this often). The work is not bounded by memory (a
-/// span's samples are reused): this bounds its time, about a second per million samples of
-/// a playback of ten curves on one core.
-pub const MAX_ANALYSIS_SAMPLES: usize = 1 << 22;
+/// span's samples are reused): this bounds its time, about 2 s of one core at the limit
+/// (512 spans of 4,096 samples, each a spin, on a playback of nine curves).
+pub const MAX_ANALYSIS_SAMPLES: usize = 1 << 21;
 
 /// Degrees of rotation-channel change (the sum over the Euler angles, or the axis-angle
 /// angle) per sample of a span.

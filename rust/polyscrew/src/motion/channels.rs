@@ -206,6 +206,28 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
 /// the rotation at all (at 1e17 the doubles are 16 radians apart).
 pub const MAX_PREVIOUS_ANGLE: f64 = 1e9;
 
+/// The most rotations one [`rotation_channels`] call converts: 2**24 (16,777,216), the
+/// most the default memory budget accepts for quaternion and axis-angle channels. Its work
+/// is a few hundred nanoseconds per rotation, so this bounds its time (a few seconds of one
+/// core) whatever the budget; more is refused before any is read ([`check_rotation_count`]).
+pub const MAX_ROTATIONS: usize = 1 << 24;
+
+/// Refuses more than [`MAX_ROTATIONS`] rotations in one call.
+///
+/// # Errors
+/// [`Error::Invalid`] (`rotations`) naming the count and the limit.
+pub fn check_rotation_count(count: usize) -> Result<()> {
+    if count > MAX_ROTATIONS {
+        return Err(Error::Invalid {
+            what: "rotations",
+            reason: format!(
+                "{count} rotations, more than {MAX_ROTATIONS} in one call: {CHANNELS_HINT}"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// How to ask [`rotation_channels`] for less memory.
 pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 
@@ -219,8 +241,8 @@ pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
 /// it holds NaN or infinity, [`Error::OutOfRange`] when one of its angles (Euler, or the
-/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Memory`] when the channels
-/// exceed the memory budget.
+/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Invalid`] for more than
+/// [`MAX_ROTATIONS`] rotations, [`Error::Memory`] when the channels exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
     mode: RotationMode,
@@ -260,6 +282,7 @@ pub fn rotation_channels(
     }
     let values = rotations.len().saturating_mul(width);
     Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    check_rotation_count(rotations.len())?;
     let mut out = try_vec(values, "rotation channels")?;
     match mode {
         RotationMode::Quaternion => {
