@@ -328,12 +328,20 @@ fn keys_parameters<'py>(
     } else {
         pose_count(F, "smooth", array.shape())?.0
     };
-    // the copies of the input and the output (the core checks its own working memory)
+    // the copies of the input and the output, and the core's working memory (which it
+    // checks again on its own): per frame four values, per pace sample five, per pose of
+    // the pace grid two and (from the keys) the smoothed pose itself
+    let grid = k.saturating_mul(PACE_SAMPLES + 1);
+    let work = Footprint::of::<f64>(t).times(4)
+        + Footprint::of::<f64>(grid.saturating_add(t)).times(5)
+        + Footprint::of::<f64>(grid).times(2)
+        + Footprint::of::<Pose>(if is_keys { grid } else { 0 });
     check_budget(
         F,
         key_frames.copy()
             + frames.copy()
             + array.copy()
+            + work
             + Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
         "timing Keys",
         HINT,
