@@ -236,13 +236,19 @@ fn analyse_spans<'py>(
     let playback = playback_arg(F, "playback", playback)?;
     let frames = float_array(F, "frames", frames)?;
     let k = vector_len(F, "frames", &frames)?;
+    let inner = &playback.get().inner;
+    // the frames' copy, and the core's working memory (which it checks again on its own):
+    // the key rows, four values per span (the results and the sample counts), and one span's
+    // samples at most (frames, rows, steps); the inserted frames are checked when counted
+    let width = inner.width();
+    let work = Footprint::of::<f64>(k.saturating_mul(width + 4))
+        .and::<f64>(MAX_SPAN_SAMPLES.saturating_mul(width + 2));
     check_budget(
         F,
-        frames.copy() + Footprint::of::<f64>(k),
+        frames.copy() + Footprint::of::<f64>(k) + work,
         "the frames",
         HINT,
     )?;
-    let inner = &playback.get().inner;
     let frames = frames.read()?;
     let view = frames.as_array();
     let spans = py.detach(|| -> PyResult<_> {
