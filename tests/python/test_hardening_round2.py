@@ -415,6 +415,7 @@ ESTIMATES = {
     "evaluate_fcurves": ("c = curve(1000); t = np.linspace(-5, 1005, 4_000_000)", "ps.evaluate_fcurves(t, **c)"),
     "Playback.channels": ("pb = playback(); t = np.linspace(-5, 15, 2_000_000)", "pb.channels(t)"),
     "keys_parameters": ("k = keys(50); t = np.linspace(0, 49, 2_000_000)", "ps.keys_parameters(np.arange(50.0), t, size=1.0, poses=k)"),
+    "analyse_spans": ("pb = playback(); f = np.linspace(0, 9, 1_000_000)", "ps.analyse_spans(pb, f)"),
     "denoise": ("p, t = noisy(400_000)", "ps.denoise(p, t)"),
     "denoise, float32 poses": ("p, t = noisy(300_000); p = p.astype(np.float32)", "ps.denoise(p, t)"),
     "denoise, a rig of 4 bodies": ("p, t = noisy(100_000); p = np.stack([p] * 4)", "ps.denoise(p, t)"),
@@ -434,3 +435,39 @@ def test_peak_memory_stays_within_the_estimate(name):
     assert result == {"finite": True}, (name, result)
     assert estimate > 40e6, (name, "not a large case", estimate)
     assert peak["growth"] <= estimate + 4 * MB, (name, estimate, peak)
+
+
+def test_sweep_peak_memory_stays_within_its_stated_estimate():
+    """The sweep checks its body up front (what a budget of 0 reports) and its output span by
+    span: its stated estimate is the body's plus 48 bytes per output vertex and 36 per output
+    triangle (the module documentation). A 20,480-triangle sphere over 64 screws."""
+    lines = run_peak(
+        """
+seg, rings = 128, 81
+th = np.pi * np.arange(1, rings) / rings
+ph = 2 * np.pi * np.arange(seg) / seg
+v = np.array([[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]], float)
+idx = lambda r, s: 1 + r * seg + s % seg
+t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
+for r in range(rings - 2):
+    for s in range(seg):
+        t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
+t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
+t = np.array(t)
+def pose(i):
+    a = 0.05 * i
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
+poses = np.stack([pose(i) for i in range(65)])
+print(json.dumps({"triangles": len(t), "estimate": need(lambda: ps.sweep(v, t, poses, steps=8))}))
+out = peak_of(lambda: ps.sweep(v, t, poses, steps=8))
+print(json.dumps({"vertices": len(out[0]), "triangles": len(out[1])}))
+"""
+    )
+    body, result, peak, size = lines
+    stated = body["estimate"] + 48 * size["vertices"] + 36 * size["triangles"]
+    print(f"\nsweep of {body['triangles']} triangles: stated {stated / 1e6:.1f} MB (body {body['estimate'] / 1e6:.1f} MB), "
+          f"peak growth {peak['growth'] / 1e6:.1f} MB ({peak['growth'] / stated:.0%}), {size['vertices']} vertices out")
+    assert result == {"finite": True}
+    assert stated > 40e6
+    assert peak["growth"] <= stated + 4 * MB, (stated, peak)
