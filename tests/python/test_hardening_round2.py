@@ -415,7 +415,7 @@ ESTIMATES = {
     "evaluate_fcurves": ("c = curve(1000); t = np.linspace(-5, 1005, 4_000_000)", "ps.evaluate_fcurves(t, **c)"),
     "Playback.channels": ("pb = playback(); t = np.linspace(-5, 15, 2_000_000)", "pb.channels(t)"),
     "keys_parameters": ("k = keys(50); t = np.linspace(0, 49, 2_000_000)", "ps.keys_parameters(np.arange(50.0), t, size=1.0, poses=k)"),
-    "analyse_spans": ("pb = playback(); f = np.linspace(0, 9, 1_000_000)", "ps.analyse_spans(pb, f)"),
+    "analyse_spans": ("pb = playback(); f = np.linspace(0, 9, 250_000)", "ps.analyse_spans(pb, f)"),
     "denoise": ("p, t = noisy(400_000)", "ps.denoise(p, t)"),
     "denoise, float32 poses": ("p, t = noisy(300_000); p = p.astype(np.float32)", "ps.denoise(p, t)"),
     "denoise, a rig of 4 bodies": ("p, t = noisy(100_000); p = np.stack([p] * 4)", "ps.denoise(p, t)"),
@@ -433,7 +433,7 @@ def test_peak_memory_stays_within_the_estimate(name):
     print(f"\n{name}: estimate {estimate / 1e6:.1f} MB, peak growth {peak['growth'] / 1e6:.1f} MB "
           f"({peak['growth'] / estimate:.0%}), {peak['cpu']:.2f} s")
     assert result == {"finite": True}, (name, result)
-    assert estimate > 40e6, (name, "not a large case", estimate)
+    assert estimate > 20e6, (name, "not a large case", estimate)
     assert peak["growth"] <= estimate + 4 * MB, (name, estimate, peak)
 
 
@@ -469,5 +469,5 @@ print(json.dumps({"vertices": len(out[0]), "triangles": len(out[1])}))
     print(f"\nsweep of {body['triangles']} triangles: stated {stated / 1e6:.1f} MB (body {body['estimate'] / 1e6:.1f} MB), "
           f"peak growth {peak['growth'] / 1e6:.1f} MB ({peak['growth'] / stated:.0%}), {size['vertices']} vertices out")
     assert result == {"finite": True}
-    assert stated > 40e6
+    assert stated > 20e6
     assert peak["growth"] <= stated + 4 * MB, (stated, peak)
