@@ -11,8 +11,8 @@ use std::marker::PhantomData;
 
 use numpy::ndarray::Dimension;
 use numpy::{
-    AllowTypeChange, PyArrayDescrMethods, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods,
-    PyUntypedArray, PyUntypedArrayMethods,
+    PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyException, PyMemoryError, PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
@@ -22,11 +22,11 @@ use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::sweep::MAX_STEPS;
 use polyscrew::MAX_LEVELS;
 
-/// An array-like argument converted to float64.
-pub type FloatArray<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+/// An array-like argument read as float64 ([`Arg::read`]).
+pub type FloatArray<'py> = PyReadonlyArrayDyn<'py, f64>;
 
-/// An integer array-like argument converted to int64.
-pub type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+/// An integer array-like argument read as int64 ([`Arg::read`]).
+pub type IntArray<'py> = PyReadonlyArrayDyn<'py, i64>;
 
 /// A float array-like argument ([`float_array`]), its type and shape known, not yet read.
 pub type FloatArg<'py> = Arg<'py, f64>;
@@ -43,10 +43,9 @@ pub type IntArg<'py> = Arg<'py, i64>;
 /// budget; only then does it read them ([`Arg::read`]). A request over the budget is
 /// refused before numpy allocates anything for it.
 pub struct Arg<'py, T> {
-    function: String,
-    what: String,
+    function: &'static str,
+    what: &'static str,
     array: Bound<'py, PyUntypedArray>,
-    shape: Vec<usize>,
     copy: Footprint,
     _element: PhantomData<T>,
 }
@@ -54,17 +53,17 @@ pub struct Arg<'py, T> {
 impl<'py, T> Arg<'py, T> {
     /// Its shape.
     pub fn shape(&self) -> &[usize] {
-        &self.shape
+        self.array.shape()
     }
 
     /// Its number of dimensions.
     pub fn ndim(&self) -> usize {
-        self.shape.len()
+        self.array.ndim()
     }
 
     /// Its number of entries.
     pub fn len(&self) -> usize {
-        self.shape.iter().product()
+        self.array.len()
     }
 
     /// What reading it allocates: nothing for an array of the target dtype, numpy's
@@ -79,12 +78,12 @@ impl<'py, T> Arg<'py, T> {
     fn check_copy(&self, what: &'static str, hint: &'static str) -> PyResult<()> {
         self.copy
             .check(what, hint)
-            .map_err(|e| crate::arg_err(&self.function, &self.what, e))
+            .map_err(|e| crate::arg_err(self.function, self.what, e))
     }
 
     /// `err` named after the function and the argument.
     fn named(&self, err: PyErr) -> PyErr {
-        named(self.array.py(), &self.function, &self.what, err)
+        named(self.array.py(), self.function, self.what, err)
     }
 
     /// The array converted by numpy to `dtype` (after the budget's check).
@@ -105,16 +104,15 @@ impl<'py> Arg<'py, f64> {
     /// numpy's own failures (its `MemoryError` included) come out naming the function and
     /// the argument.
     pub fn read(&self) -> PyResult<FloatArray<'py>> {
-        if self.array.cast::<PyArrayDyn<f64>>().is_ok() {
-            return self
-                .array
-                .extract::<FloatArray<'py>>()
-                .map_err(|e| self.named(e));
+        if let Ok(array) = self.array.cast::<PyArrayDyn<f64>>() {
+            return array.try_readonly().map_err(|e| self.named(e.into()));
         }
         self.check_copy("the float64 conversion", "pass fewer values")?;
-        self.converted("float64")?
-            .extract::<FloatArray<'py>>()
-            .map_err(|e| self.named(e))
+        let converted = self.converted("float64")?;
+        let array = converted
+            .cast::<PyArrayDyn<f64>>()
+            .map_err(|e| self.named(e.into()))?;
+        array.try_readonly().map_err(|e| self.named(e.into()))
     }
 }
 
@@ -123,11 +121,8 @@ impl<'py> Arg<'py, i64> {
     /// only when every entry is a whole number (`2.0`, not `2.7`, which is a `ValueError`
     /// naming the entry). Failures named as [`Arg::read`] of a float array names them.
     pub fn read(&self) -> PyResult<IntArray<'py>> {
-        if self.array.cast::<PyArrayDyn<i64>>().is_ok() {
-            return self
-                .array
-                .extract::<IntArray<'py>>()
-                .map_err(|e| self.named(e));
+        if let Ok(array) = self.array.cast::<PyArrayDyn<i64>>() {
+            return array.try_readonly().map_err(|e| self.named(e.into()));
         }
         self.check_copy("the integer conversion", "pass fewer entries")?;
         if self.array.dtype().kind() == b'f' {
@@ -152,9 +147,11 @@ impl<'py> Arg<'py, i64> {
                 )));
             }
         }
-        self.converted("int64")?
-            .extract::<IntArray<'py>>()
-            .map_err(|e| self.named(e))
+        let converted = self.converted("int64")?;
+        let array = converted
+            .cast::<PyArrayDyn<i64>>()
+            .map_err(|e| self.named(e.into()))?;
+        array.try_readonly().map_err(|e| self.named(e.into()))
     }
 }
 
@@ -241,8 +238,8 @@ pub fn named(py: Python<'_>, function: &str, what: &str, err: PyErr) -> PyErr {
 /// objects refused with a `TypeError`, ragged lists with numpy's `ValueError`, each naming
 /// the argument. Nothing is converted yet: [`Arg::copy`] says what the conversion will cost.
 pub fn float_array<'py>(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'py, PyAny>,
 ) -> PyResult<FloatArg<'py>> {
     let array = untyped(function, what, obj)?;
@@ -254,17 +251,15 @@ pub fn float_array<'py>(
             dtype_name(array.as_any())
         )));
     }
-    let shape = array.shape().to_vec();
     let copy = if native {
         Footprint::ZERO
     } else {
-        Footprint::of::<f64>(shape.iter().product())
+        Footprint::of::<f64>(array.len())
     };
     Ok(Arg {
-        function: function.to_owned(),
-        what: what.to_owned(),
+        function,
+        what,
         array,
-        shape,
         copy,
         _element: PhantomData,
     })
@@ -274,14 +269,13 @@ pub fn float_array<'py>(
 /// arrays whose entries are whole numbers (checked when read; the int64 copy of floats is
 /// checked against the budget here already); anything else a `TypeError`.
 pub fn int_array<'py>(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'py, PyAny>,
 ) -> PyResult<IntArg<'py>> {
     let array = untyped(function, what, obj)?;
     let native = array.cast::<PyArrayDyn<i64>>().is_ok();
-    let shape = array.shape().to_vec();
-    let n: usize = shape.iter().product();
+    let n = array.len();
     let copy = match array.dtype().kind() {
         _ if native => Footprint::ZERO,
         b'i' | b'u' => Footprint::of::<i64>(n),
@@ -301,10 +295,9 @@ pub fn int_array<'py>(
         }
     };
     Ok(Arg {
-        function: function.to_owned(),
-        what: what.to_owned(),
+        function,
+        what,
         array,
-        shape,
         copy,
         _element: PhantomData,
     })
@@ -426,8 +419,8 @@ pub fn bool_array(
 /// Reads a 1-D integer array-like of at most `max_len` entries ([`int_array`]'s rules),
 /// copied within the memory budget; the length is checked before numpy reads a sequence.
 pub fn int_list(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'_, PyAny>,
     max_len: Most,
 ) -> PyResult<Vec<i64>> {

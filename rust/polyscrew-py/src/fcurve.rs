@@ -67,8 +67,8 @@ fn read_per_key(
 
 /// An optional float array-like (`None` stays `None`).
 fn optional_floats<'py>(
-    f: &str,
-    what: &str,
+    f: &'static str,
+    what: &'static str,
     a: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Option<FloatArg<'py>>> {
     a.filter(|a| !a.is_none())
@@ -242,7 +242,7 @@ impl CurveArgs {
     /// `times` times) checked before anything is copied.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn read<'py>(
-        function: &str,
+        function: &'static str,
         times: usize,
         extra: Footprint,
         offsets: &Bound<'py, PyAny>,

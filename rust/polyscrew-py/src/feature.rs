@@ -78,7 +78,7 @@ impl StiffnessArg<'_> {
 /// stiffness is left to [`StiffnessArg::keys`] (after the budget's check).
 #[allow(clippy::too_many_arguments)]
 fn read_feature_spec<'py>(
-    function: &str,
+    function: &'static str,
     scheme: &str,
     levels: u32,
     closed: bool,

@@ -266,7 +266,11 @@ impl PyScrew {
 }
 
 /// Reads exactly one pose.
-fn read_one_pose(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Pose> {
+fn read_one_pose(
+    function: &'static str,
+    what: &'static str,
+    obj: &Bound<'_, PyAny>,
+) -> PyResult<Pose> {
     let array = float_array(function, what, obj)?;
     let (_, single) = pose_count(function, what, array.shape())?;
     if !single {
@@ -431,7 +435,7 @@ struct TimedInput<'py> {
 }
 
 fn read_timed<'py>(
-    function: &str,
+    function: &'static str,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
 ) -> PyResult<TimedInput<'py>> {
