@@ -7,11 +7,9 @@
 //! `#[pyo3(from_py_with = ...)]` converters generic over a [`Function`] marker (so the
 //! message names the function too while the signature keeps its literal default).
 
-use std::marker::PhantomData;
-
 use numpy::ndarray::Dimension;
 use numpy::{
-    PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
     PyUntypedArrayMethods,
 };
 use pyo3::exceptions::{PyException, PyMemoryError, PyOverflowError, PyTypeError, PyValueError};
@@ -42,15 +40,16 @@ pub type IntArg<'py> = Arg<'py, i64>;
 /// copy for any other, a broadcast one included), adds that to its footprint and checks the
 /// budget; only then does it read them ([`Arg::read`]). A request over the budget is
 /// refused before numpy allocates anything for it.
-pub struct Arg<'py, T> {
+pub struct Arg<'py, T: Element> {
     function: &'static str,
     what: &'static str,
     array: Bound<'py, PyUntypedArray>,
+    /// The array itself when numpy holds it as `T` already (read without a copy).
+    native: Option<Bound<'py, PyArrayDyn<T>>>,
     copy: Footprint,
-    _element: PhantomData<T>,
 }
 
-impl<'py, T> Arg<'py, T> {
+impl<'py, T: Element> Arg<'py, T> {
     /// Its shape.
     pub fn shape(&self) -> &[usize] {
         self.array.shape()
@@ -95,7 +94,7 @@ impl<'py, T> Arg<'py, T> {
 }
 
 /// The copies of an optional argument ([`Arg::copy`]; nothing when it is absent).
-pub fn copy_of<T>(arg: Option<&Arg<'_, T>>) -> Footprint {
+pub fn copy_of<T: Element>(arg: Option<&Arg<'_, T>>) -> Footprint {
     arg.map_or(Footprint::ZERO, Arg::copy)
 }
 
@@ -104,7 +103,7 @@ impl<'py> Arg<'py, f64> {
     /// numpy's own failures (its `MemoryError` included) come out naming the function and
     /// the argument.
     pub fn read(&self) -> PyResult<FloatArray<'py>> {
-        if let Ok(array) = self.array.cast::<PyArrayDyn<f64>>() {
+        if let Some(array) = &self.native {
             return array.try_readonly().map_err(|e| self.named(e.into()));
         }
         self.check_copy("the float64 conversion", "pass fewer values")?;
@@ -121,7 +120,7 @@ impl<'py> Arg<'py, i64> {
     /// only when every entry is a whole number (`2.0`, not `2.7`, which is a `ValueError`
     /// naming the entry). Failures named as [`Arg::read`] of a float array names them.
     pub fn read(&self) -> PyResult<IntArray<'py>> {
-        if let Ok(array) = self.array.cast::<PyArrayDyn<i64>>() {
+        if let Some(array) = &self.native {
             return array.try_readonly().map_err(|e| self.named(e.into()));
         }
         self.check_copy("the integer conversion", "pass fewer entries")?;
@@ -243,15 +242,14 @@ pub fn float_array<'py>(
     obj: &Bound<'py, PyAny>,
 ) -> PyResult<FloatArg<'py>> {
     let array = untyped(function, what, obj)?;
-    let native = array.cast::<PyArrayDyn<f64>>().is_ok();
-    let kind = array.dtype().kind();
-    if !native && !matches!(kind, b'b' | b'i' | b'u' | b'f') {
+    let native = array.cast::<PyArrayDyn<f64>>().ok().cloned();
+    if native.is_none() && !matches!(array.dtype().kind(), b'b' | b'i' | b'u' | b'f') {
         return Err(PyTypeError::new_err(format!(
             "{function}: {what}: expected real numbers, got {}",
             dtype_name(array.as_any())
         )));
     }
-    let copy = if native {
+    let copy = if native.is_some() {
         Footprint::ZERO
     } else {
         Footprint::of::<f64>(array.len())
@@ -260,8 +258,8 @@ pub fn float_array<'py>(
         function,
         what,
         array,
+        native,
         copy,
-        _element: PhantomData,
     })
 }
 
@@ -274,10 +272,10 @@ pub fn int_array<'py>(
     obj: &Bound<'py, PyAny>,
 ) -> PyResult<IntArg<'py>> {
     let array = untyped(function, what, obj)?;
-    let native = array.cast::<PyArrayDyn<i64>>().is_ok();
+    let native = array.cast::<PyArrayDyn<i64>>().ok().cloned();
     let n = array.len();
     let copy = match array.dtype().kind() {
-        _ if native => Footprint::ZERO,
+        _ if native.is_some() => Footprint::ZERO,
         b'i' | b'u' => Footprint::of::<i64>(n),
         b'f' => {
             // the int64 copy, checked before the entries are even scanned
@@ -298,8 +296,8 @@ pub fn int_array<'py>(
         function,
         what,
         array,
+        native,
         copy,
-        _element: PhantomData,
     })
 }
 
