@@ -465,4 +465,57 @@ mod tests {
         // The angle keeps growing past 2 pi.
         assert!(aa[aa.len() - 4] > 39.0, "final angle {}", aa[aa.len() - 4]);
     }
+
+    #[test]
+    fn previous_angles_beyond_the_range_are_refused() {
+        let q = [DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2)];
+        let euler = RotationMode::Euler(EulerOrder::Xyz);
+        let err = rotation_channels(&q, euler, Some(&[0.0, 0.0, 1e17])).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "previous value 2 (1e17) is outside the working range +-1e9"
+        );
+        let err = rotation_channels(&q, RotationMode::AxisAngle, Some(&[-2e9, 0.0, 0.0, 1.0]));
+        assert!(
+            matches!(err, Err(Error::OutOfRange { index: 0, .. })),
+            "{err:?}"
+        );
+        // quaternions only take the previous sign: any finite value
+        assert!(
+            rotation_channels(&q, RotationMode::Quaternion, Some(&[1e300, 0.0, 0.0, 0.0])).is_ok()
+        );
+    }
+
+    #[test]
+    fn previous_angles_at_the_edge_of_the_range_give_the_rotation() {
+        let q = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
+        for previous in [1e9, -1e9, 123_456_789.0, 7e8] {
+            let e = rotation_channels(
+                &[q],
+                RotationMode::Euler(EulerOrder::Xyz),
+                Some(&[previous; 3]),
+            )
+            .unwrap();
+            assert!(
+                e.iter().all(|v| (v - previous).abs() <= PI),
+                "{e:?} from {previous}"
+            );
+            let m = EulerOrder::Xyz.to_mat3(DVec3::new(e[0], e[1], e[2]));
+            let err = (m - DMat3::from_quat(q))
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(err < 1e-6, "previous {previous}: error {err}");
+        }
+    }
+
+    #[test]
+    fn more_than_max_rotations_are_refused() {
+        assert!(check_rotation_count(MAX_ROTATIONS).is_ok());
+        let err = check_rotation_count(MAX_ROTATIONS + 1).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "rotations: 16777217 rotations, more than 16777216 in one call: convert fewer rotations at once"
+        );
+    }
 }
