@@ -26,20 +26,28 @@ Working ranges (every value Blender can store, float32 below 3.4e38, is inside t
   (``q''`` of a Hermite segment grows like ``1 / h^2`` and ``omega / h``: in these ranges
   every energy and normal equation stays below about 1e200).
 - ``stiffness`` and ``inserted_stiffness``: finite springs up to 1e100 (or ``inf``).
+- ``previous`` angles of ``rotation_channels`` and ``sample_channels`` (Euler angles, the
+  axis-angle angle) within ``+-MAX_PREVIOUS_ANGLE`` (1e9 radians): a continued angle is
+  ``previous`` plus less than half a turn, and beyond 1e9 a double no longer holds it to
+  1e-7 radians (at 1e17 the doubles are 16 radians apart).
 
 Memory: every call estimates what it will hold at its peak (its output, its working memory
-and its copies of the input, not the caller's own arrays) before it allocates anything, and
+and its copies of the input, numpy's conversion of an argument that is not float64 (or
+int64 for integers) included, a broadcast one too; not the caller's own arrays) before it
+allocates or converts anything, and
 raises ``ValueError`` when that exceeds ``memory_budget()`` (default
 ``DEFAULT_MEMORY_BUDGET``, 1 GiB): the message says how much was asked for and how to ask
 for less (fewer levels, fewer times, fewer steps). Should the system still refuse memory
-within the budget, the call raises ``MemoryError``. Peak bytes per item, for planning:
+within the budget, the call raises ``MemoryError`` (numpy's own allocation failure too),
+naming the function and the argument. Peak bytes per item, for planning:
 ``sample`` 192 per time (208 when windowed; ``sample_channels`` 168 with Euler channels,
 176 otherwise) plus 84 per dense pose (keys x 2**levels) up to 2,097,152 dense poses,
 beyond which the motion is subdivided in windows of key spans (memory independent of the
 key count, the same result to the bit); ``subdivide`` 212 per output pose;
 ``rotation_channels`` 56 per rotation (Euler); ``sweep`` 48 per output vertex and 36 per
 output triangle (checked before each screw's quads are added) plus 320 per body triangle;
-``feature_motion`` 640 per output pose. ``scripts/memory_footprints.py`` prints the
+``feature_motion`` 640 per output pose; ``denoise`` 1,792 per pose (its scratch measured at
+1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/memory_footprints.py`` prints the
 estimates beside the peaks measured for the largest uses (all below 160 MB).
 
 The module releases the GIL while it reads its input, computes and builds its output.
@@ -64,6 +72,16 @@ MAX_COORDINATE: float
 
 MAX_TIME: float
 """The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
+
+MAX_PREVIOUS_ANGLE: float
+"""The largest ``previous`` angle (radians, either sign) the rotation channels continue
+from: 1e9 (see the module documentation); beyond it ``ValueError``."""
+
+MAX_ROTATIONS: int
+"""The most rotations one ``rotation_channels`` call converts: 2**24 (16,777,216), the most
+the default memory budget accepts in quaternion and axis-angle modes. It bounds the call's
+time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
+is read."""
 
 DEFAULT_MEMORY_BUDGET: int
 """The default memory budget per call, 1 GiB (1073741824 bytes): about 5 times the largest
@@ -187,7 +205,9 @@ def rotation_channels(
 
     "QUATERNION": (N, 4) w, x, y, z without sign flips; "AXIS_ANGLE": (N, 4) angle, x, y, z
     unwrapped; Euler orders: (N, 3) angles per axis (x, y, z), each frame compatible with the
-    previous one (no jump above 180 degrees). ``previous`` continues from earlier values.
+    previous one (no jump above 180 degrees). ``previous`` continues from earlier values;
+    its angles (Euler, the axis-angle angle) within ``+-MAX_PREVIOUS_ANGLE`` (1e9), else
+    ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
     """
 
 # --- Angular-velocity editing (Xie et al. 2011, "Sketch-based rotation editing") ---
@@ -508,6 +528,10 @@ SPAN_SAMPLES: int
 """Samples of the playback per key span in ``analyse_spans`` (8; more for spinning spans)."""
 MAX_SPAN_SAMPLES: int
 """At most this many samples per span in ``analyse_spans`` (4096; one per 10 degrees)."""
+MAX_ANALYSIS_SAMPLES: int
+"""At most this many samples in one ``analyse_spans`` call, all spans together (2,097,152):
+its work is not bounded by memory, this bounds its time (about 2 s of one core at the
+limit: 512 spans of 4,096 samples, each a spin)."""
 HOLD_TOLERANCE: float
 """A channel moving less than this times (its size + 1) over a span is still (1e-6)."""
 PACE_SAMPLES: int
@@ -602,7 +626,8 @@ def analyse_spans(
     and the runs of its followed neighbours turning more than ``WIND_STEP``, get
     ``ceil(turn / WIND_STEP) - 1`` frames where the accumulated turn
     reaches equal fractions of the span's (linear between samples). GIL released. Raises
-    ValueError for fewer than two frames or frames that do not increase.
+    ValueError for fewer than two frames, frames that do not increase, or spans that would
+    take more than ``MAX_ANALYSIS_SAMPLES`` samples in all (refused before any is taken).
     """
 
 def keys_parameters(

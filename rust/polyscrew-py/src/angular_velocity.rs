@@ -21,7 +21,9 @@ use polyscrew::{
 };
 
 use crate::args::{self, FitAngularVelocity, Function, Most};
-use crate::{check_budget, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len};
+use crate::{
+    check_budget, copy_of, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len,
+};
 use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::Error;
@@ -231,10 +233,11 @@ impl PyAngularVelocityFit {
         let m = vector_len(G, "times", &times)?;
         check_budget(
             G,
-            Footprint::of::<f64>(m).and::<DQuat>(m).and::<[f64; 4]>(m),
+            times.copy() + Footprint::of::<f64>(m).and::<DQuat>(m).and::<[f64; 4]>(m),
             "the sampled orientations",
             FIT_HINT,
         )?;
+        let times = times.read()?;
         let view = times.as_array();
         let inner = &self.inner;
         let out = py.detach(|| -> PyResult<Array2<f64>> {
@@ -256,13 +259,15 @@ impl PyAngularVelocityFit {
         let m = vector_len(G, "times", &times)?;
         check_budget(
             G,
-            Footprint::of::<f64>(m)
-                .and::<DQuat>(m)
-                .and::<DVec3>(m)
-                .and::<[f64; 3]>(m),
+            times.copy()
+                + Footprint::of::<f64>(m)
+                    .and::<DQuat>(m)
+                    .and::<DVec3>(m)
+                    .and::<[f64; 3]>(m),
             "the angular velocities",
             FIT_HINT,
         )?;
+        let times = times.read()?;
         let view = times.as_array();
         let inner = &self.inner;
         let out = py.detach(|| -> PyResult<Array2<f64>> {
@@ -327,13 +332,8 @@ fn fit_angular_velocity(
         .map(|s| float_array(F, "sample_times", s))
         .transpose()?;
     let fragment_duration = args::optional_float(F, "fragment_duration", fragment_duration)?;
-    let n = key_quaternions
-        .as_array()
-        .shape()
-        .first()
-        .copied()
-        .unwrap_or(0);
-    let n_targets = target_times.as_array().len();
+    let n = key_quaternions.shape().first().copied().unwrap_or(0);
+    let n_targets = target_times.len();
     let n_samples = match &sample_times {
         Some(s) => vector_len(F, "sample_times", s)?,
         None => vector_len(F, "key_times", &key_times)?,
@@ -347,7 +347,13 @@ fn fit_angular_velocity(
     };
     check_budget(
         F,
-        Footprint::of::<[f64; 5]>(n)
+        key_quaternions.copy()
+            + key_times.copy()
+            + target_times.copy()
+            + target_omega.copy()
+            + copy_of(target_speed.as_ref())
+            + copy_of(sample_times.as_ref())
+            + Footprint::of::<[f64; 5]>(n)
             + Footprint::of::<[f64; 8]>(n_targets)
             + fit_footprint(n, n_targets, &options)
             + Footprint::of::<[f64; 8]>(n_samples).times(2),
@@ -355,6 +361,14 @@ fn fit_angular_velocity(
         FIT_HINT,
     )?;
     let constrained = read_constrained(constrained, n)?;
+    let (key_quaternions, key_times, target_times, target_omega) = (
+        key_quaternions.read()?,
+        key_times.read()?,
+        target_times.read()?,
+        target_omega.read()?,
+    );
+    let target_speed = target_speed.as_ref().map(|s| s.read()).transpose()?;
+    let sample_times = sample_times.as_ref().map(|s| s.read()).transpose()?;
     let views = (
         key_quaternions.as_array(),
         key_times.as_array(),

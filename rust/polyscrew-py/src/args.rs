@@ -8,8 +8,11 @@
 //! message names the function too while the signature keeps its literal default).
 
 use numpy::ndarray::Dimension;
-use numpy::{AllowTypeChange, PyArrayDyn, PyArrayLikeDyn, PyArrayMethods, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
+use numpy::{
+    Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
+    PyUntypedArrayMethods,
+};
+use pyo3::exceptions::{PyException, PyMemoryError, PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyFloat, PyString};
 
@@ -17,11 +20,154 @@ use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::sweep::MAX_STEPS;
 use polyscrew::MAX_LEVELS;
 
-/// An array-like argument converted to float64.
-pub type FloatArray<'py> = PyArrayLikeDyn<'py, f64, AllowTypeChange>;
+/// An array-like argument read as float64 ([`Arg::read`]).
+pub type FloatArray<'py> = PyReadonlyArrayDyn<'py, f64>;
 
-/// An integer array-like argument converted to int64.
-pub type IntArray<'py> = PyArrayLikeDyn<'py, i64, AllowTypeChange>;
+/// An integer array-like argument read as int64 ([`Arg::read`]).
+pub type IntArray<'py> = PyReadonlyArrayDyn<'py, i64>;
+
+/// A float array-like argument ([`float_array`]), its type and shape known, not yet read.
+pub type FloatArg<'py> = Arg<'py, f64>;
+
+/// An integer array-like argument ([`int_array`]), its type and shape known, not yet read.
+pub type IntArg<'py> = Arg<'py, i64>;
+
+/// An array-like argument as numpy sees it (its shape and dtype), before any conversion.
+///
+/// Reading an argument takes two steps so that every byte it costs is in the budget: the
+/// function first learns the shapes of its arguments and what converting them will allocate
+/// ([`Arg::copy`]: nothing for an array of the right dtype, whatever its strides; a full
+/// copy for any other, a broadcast one included), adds that to its footprint and checks the
+/// budget; only then does it read them ([`Arg::read`]). A request over the budget is
+/// refused before numpy allocates anything for it.
+pub struct Arg<'py, T: Element> {
+    function: &'static str,
+    what: &'static str,
+    array: Bound<'py, PyUntypedArray>,
+    /// The array itself when numpy holds it as `T` already (read without a copy).
+    native: Option<Bound<'py, PyArrayDyn<T>>>,
+    copy: Footprint,
+}
+
+impl<'py, T: Element> Arg<'py, T> {
+    /// Its shape.
+    pub fn shape(&self) -> &[usize] {
+        self.array.shape()
+    }
+
+    /// Its number of dimensions.
+    pub fn ndim(&self) -> usize {
+        self.array.ndim()
+    }
+
+    /// Its number of entries.
+    pub fn len(&self) -> usize {
+        self.array.len()
+    }
+
+    /// What reading it allocates: nothing for an array of the target dtype, numpy's
+    /// converted copy otherwise (for integers given as non-float64 floats, the float64
+    /// copy their entries are checked on as well).
+    pub fn copy(&self) -> Footprint {
+        self.copy
+    }
+
+    /// The copy made by reading, checked alone against the budget (the function checked it
+    /// within its footprint already: this keeps a reader that forgot within the budget).
+    fn check_copy(&self, what: &'static str, hint: &'static str) -> PyResult<()> {
+        self.copy
+            .check(what, hint)
+            .map_err(|e| crate::arg_err(self.function, self.what, e))
+    }
+
+    /// `err` named after the function and the argument.
+    fn named(&self, err: PyErr) -> PyErr {
+        named(self.array.py(), self.function, self.what, err)
+    }
+
+    /// The array converted by numpy to `dtype` (after the budget's check).
+    fn converted(&self, dtype: &str) -> PyResult<Bound<'py, PyAny>> {
+        self.array
+            .call_method1("astype", (dtype,))
+            .map_err(|e| self.named(e))
+    }
+}
+
+/// The copies of an optional argument ([`Arg::copy`]; nothing when it is absent).
+pub fn copy_of<T: Element>(arg: Option<&Arg<'_, T>>) -> Footprint {
+    arg.map_or(Footprint::ZERO, Arg::copy)
+}
+
+impl<'py> Arg<'py, f64> {
+    /// The argument as float64: as it is for a float64 array, converted by numpy otherwise.
+    /// numpy's own failures (its `MemoryError` included) come out naming the function and
+    /// the argument.
+    pub fn read(&self) -> PyResult<FloatArray<'py>> {
+        if let Some(array) = &self.native {
+            return array.try_readonly().map_err(|e| self.named(e.into()));
+        }
+        self.check_copy("the float64 conversion", "pass fewer values")?;
+        let converted = self.converted("float64")?;
+        let array = converted
+            .cast::<PyArrayDyn<f64>>()
+            .map_err(|e| self.named(e.into()))?;
+        array.try_readonly().map_err(|e| self.named(e.into()))
+    }
+}
+
+impl<'py> Arg<'py, i64> {
+    /// The argument as int64: as it is for an int64 array, other integers converted, floats
+    /// only when every entry is a whole number (`2.0`, not `2.7`, which is a `ValueError`
+    /// naming the entry). Failures named as [`Arg::read`] of a float array names them.
+    pub fn read(&self) -> PyResult<IntArray<'py>> {
+        if let Some(array) = &self.native {
+            return array.try_readonly().map_err(|e| self.named(e.into()));
+        }
+        self.check_copy("the integer conversion", "pass fewer entries")?;
+        if self.array.dtype().kind() == b'f' {
+            let floats = match self.array.cast::<PyArrayDyn<f64>>() {
+                Ok(a) => a.readonly(),
+                Err(_) => self
+                    .converted("float64")?
+                    .cast_into::<PyArrayDyn<f64>>()
+                    .map_err(|e| self.named(e.into()))?
+                    .readonly(),
+            };
+            let view = floats.as_array();
+            if let Some((index, value)) = view
+                .indexed_iter()
+                .find(|(_, v)| !(v.fract() == 0.0 && v.abs() < 9.2e18))
+            {
+                return Err(PyValueError::new_err(format!(
+                    "{}: {}: entry {:?} is {value}, not an integer",
+                    self.function,
+                    self.what,
+                    index.slice()
+                )));
+            }
+        }
+        let converted = self.converted("int64")?;
+        let array = converted
+            .cast::<PyArrayDyn<i64>>()
+            .map_err(|e| self.named(e.into()))?;
+        array.try_readonly().map_err(|e| self.named(e.into()))
+    }
+}
+
+/// Takes `obj` as a numpy array: a numpy array as it is, anything else through
+/// `numpy.asarray` (a Python sequence becomes an array no larger than the sequence itself).
+fn untyped<'py>(
+    function: &str,
+    what: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyUntypedArray>> {
+    if let Ok(array) = obj.cast::<PyUntypedArray>() {
+        return Ok(array.clone());
+    }
+    as_numpy(function, what, obj)?
+        .cast_into::<PyUntypedArray>()
+        .map_err(|e| named(obj.py(), function, what, e.into()))
+}
 
 /// A Python function of the module, for the messages of the argument converters.
 pub trait Function {
@@ -61,87 +207,98 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
         .map_or_else(|_| "?".to_owned(), |n| n.to_string())
 }
 
-/// `err` with `"{function}: {what}: "` before its message, of the same exception type.
+/// `err` with `"{function}: {what}: "` before its message, as a `MemoryError` (numpy's own
+/// allocation failure included), a `TypeError`, or a `ValueError` for any other exception
+/// (numpy's exception classes cannot all be rebuilt from one message); the original is its
+/// `__cause__`. A `BaseException` that is not an `Exception` (`KeyboardInterrupt`) passes
+/// as it is.
 pub fn named(py: Python<'_>, function: &str, what: &str, err: PyErr) -> PyErr {
     let message = err.value(py).to_string();
     let prefix = format!("{function}: {what}: ");
     if message.starts_with(&prefix) {
         return err;
     }
-    let renamed = PyErr::from_type(err.get_type(py), format!("{prefix}{message}"));
+    let text = format!("{prefix}{message}");
+    let renamed = if err.is_instance_of::<PyMemoryError>(py) {
+        PyMemoryError::new_err(text)
+    } else if err.is_instance_of::<PyTypeError>(py) {
+        PyTypeError::new_err(text)
+    } else if err.is_instance_of::<PyException>(py) {
+        PyValueError::new_err(text)
+    } else {
+        return err;
+    };
     renamed.set_cause(py, Some(err));
     renamed
 }
 
-/// Reads a float array-like: float64 arrays as they are, other real numbers (ints, bools,
-/// float32, nested lists) converted; complex, strings and objects refused with a
-/// `TypeError`, ragged lists with numpy's `ValueError`, each naming the argument.
+/// Takes a float array-like for reading ([`Arg::read`]): float64 arrays as they are, other
+/// real numbers (ints, bools, float32, nested lists) to be converted; complex, strings and
+/// objects refused with a `TypeError`, ragged lists with numpy's `ValueError`, each naming
+/// the argument. Nothing is converted yet: [`Arg::copy`] says what the conversion will cost.
 pub fn float_array<'py>(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'py, PyAny>,
-) -> PyResult<FloatArray<'py>> {
-    let py = obj.py();
-    if obj.cast::<PyArrayDyn<f64>>().is_err() {
-        let array = as_numpy(function, what, obj)?;
-        let kind = dtype_kind(&array)?;
-        if !matches!(kind, 'b' | 'i' | 'u' | 'f') {
-            return Err(PyTypeError::new_err(format!(
-                "{function}: {what}: expected real numbers, got {}",
-                dtype_name(&array)
-            )));
-        }
+) -> PyResult<FloatArg<'py>> {
+    let array = untyped(function, what, obj)?;
+    let native = array.cast::<PyArrayDyn<f64>>().ok().cloned();
+    if native.is_none() && !matches!(array.dtype().kind(), b'b' | b'i' | b'u' | b'f') {
+        return Err(PyTypeError::new_err(format!(
+            "{function}: {what}: expected real numbers, got {}",
+            dtype_name(array.as_any())
+        )));
     }
-    obj.extract::<FloatArray<'py>>()
-        .map_err(|e| named(py, function, what, e))
+    let copy = if native.is_some() {
+        Footprint::ZERO
+    } else {
+        Footprint::of::<f64>(array.len())
+    };
+    Ok(Arg {
+        function,
+        what,
+        array,
+        native,
+        copy,
+    })
 }
 
-/// Reads an integer array-like: integer arrays as they are, float arrays only when every
-/// entry is a whole number (`2.0`, not `2.7`, which is a `ValueError` naming the entry);
-/// anything else a `TypeError`.
+/// Takes an integer array-like for reading ([`Arg::read`]): integer arrays, and float
+/// arrays whose entries are whole numbers (checked when read; the int64 copy of floats is
+/// checked against the budget here already); anything else a `TypeError`.
 pub fn int_array<'py>(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'py, PyAny>,
-) -> PyResult<IntArray<'py>> {
-    let py = obj.py();
-    if obj.cast::<PyArrayDyn<i64>>().is_err() {
-        let array = as_numpy(function, what, obj)?;
-        match dtype_kind(&array)? {
-            'i' | 'u' => {}
-            'f' => {
-                let floats = float_array(function, what, &array)?;
-                let view = floats.as_array();
-                // the int64 copy made below, checked before the entries are even scanned
-                Footprint::of::<i64>(view.len())
-                    .check("the integer conversion", "pass fewer entries")
-                    .map_err(|e| crate::arg_err(function, what, e))?;
-                if let Some((index, value)) = view
-                    .indexed_iter()
-                    .find(|(_, v)| !(v.fract() == 0.0 && v.abs() < 9.2e18))
-                {
-                    return Err(PyValueError::new_err(format!(
-                        "{function}: {what}: entry {:?} is {value}, not an integer",
-                        index.slice()
-                    )));
-                }
-            }
-            _ => {
-                return Err(PyTypeError::new_err(format!(
-                    "{function}: {what}: expected integers, got {}",
-                    dtype_name(&array)
-                )))
-            }
+) -> PyResult<IntArg<'py>> {
+    let array = untyped(function, what, obj)?;
+    let native = array.cast::<PyArrayDyn<i64>>().ok().cloned();
+    let n = array.len();
+    let copy = match array.dtype().kind() {
+        _ if native.is_some() => Footprint::ZERO,
+        b'i' | b'u' => Footprint::of::<i64>(n),
+        b'f' => {
+            // the int64 copy, checked before the entries are even scanned
+            Footprint::of::<i64>(n)
+                .check("the integer conversion", "pass fewer entries")
+                .map_err(|e| crate::arg_err(function, what, e))?;
+            let floats = array.cast::<PyArrayDyn<f64>>().is_ok();
+            Footprint::of::<i64>(n).and::<f64>(if floats { 0 } else { n })
         }
-        let converted = array
-            .call_method1("astype", ("int64",))
-            .map_err(|e| named(py, function, what, e))?;
-        return converted
-            .extract::<IntArray<'py>>()
-            .map_err(|e| named(py, function, what, e));
-    }
-    obj.extract::<IntArray<'py>>()
-        .map_err(|e| named(py, function, what, e))
+        _ => {
+            return Err(PyTypeError::new_err(format!(
+                "{function}: {what}: expected integers, got {}",
+                dtype_name(array.as_any())
+            )))
+        }
+    };
+    Ok(Arg {
+        function,
+        what,
+        array,
+        native,
+        copy,
+    })
 }
 
 /// Refuses a sequence (a numpy array: its first axis) of more than `max` entries before
@@ -260,20 +417,21 @@ pub fn bool_array(
 /// Reads a 1-D integer array-like of at most `max_len` entries ([`int_array`]'s rules),
 /// copied within the memory budget; the length is checked before numpy reads a sequence.
 pub fn int_list(
-    function: &str,
-    what: &str,
+    function: &'static str,
+    what: &'static str,
     obj: &Bound<'_, PyAny>,
     max_len: Most,
 ) -> PyResult<Vec<i64>> {
     check_len(function, what, obj, max_len)?;
     let array = int_array(function, what, obj)?;
+    if array.ndim() != 1 {
+        return Err(crate::shape_err(function, what, "(N,)", array.shape()));
+    }
+    if array.len() > max_len.count() {
+        return Err(too_long(function, what, max_len, array.len().to_string()));
+    }
+    let array = array.read()?;
     let view = array.as_array();
-    if view.ndim() != 1 {
-        return Err(crate::shape_err(function, what, "(N,)", view.shape()));
-    }
-    if view.len() > max_len.count() {
-        return Err(too_long(function, what, max_len, view.len().to_string()));
-    }
     let mut out =
         try_vec(view.len(), "input integers").map_err(|e| crate::to_py_err(function, e))?;
     out.extend(view.iter().copied());

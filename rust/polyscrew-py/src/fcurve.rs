@@ -18,7 +18,7 @@ use polyscrew::fcurve::{
 };
 use polyscrew::memory::{try_vec, Footprint};
 
-use crate::args::{self, float_array, int_array, FloatArray, IntArray, Most};
+use crate::args::{self, copy_of, float_array, int_array, FloatArg, Most};
 use crate::{read_vector, shape_err, to_py_err, vector_len};
 
 const F: &str = "evaluate_fcurves";
@@ -55,22 +55,22 @@ fn filled<T: Clone>(f: &str, value: T, n: usize, what: &'static str) -> PyResult
 fn read_per_key(
     f: &str,
     what: &str,
-    array: Option<&FloatArray<'_>>,
+    array: Option<&FloatArg<'_>>,
     k: usize,
     default: f32,
 ) -> PyResult<Vec<f64>> {
     match array {
-        Some(a) => read_vector(f, what, &a.as_array()),
+        Some(a) => read_vector(f, what, &a.read()?.as_array()),
         None => filled(f, default as f64, k, "per-key values"),
     }
 }
 
 /// An optional float array-like (`None` stays `None`).
 fn optional_floats<'py>(
-    f: &str,
-    what: &str,
+    f: &'static str,
+    what: &'static str,
     a: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Option<FloatArray<'py>>> {
+) -> PyResult<Option<FloatArg<'py>>> {
     a.filter(|a| !a.is_none())
         .map(|a| float_array(f, what, a))
         .transpose()
@@ -115,7 +115,14 @@ const CYCLES_KEYS: [&str; 11] = [
 fn read_cycles(f: &str, c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
     let err = |reason: String| PyValueError::new_err(format!("{f}: cycles[{c}]: {reason}"));
     for key in dict.keys() {
-        let key: String = key.extract()?;
+        let key: String = key.extract().map_err(|_| {
+            PyTypeError::new_err(format!(
+                "{f}: cycles[{c}]: setting names must be str, got {}",
+                key.get_type()
+                    .name()
+                    .map_or_else(|_| "?".to_owned(), |n| n.to_string())
+            ))
+        })?;
         if !CYCLES_KEYS.contains(&key.as_str()) {
             return Err(err(format!(
                 "unknown setting {key:?} (expected some of {})",
@@ -235,7 +242,7 @@ impl CurveArgs {
     /// `times` times) checked before anything is copied.
     #[allow(clippy::too_many_arguments)]
     pub(crate) fn read<'py>(
-        function: &str,
+        function: &'static str,
         times: usize,
         extra: Footprint,
         offsets: &Bound<'py, PyAny>,
@@ -251,7 +258,7 @@ impl CurveArgs {
         cycles: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         let f = function;
-        let offsets: IntArray<'py> = int_array(f, "offsets", offsets)?;
+        let offsets = int_array(f, "offsets", offsets)?;
         let co = float_array(f, "co", co)?;
         let handle_left = float_array(f, "handle_left", handle_left)?;
         let handle_right = float_array(f, "handle_right", handle_right)?;
@@ -261,13 +268,11 @@ impl CurveArgs {
         let amplitude = optional_floats(f, "amplitude", amplitude)?;
         let period = optional_floats(f, "period", period)?;
 
-        let offsets_view = offsets.as_array();
-        if offsets_view.ndim() != 1 {
-            return Err(shape_err(f, "offsets", "(N,)", offsets_view.shape()));
+        if offsets.ndim() != 1 {
+            return Err(shape_err(f, "offsets", "(N,)", offsets.shape()));
         }
-        let c = offsets_view.len().saturating_sub(1);
-        let co_view = co.as_array();
-        let shape = co_view.shape();
+        let c = offsets.len().saturating_sub(1);
+        let shape = co.shape();
         if shape.len() != 2 || shape[1] != 2 {
             return Err(shape_err(f, "co", "(K, 2)", shape));
         }
@@ -276,26 +281,41 @@ impl CurveArgs {
         // given (a wrong length is the core's error, found after the copy).
         let pairs = [&co, &handle_left, &handle_right]
             .into_iter()
-            .map(|a| a.as_array().len().div_ceil(2));
+            .map(|a| a.len().div_ceil(2));
         let singles = [&interpolation, &easing]
             .into_iter()
-            .map(|a| a.as_array().len())
+            .map(|a| a.len())
             .chain(
                 [&back, &amplitude, &period]
                     .into_iter()
-                    .map(|a| a.as_ref().map_or(0, |a| a.as_array().len())),
+                    .map(|a| a.as_ref().map_or(0, |a| a.len())),
             );
         let rows = pairs.chain(singles).fold(k, usize::max);
-        let copies = packed_footprint(c, rows);
+        // ... and numpy's conversions of the arguments that are not of their dtype already
+        let conversions = [&co, &handle_left, &handle_right]
+            .into_iter()
+            .map(|a| a.copy())
+            .chain(
+                [&offsets, &interpolation, &easing]
+                    .into_iter()
+                    .map(|a| a.copy()),
+            )
+            .chain(
+                [&back, &amplitude, &period]
+                    .into_iter()
+                    .map(|a| copy_of(a.as_ref())),
+            )
+            .sum::<Footprint>();
+        let copies = packed_footprint(c, rows) + conversions;
         check_batch_with(c, k, times, copies + extra).map_err(|e| to_py_err(f, e))?;
 
         Ok(Self {
-            offsets: read_ints(f, "offsets", offsets_view)?,
-            co: read_pairs(f, "co", co_view)?,
-            handle_left: read_pairs(f, "handle_left", handle_left.as_array())?,
-            handle_right: read_pairs(f, "handle_right", handle_right.as_array())?,
-            interpolation: read_ints(f, "interpolation", interpolation.as_array())?,
-            easing: read_ints(f, "easing", easing.as_array())?,
+            offsets: read_ints(f, "offsets", offsets.read()?.as_array())?,
+            co: read_pairs(f, "co", co.read()?.as_array())?,
+            handle_left: read_pairs(f, "handle_left", handle_left.read()?.as_array())?,
+            handle_right: read_pairs(f, "handle_right", handle_right.read()?.as_array())?,
+            interpolation: read_ints(f, "interpolation", interpolation.read()?.as_array())?,
+            easing: read_ints(f, "easing", easing.read()?.as_array())?,
             back: read_per_key(f, "back", back.as_ref(), k, DEFAULT_BACK)?,
             amplitude: read_per_key(f, "amplitude", amplitude.as_ref(), k, DEFAULT_AMPLITUDE)?,
             period: read_per_key(f, "period", period.as_ref(), k, DEFAULT_PERIOD)?,
@@ -358,7 +378,7 @@ fn evaluate_fcurves<'py>(
     let args = CurveArgs::read(
         F,
         n,
-        Footprint::of::<f64>(n), // the copy of the times
+        times.copy() + Footprint::of::<f64>(n), // the times' conversion and copy
         offsets,
         co,
         handle_left,
@@ -371,7 +391,7 @@ fn evaluate_fcurves<'py>(
         period,
         cycles,
     )?;
-    let times = read_vector(F, "times", &times.as_array())?;
+    let times = read_vector(F, "times", &times.read()?.as_array())?;
     let packed = args.packed();
     let c = packed.len();
     let values = py

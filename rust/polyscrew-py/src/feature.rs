@@ -16,8 +16,8 @@ use polyscrew::{
 
 use crate::args::{self, FeatureMotion, Function, SampleFeature};
 use crate::{
-    check_budget, float_array, key_count, poses_to_array, read_keys, read_rows3, read_vector,
-    to_py_err, vec3s_to_array, vector_len,
+    check_budget, copy_of, float_array, key_count, poses_to_array, read_keys, read_rows3,
+    read_vector, to_py_err, vec3s_to_array, vector_len,
 };
 
 /// Reads `(K, 3)` points; finiteness and range are checked by the core, which names the
@@ -27,8 +27,8 @@ fn read_points(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyRes
 }
 
 /// The feature points' count of an optional `(K, 3)` argument.
-fn points_len(points: Option<&crate::FloatArray<'_>>) -> usize {
-    points.map_or(6, |p| p.as_array().shape().first().copied().unwrap_or(0))
+fn points_len(points: Option<&crate::FloatArg<'_>>) -> usize {
+    points.map_or(6, |p| p.shape().first().copied().unwrap_or(0))
 }
 
 /// The `stiffness` argument, read but not yet one value per key (that copy waits for the
@@ -39,7 +39,7 @@ enum StiffnessArg<'py> {
     /// One value for every key.
     Scalar(f64),
     /// One value per key (its length is checked by the core).
-    PerKey(crate::FloatArray<'py>),
+    PerKey(crate::FloatArg<'py>),
 }
 
 impl StiffnessArg<'_> {
@@ -48,7 +48,15 @@ impl StiffnessArg<'_> {
         match self {
             Self::Absent => 0,
             Self::Scalar(_) => n,
-            Self::PerKey(a) => a.as_array().len(),
+            Self::PerKey(a) => a.len(),
+        }
+    }
+
+    /// What reading it copies besides the values it holds.
+    fn copy(&self) -> Footprint {
+        match self {
+            Self::PerKey(a) => a.copy(),
+            _ => Footprint::ZERO,
         }
     }
 
@@ -61,7 +69,7 @@ impl StiffnessArg<'_> {
                 out.resize(n, *v);
                 Ok(Some(out))
             }
-            Self::PerKey(a) => read_vector(function, "stiffness", &a.as_array()).map(Some),
+            Self::PerKey(a) => read_vector(function, "stiffness", &a.read()?.as_array()).map(Some),
         }
     }
 }
@@ -70,7 +78,7 @@ impl StiffnessArg<'_> {
 /// stiffness is left to [`StiffnessArg::keys`] (after the budget's check).
 #[allow(clippy::too_many_arguments)]
 fn read_feature_spec<'py>(
-    function: &str,
+    function: &'static str,
     scheme: &str,
     levels: u32,
     closed: bool,
@@ -90,17 +98,12 @@ fn read_feature_spec<'py>(
                 StiffnessArg::Scalar(args::float_scalar(function, "stiffness", s)?)
             } else {
                 let a = float_array(function, "stiffness", s)?;
-                let view = a.as_array();
-                if view.ndim() == 0 {
-                    StiffnessArg::Scalar(view.iter().next().copied().unwrap_or(f64::NAN))
+                if a.ndim() == 0 {
+                    let value = a.read()?.as_array().iter().next().copied();
+                    StiffnessArg::Scalar(value.unwrap_or(f64::NAN))
                 } else {
-                    if view.ndim() != 1 {
-                        return Err(crate::shape_err(
-                            function,
-                            "stiffness",
-                            "(N,)",
-                            view.shape(),
-                        ));
+                    if a.ndim() != 1 {
+                        return Err(crate::shape_err(function, "stiffness", "(N,)", a.shape()));
                     }
                     StiffnessArg::PerKey(a)
                 }
@@ -145,13 +148,18 @@ fn register_points<'py>(
         .filter(|w| !w.is_none())
         .map(|w| float_array(F, "weights", w))
         .transpose()?;
-    let k = src.as_array().len() + dst.as_array().len();
+    let k = src.len() + dst.len();
     check_budget(
         F,
-        Footprint::of::<f64>(k).and::<f64>(weights.as_ref().map_or(0, |w| w.as_array().len())),
+        src.copy()
+            + dst.copy()
+            + copy_of(weights.as_ref())
+            + Footprint::of::<f64>(k).and::<f64>(weights.as_ref().map_or(0, |w| w.len())),
         "the point copies",
         "register fewer points",
     )?;
+    let (src, dst) = (src.read()?, dst.read()?);
+    let weights = weights.as_ref().map(|w| w.read()).transpose()?;
     let views = (
         src.as_array(),
         dst.as_array(),
@@ -186,10 +194,11 @@ fn inertia_points<'py>(
     let points = float_array(F, "points", points)?;
     check_budget(
         F,
-        Footprint::of::<f64>(points.as_array().len()),
+        points.copy() + Footprint::of::<f64>(points.len()),
         "the point copy",
         "pass fewer points",
     )?;
+    let points = points.read()?;
     let view = points.as_array();
     let six = py.detach(|| -> PyResult<[DVec3; 6]> {
         let points = read_points(F, "points", &view)?;
@@ -246,7 +255,10 @@ fn feature_motion<'py>(
     };
     check_budget(
         F,
-        Footprint::of::<Pose>(n)
+        poses.copy()
+            + copy_of(points.as_ref())
+            + stiffness.copy()
+            + Footprint::of::<Pose>(n)
             + Footprint::of::<DVec3>(k)
             + Footprint::of::<f64>(stiffness.len(n))
             + feature_footprint(n, k, &spec)
@@ -255,6 +267,8 @@ fn feature_motion<'py>(
         FEATURE_HINT,
     )?;
     spec.stiffness.keys = stiffness.keys(F, n)?;
+    let poses = poses.read()?;
+    let points = points.as_ref().map(|p| p.read()).transpose()?;
     let views = (poses.as_array(), points.as_ref().map(|p| p.as_array()));
     let out = py.detach(|| -> PyResult<_> {
         let (v, p) = &views;
@@ -320,7 +334,12 @@ fn sample_feature<'py>(
     let k = points_len(points.as_ref());
     check_budget(
         F,
-        Footprint::of::<Pose>(n)
+        poses.copy()
+            + key_times.copy()
+            + times.copy()
+            + copy_of(points.as_ref())
+            + stiffness.copy()
+            + Footprint::of::<Pose>(n)
             + Footprint::of::<f64>(n_key_times + m)
             + Footprint::of::<DVec3>(k)
             + Footprint::of::<f64>(stiffness.len(n))
@@ -332,6 +351,8 @@ fn sample_feature<'py>(
         FEATURE_HINT,
     )?;
     spec.stiffness.keys = stiffness.keys(F, n)?;
+    let (poses, key_times, times) = (poses.read()?, key_times.read()?, times.read()?);
+    let points = points.as_ref().map(|p| p.read()).transpose()?;
     let views = (
         poses.as_array(),
         key_times.as_array(),

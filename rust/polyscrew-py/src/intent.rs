@@ -13,8 +13,8 @@ use polyscrew::intent::{
     analyse_turns as core_analyse_turns, departure as core_departure,
     keys_parameters as core_keys_parameters, pace_parameters as core_pace_parameters,
     rotation_matrices as core_rotation_matrices, screw_pace_poses, Channel, KeysTiming, Playback,
-    Spans, Turns, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES,
-    WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
+    Spans, Turns, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES, PACE_SAMPLES,
+    RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode};
@@ -128,7 +128,7 @@ impl PyPlayback {
         let args = CurveArgs::read(
             F,
             0,
-            Footprint::of::<f64>(width), // the copy of the owner's values
+            unkeyed.copy() + Footprint::of::<f64>(width), // the owner's values and their copy
             offsets,
             co,
             handle_left,
@@ -141,7 +141,7 @@ impl PyPlayback {
             period,
             cycles,
         )?;
-        let unkeyed = read_vector(F, "unkeyed", &unkeyed.as_array())?;
+        let unkeyed = read_vector(F, "unkeyed", &unkeyed.read()?.as_array())?;
         let packed = args.packed();
         let inner = py
             .detach(|| {
@@ -176,10 +176,11 @@ impl PyPlayback {
         // the frames, the rows, the three outputs
         check_budget(
             F,
-            Footprint::of::<f64>(t).and::<f64>(t.saturating_mul(2 * width)),
+            frames.copy() + Footprint::of::<f64>(t).and::<f64>(t.saturating_mul(2 * width)),
             "the channel values",
             HINT,
         )?;
+        let frames = frames.read()?;
         let view = frames.as_array();
         let (location, rotation, scale) = py.detach(|| -> PyResult<_> {
             let frames = read_vector(F, "frames", &view)?;
@@ -233,19 +234,23 @@ impl PyPlayback {
         let location = float_array(F, "location", location)?;
         let rotation = float_array(F, "rotation", rotation)?;
         for (array, what, width) in [(&location, "location", 3), (&rotation, "rotation", w)] {
-            let view = array.as_array();
-            let shape = view.shape();
+            let shape = array.shape();
             if shape.len() != 2 || shape[1] != width || shape[0] != t {
                 return Err(shape_err(F, what, &format!("({t}, {width})"), shape));
             }
         }
-        // the values read, the playback's rows, the two outputs
+        // the arguments' conversions, the values read, the playback's rows, the two outputs
         check_budget(
             F,
-            Footprint::of::<f64>(t.saturating_mul(3 + w + 3)).and::<f64>(4096 * inner.width()),
+            frames.copy()
+                + location.copy()
+                + rotation.copy()
+                + Footprint::of::<f64>(t.saturating_mul(3 + w + 3))
+                    .and::<f64>(4096 * inner.width()),
             "the departure",
             HINT,
         )?;
+        let (frames, location, rotation) = (frames.read()?, location.read()?, rotation.read()?);
         let (frames, location, rotation) =
             (frames.as_array(), location.as_array(), rotation.as_array());
         let out = py.detach(|| -> PyResult<_> {
@@ -267,7 +272,7 @@ impl PyPlayback {
 /// Reads the arguments of `analyse_spans` / `analyse_turns` and runs the core, GIL released.
 fn spans_of(
     py: Python<'_>,
-    function: &str,
+    function: &'static str,
     playback: &Bound<'_, PyAny>,
     frames: &Bound<'_, PyAny>,
     turns: &str,
@@ -276,8 +281,20 @@ fn spans_of(
     let turns = Turns::from_name(turns).map_err(|e| to_py_err(function, e))?;
     let frames = float_array(function, "frames", frames)?;
     let k = vector_len(function, "frames", &frames)?;
-    check_budget(function, Footprint::of::<f64>(k), "the frames", HINT)?;
     let inner = &playback.get().inner;
+    // the frames' copy, and the core's working memory (which it checks again on its own):
+    // the key rows, four values per span (the results and the sample counts), and one span's
+    // samples at most (frames, rows, steps); the inserted frames are checked when counted
+    let width = inner.width();
+    let work = Footprint::of::<f64>(k.saturating_mul(width + 4))
+        .and::<f64>(MAX_SPAN_SAMPLES.saturating_mul(width + 2));
+    check_budget(
+        function,
+        frames.copy() + Footprint::of::<f64>(k) + work,
+        "the frames",
+        HINT,
+    )?;
+    let frames = frames.read()?;
     let view = frames.as_array();
     py.detach(|| -> PyResult<_> {
         let frames = read_vector(function, "frames", &view)?;
@@ -418,15 +435,27 @@ fn keys_parameters<'py>(
     let n = if is_keys {
         key_count(F, &array)?
     } else {
-        pose_count(F, "smooth", array.as_array().shape())?.0
+        pose_count(F, "smooth", array.shape())?.0
     };
-    // the copies of the input and the output (the core checks its own working memory)
+    // the copies of the input and the output, and the core's working memory (which it
+    // checks again on its own): per frame four values, per pace sample five, per pose of
+    // the pace grid two and (from the keys) the smoothed pose itself
+    let grid = k.saturating_mul(PACE_SAMPLES + 1);
+    let work = Footprint::of::<f64>(t).times(4)
+        + Footprint::of::<f64>(grid.saturating_add(t)).times(5)
+        + Footprint::of::<f64>(grid).times(2)
+        + Footprint::of::<Pose>(if is_keys { grid } else { 0 });
     check_budget(
         F,
-        Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
+        key_frames.copy()
+            + frames.copy()
+            + array.copy()
+            + work
+            + Footprint::of::<f64>(k.saturating_add(2 * t)).and::<Pose>(n),
         "timing Keys",
         HINT,
     )?;
+    let (key_frames, frames, array) = (key_frames.read()?, frames.read()?, array.read()?);
     let inner = playback.map(|p| &p.get().inner);
     let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
     let out = py.detach(|| -> PyResult<Vec<f64>> {
@@ -485,9 +514,8 @@ fn rotation_matrices<'py>(
     let mode =
         RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
     let values = float_array(F, "values", values)?;
-    let view = values.as_array();
     let width = mode.width();
-    let shape = view.shape();
+    let shape = values.shape();
     if shape.len() != 2 || shape[1] != width {
         return Err(shape_err(F, "values", &format!("(N, {width})"), shape));
     }
@@ -495,10 +523,13 @@ fn rotation_matrices<'py>(
     // the values read, the matrices, the output
     check_budget(
         F,
-        Footprint::of::<f64>(n.saturating_mul(width)).and::<[f64; 9]>(n.saturating_mul(2)),
+        values.copy()
+            + Footprint::of::<f64>(n.saturating_mul(width)).and::<[f64; 9]>(n.saturating_mul(2)),
         "the rotation matrices",
         HINT,
     )?;
+    let values = values.read()?;
+    let view = values.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let run = || -> Result<Array3<f64>, Error> {
             let mut values = try_vec(n.saturating_mul(width), "input values")?;
@@ -529,6 +560,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("WIND_STEP", WIND_STEP)?;
     m.add("SPAN_SAMPLES", SPAN_SAMPLES)?;
     m.add("MAX_SPAN_SAMPLES", MAX_SPAN_SAMPLES)?;
+    m.add("MAX_ANALYSIS_SAMPLES", MAX_ANALYSIS_SAMPLES)?;
     m.add("HOLD_TOLERANCE", HOLD_TOLERANCE)?;
     m.add("PACE_SAMPLES", PACE_SAMPLES)?;
     m.add("WRAP_MARGIN", WRAP_MARGIN)?;

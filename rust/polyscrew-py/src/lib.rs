@@ -13,7 +13,7 @@ mod reduce;
 mod sweep;
 
 use glam::{DQuat, DVec3};
-use numpy::ndarray::{Array2, Array3, ArrayViewD};
+use numpy::ndarray::{Array2, Array3, ArrayViewD, Ix3};
 use numpy::{IntoPyArray, PyArray2, PyArray3};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::motion::sample::sample_footprint;
@@ -27,7 +27,7 @@ use polyscrew::{
 use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 
-pub use args::{float_array, FloatArray};
+pub use args::{copy_of, float_array, FloatArg, FloatArray};
 use args::{Function, Sample, SampleChannels, SampleVectors, Subdivide, SubdivideVectors};
 
 /// The one place a core error becomes a Python exception, with the function's name:
@@ -80,12 +80,11 @@ pub fn pose_count(function: &str, what: &str, shape: &[usize]) -> PyResult<(usiz
 pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<Pose>> {
     let (n, single) = pose_count(function, what, array.shape())?;
     let mut poses = try_vec(n, "input poses").map_err(|e| to_py_err(function, e))?;
-    let mut values = array.iter();
-    for i in 0..n {
+    // read through a view of fixed dimensions: ndarray iterates a broadcast or strided view
+    // of dynamic dimensions about twice as slowly
+    let mut push = |values: &mut dyn FnMut(&mut [f64; 16]), i: usize| -> PyResult<()> {
         let mut m = [0.0; 16];
-        for (slot, v) in m.iter_mut().zip(&mut values) {
-            *slot = *v;
-        }
+        values(&mut m);
         let row = |r: usize| [m[4 * r], m[4 * r + 1], m[4 * r + 2], m[4 * r + 3]];
         let pose = Pose::from_rows(&[row(0), row(1), row(2), row(3)], i).map_err(|e| {
             if single {
@@ -100,8 +99,24 @@ pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> Py
             }
         })?;
         poses.push(pose);
+        Ok(())
+    };
+    if let Ok(fixed) = array.view().into_dimensionality::<Ix3>() {
+        for (i, matrix) in fixed.outer_iter().enumerate() {
+            push(&mut |m| fill(m, matrix.iter()), i)?;
+        }
+    } else {
+        push(&mut |m| fill(m, array.iter()), 0)?;
     }
     Ok(poses)
+}
+
+/// `m` filled from `values` (as many as it holds).
+#[inline]
+fn fill<'a, const K: usize>(m: &mut [f64; K], values: impl Iterator<Item = &'a f64>) {
+    for (slot, v) in m.iter_mut().zip(values) {
+        *slot = *v;
+    }
 }
 
 /// Reads `(N, 4, 4)` key poses (a single matrix is refused), no GIL needed.
@@ -114,8 +129,8 @@ pub fn read_keys(function: &str, poses: &ArrayViewD<'_, f64>) -> PyResult<Vec<Po
 }
 
 /// The key count of an `(N, 4, 4)` argument (checked again when read).
-pub fn key_count(function: &str, poses: &FloatArray<'_>) -> PyResult<usize> {
-    pose_count(function, "poses", poses.as_array().shape()).map(|(n, _)| n)
+pub fn key_count(function: &str, poses: &FloatArg<'_>) -> PyResult<usize> {
+    pose_count(function, "poses", poses.shape()).map(|(n, _)| n)
 }
 
 /// Poses as an `(N, 4, 4)` array in Blender's layout (allocated fallibly).
@@ -138,12 +153,11 @@ pub fn read_vector(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> P
 }
 
 /// The length of a 1-D array (checked again when read).
-pub fn vector_len(function: &str, what: &str, array: &FloatArray<'_>) -> PyResult<usize> {
-    let a = array.as_array();
-    if a.ndim() != 1 {
-        return Err(shape_err(function, what, "(N,)", a.shape()));
+pub fn vector_len(function: &str, what: &str, array: &FloatArg<'_>) -> PyResult<usize> {
+    if array.ndim() != 1 {
+        return Err(shape_err(function, what, "(N,)", array.shape()));
     }
-    Ok(a.len())
+    Ok(array.len())
 }
 
 /// Reads `(N, 3)` rows without judging their values (no GIL needed).
@@ -165,8 +179,8 @@ pub fn read_rows3(
 }
 
 /// The row count of an `(N, 3)` argument (checked again when read).
-pub fn rows3_len(array: &FloatArray<'_>) -> usize {
-    array.as_array().shape().first().copied().unwrap_or(0)
+pub fn rows3_len(array: &FloatArg<'_>) -> usize {
+    array.shape().first().copied().unwrap_or(0)
 }
 
 /// Reads `(N, 3)` vectors, finite and within the working range (no GIL needed).
@@ -253,13 +267,18 @@ impl PyScrew {
 }
 
 /// Reads exactly one pose.
-fn read_one_pose(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<Pose> {
+fn read_one_pose(
+    function: &'static str,
+    what: &'static str,
+    obj: &Bound<'_, PyAny>,
+) -> PyResult<Pose> {
     let array = float_array(function, what, obj)?;
-    let view = array.as_array();
-    let (_, single) = pose_count(function, what, view.shape())?;
+    let (_, single) = pose_count(function, what, array.shape())?;
     if !single {
-        return Err(shape_err(function, what, "(4, 4)", view.shape()));
+        return Err(shape_err(function, what, "(4, 4)", array.shape()));
     }
+    let array = array.read()?;
+    let view = array.as_array();
     Ok(read_poses(function, what, &view)?[0])
 }
 
@@ -322,9 +341,14 @@ fn interpolate<'py>(
             .into_any());
     }
     let ts = float_array(F, "t", t)?;
-    let view = ts.as_array();
-    if view.ndim() == 0 {
-        let t = view.iter().next().copied().unwrap_or(f64::NAN);
+    if ts.ndim() == 0 {
+        let t = ts
+            .read()?
+            .as_array()
+            .iter()
+            .next()
+            .copied()
+            .unwrap_or(f64::NAN);
         check_t(0, t)?;
         let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
         return Ok(out
@@ -335,10 +359,12 @@ fn interpolate<'py>(
     let m = vector_len(F, "t", &ts)?;
     check_budget(
         F,
-        Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
+        ts.copy() + Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
         "the interpolated poses",
         "pass fewer t at once",
     )?;
+    let ts = ts.read()?;
+    let view = ts.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let ts = read_vector(F, "t", &view)?;
         for (index, t) in ts.iter().enumerate() {
@@ -383,12 +409,14 @@ fn subdivide<'py>(
     };
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + keys_footprint(n)
             + subdivision_footprint::<Pose>(n, levels, closed)
             + Footprint::of::<[f64; 16]>(out_len),
         "the subdivided poses",
         SUBDIVISION_HINT,
     )?;
+    let poses = poses.read()?;
     let view = poses.as_array();
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let keys = read_keys(F, &view)?;
@@ -401,14 +429,14 @@ fn subdivide<'py>(
 
 /// The inputs of the sampling functions: key count, key times and times arrays.
 struct TimedInput<'py> {
-    key_times: FloatArray<'py>,
-    times: FloatArray<'py>,
+    key_times: FloatArg<'py>,
+    times: FloatArg<'py>,
     n_times: usize,
     n_key_times: usize,
 }
 
 fn read_timed<'py>(
-    function: &str,
+    function: &'static str,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
 ) -> PyResult<TimedInput<'py>> {
@@ -422,6 +450,18 @@ fn read_timed<'py>(
         n_times,
         n_key_times,
     })
+}
+
+impl<'py> TimedInput<'py> {
+    /// What reading the two arrays copies.
+    fn copy(&self) -> Footprint {
+        self.key_times.copy() + self.times.copy()
+    }
+
+    /// The two arrays read (after the budget's check).
+    fn read(&self) -> PyResult<(FloatArray<'py>, FloatArray<'py>)> {
+        Ok((self.key_times.read()?, self.times.read()?))
+    }
 }
 
 /// sample(poses, key_times, times, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> ndarray
@@ -455,18 +495,17 @@ fn sample<'py>(
     let m = input.n_times;
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + input.copy()
+            + keys_footprint(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<Pose>(n, m, &spec)
             + Footprint::of::<[f64; 16]>(m),
         "the sampled poses",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        poses.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (poses, (key_times, times)) = (poses.read()?, input.read()?);
+    let (view, kt, tt) = (poses.as_array(), key_times.as_array(), times.as_array());
     let out = py.detach(|| -> PyResult<Array3<f64>> {
         let keys = read_keys(F, &view)?;
         let key_times = read_vector(F, "key_times", &kt)?;
@@ -516,7 +555,10 @@ fn sample_channels<'py>(
     let width = mode.width();
     check_budget(
         F,
-        keys_footprint(n)
+        poses.copy()
+            + input.copy()
+            + copy_of(previous.as_ref())
+            + keys_footprint(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<Pose>(n, m, &spec)
             + Footprint::of::<(DQuat, DVec3)>(m)
@@ -525,11 +567,9 @@ fn sample_channels<'py>(
         "the sampled channels",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        poses.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (poses, (key_times, times)) = (poses.read()?, input.read()?);
+    let previous = previous.as_ref().map(|p| p.read()).transpose()?;
+    let (view, kt, tt) = (poses.as_array(), key_times.as_array(), times.as_array());
     let pv = previous.as_ref().map(|p| p.as_array());
     let (locations, rotations) = py.detach(|| -> PyResult<(Array2<f64>, Array2<f64>)> {
         let keys = read_keys(F, &view)?;
@@ -581,12 +621,14 @@ fn subdivide_vectors<'py>(
     };
     check_budget(
         F,
-        Footprint::of::<DVec3>(n)
+        values.copy()
+            + Footprint::of::<DVec3>(n)
             + subdivision_footprint::<DVec3>(n, levels, closed)
             + Footprint::of::<[f64; 3]>(out_len),
         "the subdivided vectors",
         SUBDIVISION_HINT,
     )?;
+    let values = values.read()?;
     let view = values.as_array();
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let keys = read_vec3s(F, "values", &view)?;
@@ -624,18 +666,17 @@ fn sample_vectors<'py>(
     let m = input.n_times;
     check_budget(
         F,
-        Footprint::of::<DVec3>(n)
+        values.copy()
+            + input.copy()
+            + Footprint::of::<DVec3>(n)
             + Footprint::of::<f64>(input.n_key_times + m)
             + sample_footprint::<DVec3>(n, m, &spec)
             + Footprint::of::<[f64; 3]>(m),
         "the sampled vectors",
         SAMPLE_HINT,
     )?;
-    let (view, kt, tt) = (
-        values.as_array(),
-        input.key_times.as_array(),
-        input.times.as_array(),
-    );
+    let (values, (key_times, times)) = (values.read()?, input.read()?);
+    let (view, kt, tt) = (values.as_array(), key_times.as_array(), times.as_array());
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let keys = read_vec3s(F, "values", &view)?;
         let key_times = read_vector(F, "key_times", &kt)?;
@@ -659,12 +700,13 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
         }
         [n, 3, 3] => {
             let mut out = try_vec(*n, "rotations").map_err(|e| to_py_err(function, e))?;
-            let mut values = array.iter();
-            for i in 0..*n {
+            let fixed = array
+                .view()
+                .into_dimensionality::<Ix3>()
+                .map_err(|e| PyValueError::new_err(format!("{function}: rotations: {e}")))?;
+            for (i, matrix) in fixed.outer_iter().enumerate() {
                 let mut m = [0.0; 9];
-                for (slot, v) in m.iter_mut().zip(&mut values) {
-                    *slot = *v;
-                }
+                fill(&mut m, matrix.iter());
                 let rows = [
                     [m[0], m[1], m[2], 0.0],
                     [m[3], m[4], m[5], 0.0],
@@ -693,7 +735,8 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
 /// "AXIS_ANGLE" -> (N, 4) angle, x, y, z, unwrapped; "XYZ", "XZY", "YXZ", "YZX", "ZXY",
 /// "ZYX" -> (N, 3) Euler angles (radians, per axis x, y, z) each compatible with the
 /// previous frame as `Euler.make_compatible` does. `previous`: the channel values just
-/// before the first frame, to continue from.
+/// before the first frame, to continue from (its angles within +-`MAX_PREVIOUS_ANGLE`).
+/// At most `MAX_ROTATIONS` rotations per call.
 #[pyfunction]
 #[pyo3(signature = (rotations, mode, previous=None))]
 fn rotation_channels<'py>(
@@ -710,15 +753,21 @@ fn rotation_channels<'py>(
         .filter(|p| !p.is_none())
         .map(|p| float_array(F, "previous", p))
         .transpose()?;
-    let view = rotations.as_array();
-    let n = view.shape().first().copied().unwrap_or(0);
+    let n = rotations.shape().first().copied().unwrap_or(0);
     let width = mode.width();
     check_budget(
         F,
-        Footprint::of::<DQuat>(n) + Footprint::of::<f64>(n.saturating_mul(width)),
+        rotations.copy()
+            + copy_of(previous.as_ref())
+            + Footprint::of::<DQuat>(n)
+            + Footprint::of::<f64>(n.saturating_mul(width)),
         "the rotation channels",
         polyscrew::motion::channels::CHANNELS_HINT,
     )?;
+    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(F, e))?;
+    let rotations = rotations.read()?;
+    let view = rotations.as_array();
+    let previous = previous.as_ref().map(|p| p.read()).transpose()?;
     let pv = previous.as_ref().map(|p| p.as_array());
     let out = py.detach(|| -> PyResult<Array2<f64>> {
         let quats = read_rotations(F, &view)?;
@@ -772,6 +821,8 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_MEMORY_BUDGET", polyscrew::DEFAULT_MEMORY_BUDGET)?;
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
+    m.add("MAX_PREVIOUS_ANGLE", polyscrew::MAX_PREVIOUS_ANGLE)?;
+    m.add("MAX_ROTATIONS", polyscrew::MAX_ROTATIONS)?;
     angular_velocity::register(m)?;
     sweep::register(m)?;
     feature::register(m)?;

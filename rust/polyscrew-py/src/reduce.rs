@@ -80,7 +80,7 @@ fn read_radius(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<f64>> {
     if let Ok(r) = float_scalar(F, "radius", obj) {
         return Ok(vec![r; b]);
     }
-    let array = float_array(F, "radius", obj)?;
+    let array = float_array(F, "radius", obj)?.read()?;
     let view = array.as_array();
     match view.shape() {
         [] => Ok(vec![view.iter().copied().next().unwrap_or(f64::NAN); b]),
@@ -113,13 +113,13 @@ fn read_mask(
 /// A float array of shape `shape`, or `None`.
 fn read_floats(
     obj: Option<&Bound<'_, PyAny>>,
-    what: &str,
+    what: &'static str,
     shape: &[usize],
 ) -> PyResult<Option<Vec<f64>>> {
     let Some(obj) = obj.filter(|o| !o.is_none()) else {
         return Ok(None);
     };
-    let array = float_array(F, what, obj)?;
+    let array = float_array(F, what, obj)?.read()?;
     let view = array.as_array();
     if view.shape() != shape {
         let expected = format!("{shape:?}").replace('[', "(").replace(']', ")");
@@ -180,18 +180,16 @@ fn reduce_keys<'py>(
     let angle = float_scalar(F, "angle", angle)?;
     let poses = float_array(F, "poses", poses)?;
     let frames = float_array(F, "frames", frames)?;
-    let pv = poses.as_array();
-    let (b, n) = match pv.shape() {
+    let (b, n) = match poses.shape() {
         [b, n, 4, 4] => (*b, *n),
         s => return Err(shape_err(F, "poses", "(B, N, 4, 4)", s)),
     };
-    let fv = frames.as_array();
-    if fv.shape() != [n] {
+    if frames.shape() != [n] {
         return Err(shape_err(
             F,
             "frames",
             &format!("({n},) (N of poses)"),
-            fv.shape(),
+            frames.shape(),
         ));
     }
     if n > MAX_REDUCE_FRAMES || b.saturating_mul(n) > MAX_REDUCE_POSES {
@@ -205,8 +203,10 @@ fn reduce_keys<'py>(
     let keys_bound = b.saturating_mul(n).saturating_mul(10);
     crate::check_budget(
         F,
-        Footprint::of::<Pose>(b.saturating_mul(n).saturating_mul(2))
-            .and::<f64>(b.saturating_mul(n).saturating_mul(3))
+        poses.copy()
+            + frames.copy()
+            + Footprint::of::<Pose>(b.saturating_mul(n).saturating_mul(2))
+                .and::<f64>(b.saturating_mul(n).saturating_mul(3))
             + reduce_footprint(b, n, threads, with_parents)
             + Footprint::of::<f64>(keys_bound.saturating_mul(6))
             + Footprint::of::<i64>(keys_bound.saturating_mul(3)),
@@ -245,7 +245,7 @@ fn reduce_keys<'py>(
         match offsets.filter(|o| !o.is_none()) {
             None => None,
             Some(o) => {
-                let array = float_array(F, "offsets", o)?;
+                let array = float_array(F, "offsets", o)?.read()?;
                 let view = array.as_array();
                 if view.shape() != [b, 4, 4] {
                     return Err(shape_err(
@@ -271,6 +271,8 @@ fn reduce_keys<'py>(
                 Some(out)
             }
         };
+    let (poses, frames) = (poses.read()?, frames.read()?);
+    let (pv, fv) = (poses.as_array(), frames.as_array());
     let reduced = py.detach(|| -> PyResult<polyscrew::Reduced> {
         let poses = read_poses(&pv, b, n)?;
         let frames: Vec<f64> = fv.iter().copied().collect();

@@ -57,21 +57,26 @@ fn sweep<'py>(
     let vertices = float_array(F, "vertices", vertices)?;
     let triangles = args::int_array(F, "triangles", triangles)?;
     let poses = float_array(F, "poses", poses)?;
-    let (n, single) = pose_count(F, "poses", poses.as_array().shape())?;
+    let (n, single) = pose_count(F, "poses", poses.shape())?;
     if single {
         return Err(to_py_err(F, Error::TooFew { got: 1, need: 2 }));
     }
     let (nv, nt) = (
-        vertices.as_array().shape().first().copied().unwrap_or(0),
-        triangles.as_array().shape().first().copied().unwrap_or(0),
+        vertices.shape().first().copied().unwrap_or(0),
+        triangles.shape().first().copied().unwrap_or(0),
     );
     // The inputs read and the body built; the core checks the output span by span.
     check_budget(
         F,
-        Footprint::of::<Pose>(n) + body_footprint(nv, nt),
+        vertices.copy()
+            + triangles.copy()
+            + poses.copy()
+            + Footprint::of::<Pose>(n)
+            + body_footprint(nv, nt),
         "the swept body",
         SWEEP_HINT,
     )?;
+    let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let options = SweepOptions { steps, caps };
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
     let (vo, to) = py.detach(|| -> PyResult<(Array2<f64>, Array2<i64>)> {

@@ -53,7 +53,7 @@ pub use pace::{
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{
-    analyse_spans, analyse_turns, Spans, HOLD_TOLERANCE, MAX_SPAN_SAMPLES, SPAN_SAMPLES,
-    WIND_LIMIT, WIND_STEP,
+    analyse_spans, analyse_turns, Spans, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES,
+    SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
 };
 pub use turns::{is_euler_wrap, is_flip, is_sign_flip, Turns, RANGE_TOLERANCE, WRAP_MARGIN};

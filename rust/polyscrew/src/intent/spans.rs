@@ -28,6 +28,13 @@ pub const SPAN_SAMPLES: usize = 8;
 /// At most this many samples per span.
 pub const MAX_SPAN_SAMPLES: usize = 4096;
 
+/// At most this many samples of the playback in one [`analyse_spans`] call, all spans
+/// together (2**21; spins are walked a second time to place their added frames, so the
+/// playback is evaluated at most twice this often). The work is not bounded by memory (a
+/// span's samples are reused): this bounds its time, about 2 s of one core at the limit
+/// (512 spans of 4,096 samples, each a spin, on a playback of nine curves).
+pub const MAX_ANALYSIS_SAMPLES: usize = 1 << 21;
+
 /// Degrees of rotation-channel change (the sum over the Euler angles, or the axis-angle
 /// angle) per sample of a span.
 pub const DEGREES_PER_SAMPLE: f64 = 10.0;
@@ -127,7 +134,7 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
 /// channel of any sample moves from the span's start by more than [`HOLD_TOLERANCE`]; it
 /// pops when it is held and a channel differs between its keys. Its turn is the sum of
 /// [`rotation_angle`]s between consecutive samples and from the last sample to the span's
-/// end. A span is a flip when it is not held and its key values are an Euler wrap or a
+/// end. All spans together take at most [`MAX_ANALYSIS_SAMPLES`] samples. A span is a flip when it is not held and its key values are an Euler wrap or a
 /// quaternion sign flip ([`is_flip`]). A span is *followed* when `turns` is
 /// [`Turns::AsPlayed`]; with [`Turns::Auto`] when it is not a flip and the mode is Euler or
 /// axis-angle (quaternion keys keep the shortest arc); never with [`Turns::Shortest`]. Spins:
@@ -139,7 +146,8 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
 /// # Errors
 /// [`Error::TooFew`] for fewer than two frames, [`Error::KeyTimes`] for frames that are not
 /// finite and strictly increasing, the errors of [`Playback::channels`], and a request over
-/// the size limit ([`check_footprint`]).
+/// the size limit ([`check_footprint`]), [`Error::Invalid`] (`frames`) for spans that would
+/// take more than [`MAX_ANALYSIS_SAMPLES`] samples in all (before any is taken).
 pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Result<Spans> {
     let k = frames.len();
     if k < 2 {
@@ -174,6 +182,18 @@ pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Resul
         }),
         "spans",
     )?;
+    let total = counts.iter().fold(0usize, |a, &c| a.saturating_add(c));
+    if total > MAX_ANALYSIS_SAMPLES {
+        return Err(Error::Invalid {
+            what: "frames",
+            reason: format!(
+                "the {spans} key spans would take {total} samples of the playback, more than \
+                 {MAX_ANALYSIS_SAMPLES} (a span whose rotation channels change by d degrees \
+                 takes d / {DEGREES_PER_SAMPLE} of them, {SPAN_SAMPLES} to {MAX_SPAN_SAMPLES}): \
+                 analyse fewer key frames at once"
+            ),
+        });
+    }
 
     let mut held = filled(spans, true, "spans")?;
     let mut pops = filled(spans, false, "spans")?;

@@ -621,3 +621,28 @@ fn sizes_are_checked_against_the_budget_before_allocating() {
     let frames = vec![1.0; budget / (8 * p.width()) + 1];
     assert!(over(p.channels(&frames).unwrap_err()));
 }
+
+#[test]
+fn span_analysis_refuses_more_samples_than_its_cap_before_taking_any() {
+    // 513 spans of one frame each, the Z angle turning 1,000 radians per frame: 4,096 samples
+    // each, 2,101,248 in all, over MAX_ANALYSIS_SAMPLES; 512 of them are exactly at it.
+    let spin = |k: usize| {
+        let points: Vec<(f32, f32)> = (0..k).map(|i| (i as f32, 1000.0 * i as f32)).collect();
+        let p = playback(
+            vec![(Channel::Rotation(2), curve(&points, Interpolation::Linear))],
+            XYZ,
+        );
+        let frames: Vec<f64> = (0..k).map(|i| i as f64).collect();
+        (p, frames)
+    };
+    let (p, frames) = spin(514);
+    let err = analyse_spans(&p, &frames).unwrap_err();
+    assert!(
+        matches!(&err, Error::Invalid { what: "frames", reason } if reason.starts_with("the 513 key spans would take 2101248 samples of the playback, more than 2097152")),
+        "{err}"
+    );
+    let (p, frames) = spin(513);
+    let spans = analyse_spans(&p, &frames).unwrap();
+    assert_eq!(spans.turn.len(), 512);
+    assert!(spans.held.iter().all(|h| !h), "{:?}", &spans.held[..4]);
+}

@@ -199,6 +199,35 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
     }
 }
 
+/// The largest `previous` angle (radians, either sign) [`rotation_channels`] continues from:
+/// Euler angles and the axis-angle angle. A continued angle is `previous` plus less than
+/// half a turn; within this range a double holds it to about 1e-7 radians (its spacing at
+/// 1e9 is 1.2e-7), beyond it the spacing grows until no double near `previous` stands for
+/// the rotation at all (at 1e17 the doubles are 16 radians apart).
+pub const MAX_PREVIOUS_ANGLE: f64 = 1e9;
+
+/// The most rotations one [`rotation_channels`] call converts: 2**24 (16,777,216), the
+/// most the default memory budget accepts for quaternion and axis-angle channels. Its work
+/// is a few hundred nanoseconds per rotation, so this bounds its time (a few seconds of one
+/// core) whatever the budget; more is refused before any is read ([`check_rotation_count`]).
+pub const MAX_ROTATIONS: usize = 1 << 24;
+
+/// Refuses more than [`MAX_ROTATIONS`] rotations in one call.
+///
+/// # Errors
+/// [`Error::Invalid`] (`rotations`) naming the count and the limit.
+pub fn check_rotation_count(count: usize) -> Result<()> {
+    if count > MAX_ROTATIONS {
+        return Err(Error::Invalid {
+            what: "rotations",
+            reason: format!(
+                "{count} rotations, more than {MAX_ROTATIONS} in one call: {CHANNELS_HINT}"
+            ),
+        });
+    }
+    Ok(())
+}
+
 /// How to ask [`rotation_channels`] for less memory.
 pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 
@@ -211,7 +240,9 @@ pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
-/// it holds NaN or infinity, [`Error::Memory`] when the channels exceed the memory budget.
+/// it holds NaN or infinity, [`Error::OutOfRange`] when one of its angles (Euler, or the
+/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Invalid`] for more than
+/// [`MAX_ROTATIONS`] rotations, [`Error::Memory`] when the channels exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
     mode: RotationMode,
@@ -232,9 +263,26 @@ pub fn rotation_channels(
                 index,
             });
         }
+        let angles = match mode {
+            RotationMode::Quaternion => 0,
+            RotationMode::AxisAngle => 1,
+            RotationMode::Euler(_) => 3,
+        };
+        if let Some(index) = p[..angles]
+            .iter()
+            .position(|v| v.abs() > MAX_PREVIOUS_ANGLE)
+        {
+            return Err(Error::OutOfRange {
+                what: "previous value",
+                index,
+                value: p[index],
+                range: "+-1e9",
+            });
+        }
     }
     let values = rotations.len().saturating_mul(width);
     Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    check_rotation_count(rotations.len())?;
     let mut out = try_vec(values, "rotation channels")?;
     match mode {
         RotationMode::Quaternion => {
@@ -416,5 +464,58 @@ mod tests {
         assert!(max_channel_jump(&aa, 4) < 0.05);
         // The angle keeps growing past 2 pi.
         assert!(aa[aa.len() - 4] > 39.0, "final angle {}", aa[aa.len() - 4]);
+    }
+
+    #[test]
+    fn previous_angles_beyond_the_range_are_refused() {
+        let q = [DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2)];
+        let euler = RotationMode::Euler(EulerOrder::Xyz);
+        let err = rotation_channels(&q, euler, Some(&[0.0, 0.0, 1e17])).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "previous value 2 (1e17) is outside the working range +-1e9"
+        );
+        let err = rotation_channels(&q, RotationMode::AxisAngle, Some(&[-2e9, 0.0, 0.0, 1.0]));
+        assert!(
+            matches!(err, Err(Error::OutOfRange { index: 0, .. })),
+            "{err:?}"
+        );
+        // quaternions only take the previous sign: any finite value
+        assert!(
+            rotation_channels(&q, RotationMode::Quaternion, Some(&[1e300, 0.0, 0.0, 0.0])).is_ok()
+        );
+    }
+
+    #[test]
+    fn previous_angles_at_the_edge_of_the_range_give_the_rotation() {
+        let q = DQuat::from_rotation_z(std::f64::consts::FRAC_PI_2);
+        for previous in [1e9, -1e9, 123_456_789.0, 7e8] {
+            let e = rotation_channels(
+                &[q],
+                RotationMode::Euler(EulerOrder::Xyz),
+                Some(&[previous; 3]),
+            )
+            .unwrap();
+            assert!(
+                e.iter().all(|v| (v - previous).abs() <= PI),
+                "{e:?} from {previous}"
+            );
+            let m = EulerOrder::Xyz.to_mat3(DVec3::new(e[0], e[1], e[2]));
+            let err = (m - DMat3::from_quat(q))
+                .to_cols_array()
+                .iter()
+                .fold(0.0f64, |a, v| a.max(v.abs()));
+            assert!(err < 1e-6, "previous {previous}: error {err}");
+        }
+    }
+
+    #[test]
+    fn more_than_max_rotations_are_refused() {
+        assert!(check_rotation_count(MAX_ROTATIONS).is_ok());
+        let err = check_rotation_count(MAX_ROTATIONS + 1).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "rotations: 16777217 rotations, more than 16777216 in one call: convert fewer rotations at once"
+        );
     }
 }
