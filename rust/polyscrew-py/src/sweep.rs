@@ -71,7 +71,7 @@ fn sweep<'py>(
     const F: &str = Sweep::NAME;
     let accuracy = match args::optional_float(F, "tolerance", tolerance)? {
         None => Accuracy::Relative(DEFAULT_TOLERANCE_REL),
-        Some(t) if t == 0.0 => Accuracy::Steps,
+        Some(0.0) => Accuracy::Steps,
         Some(t) if t.is_finite() && t > 0.0 => Accuracy::Tolerance(t),
         Some(t) => {
             return Err(PyValueError::new_err(format!(
