@@ -289,7 +289,7 @@ def main() -> None:
               f"Hausdorff {h[0]:.4f} / {h[1]:.4f}", flush=True)
         return row
 
-    seconds, (sv, st) = median_time(lambda: polyscrew.sweep(vertices, triangles, poses, steps=OUR_STEPS), 7)
+    seconds, (sv, st) = median_time(lambda: polyscrew.sweep(vertices, triangles, poses, steps=OUR_STEPS, tolerance=0), 7)
     ours = record(result["rows"], "ours (polyscrew.sweep)", f"{OUR_STEPS} steps per screw", seconds, len(st),
                   scene.error(sv, st), ours=True)
     target = max(ours["h_to_ref"], ours["h_from_ref"])

@@ -94,7 +94,7 @@ CASES = {
     ),
     "sweep 100,000 triangles x 64 screws x 8 steps": (
         "v, tr = bumpy_torus(250, 200); p = helix(65)",
-        "lambda: ps.sweep(v, tr, p, steps=8)",
+        "lambda: ps.sweep(v, tr, p, steps=8, tolerance=0)",
     ),
     "rotation_channels 1,000,000 rotations, XYZ": (
         "r = np.tile(np.eye(3), (1_000_000, 1, 1))",

@@ -9,7 +9,9 @@ The pipeline, per object (Rossignac-Kim, "Swept volumes"):
    made by Smooth Motion where there is one, otherwise at every frame of the scene's range;
    a mesh carried by a bone (:func:`bone_driver`: parented to it, or deformed rigidly by it
    through an Armature modifier) moves with the bone's world motion;
-3. `polyscrew.sweep` builds the swept mesh (each pair of samples is one screw);
+3. `polyscrew.sweep` builds the swept mesh (each pair of samples is one screw), each screw in
+   the fewest steps that keep the swept surfaces within a tolerance of the exact ones (by
+   default 0.2 % of the body's bounding radius);
 4. :func:`create_object` writes it into a new object of the "Swept Regions" collection,
    optionally closed into a manifold volume by Blender's voxel remesh.
 
@@ -53,6 +55,10 @@ class Swept:
     triangles: np.ndarray
     poses: np.ndarray
     seconds: float
+    #: The tolerance asked for (world units) and the bound the sweep met (`polyscrew.sweep`'s
+    #: `info`): every swept triangle within `error_bound` of the exact swept surface.
+    tolerance: float = 0.0
+    error_bound: float = 0.0
 
 
 def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
@@ -288,8 +294,12 @@ def world_poses(
     return np.array(poses), scales[0]
 
 
-def compute(obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps: bool) -> Swept:
-    """The swept mesh of `obj` along its world motion (nothing is created)."""
+def compute(
+    obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps: bool, tolerance: float | None = None
+) -> Swept:
+    """The swept mesh of `obj` along its world motion (nothing is created): each screw in the
+    fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
+    bounding radius; 0: exactly `steps`)."""
     scene = context.scene
     if obj.type != "MESH":
         raise SweepError(f"{obj.name}: not a mesh object")
@@ -306,10 +316,10 @@ def compute(obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps:
     poses, scale = world_poses(obj, scene, frames, driver)
     start = time.perf_counter()
     try:
-        v, t = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps)
+        v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
     except ValueError as err:
         raise SweepError(f"{obj.name}: {err}") from err
-    return Swept(obj, v, t, poses, time.perf_counter() - start)
+    return Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"])
 
 
 def collection(scene: bpy.types.Scene, t: transaction.Transaction | None = None) -> bpy.types.Collection:
@@ -388,6 +398,16 @@ def create_object(
 def triangle_count(mesh: bpy.types.Mesh) -> int:
     mesh.calc_loop_triangles()
     return len(mesh.loop_triangles)
+
+
+def mesh_triangles(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (V, 3) and loop triangles (T, 3) of `mesh` (bulk foreach_get)."""
+    mesh.calc_loop_triangles()
+    verts = np.empty(3 * len(mesh.vertices), dtype=np.float64)
+    mesh.vertices.foreach_get("co", verts)
+    tris = np.empty(3 * len(mesh.loop_triangles), dtype=np.int64)
+    mesh.loop_triangles.foreach_get("vertices", tris)
+    return verts.reshape(-1, 3), tris.reshape(-1, 3)
 
 
 # --- clearance ----------------------------------------------------------------------------

@@ -8,7 +8,7 @@ import time
 import bpy
 from bpy.props import BoolProperty, FloatProperty, IntProperty
 
-from . import swept, transaction
+from . import sweep_report, swept, transaction
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):
@@ -18,14 +18,24 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     bl_label = "Build Swept Region"
     bl_options = {"REGISTER", "UNDO"}
 
+    tolerance: FloatProperty(
+        name="Tolerance",
+        default=0.0,
+        min=0.0,
+        soft_max=0.1,
+        precision=4,
+        subtype="DISTANCE",
+        description="Largest distance of the swept surfaces from the exact ones: each span between two "
+        "sampled poses takes the fewest steps within it (0: 0.2 % of the object's bounding radius)",
+    )
     steps: IntProperty(
-        name="Steps per Span",
-        default=2,
+        name="Minimum Steps",
+        default=1,
         min=1,
         max=256,
         soft_max=32,
-        description="Quads each silhouette segment sweeps between two sampled poses (long segments "
-        "that twist are cut further)",
+        options={"HIDDEN", "SKIP_SAVE"},
+        description="Least number of steps per span (scripts; the tolerance adds more where needed)",
     )
     caps: BoolProperty(
         name="Caps", default=True, description="Include the object at the first and last pose"
@@ -57,7 +67,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
         layout.use_property_split = True
-        layout.prop(self, "steps")
+        layout.prop(self, "tolerance")
         layout.prop(self, "caps")
         layout.prop(self, "closed")
         row = layout.row()
@@ -68,9 +78,18 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
         start = time.perf_counter()
         try:
-            computed = [swept.compute(o, context, self.steps, self.caps) for o in objects]
+            tolerance = self.tolerance if self.tolerance > 0.0 else None
+            computed = [swept.compute(o, context, self.steps, self.caps, tolerance) for o in objects]
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, self.closed, self.voxel_size, t) for s in computed]
+                # Area, volume (a closed result) and the tolerance met, on each new object.
+                found = [sweep_report.measures(*swept.mesh_triangles(o.data)) for o in created]
+                for obj, s, m in zip(created, computed, found):
+                    obj["screwbender_tolerance"] = s.tolerance
+                    obj["screwbender_error_bound"] = s.error_bound
+                    obj["screwbender_area"] = m.area
+                    if m.volume is not None:
+                        obj["screwbender_volume"] = m.volume
                 t.keep_selection(context.view_layer)
                 for obj in context.selected_objects:
                     obj.select_set(False)
@@ -85,9 +104,14 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         seconds = time.perf_counter() - start
         tris = sum(swept.triangle_count(o.data) for o in created)
         sweep_ms = 1e3 * sum(s.seconds for s in computed)
+        volumes = [m.volume for m in found]
         self.report(
             {"INFO"},
-            f"Swept {len(created)} object(s): {tris} triangles in {seconds:.2f} s (sweep {sweep_ms:.1f} ms)",
+            sweep_report.summary(
+                len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
+                max(s.error_bound for s in computed), sum(m.area for m in found),
+                None if any(v is None for v in volumes) else sum(volumes),
+            ),
         )
         return {"FINISHED"}
 

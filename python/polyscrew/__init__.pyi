@@ -53,7 +53,7 @@ estimates beside the peaks measured for the largest uses (all below 160 MB).
 The module releases the GIL while it reads its input, computes and builds its output.
 """
 
-from typing import Literal, overload
+from typing import Literal, TypedDict, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -338,35 +338,68 @@ def fit_angular_velocity(
 MAX_STEPS: int
 """The largest accepted number of sweep steps per screw (4096)."""
 
+DEFAULT_SWEEP_TOLERANCE: float
+"""The default tolerance of ``sweep``, as a fraction of the body's bounding radius (0.002)."""
+
 IntArray = npt.NDArray[np.int64]
 
+class SweepInfo(TypedDict):
+    tolerance: float
+    error_bound: float
+    max_steps: int
+    generator_segments: int
+
+@overload
 def sweep(
     vertices: ArrayLike,
     triangles: ArrayLike,
     poses: ArrayLike,
-    steps: int = 8,
+    steps: int = 1,
     caps: bool = True,
-) -> tuple[FloatArray, IntArray]:
+    tolerance: float | None = None,
+    info: Literal[False] = False,
+) -> tuple[FloatArray, IntArray]: ...
+@overload
+def sweep(
+    vertices: ArrayLike,
+    triangles: ArrayLike,
+    poses: ArrayLike,
+    steps: int = 1,
+    caps: bool = True,
+    tolerance: float | None = None,
+    *,
+    info: Literal[True],
+) -> tuple[FloatArray, IntArray, SweepInfo]:
     """The region swept by a triangle mesh moving through ``poses``, as one triangle mesh.
 
     ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame; ``poses``
     (N >= 2, 4, 4) its world poses, one screw per span (Rossignac-Kim, "Swept volumes").
     Each screw's generator (silhouette edge segments and characteristic segments inside
-    faces, computed in the body frame) is swept in ``steps`` quads; ``caps`` adds the body
-    at the first and the last pose; at interior poses the faces where the motion turns back
-    are added. The result is a superset of the swept region's boundary whose excess lies
-    inside the region: its depth image from outside equals that of the union of the body's
-    instances (in the limit of fine steps).
+    faces, computed in the body frame) is swept in quads; ``caps`` adds the body at the first
+    and the last pose; at interior poses the faces where the motion turns back are added. The
+    result is a superset of the swept region's boundary whose excess lies inside the region:
+    its depth image from outside equals that of the union of the body's instances.
+
+    Accuracy: each screw takes the fewest steps (at least ``steps``) that keep every swept
+    triangle within ``tolerance`` (a length, the body's units) of the exact surface its
+    generator sweeps: the chord sagitta ``rho (1 - cos(theta / 2k))`` (``rho`` the farthest
+    generator point from the screw's axis, ``theta`` its angle, ``k`` steps) and the quads'
+    twist ``sin(theta / 2k) l / (2 n)`` (a segment of length ``l`` across the axis cut into
+    ``n`` pieces), each held to half the tolerance. ``tolerance=None``: ``DEFAULT_SWEEP_TOLERANCE``
+    (0.2 %) of the body's bounding radius (half its bounding box's diagonal);
+    ``tolerance=0``: no tolerance, exactly ``steps`` per screw.
 
     Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
-    triangles counter-clockwise seen from outside, none degenerate.
+    triangles counter-clockwise seen from outside, none degenerate; with ``info=True`` also a
+    dict: ``tolerance`` (asked for; 0 without), ``error_bound`` (the bound met: at most
+    ``tolerance`` unless ``MAX_STEPS`` capped a screw), ``max_steps``, ``generator_segments``.
 
     Raises ``ValueError`` for an empty mesh, a NaN or infinite vertex or one beyond +-1e75, a
     triangle with an index out of range or zero area (naming the triangle), a fractional
     index (``2.7``: float arrays are accepted only with whole numbers), fewer than 2 poses, a
-    non-rigid pose (naming it), ``steps`` outside ``1..=MAX_STEPS``, or a swept mesh over the
-    memory budget (checked before each screw's quads are added: 48 bytes per vertex, 36 per
-    triangle).
+    non-rigid pose (naming it), ``steps`` outside ``1..=MAX_STEPS``, a negative or non-finite
+    ``tolerance``, or a swept mesh over the memory budget (checked before each screw's quads
+    are added: 48 bytes per vertex, 36 per triangle).
     """
 
 # --- Feature-point motion design (Hofer-Pottmann-Ravani), issue 5 -------------------------

@@ -6,7 +6,7 @@ use std::hint::black_box;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use glam::{DQuat, DVec3};
-use polyscrew::sweep::{sweep, sweep_mesh, Body, SweepOptions};
+use polyscrew::sweep::{sweep, sweep_mesh, Accuracy, Body, SweepOptions};
 use polyscrew::Pose;
 
 /// A bumpy torus with `n x m` quads (`2 n m` triangles).
@@ -57,6 +57,7 @@ fn bench(c: &mut Criterion) {
     let opts = SweepOptions {
         steps: 8,
         caps: true,
+        accuracy: Accuracy::Steps,
     };
     let out = sweep_mesh(&v, &t, &poses, &opts).unwrap();
     println!(

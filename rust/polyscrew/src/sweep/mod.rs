@@ -21,10 +21,32 @@
 //!   are added there (a superset of those points, a thin band along the silhouette for a
 //!   smooth motion).
 //!
-//! A quad `(a_j, b_j, b_{j+1}, a_{j+1})` is twisted: its two triangles leave the ruled
-//! surface swept by `(a, b)` by up to `|omega x (b - a)| / (4 k)` (`omega = r S`), first order
-//! in the step. Long segments are therefore cut into `n` equal pieces with
-//! `|omega x (b - a)| / (4 k n) <= TWIST_REL * extent` (at most [`MAX_PIECES`]).
+//! ## Accuracy: steps chosen from a tolerance
+//!
+//! Two errors separate the triangles from the exact surface swept by a generator segment
+//! `(a, b)` along a screw of angle `theta` (its slide adds none: it is linear in time, on the
+//! chord as on the helix):
+//!
+//! - **chord**: a point at distance `rho` from the screw's axis moves on a helix; sampled in
+//!   `k` steps, the chord between two samples leaves it by at most the sagitta
+//!   `rho (1 - cos(theta / 2k))` (at the step's middle, in the plane across the axis);
+//! - **twist**: a quad `(a_j, b_j, b_{j+1}, a_{j+1})` is not planar; its two triangles leave
+//!   the bilinear patch through its corners by at most `|w| / 4` (at its centre, `w` the
+//!   twist vector `(b_{j+1} - b_j) - (a_{j+1} - a_j)`), and `|w| = |(R - I)(b - a)| <=
+//!   2 sin(theta / 2k) l` with `l` the length of `b - a` across the axis (`R` the step's
+//!   rotation). A segment cut into `n` pieces: `sin(theta / 2k) l / (2 n)`.
+//!
+//! The bilinear patch is within the chord error of the exact ruled surface (each of its
+//! points is an affine combination of two chord points at the same time), so every triangle
+//! point is within `chord + twist` of the body's surface at the pose of its time. With a
+//! tolerance `tol` ([`Accuracy::Tolerance`]), each span takes the fewest steps `k` (at least
+//! `steps`) with `rho_max (1 - cos(theta / 2k)) <= tol / 2` (`rho_max`: the generator's
+//! farthest point from the axis), then cuts each segment into the fewest pieces with
+//! `sin(theta / 2k) l / (2 n) <= tol / 2`. [`MAX_STEPS`] and [`MAX_PIECES`] bound both; the
+//! bound actually met is returned as [`SweptMesh::error_bound`].
+//!
+//! With [`Accuracy::Steps`] (`steps` exactly per span) long segments are cut into `n` equal
+//! pieces with `|omega x (b - a)| / (4 k n) <= TWIST_REL * extent` (at most [`MAX_PIECES`]).
 //!
 //! Triangles whose area is below [`DEGENERATE_REL`] (points on the axis of a rotation, which
 //! do not move) are left out.
@@ -61,6 +83,10 @@ pub const TWIST_REL: f64 = 5e-3;
 /// Most pieces a generator segment is cut into against twist.
 pub const MAX_PIECES: u32 = 256;
 
+/// The default tolerance of [`Accuracy::Relative`]: a fraction of the body's bounding radius
+/// (half the diagonal of its bounding box): 0.2 %.
+pub const DEFAULT_TOLERANCE_REL: f64 = 2e-3;
+
 /// Bytes the sweep counts per output vertex against the memory budget: its own (24) and
 /// the float64 copy the Python module returns (24).
 pub const BYTES_PER_OUTPUT_VERTEX: usize = 48;
@@ -74,23 +100,75 @@ fn output_footprint(vertices: usize, triangles: usize) -> Footprint {
         + Footprint::bytes(BYTES_PER_OUTPUT_TRIANGLE).times(triangles)
 }
 
+/// How [`sweep`] chooses the steps of each screw (see the module documentation).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Accuracy {
+    /// Exactly [`SweepOptions::steps`] per screw; long segments cut against
+    /// [`TWIST_REL`].
+    Steps,
+    /// Per screw the fewest steps (at least [`SweepOptions::steps`]) that keep every swept
+    /// triangle within this distance (body units, `> 0`) of the exact swept surface.
+    Tolerance(f64),
+    /// [`Accuracy::Tolerance`] of this fraction (`> 0`) of the body's bounding radius (half
+    /// the diagonal of its bounding box, `Body::extent() / 2`).
+    Relative(f64),
+}
+
+impl Default for Accuracy {
+    fn default() -> Self {
+        Self::Relative(DEFAULT_TOLERANCE_REL)
+    }
+}
+
 /// Options of [`sweep`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SweepOptions {
-    /// Steps `k` per screw, `1..=MAX_STEPS`: the sweep of each generator segment along one
-    /// screw is `k` quads.
+    /// Steps `k` per screw, `1..=MAX_STEPS`: with [`Accuracy::Steps`] the sweep of each
+    /// generator segment along one screw is `k` quads; otherwise the fewest steps per screw.
     pub steps: u32,
     /// Whether to add the body at the first and the last pose.
     pub caps: bool,
+    /// How the steps of each screw are chosen.
+    pub accuracy: Accuracy,
 }
 
 impl Default for SweepOptions {
+    /// One step at least, caps, and the tolerance [`DEFAULT_TOLERANCE_REL`] of the body's
+    /// bounding radius.
     fn default() -> Self {
         Self {
-            steps: 8,
+            steps: 1,
             caps: true,
+            accuracy: Accuracy::default(),
         }
     }
+}
+
+/// The steps and pieces that keep one screw's sweep within `tol`, and the bound they meet:
+/// `(k, bound)` for the chord error (see the module documentation), `rho_max` the farthest
+/// generator point from the axis, `theta` the screw's angle, `min_steps` the least `k`.
+fn chord_steps(theta: f64, rho_max: f64, tol: f64, min_steps: u32) -> (u32, f64) {
+    let sagitta = |k: u32| rho_max * (1.0 - (0.5 * theta / k as f64).cos());
+    if theta <= 0.0 || rho_max <= 0.0 {
+        return (min_steps, 0.0);
+    }
+    let half = 0.5 * tol;
+    // rho (1 - cos(theta / 2k)) <= half  <=>  theta / 2k <= acos(1 - half / rho).
+    let step_angle = 2.0 * (1.0 - half / rho_max).max(-1.0).acos();
+    let mut k = (theta / step_angle).ceil().clamp(1.0, MAX_STEPS as f64) as u32;
+    k = k.max(min_steps);
+    // Rounding: one more step where the closed form lands a hair above.
+    if k < MAX_STEPS && sagitta(k) > half {
+        k += 1;
+    }
+    (k, sagitta(k))
+}
+
+/// Distance of `q` from the line through `point` along the unit `axis`.
+#[inline]
+fn axis_distance(q: DVec3, point: DVec3, axis: DVec3) -> f64 {
+    let d = q - point;
+    (d - d.dot(axis) * axis).length()
 }
 
 /// The swept region's mesh (world frame) and what it is made of.
@@ -104,6 +182,15 @@ pub struct SweptMesh {
     pub generator_segments: usize,
     /// Triangles of the caps and of the interior poses' bands.
     pub cap_triangles: usize,
+    /// The tolerance asked for (body units; 0 with [`Accuracy::Steps`]).
+    pub tolerance: f64,
+    /// A bound, met by construction, on the distance of every swept triangle's points from
+    /// the exact surface swept by its generator segment: the largest chord plus twist error
+    /// over the screws (see the module documentation). At most `tolerance` unless
+    /// [`MAX_STEPS`] or [`MAX_PIECES`] capped a screw.
+    pub error_bound: f64,
+    /// The most steps taken by one screw.
+    pub max_steps: u32,
 }
 
 /// Sweeps `body` along the polyscrew through `poses` (Rossignac-Kim, "Sweeping and
@@ -114,6 +201,7 @@ pub struct SweptMesh {
 /// - [`Error::BadPose`] (`NotFinite`) for a pose with a NaN or infinite entry;
 /// - [`Error::Invalid`] (`"steps"`) for `steps` outside `1..=MAX_STEPS`, or an output of
 ///   more than `u32::MAX` vertices;
+/// - [`Error::Invalid`] (`"tolerance"`) for a tolerance that is not finite and positive;
 /// - [`Error::Memory`] before the span whose quads would take the mesh (with its Python
 ///   copy, [`BYTES_PER_OUTPUT_VERTEX`], [`BYTES_PER_OUTPUT_TRIANGLE`]) and the body's
 ///   buffers ([`body_footprint`]) over the memory budget.
@@ -135,6 +223,19 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
             reason: format!("{k} is outside 1..={MAX_STEPS}"),
         });
     }
+    let tolerance = match options.accuracy {
+        Accuracy::Steps => None,
+        Accuracy::Tolerance(t) => Some(t),
+        Accuracy::Relative(r) => Some(r * 0.5 * body.extent()),
+    };
+    if let Some(t) = tolerance {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(Error::Invalid {
+                what: "tolerance",
+                reason: format!("{t} is not a positive length"),
+            });
+        }
+    }
     let nf = body.triangles().len();
     let min_cross = DEGENERATE_REL * body.extent() * body.extent();
     let fixed = body_footprint(body.vertices().len(), nf);
@@ -149,7 +250,10 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         try_reserve(&mut out.vertices, vertices, "the swept mesh")?;
         try_reserve(&mut out.triangles, triangles, "the swept mesh")
     };
-    let mut out = SweptMesh::default();
+    let mut out = SweptMesh {
+        tolerance: tolerance.unwrap_or(0.0),
+        ..SweptMesh::default()
+    };
     let mut remap = vec![u32::MAX; body.vertices().len()];
     let all: Vec<u32> = (0..nf as u32).collect();
     if options.caps {
@@ -186,16 +290,44 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         if gen.segments.is_empty() {
             continue;
         }
+        // Steps of this screw: `k` exactly, or the fewest within the tolerance.
+        let (theta, axis, point) = (screw.angle(), screw.axis(), screw.point());
+        let (k, chord) = match tolerance {
+            None => (k, 0.0),
+            Some(tol) => {
+                let rho_max = gen
+                    .points
+                    .iter()
+                    .map(|&q| axis_distance(q, point, axis))
+                    .fold(0.0, f64::max);
+                chord_steps(theta, rho_max, tol, k)
+            }
+        };
+        out.max_steps = out.max_steps.max(k);
+        let half_step = (0.5 * theta / k as f64).sin();
         // Cut long segments against twist: extra points after the generator's own.
         points.clear();
         points.extend_from_slice(&gen.points);
         segments.clear();
         let twist_max = 4.0 * k as f64 * TWIST_REL * body.extent();
+        let mut twist_bound: f64 = 0.0;
         for s in &gen.segments {
             let [sa, sb] = s.ends;
             let (pa, pb) = (gen.points[sa as usize], gen.points[sb as usize]);
-            let twist = velocity.omega.cross(pb - pa).length();
-            let n = ((twist / twist_max).ceil() as u32).clamp(1, MAX_PIECES);
+            let n = match tolerance {
+                None => {
+                    let twist = velocity.omega.cross(pb - pa).length();
+                    ((twist / twist_max).ceil() as u32).clamp(1, MAX_PIECES)
+                }
+                Some(tol) => {
+                    // The segment's length across the axis: sin(theta / 2k) l / (2 n) <= tol / 2.
+                    let d = pb - pa;
+                    let across = (d - d.dot(axis) * axis).length();
+                    let n = ((half_step * across / tol).ceil() as u32).clamp(1, MAX_PIECES);
+                    twist_bound = twist_bound.max(half_step * across / (2.0 * n as f64));
+                    n
+                }
+            };
             let mut prev = sa;
             for piece in 1..n {
                 let next = points.len() as u32;
@@ -204,6 +336,9 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
                 prev = next;
             }
             segments.push([prev, sb]);
+        }
+        if tolerance.is_some() {
+            out.error_bound = out.error_bound.max(chord + twist_bound);
         }
         let g = points.len();
         let total = out.vertices.len() as u64 + (k as u64 + 1) * g as u64;
@@ -297,3 +432,5 @@ pub fn sweep_mesh(
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tolerance_tests;

@@ -301,6 +301,7 @@ fn translated_box_keeps_the_rims_of_its_leading_and_trailing_faces() {
         &SweepOptions {
             steps: 3,
             caps: true,
+            accuracy: Accuracy::Steps,
         },
     )
     .unwrap();
@@ -340,6 +341,7 @@ fn sweeps_have_no_degenerate_triangles_and_face_outward() {
                 &SweepOptions {
                     steps: 8,
                     caps: true,
+                    accuracy: Accuracy::Steps,
                 },
             )
             .unwrap();
@@ -365,6 +367,7 @@ fn sweeps_have_no_degenerate_triangles_and_face_outward() {
         &SweepOptions {
             steps: 4,
             caps: true,
+            accuracy: Accuracy::Steps,
         },
     )
     .unwrap();
@@ -395,6 +398,7 @@ fn polyscrew_with_a_reversal_adds_the_turning_face() {
         &SweepOptions {
             steps: 2,
             caps: false,
+            accuracy: Accuracy::Steps,
         },
     )
     .unwrap();
@@ -422,7 +426,15 @@ fn bad_input_errors() {
     let two = [Pose::IDENTITY, Pose::from_translation(DVec3::X)];
     for steps in [0, MAX_STEPS + 1] {
         assert!(matches!(
-            sweep(&body, &two, &SweepOptions { steps, caps: true }),
+            sweep(
+                &body,
+                &two,
+                &SweepOptions {
+                    steps,
+                    caps: true,
+                    accuracy: Accuracy::Steps
+                }
+            ),
             Err(Error::Invalid { what: "steps", .. })
         ));
     }
@@ -504,7 +516,7 @@ proptest! {
         caps in any::<bool>(),
     ) {
         let v: Vec<DVec3> = raw.iter().map(|&a| DVec3::from(a)).collect();
-        let r = sweep_mesh(&v, &tris, &poses, &SweepOptions { steps, caps });
+        let r = sweep_mesh(&v, &tris, &poses, &SweepOptions { steps, caps, accuracy: Accuracy::Steps });
         if let Ok(out) = r {
             for t in &out.triangles {
                 prop_assert!(t.iter().all(|&k| (k as usize) < out.vertices.len()));
@@ -525,7 +537,7 @@ proptest! {
         let v: Vec<DVec3> = raw.iter().map(|&a| DVec3::from(a)).collect();
         let tris: Vec<[i64; 3]> = tris.iter().map(|t| t.map(|i| (i % v.len()) as i64)).collect();
         let Ok(body) = Body::new(&v, &tris) else { return Ok(()); };
-        let out = sweep(&body, &poses, &SweepOptions { steps: 3, caps: true }).unwrap();
+        let out = sweep(&body, &poses, &SweepOptions { steps: 3, caps: true, accuracy: Accuracy::Steps }).unwrap();
         let s = body.extent();
         for t in &out.triangles {
             let [a, b, c] = t.map(|k| out.vertices[k as usize]);
