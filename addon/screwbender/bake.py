@@ -106,6 +106,11 @@ class Options:
     #: Smooth the current action even when it is a result of Smooth Motion (else such an
     #: object's original keys are smoothed again, replacing the earlier result).
     smooth_result: bool = False
+    #: "EVERY_STEP" (one key per baked frame) or "REDUCED" (the fewest keys within the
+    #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
+    keys: str = "EVERY_STEP"
+    key_distance: float = 0.001
+    key_angle: float = 0.008726646259971648
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -129,6 +134,9 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
         approximate=settings.approximate,
         stiffness=settings.stiffness,
         smooth_result=getattr(settings, "smooth_result", False),
+        keys=getattr(settings, "keys", "EVERY_STEP"),
+        key_distance=getattr(settings, "key_distance", 0.001),
+        key_angle=getattr(settings, "key_angle", 0.008726646259971648),
     )
 
 
@@ -149,6 +157,8 @@ class Baked:
     #: Cycles modifier modes (before, after) per (property, index) for a motion extended by
     #: its Cycles modifier and baked over one period (Repeat with Offset, Mirror).
     cycle_modes: dict | None = None
+    #: Keys: Reduced: the reduced curves (:class:`reduce.Reduced`), written instead of `values`.
+    reduced: object | None = None
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -403,6 +413,11 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
         for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
         for part in bake.parts:
+            if part.reduced is not None:
+                from . import reduce
+
+                reduce.write_reduced(bag, part.reduced, part.cycle_modes, part.cyclic)
+                continue
             for prop, values in part.values.items():
                 indices = np.flatnonzero(part.motion.scale_axes) if prop == "scale" else None
                 _write_curves(
@@ -642,6 +657,10 @@ def smooth(
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
+    if options.keys == "REDUCED" and bakes:
+        from . import reduce
+
+        reduce.reduce_bakes(bakes, options.key_distance, options.key_angle)
     with contextlib.ExitStack() as stack:
         if t is None:
             t = stack.enter_context(transaction.atomic())

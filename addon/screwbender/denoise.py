@@ -47,6 +47,11 @@ class Options:
     #: On an action that is already a result of Remove Noise: smooth that result (else the
     #: original keys again).
     smooth_result: bool = False
+    #: "EVERY_STEP" (the keys stay keys) or "REDUCED" (then the fewest keys within the
+    #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
+    keys: str = "EVERY_STEP"
+    key_distance: float = 0.001
+    key_angle: float = 0.008726646259971648
 
 
 @dataclass
@@ -319,6 +324,10 @@ def remove_noise(
                 by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
                 for part in parts:
                     _edit_keys(by_owner.get(part.owner.bone, []), part)
+                if options.keys == "REDUCED":
+                    from . import reduce
+
+                    reduce.reduce_bag(bag, [part.owner for part in parts], options.key_distance, options.key_angle)
 
             actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise"))
             if progress is not None:

@@ -1,0 +1,562 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Reduce Keys: a dense motion (a Smooth Motion or Remove Noise result, an `nla.bake` result,
+an imported capture) -> the fewest Bezier keys whose playback by Blender stays within a
+tolerance of it in world space, `polyscrew.reduce_keys`.
+
+The pipeline, as for every writing operator of the add-on:
+
+1. read: every selected owner's transform curves once (:func:`keys.read`, which packs them
+   for `polyscrew.evaluate_fcurves` with one `foreach_get` per attribute and curve), then the
+   dense motion as Blender plays it (the owner's `polyscrew.Playback`) at every frame of the
+   key range of all the owners together, plus their subframe keys: rigid poses in channel
+   space (an object's parent space, a bone's `matrix_basis`), scale apart;
+2. compute: ONE `polyscrew.reduce_keys` call for all owners of the operator. Bones whose parent
+   bone is reduced with them are given `parents` and `offsets` (the rest matrices: Blender's
+   `parent.matrix_local^-1 @ bone.matrix_local`), a root bone the armature object when that
+   is reduced too (`offset = bone.matrix_local`), so the tolerance holds in world space along
+   every chain (up to the owners' scale, which is not a rigid motion); objects are roots;
+3. write: a copy of the current action whose reduced transform curves replace the dense ones
+   (key values, Bezier handles and handle types, interpolation and easing as `reduce_keys`
+   returned them; each curve's extrapolation, Cycles modifier, group, colour and flags kept),
+   every other curve copied; the source kept and recorded for Revert (:func:`bake.new_result`,
+   made by "reduce"), all or nothing.
+
+Smooth Motion and Remove Noise with *Keys: Reduced* call :func:`reduce_bakes` (on Smooth
+Motion's dense channels, before anything is written) and :func:`reduce_bag` (on the keys
+Remove Noise has just written, inside its transaction).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+import polyscrew
+
+from . import bake, channels, keys, owners, transaction
+from .keys import SmoothError
+
+#: The default tolerance: 1 mm (at the scene's unit scale, :func:`default_distance`) and half
+#: a degree: below what an animator sees at any usual framing.
+DEFAULT_DISTANCE_M = 0.001
+DEFAULT_ANGLE = math.radians(0.5)
+
+#: Smooth Motion and Remove Noise: which keys they write.
+KEY_MODES = (
+    ("EVERY_STEP", "Every Step", "One key per baked frame (per Step), as nla.bake writes them"),
+    (
+        "REDUCED",
+        "Reduced",
+        "The fewest Bezier keys whose playback stays within the tolerance of the result in world space "
+        "(editable keys), in the same operator",
+    ),
+)
+
+#: Most dense frames one Reduce Keys reads per owner (a longer range is refused).
+MAX_FRAMES = 1_000_000
+
+
+@dataclass
+class Options:
+    """What Reduce Keys needs besides the owners."""
+
+    #: Largest distance (Blender units) any point of the body may move from the dense motion.
+    distance: float = DEFAULT_DISTANCE_M
+    #: Largest rotation difference (radians).
+    angle: float = DEFAULT_ANGLE
+    #: On an action that is already a result of Reduce Keys: reduce that result (else the
+    #: original keys again, replacing the earlier result).
+    reduce_result: bool = False
+
+
+def default_distance(scene: bpy.types.Scene) -> float:
+    """1 mm in Blender units at the scene's unit scale (`unit_settings.scale_length`)."""
+    scale = float(scene.unit_settings.scale_length)
+    return DEFAULT_DISTANCE_M / scale if scale > 0.0 else DEFAULT_DISTANCE_M
+
+
+def body_radius(owner: owners.Owner) -> float:
+    """How far the owner's body reaches from its origin: an object's bounding box corner
+    furthest from its origin (its scale applied), an empty's display size, a bone's length."""
+    if owner.bone:
+        return float(owner.obj.data.bones[owner.bone].length)
+    obj = owner.obj
+    if obj.type == "EMPTY":
+        return float(obj.empty_display_size) * float(max(abs(s) for s in obj.scale))
+    corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64) * np.abs(np.array(obj.scale))
+    return float(np.max(np.linalg.norm(corners, axis=1))) if len(corners) else 0.0
+
+
+@dataclass
+class Item:
+    """One owner's dense motion, ready for `polyscrew.reduce_keys`."""
+
+    owner: owners.Owner
+    mode: str
+    #: (N, 4, 4) rigid poses in channel space and (N, 3) positive scales at the batch's frames.
+    poses: np.ndarray
+    scales: np.ndarray
+    #: Which of location, rotation, scale the owner keys.
+    channels: np.ndarray
+    #: (N - 1,) spans that are steps (CONSTANT pops) in the source.
+    constant: np.ndarray
+    #: The rotation channel values at the first frame (4,), as the source has them.
+    start: np.ndarray
+    radius: float
+    #: (property, index) of the curves to write.
+    written: list[tuple[str, int]]
+    #: Key frames before (distinct frames over its transform curves).
+    keys_before: int = 0
+    #: Whether its curves repeat (Cycles modifier).
+    cyclic: bool = False
+
+
+@dataclass
+class Curve:
+    """One reduced F-curve: keys (K, 2) and handles, enums as Blender's RNA identifiers' codes."""
+
+    co: np.ndarray
+    handle_left: np.ndarray
+    handle_right: np.ndarray
+    interpolation: np.ndarray
+    easing: np.ndarray
+    handle_type: np.ndarray
+
+
+@dataclass
+class Reduced:
+    """One owner's reduced curves and what was measured."""
+
+    item: Item
+    #: (property, index) -> its curve (only those in `item.written`).
+    curves: dict[tuple[str, int], Curve]
+    keys: int
+    distance_error: float
+    angle_error: float
+
+
+def _rigid(matrix) -> np.ndarray:
+    """A 4x4 rigid matrix from a Blender matrix (float32 rest matrices: rotation made exactly
+    orthonormal by the polar decomposition, translation kept)."""
+    m = np.array(matrix, dtype=np.float64)
+    u, _, vt = np.linalg.svd(m[:3, :3])
+    rot = u @ vt
+    if np.linalg.det(rot) < 0:
+        u[:, -1] *= -1
+        rot = u @ vt
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rot, m[:3, 3]
+    return out
+
+
+def parents_of(items: list[Item]) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """`parents` and `offsets` for `polyscrew.reduce_keys`: a bone whose parent bone is in the
+    batch (and inherits its rotation) is that bone's child through the rest matrices; a root
+    bone is the armature object's child when that is in the batch. None when no owner has a
+    parent in the batch."""
+    index = {(it.owner.obj.as_pointer(), it.owner.bone): i for i, it in enumerate(items)}
+    parents = np.full(len(items), -1, dtype=np.int64)
+    offsets = np.tile(np.eye(4), (len(items), 1, 1))
+    for i, it in enumerate(items):
+        if not it.owner.bone:
+            continue
+        bone = it.owner.obj.data.bones[it.owner.bone]
+        if not bone.use_inherit_rotation:
+            continue
+        ptr = it.owner.obj.as_pointer()
+        if bone.parent is not None:
+            j = index.get((ptr, bone.parent.name))
+            if j is not None:
+                parents[i] = j
+                offsets[i] = np.linalg.inv(_rigid(bone.parent.matrix_local)) @ _rigid(bone.matrix_local)
+        else:
+            j = index.get((ptr, ""))
+            if j is not None:
+                parents[i], offsets[i] = j, _rigid(bone.matrix_local)
+    if not (parents >= 0).any():
+        return None, None
+    return parents, offsets
+
+
+def _pad4(values: np.ndarray) -> np.ndarray:
+    out = np.zeros(4)
+    out[: len(values)] = values
+    return out
+
+
+def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool = False) -> list[Reduced]:
+    """One `polyscrew.reduce_keys` call for every item (all at `frames`). Raises SmoothError
+    with polyscrew's message."""
+    parents, offsets = parents_of(items)
+    scaled = any(it.channels[2] for it in items)
+    try:
+        r = polyscrew.reduce_keys(
+            np.stack([it.poses for it in items]),
+            np.ascontiguousarray(frames, dtype=np.float64),
+            [it.mode for it in items],
+            np.array([it.radius for it in items], dtype=np.float64),
+            float(options.distance),
+            float(options.angle),
+            scales=np.stack([it.scales for it in items]) if scaled else None,
+            channels=np.stack([it.channels for it in items]),
+            parents=parents,
+            offsets=offsets,
+            constant=np.stack([it.constant for it in items]) if any(it.constant.any() for it in items) else None,
+            cyclic=cyclic,
+            start=np.stack([it.start for it in items]),
+        )
+    except (ValueError, TypeError, MemoryError) as err:
+        names = ", ".join(it.owner.name for it in items[:3]) + (" ..." if len(items) > 3 else "")
+        raise SmoothError(f"{names}: {err}") from err
+    offsets_ = np.asarray(r["offsets"])
+    owner_of = np.asarray(r["owner"])
+    wanted = [set(it.written) for it in items]
+    curves: list[dict] = [{} for _ in items]
+    for c, (b, path, index) in enumerate(zip(owner_of.tolist(), r["path"], np.asarray(r["index"]).tolist())):
+        if (path, index) not in wanted[b]:
+            continue
+        lo, hi = int(offsets_[c]), int(offsets_[c + 1])
+        curves[b][path, index] = Curve(
+            co=np.asarray(r["co"])[lo:hi],
+            handle_left=np.asarray(r["handle_left"])[lo:hi],
+            handle_right=np.asarray(r["handle_right"])[lo:hi],
+            interpolation=np.asarray(r["interpolation"])[lo:hi],
+            easing=np.asarray(r["easing"])[lo:hi],
+            handle_type=np.asarray(r["handle_type"])[lo:hi],
+        )
+    return [
+        Reduced(
+            item=it, curves=curves[b], keys=int(r["keys"][b]),
+            distance_error=float(r["distance_error"][b]), angle_error=float(r["angle_error"][b]),
+        )
+        for b, it in enumerate(items)
+    ]
+
+
+# Reading ---------------------------------------------------------------------------------
+
+
+def dense_frames(key_frames: list[np.ndarray]) -> np.ndarray:
+    """Every whole frame from the first key to the last of all owners, plus every key frame
+    (subframe keys included), strictly increasing (frames closer than
+    :data:`keys.FRAME_TOLERANCE` are one)."""
+    first = min(float(f[0]) for f in key_frames)
+    last = max(float(f[-1]) for f in key_frames)
+    if last - first > MAX_FRAMES:
+        raise SmoothError(f"keys from frame {first:g} to {last:g}: Reduce Keys reads at most {MAX_FRAMES:,} frames")
+    whole = np.arange(math.ceil(first), math.floor(last) + 1, dtype=np.float64)
+    merged = np.unique(np.concatenate([whole] + [np.asarray(f, dtype=np.float64) for f in key_frames]))
+    keep = np.concatenate(([True], np.diff(merged) > keys.FRAME_TOLERANCE))
+    return merged[keep]
+
+
+def _steps(source, frames: np.ndarray) -> np.ndarray:
+    """(N - 1,) the spans between dense frames that Blender plays as a step: the channels
+    hold the first frame's values exactly through the span (at a quarter, half and three
+    quarters and just before its end) and jump at its end (a CONSTANT pop)."""
+    a, b = frames[:-1], frames[1:]
+    width = b - a
+    probes = [a + 0.25 * width, a + 0.5 * width, a + 0.75 * width, b - np.minimum(1e-3, 0.01 * width)]
+    n = len(a)
+    values = source.channels(np.concatenate([frames] + probes))
+    stacked = np.concatenate([values[k] for k in sorted(values)], axis=1)
+    at, inside = stacked[: len(frames)], stacked[len(frames):].reshape(len(probes), n, -1)
+    held = np.all(inside == at[None, :-1], axis=(0, 2))
+    return held & np.any(at[1:] != at[:-1], axis=1)
+
+
+def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> Item:
+    """The owner's dense motion at `frames` as Blender plays its curves."""
+    source = motion.source
+    mode = motion.rotation_mode
+    rot_path = keys.rotation_path(mode)
+    played = source.channels(frames)
+    location = played["location"] if motion.located else np.zeros((len(frames), 3))
+    rotation = played[rot_path]
+    scale = played["scale"]
+    for label, values in (("location", location), (rot_path, rotation), ("scale", scale)):
+        if not np.all(np.isfinite(values)):
+            raise SmoothError(f"{owner.name}: {label} is not finite between the keys: skipped")
+    scale_axes = motion.scale_axes
+    if np.any((scale <= 0.0) & scale_axes):
+        raise SmoothError(f"{owner.name}: keyed scale reaches zero or below: Reduce Keys needs a positive scale: skipped")
+    columns = set(source.columns)
+    located = motion.located and any(p == "location" for p, _ in columns)
+    rotated = any(p == rot_path for p, _ in columns)
+    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
+    written = [("location", i) for i in range(3)] if located else []
+    written += [(rot_path, i) for i in range(size)] if rotated else []
+    written += [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
+    return Item(
+        owner=owner,
+        mode=mode,
+        poses=keys.compose(location, keys.rotation_matrices(rotation, mode)),
+        scales=np.where(scale_axes, scale, 1.0),
+        channels=np.array([located, rotated, bool(scale_axes.any())]),
+        constant=_steps(source, frames),
+        start=_pad4(rotation[0]),
+        radius=body_radius(owner),
+        written=written,
+        keys_before=len(motion.frames),
+        cyclic=motion.cyclic,
+    )
+
+
+def read_motion(owner: owners.Owner, fcurves: list, action=None, slot: str = "") -> keys.KeyedMotion:
+    """The owner's keys, read once (no analysis); refuses curves Blender plays in a way the
+    add-on cannot evaluate (the reduced keys must match Blender's playback)."""
+    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False)
+    if motion.source is None:
+        raise SmoothError(f"{owner.name}: {'; '.join(motion.kept)}; Reduce Keys needs Blender's playback: skipped")
+    return motion
+
+
+def batch(pairs: list[tuple[owners.Owner, keys.KeyedMotion]]) -> tuple[list[Item], np.ndarray, bool]:
+    """Items of every (owner, motion) at the dense frames of them all; whether they form one
+    cycle (every owner's curves repeat and its first pose is its last)."""
+    frames = dense_frames([m.frames for _, m in pairs])
+    items = [_item(o, m, frames) for o, m in pairs]
+    cyclic = all(
+        it.cyclic
+        and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
+        and np.allclose(it.scales[0], it.scales[-1], atol=1e-6)
+        for it in items
+    )
+    return items, frames, cyclic
+
+
+# Writing ---------------------------------------------------------------------------------
+
+
+def _enum_values(prop: str, names: tuple[str, ...]) -> np.ndarray:
+    """Blender's RNA values of `Keyframe.<prop>` for polyscrew's codes (index into `names`)."""
+    items = bpy.types.Keyframe.bl_rna.properties[prop].enum_items
+    return np.array([items[name].value for name in names], dtype=np.int64)
+
+
+_ENUMS: dict[str, np.ndarray] = {}
+
+
+def _enum(prop: str) -> np.ndarray:
+    if prop not in _ENUMS:
+        names = {
+            "interpolation": polyscrew.INTERPOLATIONS,
+            "easing": polyscrew.EASINGS,
+            "handle_left_type": polyscrew.HANDLE_TYPES,
+        }[prop]
+        _ENUMS[prop] = _enum_values(prop, tuple(names))
+    return _ENUMS[prop]
+
+
+#: F-curve properties kept when a curve's keys are replaced.
+_KEPT = ("extrapolation", "color_mode", "color", "hide", "lock", "select", "auto_smoothing")
+
+
+def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, cycle: tuple | None = None) -> None:
+    """Replaces the curve (`prop`, `index`) of `owner` in `bag` (made when missing) by the
+    reduced keys: co, handles, interpolation, easing, handle types (one `foreach_set` each).
+    The old curve's extrapolation, modifiers, group, colour and flags are kept; `cycle`
+    (mode_before, mode_after) adds a Cycles modifier to a new curve."""
+    path = owner.path(prop)
+    old = channels.find_fcurve(bag, path, index)
+    kept, group = {}, owner.group
+    if old is not None:
+        kept = {name: getattr(old, name) for name in _KEPT if hasattr(old, name)}
+        kept["color"] = tuple(old.color)
+        group = old.group.name if old.group is not None else ""
+        # the old modifiers' settings, read before the curve goes, set on the new one below
+        snapshot = []
+        for m in old.modifiers:
+            values = {}
+            for p in m.bl_rna.properties:
+                if p.is_readonly or p.identifier in ("rna_type", "type"):
+                    continue
+                if p.type in ("BOOLEAN", "INT", "FLOAT", "ENUM"):
+                    value = getattr(m, p.identifier)
+                    values[p.identifier] = tuple(value) if hasattr(value, "__len__") and not isinstance(value, str) else value
+            snapshot.append((m.type, values))
+        channels.remove_fcurve(bag, old)
+    else:
+        snapshot = [("CYCLES", {"mode_before": cycle[0], "mode_after": cycle[1]})] if cycle else []
+    fc = channels.new_fcurve(bag, path, index, group)
+    n = len(curve.co)
+    points = fc.keyframe_points
+    points.add(n)
+    points.foreach_set("co", np.asarray(curve.co, dtype=np.float32).ravel())
+    points.foreach_set("handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
+    points.foreach_set("handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
+    points.foreach_set("interpolation", tuple(_enum("interpolation")[curve.interpolation].tolist()))
+    if np.any(curve.easing != 0):
+        points.foreach_set("easing", tuple(_enum("easing")[curve.easing].tolist()))
+    types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
+    points.foreach_set("handle_left_type", types)
+    points.foreach_set("handle_right_type", types)
+    for name, value in kept.items():
+        with contextlib.suppress(AttributeError, TypeError, ValueError):
+            setattr(fc, name, value)
+    for kind, values in snapshot:
+        modifier = fc.modifiers.new(kind)
+        for name, value in values.items():
+            with contextlib.suppress(AttributeError, TypeError, ValueError):
+                setattr(modifier, name, value)
+    # Keys are sorted and their handles are the fitted ones: no fcurve.update(), which would
+    # recompute them.
+
+
+def write_reduced(bag, reduced: Reduced, cycle_modes: dict | None = None, cyclic: bool = False) -> None:
+    """Every reduced curve of one owner into `bag`."""
+    for (prop, index), curve in reduced.curves.items():
+        cycle = None
+        if cycle_modes and (prop, index) in cycle_modes:
+            cycle = cycle_modes[prop, index]
+        elif cyclic:
+            cycle = ("REPEAT", "REPEAT")
+        write_curve(bag, reduced.item.owner, prop, index, curve, cycle)
+
+
+# The operator's pipeline -----------------------------------------------------------------
+
+
+@dataclass
+class Result:
+    """What Reduce Keys did."""
+
+    actions: list[bpy.types.Action]
+    owners: list[str]
+    skipped: list[str]
+    notes: list[str] = field(default_factory=list)
+    keys_before: int = 0
+    keys_after: int = 0
+    frames: int = 0
+    distance_error: float = 0.0
+    angle_error: float = 0.0
+
+
+def reduce_keys(
+    selection: Iterable,
+    options: Options,
+    progress: Callable[[int, int], None] | None = None,
+    t: transaction.Transaction | None = None,
+) -> Result:
+    """Reduces the keys of the owners in `selection` (objects or :class:`owners.Owner`s);
+    owners animated by one action get one new action. Everything is read and reduced (one
+    `polyscrew.reduce_keys` call) before anything is written; the writing is all or nothing."""
+    selection = [owners.as_owner(item) for item in selection]
+    groups: dict[tuple, list[owners.Owner]] = {}
+    skipped = []
+    for owner in selection:
+        adt = owner.obj.animation_data
+        if adt is None or adt.action is None:
+            skipped.append(f"{owner.name}: no animation (no active action): skipped")
+            continue
+        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
+    pairs, plans, notes, rerun = [], [], [], []
+    for members in groups.values():
+        first = members[0].obj
+        current = first.animation_data.action
+        identifier = channels.slot_identifier(first)
+        source, slot = current, identifier
+        found = bake.original_of(current, "reduce")
+        if found is not None and not options.reduce_result:
+            source, slot = found
+        by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
+        done = []
+        for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
+            try:
+                motion = read_motion(owner, by_owner.get(owner.bone, []), None if source is current else source, slot)
+            except SmoothError as err:
+                skipped.append(str(err))
+                continue
+            pairs.append((owner, motion))
+            done.append(owner)
+        if done:
+            plans.append((bake.users_of(current, identifier) or [first], source, current, identifier, done))
+            if source is not current:
+                rerun.append(first.name)
+    if rerun:
+        notes.append(f"reduced the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
+    if not pairs:
+        return Result(actions=[], owners=[], skipped=skipped, notes=notes)
+    if progress is not None:
+        progress(1, 3)
+    items, frames, cyclic = batch(pairs)
+    reduced = {(r.item.owner.obj.as_pointer(), r.item.owner.bone): r for r in solve(items, frames, options, cyclic)}
+    if progress is not None:
+        progress(2, 3)
+    actions = []
+    with contextlib.ExitStack() as stack:
+        if t is None:
+            t = stack.enter_context(transaction.atomic())
+        for objects, source, current, identifier, done in plans:
+            parts = [reduced[(o.obj.as_pointer(), o.bone)] for o in done]
+
+            def edit(bag, parts=parts) -> None:
+                for part in parts:
+                    write_reduced(bag, part)
+
+            actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce"))
+    parts = list(reduced.values())
+    return Result(
+        actions=actions,
+        owners=[p.item.owner.name for p in parts],
+        skipped=skipped,
+        notes=notes,
+        keys_before=sum(p.item.keys_before for p in parts),
+        keys_after=sum(p.keys for p in parts),
+        frames=len(frames),
+        distance_error=max(p.distance_error for p in parts),
+        angle_error=max(p.angle_error for p in parts),
+    )
+
+
+# Smooth Motion and Remove Noise with Keys: Reduced -----------------------------------------
+
+
+def reduce_bakes(bakes: list, distance: float, angle: float) -> None:
+    """Smooth Motion, Keys: Reduced: reduces the dense channels of every part of `bakes`
+    (:class:`bake.ActionBake`) before anything is written, setting each part's `reduced`.
+    One `polyscrew.reduce_keys` call per set of baked frames (usually one: all owners of the
+    operator)."""
+    batches: dict[tuple, list] = {}
+    for action_bake in bakes:
+        for part in action_bake.parts:
+            batches.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
+    options = Options(distance=distance, angle=angle)
+    for (_, cyclic), parts in batches.items():
+        items = []
+        for part in parts:
+            motion, owner = part.motion, part.owner
+            mode = motion.rotation_mode
+            rotation = part.values[keys.rotation_path(mode)]
+            n = len(part.frames)
+            location = part.values.get("location", np.zeros((n, 3)))
+            scales = np.ones((n, 3))
+            if "scale" in part.values:
+                scales[:, motion.scale_axes] = part.values["scale"]
+            constant = np.zeros(n - 1, dtype=bool) if part.constant is None else np.asarray(part.constant[:-1], bool)
+            items.append(
+                Item(
+                    owner=owner, mode=mode, poses=keys.compose(location, keys.rotation_matrices(rotation, mode)),
+                    scales=scales, channels=np.array(["location" in part.values, True, "scale" in part.values]),
+                    constant=constant, start=_pad4(rotation[0]), radius=body_radius(owner), written=part.written,
+                )
+            )
+        for part, result in zip(parts, solve(items, parts[0].frames, options, cyclic)):
+            part.reduced = result
+
+
+def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) -> list[Reduced]:
+    """Remove Noise, Keys: Reduced: the transform curves of `members` in `bag` (the new
+    action, just written) replaced by their reduction (one `polyscrew.reduce_keys` call).
+    Raises SmoothError (the caller's transaction undoes everything)."""
+    by_owner = owners.curves_by_owner(channels.fcurves(bag))
+    pairs = [(o, read_motion(o, by_owner.get(o.bone, []))) for o in members]
+    items, frames, cyclic = batch(pairs)
+    results = solve(items, frames, Options(distance=distance, angle=angle), cyclic)
+    for result in results:
+        write_reduced(bag, result)
+    return results
