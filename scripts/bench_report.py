@@ -539,7 +539,84 @@ class Report:
 
     def later_sections(self) -> None:
         self.sweep_section()
+        self.reduce_section()
         self.papers_section()
+
+    def reduce_section(self) -> None:
+        """Reduce Keys against graph.decimate, from scripts/bench_reduce.py's JSON (issue 26)."""
+        self.w("## Reduce Keys against graph.decimate", "")
+        js = self.run / "reduce.json"
+        if not js.exists():
+            path = self.run / "reduce.missing"
+            self.w("not available: " + (path.read_text().strip() if path.exists() else "not run"), "")
+            self.targets.append(("Reduce Keys <= 0.6x the keys of the best graph.decimate margin", "not measured", "n/a"))
+            return
+        d = json.loads(js.read_text())
+        self.w(f"`scripts/bench_reduce.py`, Blender {d['blender']}. Ours: the Reduce Keys operator (all of it: read, "
+               "one `polyscrew.reduce_keys` call, write). Theirs: `graph.decimate` in ERROR mode, every other option at "
+               f"its default, its margin bisected ({d['steps']} steps in log scale) for the largest value whose result "
+               "meets the same world-space tolerance; its time is one decimate call at that margin. Both results "
+               "checked by Blender's own playback (`frame_set` at every frame and 3 subframes between frames, every "
+               "owner's world matrix) against the dense clip's playback: the largest distance of a point of the body "
+               "(bounding box corners, a bone's head and tail) and the largest rotation angle. Keys: keyframe points "
+               "over the transform curves; % of frames: distinct key frames per owner over frames x owners. "
+               f"Within: the share of (owner, sample) pairs within the tolerance (+{d['slack']:g} for float32 "
+               "world matrices).", "",
+               "| clip | tolerance | ours: keys | % of frames | error (mm / deg) | within | decimate: margin | keys | "
+               "% of frames | error (mm / deg) | within | keys ours / decimate | time ours | time decimate | "
+               "time ours / decimate |",
+               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        key_ratios, time_ratios, within, captured_share = [], [], [], []
+        for clip in d["clips"]:
+            for c in clip["cases"]:
+                o, t = c["ours"], c["decimate"]
+                within.append(o["within"])
+                if clip["captured"] and c["distance"] == 0.001:
+                    captured_share.append((clip["name"], o["fraction"]))
+                tol = f"{1000 * c['distance']:g} mm / {c['angle']:g} deg"
+                ours = (f"{o['points']:,} | {100 * o['fraction']:.1f} % | {1000 * o['distance']:.3g} / {o['angle']:.3g} | "
+                        f"{100 * o['within']:.2f} %")
+                if t is None:
+                    self.w(f"| {clip['label']} | {tol} | {ours} | no margin meets it | - | - | - | - | - | "
+                           f"{fmt_seconds(o['time'])} | - | - |")
+                    continue
+                kr, tr = o["points"] / t["points"], o["time"] / t["time"]
+                key_ratios.append((clip["name"], kr))
+                time_ratios.append((clip["name"], tr))
+                self.w(f"| {clip['label']} | {tol} | {ours} | {t['margin']:.3g} | {t['points']:,} | "
+                       f"{100 * t['fraction']:.1f} % | {1000 * t['distance']:.3g} / {t['angle']:.3g} | "
+                       f"{100 * t['within']:.2f} % | {kr:.2f} | {fmt_seconds(o['time'])} | {fmt_seconds(t['time'])} | "
+                       f"{tr:.2f} |")
+        self.w("")
+        smooth = d.get("smooth", [])
+        if smooth:
+            self.w("Smooth Motion with Keys: Reduced (default tolerance, 1 mm / 0.5 deg) against Every Step, the whole "
+                   "operator, median of runs:", "", "| case | Every Step | keys | Reduced | keys | Reduced / Every Step |",
+                   "| --- | --- | --- | --- | --- | --- |")
+            for s_ in smooth:
+                self.w(f"| {s_['case']} | {fmt_seconds(s_['every_step'])} | {s_['every_keys']:,} | "
+                       f"{fmt_seconds(s_['reduced'])} | {s_['reduced_keys']:,} | {s_['reduced'] / s_['every_step']:.2f} |")
+            self.w("")
+        self.w(f"The whole benchmark ran in {d['seconds']:.0f} s.", "")
+        if key_ratios:
+            worst = max(r for _, r in key_ratios)
+            self.targets.append(("Reduce Keys <= 0.6x the keys of the best graph.decimate margin (every clip, every "
+                                 "tolerance)", f"at most {worst:.2f}x", verdict(worst <= 0.6)))
+        if captured_share:
+            self.targets.append(("<= 10 % of frames on captured motion at 1 mm / 0.5 deg",
+                                 ", ".join(f"{n} {100 * f:.1f} %" for n, f in captured_share),
+                                 verdict(max(f for _, f in captured_share) <= 0.10)))
+        if within:
+            self.targets.append(("Reduce Keys within the tolerance at 100 % of checked samples",
+                                 f"at least {100 * min(within):.2f} %", verdict(min(within) >= 1.0)))
+        if time_ratios:
+            worst = max(r for _, r in time_ratios)
+            self.targets.append(("Reduce Keys <= 2x graph.decimate's time", f"at most {worst:.2f}x",
+                                 verdict(worst <= 2.0)))
+        if smooth:
+            worst = max(s_["reduced"] / s_["every_step"] for s_ in smooth)
+            self.targets.append(("Smooth Motion with Reduced no slower than Every Step", f"at most {worst:.2f}x",
+                                 verdict(worst <= 1.0)))
 
     def sweep_section(self) -> None:
         self.w("## Sweep against peers", "")

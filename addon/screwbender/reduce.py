@@ -8,9 +8,11 @@ The pipeline, as for every writing operator of the add-on:
 1. read: every selected owner's transform curves once (:func:`keys.read`, which packs them
    for `polyscrew.evaluate_fcurves` with one `foreach_get` per attribute and curve), then the
    dense motion as Blender plays it (the owner's `polyscrew.Playback`) at every frame of the
-   key range of all the owners together, plus their subframe keys: rigid poses in channel
-   space (an object's parent space, a bone's `matrix_basis`), scale apart;
-2. compute: ONE `polyscrew.reduce_keys` call for all owners of the operator. Bones whose parent
+   key range, plus its subframe keys: rigid poses in channel space (an object's parent
+   space, a bone's `matrix_basis`), scale apart;
+2. compute: ONE `polyscrew.reduce_keys` call for all owners of the operator keyed over the
+   same frames (a rig, a capture; owners keyed over other ranges are a call each, so that
+   each keeps its own range, which a Cycles modifier repeats). Bones whose parent
    bone is reduced with them are given `parents` and `offsets` (the rest matrices: Blender's
    `parent.matrix_local^-1 @ bone.matrix_local`), a root bone the armature object when that
    is reduced too (`offset = bone.matrix_local`), so the tolerance holds in world space along
@@ -315,18 +317,26 @@ def read_motion(owner: owners.Owner, fcurves: list, action=None, slot: str = "")
     return motion
 
 
-def batch(pairs: list[tuple[owners.Owner, keys.KeyedMotion]]) -> tuple[list[Item], np.ndarray, bool]:
-    """Items of every (owner, motion) at the dense frames of them all; whether they form one
-    cycle (every owner's curves repeat and its first pose is its last)."""
-    frames = dense_frames([m.frames for _, m in pairs])
-    items = [_item(o, m, frames) for o, m in pairs]
-    cyclic = all(
-        it.cyclic
-        and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
-        and np.allclose(it.scales[0], it.scales[-1], atol=1e-6)
-        for it in items
-    )
-    return items, frames, cyclic
+def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]]) -> list[tuple[list[Item], np.ndarray, bool]]:
+    """The (owner, motion) pairs as items at their dense frames, one batch per set of dense
+    frames (owners keyed over the same range: a rig, a capture, are one batch; an owner keeps
+    its own range, which a Cycles modifier repeats); and whether a batch is one cycle (every
+    owner's curves repeat and its first pose is its last)."""
+    grouped: dict[bytes, tuple[np.ndarray, list]] = {}
+    for owner, motion in pairs:
+        frames = dense_frames([motion.frames])
+        grouped.setdefault(frames.tobytes(), (frames, []))[1].append((owner, motion))
+    out = []
+    for frames, members in grouped.values():
+        items = [_item(o, m, frames) for o, m in members]
+        cyclic = all(
+            it.cyclic
+            and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
+            and np.allclose(it.scales[0], it.scales[-1], atol=1e-6)
+            for it in items
+        )
+        out.append((items, frames, cyclic))
+    return out
 
 
 # Writing ---------------------------------------------------------------------------------
@@ -483,8 +493,11 @@ def reduce_keys(
         return Result(actions=[], owners=[], skipped=skipped, notes=notes)
     if progress is not None:
         progress(1, 3)
-    items, frames, cyclic = batch(pairs)
-    reduced = {(r.item.owner.obj.as_pointer(), r.item.owner.bone): r for r in solve(items, frames, options, cyclic)}
+    reduced = {
+        (r.item.owner.obj.as_pointer(), r.item.owner.bone): r
+        for items, frames, cyclic in batches(pairs)
+        for r in solve(items, frames, options, cyclic)
+    }
     if progress is not None:
         progress(2, 3)
     actions = []
@@ -507,7 +520,7 @@ def reduce_keys(
         notes=notes,
         keys_before=sum(p.item.keys_before for p in parts),
         keys_after=sum(p.keys for p in parts),
-        frames=len(frames),
+        frames=sum(len(p.item.poses) for p in parts),
         distance_error=max(p.distance_error for p in parts),
         angle_error=max(p.angle_error for p in parts),
     )
@@ -555,8 +568,8 @@ def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) 
     Raises SmoothError (the caller's transaction undoes everything)."""
     by_owner = owners.curves_by_owner(channels.fcurves(bag))
     pairs = [(o, read_motion(o, by_owner.get(o.bone, []))) for o in members]
-    items, frames, cyclic = batch(pairs)
-    results = solve(items, frames, Options(distance=distance, angle=angle), cyclic)
+    options = Options(distance=distance, angle=angle)
+    results = [r for items, frames, cyclic in batches(pairs) for r in solve(items, frames, options, cyclic)]
     for result in results:
         write_reduced(bag, result)
     return results

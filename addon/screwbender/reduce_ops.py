@@ -107,11 +107,11 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
             return {"CANCELLED"}
         bake_ops.report_skipped(self, result.skipped, "WARNING")
         bake_ops.report_notes(self, result.notes)
-        share = 100.0 * result.keys_after / max(result.frames * len(result.owners), 1)
+        share = 100.0 * result.keys_after / max(result.frames, 1)
         self.report(
             {"INFO"},
             f"Reduced the keys of {len(result.owners)}: {bake.summary(result.owners)}: {result.keys_before:,} key frames "
-            f"-> {result.keys_after:,} ({share:.1f} % of {result.frames:,} frames); largest error "
+            f"-> {result.keys_after:,} ({share:.1f} % of the frames); largest error "
             f"{result.distance_error:.3g} (tolerance {self.distance:.3g}) and "
             f"{math.degrees(result.angle_error):.3g} degrees (tolerance {math.degrees(self.angle):.3g})",
         )

@@ -232,7 +232,7 @@ def test_reduce_keys_on_a_remove_noise_result(sb):
 
 
 def test_undo_restores_the_scene(sb):
-    obj = dense_object("U")
+    dense_object("U")
     bpy.ops.ed.undo_push(message="before reducing")
     before = h.snapshot_scene()
     assert bpy.ops.screwbender.reduce_keys("EXEC_DEFAULT", True) == {"FINISHED"}
@@ -240,7 +240,8 @@ def test_undo_restores_the_scene(sb):
     assert bpy.ops.ed.undo() == {"FINISHED"}
     assert h.snapshot_scene() == before
     assert bpy.data.objects["U"].animation_data.action.name == "UAction"
-    assert obj.name == "U"
+    assert bpy.ops.ed.redo() == {"FINISHED"}
+    assert bpy.data.objects["U"].animation_data.action.name == "UAction.reduce"
 
 
 def test_a_failure_halfway_changes_nothing(sb):
