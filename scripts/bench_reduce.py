@@ -551,7 +551,7 @@ def smooth_timing(runs: int) -> list[dict]:
                     objects, kw = [rig], {"armature": "BONES"}
                 select(objects)
                 start = time.perf_counter()
-                result = bpy.ops.screwbender.smooth(keys=mode, **kw)
+                result = bpy.ops.screwbender.smooth(key_mode=mode, **kw)
                 times[mode].append(time.perf_counter() - start)
                 assert result == {"FINISHED"}, result
                 owners = [(o, b.name) for o in objects if o.type == "ARMATURE" for b in o.pose.bones] or \

@@ -108,7 +108,7 @@ class Options:
     smooth_result: bool = False
     #: "EVERY_STEP" (one key per baked frame) or "REDUCED" (the fewest keys within the
     #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
-    keys: str = "EVERY_STEP"
+    key_mode: str = "EVERY_STEP"
     key_distance: float = 0.001
     key_angle: float = 0.008726646259971648
 
@@ -134,7 +134,7 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
         approximate=settings.approximate,
         stiffness=settings.stiffness,
         smooth_result=getattr(settings, "smooth_result", False),
-        keys=getattr(settings, "keys", "EVERY_STEP"),
+        key_mode=getattr(settings, "key_mode", "EVERY_STEP"),
         key_distance=getattr(settings, "key_distance", 0.001),
         key_angle=getattr(settings, "key_angle", 0.008726646259971648),
     )
@@ -657,7 +657,7 @@ def smooth(
     resmoothed = [b.obj.name for b in bakes if b.current is not b.source]
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
-    if options.keys == "REDUCED" and bakes:
+    if options.key_mode == "REDUCED" and bakes:
         from . import reduce
 
         reduce.reduce_bakes(bakes, options.key_distance, options.key_angle)

@@ -177,7 +177,7 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         "result itself (Revert then returns to it). Off: smooth the original keys again with these "
         "options, replacing the earlier result (one Revert returns to the original)",
     )
-    keys: EnumProperty(
+    key_mode: EnumProperty(
         name="Keys",
         items=reduce.KEY_MODES,
         default="EVERY_STEP",
@@ -257,7 +257,7 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 _OPTION_NAMES = (
     "method", "parametrization", "approximate", "stiffness",
     "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
-    "armature", "smooth_result", "keys", "key_distance", "key_angle",
+    "armature", "smooth_result", "key_mode", "key_distance", "key_angle",
 )
 
 
@@ -284,7 +284,7 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
     step: _same_property("step")
     armature: _same_property("armature")
     smooth_result: _same_property("smooth_result")
-    keys: _same_property("keys")
+    key_mode: _same_property("key_mode")
     key_distance: _same_property("key_distance")
     key_angle: _same_property("key_angle")
 

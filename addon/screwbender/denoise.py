@@ -49,7 +49,7 @@ class Options:
     smooth_result: bool = False
     #: "EVERY_STEP" (the keys stay keys) or "REDUCED" (then the fewest keys within the
     #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
-    keys: str = "EVERY_STEP"
+    key_mode: str = "EVERY_STEP"
     key_distance: float = 0.001
     key_angle: float = 0.008726646259971648
 
@@ -324,7 +324,7 @@ def remove_noise(
                 by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
                 for part in parts:
                     _edit_keys(by_owner.get(part.owner.bone, []), part)
-                if options.keys == "REDUCED":
+                if options.key_mode == "REDUCED":
                     from . import reduce
 
                     reduce.reduce_bag(bag, [part.owner for part in parts], options.key_distance, options.key_angle)

@@ -58,7 +58,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         description="On an action that is already a result of Remove Noise, smooth that result "
         "(else the original keys again, replacing the earlier result)",
     )
-    keys: EnumProperty(
+    key_mode: EnumProperty(
         name="Keys",
         items=reduce.KEY_MODES,
         default="EVERY_STEP",
@@ -115,7 +115,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             strength=None if self.auto_strength else self.strength,
             frame_range=frame_range,
             smooth_result=self.smooth_result,
-            keys=self.keys,
+            key_mode=self.key_mode,
             key_distance=self.key_distance,
             key_angle=self.key_angle,
         )

@@ -146,8 +146,8 @@ class GRAPH_PT_screwbender_reduce(bpy.types.Panel):
 
 def draw_key_options(layout: bpy.types.UILayout, settings) -> None:
     """Keys: Every Step / Reduced and its tolerance (Smooth Motion and Remove Noise)."""
-    layout.prop(settings, "keys")
-    if settings.keys == "REDUCED":
+    layout.prop(settings, "key_mode")
+    if settings.key_mode == "REDUCED":
         col = layout.column(align=True)
         col.prop(settings, "key_distance")
         col.prop(settings, "key_angle")

@@ -324,7 +324,7 @@ def test_keys_reduced_in_smooth_motion_and_remove_noise(sb, operator):
     h.select_only(reduced)
     bpy.ops.ed.undo_push(message="before")
     with counting_reduce_calls() as calls:
-        assert run("EXEC_DEFAULT", True, keys="REDUCED", key_distance=DISTANCE, key_angle=ANGLE) == {"FINISHED"}
+        assert run("EXEC_DEFAULT", True, key_mode="REDUCED", key_distance=DISTANCE, key_angle=ANGLE) == {"FINISHED"}
     assert calls["n"] == 1
     assert reduced.animation_data.action.name == every.animation_data.action.name.replace("Every", "Reduced")
     dense, few = transform_keys(every), transform_keys(reduced)
