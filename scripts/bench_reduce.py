@@ -29,7 +29,7 @@ origin, a bone's head and tail) and the largest rotation angle.
 
 Keys: keyframe points over the owners' transform curves (what Blender stores and the animator
 edits; Decimate keys each curve on its own frames), and key frames (distinct frames per owner)
-as a fraction of the frames. Also: Smooth Motion with Keys: Reduced against Every Step (time).
+as a fraction of the frames (each owner's own key range). Also: Smooth Motion with Keys: Reduced against Every Step (time).
 
 Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_reduce.py [--json out.json] [--quick]
 """
@@ -62,6 +62,7 @@ curves = importlib.import_module(f"{ADDON}.curves")
 TOLERANCES = ((0.0005, 0.05), (0.001, 0.5), (0.005, 1.0))  # metres, degrees
 #: Float32 world matrices in Blender's playback: what a check may add to the tolerance.
 SLACK = 1e-5
+TRANSFORM = ("location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale")
 ROTATION_PATHS = {"QUATERNION": "rotation_quaternion", "AXIS_ANGLE": "rotation_axis_angle"}
 
 
@@ -408,7 +409,7 @@ def counts(owners) -> tuple[int, int]:
         found = owner_curves(obj, bone)
         per = []
         for (path, _), fc in found.items():
-            if path in ("location", "rotation_euler", "rotation_quaternion", "rotation_axis_angle", "scale"):
+            if path in TRANSFORM:
                 co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
                 fc.keyframe_points.foreach_get("co", co)
                 per.append(co[0::2])
@@ -433,6 +434,13 @@ class Clip:
         self.first, self.last = first, last
         self.times = samples(first, last)
         self.frames = int(round(last - first)) + 1
+        # frames per owner: its own key range (the demo's objects have ranges of their own)
+        self.owner_frames = 0
+        for obj, bone in self.owners:
+            found = [fc for (p, _), fc in owner_curves(obj, bone).items() if p in TRANSFORM]
+            lo = min(fc.keyframe_points[0].co.x for fc in found)
+            hi = max(fc.keyframe_points[-1].co.x for fc in found)
+            self.owner_frames += int(round(hi - lo)) + 1
 
     def restore(self) -> None:
         """Every object back on a fresh copy of its dense action."""
@@ -484,7 +492,7 @@ def measure(clip: Clip, ref: np.ndarray, distance: float, angle: float, elapsed:
     dist, ang = world_errors(clip.owners, ref, got)
     within = (dist <= distance + SLACK) & (ang <= math.radians(angle) + SLACK)
     points, frames = counts(clip.owners)
-    return {"points": points, "keyframes": frames, "fraction": frames / (clip.frames * len(clip.owners)),
+    return {"points": points, "keyframes": frames, "fraction": frames / clip.owner_frames,
             "time": elapsed, "distance": float(dist.max()), "angle": float(math.degrees(ang.max())),
             "within": float(within.mean()), "samples": int(within.size)}
 
@@ -584,6 +592,7 @@ def main() -> None:
         agreement = float(np.abs(fast_ref - ref).max())
         search = search_margin(clip, fast_ref, TOLERANCES, steps)
         entry = {"name": clip.name, "label": clip.label, "owners": len(clip.owners), "frames": clip.frames,
+                 "owner_frames": clip.owner_frames,
                  "captured": clip.captured, "samples": len(clip.times), "fast_agreement": agreement,
                  "decimate_trials": search["trials"], "cases": []}
         for distance, angle in TOLERANCES:
@@ -598,7 +607,7 @@ def main() -> None:
                 case["decimate"] = None
             entry["cases"].append(case)
             o, d = case["ours"], case["decimate"]
-            theirs = (f"decimate (margin {d['margin']:.3g}) {d['points']:,} keys, {d['keyframes'] / (clip.frames * len(clip.owners)):.1%} "
+            theirs = (f"decimate (margin {d['margin']:.3g}) {d['points']:,} keys, {d['fraction']:.1%} "
                       f"of frames, {1000 * d['time']:.0f} ms, error {1000 * d['distance']:.3g} mm / {d['angle']:.3g} deg, "
                       f"{d['within']:.2%} within") if d else "decimate: no margin meets it"
             print(f"  {clip.name} {1000 * distance:g} mm / {angle:g} deg: ours {o['points']:,} keys, {o['fraction']:.1%} of "

@@ -559,7 +559,7 @@ class Report:
                "checked by Blender's own playback (`frame_set` at every frame and 3 subframes between frames, every "
                "owner's world matrix) against the dense clip's playback: the largest distance of a point of the body "
                "(bounding box corners, a bone's head and tail) and the largest rotation angle. Keys: keyframe points "
-               "over the transform curves; % of frames: distinct key frames per owner over frames x owners. "
+               "over the transform curves; % of frames: distinct key frames per owner over the frames of its key range. "
                f"Within: the share of (owner, sample) pairs within the tolerance (+{d['slack']:g} for float32 "
                "world matrices).", "",
                "| clip | tolerance | ours: keys | % of frames | error (mm / deg) | within | decimate: margin | keys | "
