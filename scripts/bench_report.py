@@ -588,6 +588,13 @@ class Report:
                        f"{100 * t['within']:.2f} % | {kr:.2f} | {fmt_seconds(o['time'])} | {fmt_seconds(t['time'])} | "
                        f"{tr:.2f} |")
         self.w("")
+        windowed = [c for c in d["clips"] if c.get("searched_on", "the clip") != "the clip"]
+        for c in windowed:
+            self.w(f"{c['label']}: one decimate call on the whole clip takes a minute or more here, so its margin was "
+                   f"searched on the clip's {c['searched_on']} (the same motion) and then run once on the whole clip "
+                   "(x0.7 smaller, up to twice, where the whole clip missed the tolerance).")
+        if windowed:
+            self.w("")
         smooth = d.get("smooth", [])
         if smooth:
             self.w("Smooth Motion with Keys: Reduced (default tolerance, 1 mm / 0.5 deg) against Every Step, the whole "
