@@ -9,6 +9,7 @@ mod denoise;
 mod fcurve;
 mod feature;
 mod intent;
+mod reduce;
 mod sweep;
 
 use glam::{DQuat, DVec3};
@@ -777,5 +778,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fcurve::register(m)?;
     intent::register(m)?;
     denoise::register(m)?;
+    reduce::register(m)?;
     Ok(())
 }

@@ -19,6 +19,7 @@
 //! | [`angular_velocity`] | fitting a rotation to a sketched angular velocity | Xie-Xu-Yu-Weng |
 //! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
 //! | [`intent`] | what the animator meant between the keys: Blender's playback of an owner's channels, holds, pops, spins, the pace of timing "Keys" | ScrewBender issue 17 |
+//! | [`reduce`](mod@reduce) | key reduction: the fewest Bezier keys whose Blender playback stays within a world-space tolerance | ScrewBender issue 26 |
 //! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
 //!
 //! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
@@ -51,6 +52,7 @@ pub mod intent;
 pub mod memory;
 pub mod motion;
 pub(crate) mod numeric;
+pub mod reduce;
 pub mod sweep;
 
 pub use angular_velocity::{
@@ -85,4 +87,8 @@ pub use motion::subdivision::{
     subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES,
 };
 pub use motion::timing::{check_key_times, TimeMap, Timing};
+pub use reduce::{
+    reduce_keys, Group, HandleType, ReduceInput, ReduceOptions, Reduced, ReducedCurve, ReducedKey,
+    Tolerance,
+};
 pub use sweep::{sweep, sweep_mesh, Body, Generator, SweepOptions, SweptMesh};

@@ -216,4 +216,29 @@ impl BezierSegment {
         let [c0, c1, c2, c3] = self.yc;
         c0 + t * c1 + t * t * c2 + t * t * t * c3
     }
+
+    /// The parameter `u` Blender's root finder gives `frame` on this segment (`None` where it
+    /// finds none). It depends only on the keys' and handles' frames, so segments of several
+    /// curves keyed at the same frames with the same handle frames share it:
+    /// `value_at(parameter(frame))` is [`BezierSegment::eval`] bit for bit.
+    pub(crate) fn parameter(&self, frame: f32) -> Option<f32> {
+        let c0 = (self.x0 - frame) as f64;
+        match self.shape {
+            Some(shape) => solve_normalised(shape, c0 / self.xc[2]),
+            None => solve_cubic(c0, self.xc[0], self.xc[1], self.xc[2]),
+        }
+    }
+
+    /// The segment's value at parameter `u` from [`BezierSegment::parameter`] (`berekeny`;
+    /// the flat shortcut and the no-root `0.0` as in [`BezierSegment::eval`]).
+    pub(crate) fn value_at(&self, u: Option<f32>) -> f32 {
+        if self.flat {
+            return self.yc[0];
+        }
+        let Some(t) = u else {
+            return 0.0;
+        };
+        let [c0, c1, c2, c3] = self.yc;
+        c0 + t * c1 + t * t * c2 + t * t * t * c3
+    }
 }

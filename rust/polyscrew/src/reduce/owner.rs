@@ -1,0 +1,793 @@
+//! One owner's reduction: its target at every sample, its channels, the greedy choice of
+//! key frames with least-squares handles, the exact check through Blender's evaluation.
+
+use glam::{DQuat, DVec3};
+
+use super::compose::{row_error, Keyed, ROT, SCALE, STRIDE};
+use super::{
+    interpolation, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
+    SEARCH_MARGIN, SUBSAMPLES,
+};
+use crate::error::{Error, Result};
+use crate::fcurve::bezier::BezierSegment;
+use crate::fcurve::curve::KEY_THRESHOLD;
+use crate::fcurve::{Extrapolation, FCurve, Interpolation, Key};
+use crate::memory::try_vec;
+use crate::motion::channels::{rotation_channels, RotationMode};
+use crate::motion::pose::Pose;
+use crate::motion::screw::Screw;
+
+/// Channels of a cycle's last frame within this of the first frame's (relative to
+/// `1 + |value|`) are set equal to them, so the cycle's first and last keys are equal.
+pub const CYCLE_SNAP: f64 = 1e-9;
+
+/// Rounds of per-channel reduction, each with half the previous share of the tolerance,
+/// before the last one is kept (its errors reported as measured).
+const PER_CHANNEL_ROUNDS: usize = 8;
+
+/// The share of the tolerance each channel gets in the first per-channel round.
+const PER_CHANNEL_SHARE: f64 = 0.5;
+
+/// A reduced key: frame and value, handles, and the interpolation of the span it starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReducedKey {
+    /// `(frame, value)`.
+    pub co: [f64; 2],
+    /// The left handle `(frame, value)`.
+    pub handle_left: [f64; 2],
+    /// The right handle `(frame, value)`.
+    pub handle_right: [f64; 2],
+    /// The interpolation from this key to the next (BEZIER, or CONSTANT for a hold or step).
+    pub interpolation: Interpolation,
+}
+
+/// An owner's world poses at every sample, kept for its children.
+#[derive(Debug, Clone)]
+pub(crate) struct World {
+    pub dense: Vec<Pose>,
+    pub reduced: Vec<Pose>,
+}
+
+/// What one owner's reduction gives.
+#[derive(Debug)]
+pub(crate) struct OwnerResult {
+    pub curves: Vec<ReducedCurve>,
+    pub keys: usize,
+    pub distance_error: f64,
+    pub angle_error: f64,
+    pub world: Option<World>,
+}
+
+/// The buffers of one owner's reduction, reused from owner to owner on a worker.
+#[derive(Default)]
+pub(crate) struct Workspace {
+    local: Vec<Pose>,
+    target: Vec<Pose>,
+    scale: Vec<DVec3>,
+    v: Vec<[f64; STRIDE]>,
+    reduced: Vec<Pose>,
+    quats: Vec<DQuat>,
+}
+
+/// What every owner shares: the inputs, the sample times.
+pub(crate) struct Context<'a> {
+    input: ReduceInput<'a>,
+    tolerance: Tolerance,
+    cyclic: bool,
+    per_channel: bool,
+    n: usize,
+    times: Vec<f64>,
+    times32: Vec<f32>,
+}
+
+/// A span between two keys: sample positions, CONSTANT or not, the inner handle values.
+#[derive(Debug, Clone, Copy)]
+struct Span {
+    s: usize,
+    e: usize,
+    constant: bool,
+    h1: [f64; STRIDE],
+    h2: [f64; STRIDE],
+}
+
+impl<'a> Context<'a> {
+    pub fn new(input: &ReduceInput<'a>, options: &ReduceOptions, n: usize) -> Result<Self> {
+        let m = super::sample_count(n);
+        let mut times = try_vec(m, "sample times")?;
+        for f in 0..n - 1 {
+            let (a, b) = (input.frames[f], input.frames[f + 1]);
+            for k in 0..SUBSAMPLES {
+                times.push(a + (b - a) * (k as f64 / SUBSAMPLES as f64));
+            }
+        }
+        times.push(input.frames[n - 1]);
+        let mut times32 = try_vec(m, "sample times")?;
+        times32.extend(times.iter().map(|t| *t as f32));
+        Ok(Self {
+            input: *input,
+            tolerance: options.tolerance,
+            cyclic: options.cyclic,
+            per_channel: options.per_channel,
+            n,
+            times,
+            times32,
+        })
+    }
+
+    fn keyed(&self, o: usize) -> Keyed {
+        match self.input.channels {
+            Some(c) => Keyed {
+                location: c[o][0],
+                rotation: c[o][1],
+                scale: c[o][2] && self.input.scales.is_some(),
+            },
+            None => Keyed {
+                location: true,
+                rotation: true,
+                scale: self.input.scales.is_some(),
+            },
+        }
+    }
+
+    fn constant(&self, o: usize, f: usize) -> bool {
+        self.input.constant.is_some_and(|c| c[o * (self.n - 1) + f])
+    }
+
+    /// Reduces owner `o` whose parent's world poses are `parent` (`None`: a root); keeps its
+    /// own world poses when `keep_world` (it has children).
+    pub fn reduce_owner(
+        &self,
+        ws: &mut Workspace,
+        o: usize,
+        parent: Option<&World>,
+        keep_world: bool,
+    ) -> Result<OwnerResult> {
+        let n = self.n;
+        let m = self.times.len();
+        let mode = self.input.modes[o];
+        let keyed = self.keyed(o);
+        let poses = &self.input.poses[o * n..(o + 1) * n];
+        let offset = self.input.offsets.map_or(Pose::IDENTITY, |p| p[o]);
+        // The dense local motion at every sample: the screw between frames, held across
+        // CONSTANT spans.
+        ws.local.clear();
+        ws.local.reserve(m);
+        ws.scale.clear();
+        for f in 0..n - 1 {
+            ws.local.push(poses[f]);
+            let held = self.constant(o, f);
+            let screw = (!held).then(|| Screw::between(&poses[f], &poses[f + 1]));
+            for k in 1..SUBSAMPLES {
+                ws.local.push(match &screw {
+                    Some(sc) => sc.eval(k as f64 / SUBSAMPLES as f64),
+                    None => poses[f],
+                });
+            }
+        }
+        ws.local.push(poses[n - 1]);
+        if let Some(scales) = self.input.scales {
+            let sc = &scales[o * n..(o + 1) * n];
+            ws.scale.reserve(m);
+            for f in 0..n - 1 {
+                let held = self.constant(o, f);
+                for k in 0..SUBSAMPLES {
+                    let u = if held {
+                        0.0
+                    } else {
+                        k as f64 / SUBSAMPLES as f64
+                    };
+                    ws.scale.push(sc[f].lerp(sc[f + 1], u));
+                }
+            }
+            ws.scale.push(sc[n - 1]);
+        } else {
+            ws.scale.resize(m, DVec3::ONE);
+        }
+        // The target of the owner's own channels, and its dense world motion.
+        ws.target.clear();
+        ws.target.reserve(m);
+        let mut dense_world = if keep_world {
+            try_vec(m, "world poses")?
+        } else {
+            Vec::new()
+        };
+        for j in 0..m {
+            let l = ws.local[j];
+            match parent {
+                Some(p) => {
+                    let w = p.dense[j].mul_pose(&offset).mul_pose(&l);
+                    let base = p.reduced[j].mul_pose(&offset);
+                    ws.target.push(base.inverse().mul_pose(&w));
+                    if keep_world {
+                        dense_world.push(w);
+                    }
+                }
+                None => {
+                    ws.target.push(l);
+                    if keep_world {
+                        dense_world.push(offset.mul_pose(&l));
+                    }
+                }
+            }
+        }
+        // Channels, continuous along the samples.
+        ws.quats.clear();
+        ws.quats.extend(ws.target.iter().map(|p| p.rotation));
+        let width = mode.width();
+        let start = self.input.start.map(|s| &s[o][..width]);
+        let rot = rotation_channels(&ws.quats, mode, start)?;
+        ws.v.clear();
+        ws.v.reserve(m);
+        for j in 0..m {
+            let mut row = [0.0; STRIDE];
+            let t = ws.target[j].translation;
+            row[0..3].copy_from_slice(&t.to_array());
+            row[ROT..ROT + width].copy_from_slice(&rot[j * width..(j + 1) * width]);
+            row[SCALE..SCALE + 3].copy_from_slice(&ws.scale[j].to_array());
+            ws.v.push(row);
+        }
+        drop(rot);
+        let mut cols = Vec::with_capacity(STRIDE);
+        if keyed.location {
+            cols.extend(0..3);
+        }
+        if keyed.rotation {
+            cols.extend(ROT..ROT + width);
+        }
+        if keyed.scale {
+            cols.extend(SCALE..SCALE + 3);
+        }
+        if self.cyclic {
+            let (first, last) = (ws.v[0], &mut ws.v[m - 1]);
+            for &c in &cols {
+                if (last[c] - first[c]).abs() <= CYCLE_SNAP * (1.0 + first[c].abs()) {
+                    last[c] = first[c];
+                }
+            }
+        }
+        ws.reduced.clear();
+        ws.reduced.resize(m, Pose::IDENTITY);
+        let fitter = Fitter {
+            times: &self.times,
+            times32: &self.times32,
+            v: &ws.v,
+            target: &ws.target,
+            scale: &ws.scale,
+            mode,
+            keyed,
+            radius: self.input.radius[o],
+        };
+        let constant: Vec<bool> = (0..n - 1).map(|f| self.constant(o, f)).collect();
+        let (curves, keys, distance_error, angle_error) = if self.per_channel && cols.len() > 1 {
+            self.per_channel_curves(&fitter, o, &cols, &constant, &mut ws.reduced)?
+        } else {
+            let mut spans = Vec::new();
+            let (d, a) = fitter.greedy(
+                &cols,
+                &constant,
+                self.tolerance,
+                &mut ws.reduced,
+                &mut spans,
+            );
+            let curves = cols
+                .iter()
+                .map(|&c| curve_of(&fitter, o, c, &spans))
+                .collect::<Result<Vec<_>>>()?;
+            (curves, spans.len() + 1, d, a)
+        };
+        let world = if keep_world {
+            let mut reduced = try_vec(m, "world poses")?;
+            for j in 0..m {
+                let l = ws.reduced[j];
+                reduced.push(match parent {
+                    Some(p) => p.reduced[j].mul_pose(&offset).mul_pose(&l),
+                    None => offset.mul_pose(&l),
+                });
+            }
+            Some(World {
+                dense: dense_world,
+                reduced,
+            })
+        } else {
+            None
+        };
+        Ok(OwnerResult {
+            curves,
+            keys,
+            distance_error,
+            angle_error,
+            world,
+        })
+    }
+
+    /// Per-channel key frames: each channel reduced on its own within a share of the
+    /// tolerance (the others exact), the whole checked through Blender's evaluation of every
+    /// curve; the share halved until the whole is within the tolerance.
+    #[allow(clippy::type_complexity)]
+    fn per_channel_curves(
+        &self,
+        fitter: &Fitter<'_>,
+        o: usize,
+        cols: &[usize],
+        constant: &[bool],
+        reduced: &mut [Pose],
+    ) -> Result<(Vec<ReducedCurve>, usize, f64, f64)> {
+        let mut share = PER_CHANNEL_SHARE;
+        let mut scratch = vec![Pose::IDENTITY; reduced.len()];
+        let mut last = None;
+        for _ in 0..PER_CHANNEL_ROUNDS {
+            let tol = Tolerance {
+                distance: self.tolerance.distance * share,
+                angle: self.tolerance.angle * share,
+            };
+            let mut curves = Vec::with_capacity(cols.len());
+            for &c in cols {
+                let mut spans = Vec::new();
+                fitter.greedy(&[c], constant, tol, &mut scratch, &mut spans);
+                curves.push(curve_of(fitter, o, c, &spans)?);
+            }
+            let (d, a) = fitter.check_curves(cols, &curves, reduced)?;
+            let mut frames: Vec<f64> = curves
+                .iter()
+                .flat_map(|c| c.keys.iter().map(|k| k.co[0]))
+                .collect();
+            frames.sort_by(f64::total_cmp);
+            frames.dedup();
+            let within = d <= self.tolerance.distance && a <= self.tolerance.angle;
+            last = Some((curves, frames.len(), d, a));
+            if within {
+                break;
+            }
+            share *= 0.5;
+        }
+        Ok(last.expect("at least one round"))
+    }
+}
+
+/// The curve of channel column `c` through `spans`.
+fn curve_of(fitter: &Fitter<'_>, o: usize, c: usize, spans: &[Span]) -> Result<ReducedCurve> {
+    let (group, index) = match c {
+        0..3 => (Group::Location, c),
+        ROT..SCALE => (Group::Rotation, c - ROT),
+        _ => (Group::Scale, c - SCALE),
+    };
+    let mut keys = try_vec(spans.len() + 1, "reduced keys")?;
+    let t = fitter.times;
+    let v = fitter.v;
+    for (k, span) in spans.iter().enumerate() {
+        let dt = t[span.e] - t[span.s];
+        let co = [t[span.s], v[span.s][c]];
+        let right = [t[span.s] + dt / 3.0, span.h1[c]];
+        let left = match k.checked_sub(1).map(|p| spans[p]) {
+            Some(p) => [t[p.e] - (t[p.e] - t[p.s]) / 3.0, p.h2[c]],
+            None => [2.0 * co[0] - right[0], 2.0 * co[1] - right[1]],
+        };
+        keys.push(ReducedKey {
+            co,
+            handle_left: left,
+            handle_right: right,
+            interpolation: interpolation(span.constant),
+        });
+    }
+    if let Some(p) = spans.last() {
+        let co = [t[p.e], v[p.e][c]];
+        let left = [t[p.e] - (t[p.e] - t[p.s]) / 3.0, p.h2[c]];
+        keys.push(ReducedKey {
+            co,
+            handle_left: left,
+            handle_right: [2.0 * co[0] - left[0], 2.0 * co[1] - left[1]],
+            interpolation: Interpolation::Bezier,
+        });
+    }
+    Ok(ReducedCurve {
+        owner: o,
+        group,
+        index,
+        keys,
+        handle_type: HandleType::Free,
+    })
+}
+
+/// The samples, target and channels of one owner, and the span fitting and checks on them.
+struct Fitter<'w> {
+    times: &'w [f64],
+    times32: &'w [f32],
+    v: &'w [[f64; STRIDE]],
+    target: &'w [Pose],
+    scale: &'w [DVec3],
+    mode: RotationMode,
+    keyed: Keyed,
+    radius: f64,
+}
+
+/// Cubic Bernstein basis at `u`.
+#[inline(always)]
+fn bernstein(u: f64) -> [f64; 4] {
+    let w = 1.0 - u;
+    [w * w * w, 3.0 * u * w * w, 3.0 * u * u * w, u * u * u]
+}
+
+impl Fitter<'_> {
+    #[inline(always)]
+    fn error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, f64, DQuat, DVec3) {
+        let p = &self.target[j];
+        row_error(
+            self.mode,
+            self.keyed,
+            self.radius,
+            y,
+            p.rotation,
+            p.translation,
+            self.scale[j],
+        )
+    }
+
+    /// The inner handle values of the span `s..=e` for columns `cols`: least squares over
+    /// the samples strictly inside, the key values fixed; a straight line when fewer than
+    /// three samples are inside.
+    fn fit(
+        &self,
+        s: usize,
+        e: usize,
+        cols: &[usize],
+        h1: &mut [f64; STRIDE],
+        h2: &mut [f64; STRIDE],
+    ) {
+        let (v0, v3) = (&self.v[s], &self.v[e]);
+        let ts = self.times[s];
+        let inv = 1.0 / (self.times[e] - ts);
+        let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);
+        let mut r1 = [0.0; STRIDE];
+        let mut r2 = [0.0; STRIDE];
+        for j in s + 1..e {
+            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
+            a11 += b1 * b1;
+            a12 += b1 * b2;
+            a22 += b2 * b2;
+            let vj = &self.v[j];
+            for &c in cols {
+                let r = vj[c] - v0[c] * b0 - v3[c] * b3;
+                r1[c] += b1 * r;
+                r2[c] += b2 * r;
+            }
+        }
+        let det = a11 * a22 - a12 * a12;
+        if e - s < 4 || det <= 1e-9 * a11 * a22 {
+            for &c in cols {
+                h1[c] = v0[c] + (v3[c] - v0[c]) / 3.0;
+                h2[c] = v3[c] - (v3[c] - v0[c]) / 3.0;
+            }
+            return;
+        }
+        let inv_det = 1.0 / det;
+        for &c in cols {
+            h1[c] = (a22 * r1[c] - a12 * r2[c]) * inv_det;
+            h2[c] = (a11 * r2[c] - a12 * r1[c]) * inv_det;
+        }
+    }
+
+    /// Whether the `f64` cubic of the span stays within `limit` at every sample inside.
+    fn model_ok(
+        &self,
+        s: usize,
+        e: usize,
+        cols: &[usize],
+        h1: &[f64; STRIDE],
+        h2: &[f64; STRIDE],
+        limit: Tolerance,
+    ) -> bool {
+        let (v0, v3) = (&self.v[s], &self.v[e]);
+        let ts = self.times[s];
+        let inv = 1.0 / (self.times[e] - ts);
+        for j in s + 1..e {
+            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
+            let mut y = self.v[j];
+            for &c in cols {
+                y[c] = v0[c] * b0 + h1[c] * b1 + h2[c] * b2 + v3[c] * b3;
+            }
+            let (d, a, _, _) = self.error(j, &y);
+            if d > limit.distance || a > limit.angle {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Blender's evaluation of the span's `float32` keys at every sample of `s..=e` (the
+    /// first key's value across a CONSTANT span): whether it stays within `limit`, the
+    /// largest errors, and the played poses written to `out[s..=e]`.
+    #[allow(clippy::needless_range_loop)]
+    fn exact(
+        &self,
+        span: &Span,
+        cols: &[usize],
+        limit: Tolerance,
+        out: &mut [Pose],
+    ) -> (bool, f64, f64) {
+        let Span { s, e, .. } = *span;
+        let (x0, x3) = (self.times32[s], self.times32[e]);
+        let dt = self.times[e] - self.times[s];
+        let hx1 = (self.times[s] + dt / 3.0) as f32;
+        let hx2 = (self.times[e] - dt / 3.0) as f32;
+        let mut segs = [None; STRIDE];
+        let mut k0 = [0.0f32; STRIDE];
+        let mut k1 = [0.0f32; STRIDE];
+        for &c in cols {
+            let (y0, y3) = (self.v[s][c] as f32, self.v[e][c] as f32);
+            k0[c] = y0;
+            k1[c] = y3;
+            if !span.constant {
+                segs[c] = Some(BezierSegment::new(
+                    [x0, y0],
+                    [hx1, span.h1[c] as f32],
+                    [hx2, span.h2[c] as f32],
+                    [x3, y3],
+                ));
+            }
+        }
+        let first = cols.first().and_then(|c| segs[*c]);
+        let near = |a: f32, b: f32| (a - b).abs() <= KEY_THRESHOLD;
+        let (mut dmax, mut amax) = (0.0f64, 0.0f64);
+        let mut ok = true;
+        for j in s..=e {
+            let t = self.times32[j];
+            let mut y = self.v[j];
+            if j == s || near(t, x0) || (span.constant && !near(t, x3) && j != e) {
+                for &c in cols {
+                    y[c] = k0[c] as f64;
+                }
+            } else if j == e || near(t, x3) {
+                for &c in cols {
+                    y[c] = k1[c] as f64;
+                }
+            } else {
+                let u = first.and_then(|seg| seg.parameter(t));
+                for &c in cols {
+                    y[c] = segs[c].map_or(k0[c], |seg| seg.value_at(u)) as f64;
+                }
+            }
+            let (d, a, q, tr) = self.error(j, &y);
+            dmax = dmax.max(d);
+            amax = amax.max(a);
+            if !(d <= limit.distance && a <= limit.angle) {
+                ok = false;
+            }
+            out[j] = Pose {
+                rotation: q,
+                translation: tr,
+            };
+        }
+        (ok, dmax, amax)
+    }
+
+    /// Fits the span `s..=e` and checks it by the model (`exact`: and by Blender's
+    /// evaluation): the span, and the exact errors when checked exactly.
+    #[allow(clippy::too_many_arguments)]
+    fn try_span(
+        &self,
+        s: usize,
+        e: usize,
+        cols: &[usize],
+        tol: Tolerance,
+        exact: bool,
+        out: &mut [Pose],
+    ) -> (Option<Span>, f64, f64) {
+        let mut span = Span {
+            s,
+            e,
+            constant: false,
+            h1: [0.0; STRIDE],
+            h2: [0.0; STRIDE],
+        };
+        self.fit(s, e, cols, &mut span.h1, &mut span.h2);
+        let model = Tolerance {
+            distance: tol.distance * SEARCH_MARGIN,
+            angle: tol.angle * SEARCH_MARGIN,
+        };
+        if !self.model_ok(s, e, cols, &span.h1, &span.h2, model) {
+            return (None, 0.0, 0.0);
+        }
+        if !exact {
+            return (Some(span), 0.0, 0.0);
+        }
+        let (ok, d, a) = self.exact(&span, cols, tol, out);
+        (ok.then_some(span), d, a)
+    }
+
+    /// Key frames for columns `cols` within `tol`: CONSTANT spans kept, the longest feasible
+    /// span from each key elsewhere. Writes the played poses to `out` and the spans to
+    /// `spans`; returns the largest exact errors.
+    fn greedy(
+        &self,
+        cols: &[usize],
+        constant: &[bool],
+        tol: Tolerance,
+        out: &mut [Pose],
+        spans: &mut Vec<Span>,
+    ) -> (f64, f64) {
+        let n = constant.len() + 1;
+        let (mut dmax, mut amax) = (0.0f64, 0.0f64);
+        let mut f = 0;
+        while f < n - 1 {
+            if constant[f] {
+                let s = f * SUBSAMPLES;
+                let span = Span {
+                    s,
+                    e: s + SUBSAMPLES,
+                    constant: true,
+                    h1: self.v[s],
+                    h2: self.v[s],
+                };
+                let (_, d, a) = self.exact(&span, cols, tol, out);
+                dmax = dmax.max(d);
+                amax = amax.max(a);
+                spans.push(span);
+                f += 1;
+                continue;
+            }
+            let mut g = f;
+            while g < n - 1 && !constant[g] {
+                g += 1;
+            }
+            let (d, a) = self.run(f * SUBSAMPLES, g * SUBSAMPLES, cols, tol, out, spans);
+            dmax = dmax.max(d);
+            amax = amax.max(a);
+            f = g;
+        }
+        (dmax, amax)
+    }
+
+    /// The greedy choice over the samples `a..=b` (no CONSTANT span inside).
+    fn run(
+        &self,
+        a: usize,
+        b: usize,
+        cols: &[usize],
+        tol: Tolerance,
+        out: &mut [Pose],
+        spans: &mut Vec<Span>,
+    ) -> (f64, f64) {
+        let (mut dmax, mut amax) = (0.0f64, 0.0f64);
+        let mut key = a;
+        while key < b {
+            let first = (key / SUBSAMPLES + 1) * SUBSAMPLES;
+            let count = (b - first) / SUBSAMPLES + 1;
+            let pos = |k: usize| first + k * SUBSAMPLES;
+            let model = |e: usize, out: &mut [Pose]| {
+                self.try_span(key, e, cols, tol, false, out).0.is_some()
+            };
+            // The longest span by the model: exponential, then binary search.
+            let mut best: Option<usize> = None;
+            if model(pos(0), out) {
+                let (mut lo, mut hi) = (0, count);
+                let mut step = 1;
+                while lo + step < count {
+                    if model(pos(lo + step), out) {
+                        lo += step;
+                        step *= 2;
+                    } else {
+                        hi = lo + step;
+                        break;
+                    }
+                }
+                if hi == count && lo + 1 < count {
+                    if model(pos(count - 1), out) {
+                        lo = count - 1;
+                    } else {
+                        hi = count - 1;
+                    }
+                }
+                while hi - lo > 1 {
+                    let mid = lo + (hi - lo) / 2;
+                    if model(pos(mid), out) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                best = Some(lo);
+            }
+            // Blender's evaluation of the chosen span; shorter ones while it fails.
+            let mut accepted: Option<(Span, f64, f64)> = None;
+            if let Some(lo) = best {
+                if let (Some(span), d, a) = self.try_span(key, pos(lo), cols, tol, true, out) {
+                    accepted = Some((span, d, a));
+                } else {
+                    let (mut good, mut bad) = (None, lo);
+                    let mut lo2 = 0;
+                    while lo2 < bad {
+                        let mid = lo2 + (bad - lo2) / 2;
+                        match self.try_span(key, pos(mid), cols, tol, true, out) {
+                            (Some(_), _, _) => {
+                                good = Some(mid);
+                                lo2 = mid + 1;
+                            }
+                            _ => bad = mid,
+                        }
+                    }
+                    if let Some(g) = good {
+                        let (span, d, a) = self.try_span(key, pos(g), cols, tol, true, out);
+                        accepted = span.map(|s| (s, d, a));
+                    }
+                }
+            }
+            // Shorter than a frame: subframe keys, down to the next sample (exact keys).
+            let (span, d, a) = match accepted {
+                Some(x) => x,
+                None => {
+                    let mut e = first - 1;
+                    loop {
+                        if e <= key + 1 {
+                            let mut span = Span {
+                                s: key,
+                                e: key + 1,
+                                constant: false,
+                                h1: [0.0; STRIDE],
+                                h2: [0.0; STRIDE],
+                            };
+                            self.fit(key, key + 1, cols, &mut span.h1, &mut span.h2);
+                            let (_, d, a) = self.exact(&span, cols, tol, out);
+                            break (span, d, a);
+                        }
+                        if let (Some(span), d, a) = self.try_span(key, e, cols, tol, true, out) {
+                            break (span, d, a);
+                        }
+                        e -= 1;
+                    }
+                }
+            };
+            dmax = dmax.max(d);
+            amax = amax.max(a);
+            key = span.e;
+            spans.push(span);
+        }
+        (dmax, amax)
+    }
+
+    /// Blender's evaluation of whole curves (columns `cols`, `curves` in the same order) at
+    /// every sample: the largest errors, the played poses written to `out`.
+    fn check_curves(
+        &self,
+        cols: &[usize],
+        curves: &[ReducedCurve],
+        out: &mut [Pose],
+    ) -> Result<(f64, f64)> {
+        let mut fcurves = Vec::with_capacity(curves.len());
+        for c in curves {
+            let keys = c
+                .keys
+                .iter()
+                .map(|k| {
+                    Key::new(k.co[0] as f32, k.co[1] as f32)
+                        .with_handles(
+                            [k.handle_left[0] as f32, k.handle_left[1] as f32],
+                            [k.handle_right[0] as f32, k.handle_right[1] as f32],
+                        )
+                        .with_interpolation(k.interpolation)
+                })
+                .collect();
+            fcurves.push(FCurve::new(keys, Extrapolation::Constant, None)?);
+        }
+        let (mut dmax, mut amax) = (0.0f64, 0.0f64);
+        for (j, slot) in out.iter_mut().enumerate() {
+            let mut y = self.v[j];
+            for (&c, curve) in cols.iter().zip(&fcurves) {
+                y[c] = curve.evaluate(self.times[j]).map_err(|e| match e {
+                    Error::Invalid { reason, .. } => Error::Invalid {
+                        what: "keys",
+                        reason,
+                    },
+                    e => e,
+                })?;
+            }
+            let (d, a, q, t) = self.error(j, &y);
+            dmax = dmax.max(d);
+            amax = amax.max(a);
+            *slot = Pose {
+                rotation: q,
+                translation: t,
+            };
+        }
+        Ok((dmax, amax))
+    }
+}
