@@ -111,10 +111,11 @@ def check_within(owners, ref, times, distance, angle, label):
 def counting_reduce_calls():
     module = addon_module("reduce")
     original = module.polyscrew.reduce_keys
-    calls = {"n": 0}
+    calls = {"n": 0, "owners": []}
 
     def counting(*args, **kwargs):
         calls["n"] += 1
+        calls["owners"].append(len(args[0]))
         return original(*args, **kwargs)
 
     module.polyscrew.reduce_keys = counting
@@ -173,7 +174,9 @@ def test_reduce_keys_on_a_rig_in_pose_mode_holds_in_world_space(sb):
     bh.select_bones(rig, ["Upper", "Fore", "Hand"])
     with counting_reduce_calls() as calls:
         assert bpy.ops.screwbender.reduce_keys(distance=DISTANCE, angle=ANGLE) == {"FINISHED"}
-    assert calls["n"] == 1  # the three bones in one call, chained through their rest matrices
+    # the three bones in one call, chained through their rest matrices (asked again with a
+    # smaller tolerance when the add-on's own measure of the result in world space misses it)
+    assert calls["owners"] == [3] * calls["n"] and 1 <= calls["n"] <= 1 + addon_module("reduce").RETRIES
     bpy.ops.object.mode_set(mode="OBJECT")
     after = sum(transform_keys(rig, b) for b in ("Upper", "Fore", "Hand"))
     print(f"rig: {before} key frames -> {after}")
