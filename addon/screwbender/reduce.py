@@ -203,7 +203,9 @@ def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool 
             np.stack([it.poses for it in items]),
             np.ascontiguousarray(frames, dtype=np.float64),
             [it.mode for it in items],
-            np.array([it.radius for it in items], dtype=np.float64),
+            # (one owner: a float; a size-1 array would be tried as a scalar first, which numpy
+            # deprecates)
+            float(items[0].radius) if len(items) == 1 else np.array([it.radius for it in items], dtype=np.float64),
             float(options.distance),
             float(options.angle),
             scales=np.stack([it.scales for it in items]) if scaled else None,
