@@ -158,6 +158,21 @@ def _rigid(matrix) -> np.ndarray:
     return out
 
 
+def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """`a @ b` for (stacks of) 4x4 matrices without BLAS or `einsum` (a product of rows and
+    columns summed): inside a busy Blender, numpy's BLAS threads made a 4x4 `inv` take
+    milliseconds, and `einsum` with broadcasting is slower still."""
+    return (a[..., :, :, None] * b[..., None, :, :]).sum(axis=-2)
+
+
+def _rigid_inverse(m: np.ndarray) -> np.ndarray:
+    """The inverse of a rigid 4x4 matrix: `[R^T, -R^T t]`."""
+    out = np.eye(4)
+    out[:3, :3] = m[:3, :3].T
+    out[:3, 3] = -m[:3, :3].T @ m[:3, 3]
+    return out
+
+
 def parents_of(items: list[Item]) -> tuple[np.ndarray | None, np.ndarray | None]:
     """`parents` and `offsets` for `polyscrew.reduce_keys`: a bone whose parent bone is in the
     batch (and inherits its rotation) is that bone's child through the rest matrices; a root
@@ -177,7 +192,7 @@ def parents_of(items: list[Item]) -> tuple[np.ndarray | None, np.ndarray | None]
             j = index.get((ptr, bone.parent.name))
             if j is not None:
                 parents[i] = j
-                offsets[i] = np.linalg.inv(_rigid(bone.parent.matrix_local)) @ _rigid(bone.matrix_local)
+                offsets[i] = _mul(_rigid_inverse(_rigid(bone.parent.matrix_local)), _rigid(bone.matrix_local))
         else:
             j = index.get((ptr, ""))
             if j is not None:
@@ -266,19 +281,15 @@ def dense_frames(key_frames: list[np.ndarray]) -> np.ndarray:
 PROBES = (0.25, 0.5, 0.75)
 
 #: A span whose playback by Blender departs from the screw between its frames by more than
-#: this share of the tolerance (the ease of a first or last key, a fast turn) gets the
-#: playback at :data:`PROBES` as dense poses too (again for the new spans, up to
-#: :data:`REFINE_LEVELS` times); the largest departure left is taken off the tolerance given
-#: to the core, so that the reduced keys stay within the tolerance of Blender's own playback of
-#: the dense keys at every frame and at the probes. (Between the frames of Bezier keys on every
-#: frame, Blender's playback and the screw differ by a third of a millimetre on a body 3.7 m
-#: across moving a few centimetres a frame: a share of 0.1 would quadruple the frames of most
-#: captures; 0.25 cuts the eased first and last spans and the fastest ones. On the walk of
-#: scripts/bench_reduce.py at 1 mm: 719 key frames, against 819 with 0.5.)
+#: this share of the tolerance (the ease of a first or last key, a fast swing) gets the
+#: playback at :data:`PROBES` as dense poses too; the largest departure of the other spans is
+#: taken off the tolerance given to the core, so that the reduced keys stay within the
+#: tolerance of Blender's own playback of the dense keys at every frame and at the probes.
+#: (Between the frames of Bezier keys on every frame, Blender's playback and the screw differ
+#: by a third of a millimetre on a body 3.7 m across moving a few centimetres a frame, by a
+#: millimetre on a leg swinging 6 degrees a frame: the share trades dense frames, up to four
+#: times as many, against tolerance left to the core.)
 DEPARTURE_SHARE = 0.25
-
-#: At most this many times a span is cut into quarters that way.
-REFINE_LEVELS = 3
 
 
 def _probe_times(frames: np.ndarray) -> np.ndarray:
@@ -375,11 +386,11 @@ def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.nda
         play = it.probe_poses
         if parents is not None and parents[i] >= 0:
             j = int(parents[i])
-            ref = world_ref[j] @ offsets[i] @ ref
-            play = world_play[j] @ offsets[i] @ play
+            ref = _mul(world_ref[j], _mul(offsets[i], ref))
+            play = _mul(world_play[j], _mul(offsets[i], play))
         world_ref[i], world_play[i] = ref, play
-        rel = np.einsum("nji,njk->nik", ref[:, :3, :3], play[:, :3, :3])
-        theta = np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
+        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
         d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
         if it.channels[2]:
             lin = np.concatenate([it.scales[:-1] + f * np.diff(it.scales, axis=0) for f in PROBES])
@@ -439,17 +450,18 @@ def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options
         grouped.setdefault(frames.tobytes(), (frames, []))[1].append((owner, motion))
     out = []
     for frames, members in grouped.values():
-        for level in range(REFINE_LEVELS + 1):
-            items = _located_children([_item(o, m, frames) for o, m in members], members)
-            dist, ang = departure(items, frames)
-            steps = np.any([it.constant for it in items], axis=0)
-            flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
-            if not flagged.any() or level == REFINE_LEVELS:
-                break
+        items = _located_children([_item(o, m, frames) for o, m in members], members)
+        dist, ang = departure(items, frames)
+        steps = np.any([it.constant for it in items], axis=0)
+        flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
+        # the departure left: at the probes of the spans kept whole (a cut span's probes are
+        # dense frames now; steps are the core's own)
+        kept = ~flagged & ~steps
+        margin = (float(dist[kept].max(initial=0.0)), float(ang[kept].max(initial=0.0)))
+        if flagged.any():
             probes = _probe_times(frames).reshape(len(PROBES), -1)[:, flagged].ravel()
             frames = np.sort(np.concatenate([frames, probes]))
-        # the departure left (at the probes of every span; steps are the core's own)
-        margin = (float(dist[~steps].max(initial=0.0)), float(ang[~steps].max(initial=0.0)))
+            items = _located_children([_item(o, m, frames) for o, m in members], members)
         cyclic = all(
             it.cyclic
             and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
@@ -504,11 +516,11 @@ def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarr
         play = keys.compose(location, rotation)
         if parents is not None and parents[i] >= 0:
             j = int(parents[i])
-            ref = world_ref[j] @ offsets_[i] @ ref
-            play = world_play[j] @ offsets_[i] @ play
+            ref = _mul(world_ref[j], _mul(offsets_[i], ref))
+            play = _mul(world_play[j], _mul(offsets_[i], play))
         world_ref[i], world_play[i] = ref, play
-        rel = np.einsum("nji,njk->nik", ref[:, :3, :3], play[:, :3, :3])
-        theta = np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
+        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
         d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
         dist[i], ang[i] = float(d.max()), float(theta.max())
     return dist, ang
