@@ -14,7 +14,8 @@ is: the clips' own scale is 1):
 Tolerances: 0.5 mm / 0.05 degrees, 1 mm / 0.5 degrees, 5 mm / 1 degree.
 
 Ours: `bpy.ops.screwbender.reduce_keys(distance, angle)` on the clip's owners (timed: the
-whole operator). Theirs: `bpy.ops.graph.decimate(mode='ERROR', remove_error_margin=m)`, every
+whole operator), with the channels of an owner keyed on shared frames (the default) and
+Per Channel. Theirs: `bpy.ops.graph.decimate(mode='ERROR', remove_error_margin=m)`, every
 other option at its default, headless through `bpy.context.temp_override` with the largest
 area of the Animation screen switched to the Graph Editor and its WINDOW region, every key
 selected, the dope sheet's `show_only_selected` off; its margin is searched by bisection (in
@@ -502,11 +503,12 @@ def decimate(clip: Clip, margin: float) -> float:
     return elapsed
 
 
-def ours(clip: Clip, distance: float, angle: float) -> float:
+def ours(clip: Clip, distance: float, angle: float, per_channel: bool = False) -> float:
     clip.restore()
     select(clip.objects)
     start = time.perf_counter()
-    result = bpy.ops.screwbender.reduce_keys(distance=distance, angle=math.radians(angle), armature=clip.armature)
+    result = bpy.ops.screwbender.reduce_keys(distance=distance, angle=math.radians(angle), armature=clip.armature,
+                                             per_channel=per_channel)
     elapsed = time.perf_counter() - start
     assert result == {"FINISHED"}, result
     return elapsed
@@ -636,6 +638,7 @@ def main() -> None:
         for distance, angle in TOLERANCES:
             case = {"distance": distance, "angle": angle}
             case["ours"] = measure(clip, ref, distance, angle, ours(clip, distance, angle))
+            case["ours_per_channel"] = measure(clip, ref, distance, angle, ours(clip, distance, angle, True))
             margin = search["best"][distance, angle]
             if margin is None:
                 case["decimate"] = None
@@ -653,13 +656,14 @@ def main() -> None:
                         break
                     margin *= 0.7
             entry["cases"].append(case)
-            o, d = case["ours"], case["decimate"]
+            o, d, pc = case["ours"], case["decimate"], case["ours_per_channel"]
             theirs = (f"decimate (margin {d['margin']:.3g}) {d['points']:,} keys, {d['fraction']:.1%} "
                       f"of frames, {1000 * d['time']:.0f} ms, error {1000 * d['distance']:.3g} mm / {d['angle']:.3g} deg, "
                       f"{d['within']:.2%} within") if d else "decimate: no margin meets it"
             print(f"  {clip.name} {1000 * distance:g} mm / {angle:g} deg: ours {o['points']:,} keys, {o['fraction']:.1%} of "
                   f"frames, {1000 * o['time']:.0f} ms, error {1000 * o['distance']:.3g} mm / {o['angle']:.3g} deg, "
-                  f"{o['within']:.2%} within; {theirs}", flush=True)
+                  f"{o['within']:.2%} within; per channel {pc['points']:,} keys, {pc['fraction']:.1%} of frames, "
+                  f"{1000 * pc['time']:.0f} ms, {pc['within']:.2%} within; {theirs}", flush=True)
         clip.restore()
         entry["dense_points"] = counts(clip.owners)[0]
         report["clips"].append(entry)

@@ -562,31 +562,37 @@ class Report:
                "over the transform curves; % of frames: distinct key frames per owner over the frames of its key range. "
                f"Within: the share of (owner, sample) pairs within the tolerance (+{d['slack']:g} for float32 "
                "world matrices).", "",
-               "| clip | tolerance | ours: keys | % of frames | error (mm / deg) | within | decimate: margin | keys | "
-               "% of frames | error (mm / deg) | within | keys ours / decimate | time ours | time decimate | "
-               "time ours / decimate |",
-               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
-        key_ratios, time_ratios, within, captured_share = [], [], [], []
+               "Ours twice: an owner's channels keyed on shared frames (the default) and Per Channel. Ratios: "
+               "key frames, ours (shared) / decimate; keys (keyframe points), ours (per channel) / decimate.", "",
+               "| clip | tolerance | ours: key frames (% of frames) | keys | per channel: keys | decimate: margin | "
+               "key frames (% of frames) | keys | key frames ours / decimate | keys per channel / decimate | "
+               "error ours, per channel, decimate (mm / deg) | within ours, per channel, decimate | "
+               "time ours, per channel, decimate | time ours / decimate |",
+               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        key_ratios, point_ratios, time_ratios, within, captured_share = [], [], [], [], []
         for clip in d["clips"]:
             for c in clip["cases"]:
-                o, t = c["ours"], c["decimate"]
-                within.append(o["within"])
+                o, t, pc = c["ours"], c["decimate"], c.get("ours_per_channel", c["ours"])
+                within += [o["within"], pc["within"]]
                 if clip["captured"] and c["distance"] == 0.001:
                     captured_share.append((clip["name"], o["fraction"]))
                 tol = f"{1000 * c['distance']:g} mm / {c['angle']:g} deg"
-                ours = (f"{o['points']:,} | {100 * o['fraction']:.1f} % | {1000 * o['distance']:.3g} / {o['angle']:.3g} | "
-                        f"{100 * o['within']:.2f} %")
+                err = lambda r: f"{1000 * r['distance']:.3g} / {r['angle']:.3g}"  # noqa: E731
                 if t is None:
-                    self.w(f"| {clip['label']} | {tol} | {ours} | no margin meets it | - | - | - | - | - | "
-                           f"{fmt_seconds(o['time'])} | - | - |")
+                    self.w(f"| {clip['label']} | {tol} | {o['keyframes']:,} ({100 * o['fraction']:.1f} %) | "
+                           f"{o['points']:,} | {pc['points']:,} | no margin meets it | - | - | - | - | "
+                           f"{err(o)}, {err(pc)}, - | {100 * o['within']:.2f} %, {100 * pc['within']:.2f} %, - | "
+                           f"{fmt_seconds(o['time'])}, {fmt_seconds(pc['time'])}, - | - |")
                     continue
-                kr, tr = o["points"] / t["points"], o["time"] / t["time"]
+                kr, pr, tr = o["keyframes"] / t["keyframes"], pc["points"] / t["points"], o["time"] / t["time"]
                 key_ratios.append((clip["name"], kr))
-                time_ratios.append((clip["name"], tr))
-                self.w(f"| {clip['label']} | {tol} | {ours} | {t['margin']:.3g} | {t['points']:,} | "
-                       f"{100 * t['fraction']:.1f} % | {1000 * t['distance']:.3g} / {t['angle']:.3g} | "
-                       f"{100 * t['within']:.2f} % | {kr:.2f} | {fmt_seconds(o['time'])} | {fmt_seconds(t['time'])} | "
-                       f"{tr:.2f} |")
+                point_ratios.append((clip["name"], pr))
+                time_ratios.append((clip["name"], max(tr, pc["time"] / t["time"])))
+                self.w(f"| {clip['label']} | {tol} | {o['keyframes']:,} ({100 * o['fraction']:.1f} %) | {o['points']:,} | "
+                       f"{pc['points']:,} | {t['margin']:.3g} | {t['keyframes']:,} ({100 * t['fraction']:.1f} %) | "
+                       f"{t['points']:,} | {kr:.2f} | {pr:.2f} | {err(o)}, {err(pc)}, {err(t)} | "
+                       f"{100 * o['within']:.2f} %, {100 * pc['within']:.2f} %, {100 * t['within']:.2f} % | "
+                       f"{fmt_seconds(o['time'])}, {fmt_seconds(pc['time'])}, {fmt_seconds(t['time'])} | {tr:.2f} |")
         self.w("")
         windowed = [c for c in d["clips"] if c.get("searched_on", "the clip") != "the clip"]
         for c in windowed:
@@ -606,9 +612,13 @@ class Report:
             self.w("")
         self.w(f"The whole benchmark ran in {d['seconds']:.0f} s.", "")
         if key_ratios:
-            worst = max(r for _, r in key_ratios)
-            self.targets.append(("Reduce Keys <= 0.6x the keys of the best graph.decimate margin (every clip, every "
-                                 "tolerance)", f"at most {worst:.2f}x", verdict(worst <= 0.6)))
+            worst = max(key_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys <= 0.6x the key frames of the best graph.decimate margin (every clip, "
+                                 "every tolerance)", f"at most {worst[1]:.2f}x ({worst[0]})", verdict(worst[1] <= 0.6)))
+        if point_ratios:
+            worst = max(point_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys (Per Channel) <= 0.6x the keyframe points of the best graph.decimate "
+                                 "margin", f"at most {worst[1]:.2f}x ({worst[0]})", verdict(worst[1] <= 0.6)))
         if captured_share:
             self.targets.append(("<= 10 % of frames on captured motion at 1 mm / 0.5 deg",
                                  ", ".join(f"{n} {100 * f:.1f} %" for n, f in captured_share),
@@ -617,9 +627,9 @@ class Report:
             self.targets.append(("Reduce Keys within the tolerance at 100 % of checked samples",
                                  f"at least {100 * min(within):.2f} %", verdict(min(within) >= 1.0)))
         if time_ratios:
-            worst = max(r for _, r in time_ratios)
-            self.targets.append(("Reduce Keys <= 2x graph.decimate's time", f"at most {worst:.2f}x",
-                                 verdict(worst <= 2.0)))
+            worst = max(time_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys <= 2x graph.decimate's time", f"at most {worst[1]:.2f}x ({worst[0]})",
+                                 verdict(worst[1] <= 2.0)))
         if smooth:
             worst = max(s_["reduced"] / s_["every_step"] for s_ in smooth)
             self.targets.append(("Smooth Motion with Reduced no slower than Every Step", f"at most {worst:.2f}x",

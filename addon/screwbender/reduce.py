@@ -73,6 +73,9 @@ class Options:
     #: On an action that is already a result of Reduce Keys: reduce that result (else the
     #: original keys again, replacing the earlier result).
     reduce_result: bool = False
+    #: Each channel keyed on frames of its own (fewer keys in all); default: an owner's
+    #: channels keyed on the same frames (fewer key frames, one column per pose).
+    per_channel: bool = False
 
 
 def default_distance(scene: bpy.types.Scene) -> float:
@@ -229,6 +232,7 @@ def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool 
             constant=np.stack([it.constant for it in items]) if any(it.constant.any() for it in items) else None,
             cyclic=cyclic,
             start=np.stack([it.start for it in items]),
+            per_channel=bool(options.per_channel),
         )
     except (ValueError, TypeError, MemoryError) as err:
         names = ", ".join(it.owner.name for it in items[:3]) + (" ..." if len(items) > 3 else "")
@@ -538,14 +542,16 @@ def solve_batch(batch: Batch, options: Options) -> list[Reduced]:
     Blender's playback of the dense keys at every frame and at the probes)."""
     distance = max(options.distance - batch.margin[0], 0.5 * options.distance)
     angle = max(options.angle - batch.margin[1], 0.5 * options.angle)
-    inner = Options(distance=distance, angle=angle)
+    inner = Options(distance=distance, angle=angle, per_channel=options.per_channel)
     for attempt in range(RETRIES + 1):
         results = solve(batch.items, batch.frames, inner, batch.cyclic)
         dist, ang = measured(batch, results)
         over = max(dist.max() / distance, ang.max() / angle)
         if over <= 1.0 + 1e-6 or attempt == RETRIES:
             break
-        inner = Options(distance=inner.distance * 0.95 / over, angle=inner.angle * 0.95 / over)
+        inner = Options(
+            distance=inner.distance * 0.95 / over, angle=inner.angle * 0.95 / over, per_channel=options.per_channel
+        )
     for r, d, a in zip(results, dist, ang):
         r.distance_error = float(d) + batch.margin[0]
         r.angle_error = float(a) + batch.margin[1]

@@ -63,6 +63,13 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
         description="Object Mode, selected armatures: their keyed bones, their own keys, or both. "
         "In Pose Mode the selected bones",
     )
+    per_channel: BoolProperty(
+        name="Per Channel",
+        default=False,
+        description="Key each channel on frames of its own (fewest keys in all, as Decimate keys them). "
+        "Off: an owner's channels are keyed on the same frames (fewest key frames: one column per pose "
+        "in the Dope Sheet)",
+    )
     reduce_result: BoolProperty(
         name="Reduce Result",
         default=False,
@@ -85,12 +92,15 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
         col = layout.column(align=True)
         col.prop(self, "distance")
         col.prop(self, "angle")
+        layout.prop(self, "per_channel")
         layout.prop(self, "armature")
         layout.prop(self, "reduce_result")
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         selection = owners.selection(context, self.armature, channels.object_fcurves)
-        options = reduce.Options(distance=self.distance, angle=self.angle, reduce_result=self.reduce_result)
+        options = reduce.Options(
+            distance=self.distance, angle=self.angle, reduce_result=self.reduce_result, per_channel=self.per_channel
+        )
         wm = context.window_manager
         wm.progress_begin(0.0, 1.0)
         try:
