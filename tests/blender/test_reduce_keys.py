@@ -157,6 +157,18 @@ def test_reduce_keys_on_an_object_plays_within_the_tolerance(sb):
     check_within([obj], ref, times, DISTANCE, ANGLE, "object")
 
 
+def test_per_channel_keys_each_channel_on_its_own_frames(sb):
+    obj = dense_object("Chan")
+    times = sample_times(1, N)
+    ref = play([obj], times)
+    assert bpy.ops.screwbender.reduce_keys(distance=DISTANCE, angle=ANGLE, per_channel=True) == {"FINISHED"}
+    frames = [tuple(h.curve_points(fc)[:, 0]) for fc in h.fcurves(obj) if fc.data_path in ("location", "rotation_euler")]
+    points = sum(len(f) for f in frames)
+    print(f"per channel: {points} keys over 6 curves, {len(set(frames))} distinct sets of key frames")
+    assert len(set(frames)) > 1 and points < 0.2 * 6 * N
+    check_within([obj], ref, times, DISTANCE, ANGLE, "per channel")
+
+
 def test_reduce_keys_on_a_rig_in_pose_mode_holds_in_world_space(sb):
     rig = bh.armature("Rig")
     frames = np.arange(1, 97, dtype=float)
