@@ -71,6 +71,84 @@ pub fn relative_angle(a: DQuat, b: DQuat) -> (f64, f64) {
     (sin_half, 2.0 * s.atan2(c))
 }
 
+/// The rotation channels' Jacobian at channel values `r` whose rotation is the unit `q`:
+/// `J` (3 x 4, by rows; unused columns zero) with `omega = J dr` the rotation vector of
+/// `R(r)^-1 R(r + dr)` to first order (its angle `|omega|`), for the search's `f64` model:
+///
+/// - quaternion `(w, v)`: `omega = 2 Im(q^* dq) = 2 (w dv - dw v - v x dv)`;
+/// - Euler, axes applied `a1, a2, a3`: `omega = R3 R2 u1 de1 + R3 u2 de2 + u3 de3` (world
+///   frame; its length is the angle in any frame);
+/// - axis-angle: `None` (the model composes it exactly).
+pub fn jacobian(mode: RotationMode, r: &[f64], q: DQuat) -> Option<[[f64; 4]; 3]> {
+    match mode {
+        RotationMode::Quaternion => {
+            let (w, v) = (q.w, q.xyz());
+            // Signs of the stored channels may be the opposite of q's.
+            let s = if q.dot(DQuat::from_xyzw(r[1], r[2], r[3], r[0])) < 0.0 {
+                -2.0
+            } else {
+                2.0
+            };
+            // d(Im) / d(dw) = -v; d(Im) / d(dv) = w I - [v]x.
+            Some([
+                [-s * v.x, s * w, s * v.z, -s * v.y],
+                [-s * v.y, -s * v.z, s * w, s * v.x],
+                [-s * v.z, s * v.y, -s * v.x, s * w],
+            ])
+        }
+        RotationMode::AxisAngle => None,
+        RotationMode::Euler(order) => {
+            let [a1, a2, a3] = euler_axes(order);
+            let unit = |a: usize| match a {
+                0 => DVec3::X,
+                1 => DVec3::Y,
+                _ => DVec3::Z,
+            };
+            let c3 = unit(a3);
+            // R3 R2 u1 = R u1 (R1 keeps u1); R3 u2 is perpendicular to both: c3 x c1 =
+            // cos(e2) R3 u2 for an even order, -cos(e2) R3 u2 for an odd one.
+            let c1 = q * unit(a1);
+            let cross = c3.cross(c1);
+            let len = cross.length();
+            let c2 = if len > GIMBAL_JACOBIAN {
+                // The sign of cos(e2) from e2 itself: even half-turn count -> positive.
+                let turns = (r[a2] / std::f64::consts::PI + 0.5).floor();
+                let even_order = (a2 + 3 - a1) % 3 == 1;
+                let positive = (turns.rem_euclid(2.0) == 0.0) == even_order;
+                if positive {
+                    cross / len
+                } else {
+                    -cross / len
+                }
+            } else {
+                DQuat::from_axis_angle(c3, r[a3]) * unit(a2)
+            };
+            let mut j = [[0.0; 4]; 3];
+            for (axis, col) in [(a1, c1), (a2, c2), (a3, c3)] {
+                j[0][axis] = col.x;
+                j[1][axis] = col.y;
+                j[2][axis] = col.z;
+            }
+            Some(j)
+        }
+    }
+}
+
+/// Below this `|cos(e2)|` the Euler Jacobian's middle column is built with trigonometry.
+const GIMBAL_JACOBIAN: f64 = 1e-3;
+
+/// The axes of an Euler order in the order they are applied (`"XYZ"`: X first).
+fn euler_axes(order: EulerOrder) -> [usize; 3] {
+    match order {
+        EulerOrder::Xyz => [0, 1, 2],
+        EulerOrder::Xzy => [0, 2, 1],
+        EulerOrder::Yxz => [1, 0, 2],
+        EulerOrder::Yzx => [1, 2, 0],
+        EulerOrder::Zxy => [2, 0, 1],
+        EulerOrder::Zyx => [2, 1, 0],
+    }
+}
+
 /// What an owner keys: location, rotation, scale.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Keyed {
@@ -155,6 +233,45 @@ mod tests {
                 .iter()
                 .fold(0.0f64, |a, v| a.max(v.abs()));
             assert!(d < 1e-14, "{order:?}: {d}");
+        }
+    }
+
+    #[test]
+    fn jacobian_gives_the_small_turns() {
+        let mut cases = vec![];
+        for order in [
+            EulerOrder::Xyz,
+            EulerOrder::Xzy,
+            EulerOrder::Yxz,
+            EulerOrder::Yzx,
+            EulerOrder::Zxy,
+            EulerOrder::Zyx,
+        ] {
+            for r in [
+                [0.4, -0.9, 2.1],
+                [3.0, 2.5, -7.0],
+                [-1.0, 7.5, 0.3],
+                [0.2, 1.5707, 0.1],
+            ] {
+                cases.push((RotationMode::Euler(order), vec![r[0], r[1], r[2], 0.0]));
+            }
+        }
+        let q = DQuat::from_scaled_axis(DVec3::new(0.3, -1.0, 0.7));
+        cases.push((RotationMode::Quaternion, vec![-q.w, -q.x, -q.y, -q.z]));
+        for (mode, r) in cases {
+            let q = rotation(mode, &r);
+            let j = jacobian(mode, &r, q).unwrap();
+            for k in 0..mode.width() {
+                let mut d = r.clone();
+                d[k] += 1e-6;
+                let (_, angle) = relative_angle(q, rotation(mode, &d));
+                let col = DVec3::new(j[0][k], j[1][k], j[2][k]);
+                let want = col.length() * 1e-6;
+                assert!(
+                    (angle - want).abs() < 1e-11,
+                    "{mode:?} {k}: {angle} vs {want}"
+                );
+            }
         }
     }
 

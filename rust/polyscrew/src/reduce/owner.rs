@@ -3,7 +3,7 @@
 
 use glam::{DQuat, DVec3};
 
-use super::compose::{row_error, Keyed, ROT, SCALE, STRIDE};
+use super::compose::{jacobian, relative_angle, rotation, row_error, Keyed, ROT, SCALE, STRIDE};
 use super::{
     interpolation, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
     SEARCH_MARGIN, SUBSAMPLES,
@@ -20,6 +20,9 @@ use crate::motion::screw::Screw;
 /// Channels of a cycle's last frame within this of the first frame's (relative to
 /// `1 + |value|`) are set equal to them, so the cycle's first and last keys are equal.
 pub const CYCLE_SNAP: f64 = 1e-9;
+
+/// The subframes in sixteenths of a span: 1/4, 1/2, 3/4 ([`SUBSAMPLES`] = 4).
+const SUBFRAME_SIXTEENTHS: [i32; SUBSAMPLES - 1] = [4, 8, 12];
 
 /// Rounds of per-channel reduction, each with half the previous share of the tolerance,
 /// before the last one is kept (its errors reported as measured).
@@ -67,6 +70,7 @@ pub(crate) struct Workspace {
     v: Vec<[f64; STRIDE]>,
     reduced: Vec<Pose>,
     quats: Vec<DQuat>,
+    jac: Vec<[[f64; 4]; 3]>,
 }
 
 /// What every owner shares: the inputs, the sample times.
@@ -155,13 +159,12 @@ impl<'a> Context<'a> {
         ws.scale.clear();
         for f in 0..n - 1 {
             ws.local.push(poses[f]);
-            let held = self.constant(o, f);
-            let screw = (!held).then(|| Screw::between(&poses[f], &poses[f + 1]));
-            for k in 1..SUBSAMPLES {
-                ws.local.push(match &screw {
-                    Some(sc) => sc.eval(k as f64 / SUBSAMPLES as f64),
-                    None => poses[f],
-                });
+            if self.constant(o, f) {
+                ws.local.extend([poses[f]; SUBSAMPLES - 1]);
+            } else {
+                // 1/4, 1/2, 3/4 of the screw, without trigonometry.
+                let screw = Screw::between(&poses[f], &poses[f + 1]);
+                ws.local.extend(screw.eval_sixteenths(SUBFRAME_SIXTEENTHS));
             }
         }
         ws.local.push(poses[n - 1]);
@@ -195,9 +198,10 @@ impl<'a> Context<'a> {
             let l = ws.local[j];
             match parent {
                 Some(p) => {
-                    let w = p.dense[j].mul_pose(&offset).mul_pose(&l);
-                    let base = p.reduced[j].mul_pose(&offset);
-                    ws.target.push(base.inverse().mul_pose(&w));
+                    // (parent_reduced @ offset)^-1 @ parent_dense @ offset @ local.
+                    let w = mul(&mul(&p.dense[j], &offset), &l);
+                    let base = mul(&p.reduced[j], &offset);
+                    ws.target.push(mul_inverse(&base, &w));
                     if keep_world {
                         dense_world.push(w);
                     }
@@ -205,7 +209,7 @@ impl<'a> Context<'a> {
                 None => {
                     ws.target.push(l);
                     if keep_world {
-                        dense_world.push(offset.mul_pose(&l));
+                        dense_world.push(mul(&offset, &l));
                     }
                 }
             }
@@ -227,6 +231,15 @@ impl<'a> Context<'a> {
             ws.v.push(row);
         }
         drop(rot);
+        ws.jac.clear();
+        if keyed.rotation && mode != RotationMode::AxisAngle {
+            ws.jac.reserve(m);
+            for j in 0..m {
+                let r = &ws.v[j][ROT..ROT + 4];
+                let q = ws.target[j].rotation;
+                ws.jac.push(jacobian(mode, r, q).unwrap_or([[0.0; 4]; 3]));
+            }
+        }
         let mut cols = Vec::with_capacity(STRIDE);
         if keyed.location {
             cols.extend(0..3);
@@ -253,6 +266,7 @@ impl<'a> Context<'a> {
             v: &ws.v,
             target: &ws.target,
             scale: &ws.scale,
+            jac: (!ws.jac.is_empty()).then_some(&ws.jac[..]),
             mode,
             keyed,
             radius: self.input.radius[o],
@@ -280,8 +294,8 @@ impl<'a> Context<'a> {
             for j in 0..m {
                 let l = ws.reduced[j];
                 reduced.push(match parent {
-                    Some(p) => p.reduced[j].mul_pose(&offset).mul_pose(&l),
-                    None => offset.mul_pose(&l),
+                    Some(p) => mul(&mul(&p.reduced[j], &offset), &l),
+                    None => mul(&offset, &l),
                 });
             }
             Some(World {
@@ -344,6 +358,26 @@ impl<'a> Context<'a> {
     }
 }
 
+/// `a @ b` without renormalising the product of the unit quaternions (unit to rounding; the
+/// channels normalise what they read).
+#[inline(always)]
+fn mul(a: &Pose, b: &Pose) -> Pose {
+    Pose {
+        rotation: a.rotation * b.rotation,
+        translation: a.rotation * b.translation + a.translation,
+    }
+}
+
+/// `a^-1 @ b`, as [`mul`].
+#[inline(always)]
+fn mul_inverse(a: &Pose, b: &Pose) -> Pose {
+    let r = a.rotation.conjugate();
+    Pose {
+        rotation: r * b.rotation,
+        translation: r * (b.translation - a.translation),
+    }
+}
+
 /// The curve of channel column `c` through `spans`.
 fn curve_of(fitter: &Fitter<'_>, o: usize, c: usize, spans: &[Span]) -> Result<ReducedCurve> {
     let (group, index) = match c {
@@ -395,6 +429,8 @@ struct Fitter<'w> {
     v: &'w [[f64; STRIDE]],
     target: &'w [Pose],
     scale: &'w [DVec3],
+    /// Per sample, the rotation channels' Jacobian (`None`: axis-angle, composed exactly).
+    jac: Option<&'w [[[f64; 4]; 3]]>,
     mode: RotationMode,
     keyed: Keyed,
     radius: f64,
@@ -420,6 +456,55 @@ impl Fitter<'_> {
             p.translation,
             self.scale[j],
         )
+    }
+
+    /// The search's error of channel row `y` at sample `j`: as [`row_error`], with the
+    /// rotation's angle to first order (`|J dr|`, see [`jacobian`]) and `r theta` for
+    /// `2 r sin(theta / 2)` (never less).
+    #[inline(always)]
+    fn model_error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, f64) {
+        let v = &self.v[j];
+        let mut d = 0.0;
+        if self.keyed.location {
+            let (a, b, c) = (y[0] - v[0], y[1] - v[1], y[2] - v[2]);
+            d += (a * a + b * b + c * c).sqrt();
+        }
+        let mut theta = 0.0;
+        if self.keyed.rotation {
+            theta = match self.jac {
+                Some(jac) => {
+                    let jj = &jac[j];
+                    let dr = [
+                        y[ROT] - v[ROT],
+                        y[ROT + 1] - v[ROT + 1],
+                        y[ROT + 2] - v[ROT + 2],
+                        y[ROT + 3] - v[ROT + 3],
+                    ];
+                    let w = |row: &[f64; 4]| {
+                        row[0] * dr[0] + row[1] * dr[1] + row[2] * dr[2] + row[3] * dr[3]
+                    };
+                    let (a, b, c) = (w(&jj[0]), w(&jj[1]), w(&jj[2]));
+                    (a * a + b * b + c * c).sqrt()
+                }
+                None => {
+                    relative_angle(
+                        self.target[j].rotation,
+                        rotation(self.mode, &y[ROT..ROT + 4]),
+                    )
+                    .1
+                }
+            };
+            d += self.radius * theta;
+        }
+        if self.keyed.scale {
+            let (a, b, c) = (
+                y[SCALE] - v[SCALE],
+                y[SCALE + 1] - v[SCALE + 1],
+                y[SCALE + 2] - v[SCALE + 2],
+            );
+            d += self.radius * (a * a + b * b + c * c).sqrt();
+        }
+        (d, theta)
     }
 
     /// The inner handle values of the span `s..=e` for columns `cols`: least squares over
@@ -479,13 +564,17 @@ impl Fitter<'_> {
         let (v0, v3) = (&self.v[s], &self.v[e]);
         let ts = self.times[s];
         let inv = 1.0 / (self.times[e] - ts);
-        for j in s + 1..e {
+        // The middle of every frame first, where a span that is too long fails soonest.
+        let half = SUBSAMPLES / 2;
+        let mids = (s + half..e).step_by(SUBSAMPLES);
+        let rest = (s + 1..e).filter(|j| (j - s) % SUBSAMPLES != half);
+        for j in mids.chain(rest) {
             let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
             let mut y = self.v[j];
             for &c in cols {
                 y[c] = v0[c] * b0 + h1[c] * b1 + h2[c] * b2 + v3[c] * b3;
             }
-            let (d, a, _, _) = self.error(j, &y);
+            let (d, a) = self.model_error(j, &y);
             if d > limit.distance || a > limit.angle {
                 return false;
             }
@@ -649,6 +738,8 @@ impl Fitter<'_> {
     ) -> (f64, f64) {
         let (mut dmax, mut amax) = (0.0f64, 0.0f64);
         let mut key = a;
+        // Spans of neighbouring keys are alike: the search starts from the last one's length.
+        let mut guess = 4;
         while key < b {
             let first = (key / SUBSAMPLES + 1) * SUBSAMPLES;
             let count = (b - first) / SUBSAMPLES + 1;
@@ -656,36 +747,39 @@ impl Fitter<'_> {
             let model = |e: usize, out: &mut [Pose]| {
                 self.try_span(key, e, cols, tol, false, out).0.is_some()
             };
-            // The longest span by the model: exponential, then binary search.
-            let mut best: Option<usize> = None;
-            if model(pos(0), out) {
-                let (mut lo, mut hi) = (0, count);
-                let mut step = 1;
-                while lo + step < count {
-                    if model(pos(lo + step), out) {
-                        lo += step;
+            // The longest span by the model: from the previous span's length, exponential
+            // steps out to the first failure, then binary search (indices shifted by one:
+            // 0 means no whole-frame span fits).
+            let ok = |k: usize, out: &mut [Pose]| model(pos(k - 1), out);
+            let g = guess.clamp(1, count);
+            let (mut lo, mut hi) = if ok(g, out) {
+                let (mut lo, mut hi) = (g, count + 1);
+                let mut step = 1.max(g / 2);
+                while lo < count {
+                    let k = (lo + step).min(count);
+                    if ok(k, out) {
+                        lo = k;
                         step *= 2;
                     } else {
-                        hi = lo + step;
+                        hi = k;
                         break;
                     }
                 }
-                if hi == count && lo + 1 < count {
-                    if model(pos(count - 1), out) {
-                        lo = count - 1;
-                    } else {
-                        hi = count - 1;
-                    }
+                (lo, hi)
+            } else {
+                (0, g)
+            };
+            while hi - lo > 1 {
+                let mid = lo + (hi - lo) / 2;
+                if ok(mid, out) {
+                    lo = mid;
+                } else {
+                    hi = mid;
                 }
-                while hi - lo > 1 {
-                    let mid = lo + (hi - lo) / 2;
-                    if model(pos(mid), out) {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                }
-                best = Some(lo);
+            }
+            let best = lo.checked_sub(1);
+            if let Some(b) = best {
+                guess = b + 1;
             }
             // Blender's evaluation of the chosen span; shorter ones while it fails.
             let mut accepted: Option<(Span, f64, f64)> = None;
