@@ -121,6 +121,8 @@ class Item:
     #: Blender's playback at the probes of every span (:func:`departure`), when read.
     probe_poses: np.ndarray | None = None
     probe_scales: np.ndarray | None = None
+    #: (N - 1,) spans Blender plays as a straight line in channel space (LINEAR keys).
+    linear: np.ndarray | None = None
 
 
 @dataclass
@@ -325,6 +327,9 @@ def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> 
     stacked = np.concatenate([location, rotation, scale], axis=1)
     at, inside = stacked[:n], stacked[n:].reshape(len(PROBES) + 1, n - 1, -1)
     steps = np.all(inside == at[None, :-1], axis=(0, 2)) & np.any(at[1:] != at[:-1], axis=1)
+    # Linear spans: the channels at the probes on the straight line between the frames
+    chord = np.stack([at[:-1] + f * (at[1:] - at[:-1]) for f in PROBES])
+    linear = np.all(np.abs(inside[: len(PROBES)] - chord) <= 1e-6 * (1.0 + np.abs(chord)), axis=(0, 2))
     columns = set(source.columns)
     located = motion.located and any(p == "location" for p, _ in columns)
     rotated = any(p == rot_path for p, _ in columns)
@@ -349,6 +354,7 @@ def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> 
         cyclic=motion.cyclic,
         probe_poses=poses[n:m],
         probe_scales=scales[n:m],
+        linear=linear,
     )
 
 
@@ -456,10 +462,15 @@ def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options
         items = _located_children([_item(o, m, frames) for o, m in members], members)
         dist, ang = departure(items, frames)
         steps = np.any([it.constant for it in items], axis=0)
+        # LINEAR keys on every frame (a bake): the in-between is a straight line in channel
+        # space, samples of a motion rather than a curve meant between them; the screw between
+        # the frames is the reference there, as for steps
+        linear = np.all([it.linear for it in items], axis=0)
         flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
+        flagged &= ~linear
         # the departure left: at the probes of the spans kept whole (a cut span's probes are
         # dense frames now; steps are the core's own)
-        kept = ~flagged & ~steps
+        kept = ~flagged & ~steps & ~linear
         margin = (float(dist[kept].max(initial=0.0)), float(ang[kept].max(initial=0.0)))
         if flagged.any():
             probes = _probe_times(frames).reshape(len(PROBES), -1)[:, flagged].ravel()
