@@ -660,7 +660,7 @@ def smooth(
     if options.key_mode == "REDUCED" and bakes:
         from . import reduce
 
-        reduce.reduce_bakes(bakes, options.key_distance, options.key_angle)
+        notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
     with contextlib.ExitStack() as stack:
         if t is None:
             t = stack.enter_context(transaction.atomic())

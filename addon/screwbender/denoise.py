@@ -327,7 +327,8 @@ def remove_noise(
                 if options.key_mode == "REDUCED":
                     from . import reduce
 
-                    reduce.reduce_bag(bag, [part.owner for part in parts], options.key_distance, options.key_angle)
+                    results = reduce.reduce_bag(bag, [p.owner for p in parts], options.key_distance, options.key_angle)
+                    notes.append(reduce.summary(results))
 
             actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise"))
             if progress is not None:

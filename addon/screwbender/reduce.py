@@ -123,6 +123,8 @@ class Item:
     probe_scales: np.ndarray | None = None
     #: (N - 1,) spans Blender plays as a straight line in channel space (LINEAR keys).
     linear: np.ndarray | None = None
+    #: Whole frames among the dense frames (quarter frames aside), for the report.
+    whole: int = 0
 
 
 @dataclass
@@ -355,6 +357,7 @@ def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> 
         probe_poses=poses[n:m],
         probe_scales=scales[n:m],
         linear=linear,
+        whole=int(np.sum(np.abs(frames - np.round(frames)) < keys.FRAME_TOLERANCE)),
     )
 
 
@@ -759,11 +762,21 @@ def reduce_keys(
 # Smooth Motion and Remove Noise with Keys: Reduced -----------------------------------------
 
 
-def reduce_bakes(bakes: list, distance: float, angle: float) -> None:
+def summary(results: list[Reduced]) -> str:
+    """The report's line for Keys: Reduced: key frames, the share of the frames, errors."""
+    frames = sum(r.item.whole or len(r.item.poses) for r in results)
+    keys_ = sum(r.keys for r in results)
+    return (
+        f"keys reduced to {keys_:,} key frames ({100.0 * keys_ / max(frames, 1):.1f} % of {frames:,} frames); largest "
+        f"error {max(r.distance_error for r in results):.3g} and {math.degrees(max(r.angle_error for r in results)):.3g} degrees"
+    )
+
+
+def reduce_bakes(bakes: list, distance: float, angle: float) -> str:
     """Smooth Motion, Keys: Reduced: reduces the dense channels of every part of `bakes`
     (:class:`bake.ActionBake`) before anything is written, setting each part's `reduced`.
     One `polyscrew.reduce_keys` call per set of baked frames (usually one: all owners of the
-    operator)."""
+    operator). Returns the report's line (:func:`summary`)."""
     batches: dict[tuple, list] = {}
     for action_bake in bakes:
         for part in action_bake.parts:
@@ -790,6 +803,7 @@ def reduce_bakes(bakes: list, distance: float, angle: float) -> None:
             )
         for part, result in zip(parts, solve(items, parts[0].frames, options, cyclic)):
             part.reduced = result
+    return summary([part.reduced for b in bakes for part in b.parts])
 
 
 def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) -> list[Reduced]:
