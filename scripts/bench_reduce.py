@@ -518,10 +518,13 @@ def measure(clip: Clip, ref: np.ndarray, distance: float, angle: float, elapsed:
     got = blender_playback(clip.owners, clip.times)
     dist, ang = world_errors(clip.owners, ref, got)
     within = (dist <= distance + SLACK) & (ang <= math.radians(angle) + SLACK)
+    whole = np.abs(clip.times - np.round(clip.times)) < 1e-9
     points, frames = counts(clip.owners)
     return {"points": points, "keyframes": frames, "fraction": frames / clip.owner_frames,
             "time": elapsed, "distance": float(dist.max()), "angle": float(math.degrees(ang.max())),
-            "within": float(within.mean()), "samples": int(within.size)}
+            "within": float(within.mean()), "samples": int(within.size),
+            "within_frames": float(within[:, whole].mean()),
+            "distance_frames": float(dist[:, whole].max()), "angle_frames": float(math.degrees(ang[:, whole].max()))}
 
 
 def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, steps: int) -> dict:
