@@ -42,6 +42,7 @@ TARGET_S_VS_NALGEBRA = 1.5
 TARGET_BATCH_VS_PT3D = 100.0
 TARGET_JAREK_1000x6_MS = 30.0
 TARGET_BAKE_VS_NLA = 20.0
+TARGET_REDUCE_RIG_MS = 100.0  # issue 26: 100 bones x 1,000 frames reduced, Rust, one thread
 TARGET_EXPONENT_TOLERANCE = 0.1  # "linear": fitted exponent within 1 +- this, on large outputs
 LARGE_OUTPUT = 10_000  # outputs from this size up are used for the linearity verdict
 
@@ -482,6 +483,11 @@ class Report:
         for k, r in rest:
             self.w(f"| {k} | {fmt_ns(r['median_ns'])} | {fmt_ns(r['low_ns'])} .. {fmt_ns(r['high_ns'])} |")
         self.w("")
+        rig = self.find("reduce_rig", "100x1000_one_thread")
+        if rig is not None:
+            ms = rig["median_ns"] / 1e6
+            self.targets.append(("key reduction, 100 bones x 1,000 frames < 100 ms (Rust, one thread)",
+                                 f"{ms:.1f} ms (CPU time)", verdict(ms < TARGET_REDUCE_RIG_MS)))
         if "fit_angular_velocity/top_20_keys" in self.crit or any(r["group"] == "hofer_table1" for _, r in rest):
             self.w("The paper figures these compare with are in \"Figures from other machines\" below.", "")
 

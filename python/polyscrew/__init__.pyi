@@ -720,6 +720,7 @@ def reduce_keys(
     per_channel: bool = False,
     start: ArrayLike | None = None,
     threads: int = 0,
+    between: Literal["screw", "cubic", "linear"] = "screw",
 ) -> dict[str, Any]:
     """The fewest Bezier keys whose playback by Blender stays within a world-space tolerance
     of B owners' dense rigid motions.
@@ -762,6 +763,17 @@ def reduce_keys(
       sign); the first key takes the equivalent values nearest to them (a spin from 360 to 720
       degrees stays there). None: those nearest zero.
     - ``threads``: owners of one depth of the hierarchy spread over this many threads (0: all).
+    - ``between``: the dense motion at the subframes. "screw" (default): the screw between
+      two frames, what a source keyed on every frame with LINEAR keys plays (to first order).
+      "cubic": the cubic through the two poses each side (fewer at the clip's ends and
+      around CONSTANT spans) by Aitken-Neville's scheme with screws for straight lines,
+      what a source keyed on every frame with Bezier keys plays (smooth: an ``nla.bake``, an
+      imported capture); a smooth reduction can follow it much more closely than the
+      screw's corners at every frame, so it needs fewer keys at tight tolerances. Both
+      reproduce screw motions exactly and are coordinate-free. "linear": the owner's channels
+      interpolated linearly between two frames, exactly what a source keyed on every frame
+      with LINEAR keys plays (a Smooth Motion bake); not coordinate-free (Euler channels are
+      not).
 
     Keys sit on the dense values (first and last frame always keyed); rotation channels are
     unwrapped along the dense samples (quaternion signs continuous, Euler triples compatible,

@@ -447,6 +447,8 @@ def test_scales_and_channels(rng):
     channels = np.array([[True, True, True], [False, True, False]])
     r = polyscrew.reduce_keys(poses, frames, "XYZ", 0.5, MM, 0.5 * DEG, scales=scales, channels=channels)
     assert [p for o, p in zip(r["owner"], r["path"]) if o == 1] == ["rotation_euler"] * 3
+    nothing = polyscrew.reduce_keys(poses[:1], frames, "XYZ", 0.5, MM, DEG, channels=[[False, False, False]])
+    assert nothing["path"] == [] and nothing["keys"].tolist() == [0]
     assert sorted(set(p for o, p in zip(r["owner"], r["path"]) if o == 0)) == ["location", "rotation_euler", "scale"]
     times = sample_times(frames)
     dense = np.array([dense_reference(p, frames) for p in poses])
@@ -494,6 +496,85 @@ def test_fallback_when_a_frame_is_not_enough():
     poses = screw_motion(n, [1.0, 1.0, 0.2], np.radians(600), 0.3, np.array([0.3, 0.0, 0.0]))[None]
     r, _, _ = check(poses, frames, "QUATERNION", 1.0, 0.1 * MM, 0.01 * DEG, "fast")
     assert r["keys"][0] >= n
+
+
+def neville_reference(poses, frames, per=4):
+    """The "cubic" dense motion at `sample_times(frames, per)`, independently: Aitken-Neville
+    over the two poses each side of a span with pytransform3d's screw for straight lines."""
+    n = len(frames)
+    out = []
+    for f in range(n - 1):
+        lo, hi = max(f - 1, 0), min(f + 2, n - 1)
+        for k in range(per):
+            t = frames[f] + (frames[f + 1] - frames[f]) * k / per
+            if k == 0:
+                out.append(poses[f])
+                continue
+            p = [poses[i] for i in range(lo, hi + 1)]
+            for level in range(1, len(p)):
+                for i in range(len(p) - level):
+                    ti, tj = frames[lo + i], frames[lo + i + level]
+                    p[i] = reference_s(p[i], (t - ti) / (tj - ti), p[i + 1])
+            out.append(p[0])
+    out.append(poses[-1])
+    return np.array(out)
+
+
+def test_between_cubic(rng):
+    """between="cubic": the tolerance holds against the cubic through the frames (built here
+    with pytransform3d's screw), and a smooth clip needs fewer keys than against the screw's
+    corners; a screw motion is still reproduced with two keys."""
+    n = 300
+    frames = np.arange(n, dtype=float)
+    t = frames / 30.0
+    limb = np.zeros((n, 4, 4))
+    limb[:, :3, :3] = Rotation.from_rotvec(np.stack([0.5 * np.sin(2 * np.pi * t), 0.05 * np.sin(4 * np.pi * t),
+                                                     np.zeros(n)], -1)).as_matrix()
+    limb[:, 3, 3] = 1
+    clips = np.array([limb, smooth_motion(n, rng), smooth_motion(n, rng)])
+    radius = np.array([0.45, 0.3, 0.3])
+    times = sample_times(frames)
+    counts = {}
+    for between in ("screw", "cubic"):
+        r = polyscrew.reduce_keys(clips, frames, "XYZ", radius, MM, 0.5 * DEG, between=between)
+        dense = np.array([(dense_reference if between == "screw" else neville_reference)(p, frames) for p in clips])
+        played = play(r, times, ["XYZ"] * 3, dense)
+        d, a = pose_errors(played, dense, radius)
+        assert d.max() <= MM and a.max() <= 0.5 * DEG, (between, d.max(), a.max())
+        np.testing.assert_allclose(r["distance_error"], d.max(axis=1), rtol=1e-3, atol=1e-9)
+        counts[between] = r["keys"]
+    print(f"\nkeys against the screw {counts['screw'].tolist()}, against the cubic {counts['cubic'].tolist()} "
+          f"of {n} frames (limb swing, two tumbles)")
+    assert (counts["cubic"] < counts["screw"]).all()
+    helix = screw_motion(61, [0.2, 0.3, 1.0], np.radians(100), 1.0, np.array([0.5, 0.0, 0.0]))[None]
+    r = polyscrew.reduce_keys(helix, np.arange(61.0), "QUATERNION", 0.3, MM, 0.5 * DEG, between="cubic")
+    assert r["keys"][0] <= 4
+    with pytest.raises(ValueError, match="reduce_keys: between"):
+        polyscrew.reduce_keys(helix, np.arange(61.0), "XYZ", 0.3, MM, DEG, between="bezier")
+
+
+def test_between_linear(rng):
+    """between="linear": the tolerance holds against the channels interpolated linearly
+    between frames (what LINEAR keys on every frame play), built here from scipy's Euler
+    angles unwrapped by numpy and composed by scipy."""
+    n = 200
+    frames = np.arange(n, dtype=float)
+    clips = np.array([smooth_motion(n, rng) for _ in range(2)])
+    r = polyscrew.reduce_keys(clips, frames, "ZXY", 0.4, MM, 0.5 * DEG, between="linear")
+    times = sample_times(frames)
+    u = np.tile(np.arange(4) / 4, n - 1)
+    dense = np.zeros((2, len(times), 4, 4))
+    dense[:, :, 3, 3] = 1
+    for o, p in enumerate(clips):
+        e = np.unwrap(Rotation.from_matrix(p[:, :3, :3]).as_euler("zxy"), axis=0)[:, [1, 2, 0]]  # x, y, z
+        lerp = lambda v: np.r_[v[:-1].repeat(4, 0) + np.diff(v, axis=0).repeat(4, 0) * u[:, None], v[-1:]]  # noqa: E731
+        dense[o, :, :3, :3] = rotation_of("ZXY", lerp(e))
+        dense[o, :, :3, 3] = lerp(p[:, :3, 3])
+    played = play(r, times, ["ZXY"] * 2, dense)
+    d, a = pose_errors(played, dense, np.full(2, 0.4))
+    print(f"\nlinear: keys {r['keys'].tolist()} of {n}, errors {d.max() / MM:.3f} mm {np.degrees(a.max()):.3f} deg")
+    assert d.max() <= MM and a.max() <= 0.5 * DEG, (d.max(), a.max())
+    np.testing.assert_allclose(r["distance_error"], d.max(axis=1), rtol=1e-3, atol=1e-9)
 
 
 # --- the result's form -------------------------------------------------------------------

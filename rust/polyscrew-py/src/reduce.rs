@@ -11,8 +11,8 @@ use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::reduce::{
-    reduce_footprint, HandleType, ReduceInput, ReduceOptions, Tolerance, MAX_REDUCE_FRAMES,
-    MAX_REDUCE_POSES, REDUCE_HINT,
+    reduce_footprint, Between, HandleType, ReduceInput, ReduceOptions, Tolerance,
+    MAX_REDUCE_FRAMES, MAX_REDUCE_POSES, REDUCE_HINT,
 };
 use polyscrew::{reduce_keys as core_reduce_keys, Pose, RotationMode};
 
@@ -130,14 +130,14 @@ fn read_floats(
     Ok(Some(out))
 }
 
-/// reduce_keys(poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=False, per_channel=False, start=None, threads=0) -> dict
+/// reduce_keys(poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=False, per_channel=False, start=None, threads=0, between="screw") -> dict
 ///
 /// The fewest Bezier keys whose playback by Blender stays within a world-space tolerance of
 /// dense rigid motions (see the stub for the full contract).
 #[pyfunction]
-#[pyo3(signature = (poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=None, per_channel=None, start=None, threads=None))]
+#[pyo3(signature = (poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=None, per_channel=None, start=None, threads=None, between=None))]
 #[pyo3(
-    text_signature = "(poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=False, per_channel=False, start=None, threads=0)"
+    text_signature = "(poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=False, per_channel=False, start=None, threads=0, between=\"screw\")"
 )]
 #[allow(clippy::too_many_arguments)]
 fn reduce_keys<'py>(
@@ -157,7 +157,13 @@ fn reduce_keys<'py>(
     per_channel: Option<&Bound<'py, PyAny>>,
     start: Option<&Bound<'py, PyAny>>,
     threads: Option<&Bound<'py, PyAny>>,
+    between: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let between = match between.filter(|b| !b.is_none()) {
+        Some(b) => Between::from_name(crate::args::str_arg(F, "between", b)?)
+            .map_err(|e| to_py_err(F, e))?,
+        None => Between::Screw,
+    };
     let flag = |what: &str, o: Option<&Bound<'py, PyAny>>| match o {
         Some(o) if !o.is_none() => o
             .extract::<bool>()
@@ -296,6 +302,7 @@ fn reduce_keys<'py>(
             cyclic,
             per_channel,
             threads,
+            between,
         };
         core_reduce_keys(&input, &options).map_err(|e| to_py_err(F, e))
     })?;

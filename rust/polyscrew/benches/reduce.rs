@@ -81,6 +81,7 @@ fn rig_bench<M: Measurement>(c: &mut Criterion<M>, group: &str, name: &str, thre
         cyclic: false,
         per_channel: false,
         threads,
+        between: Default::default(),
     };
     let r = reduce_keys(&input, &options).unwrap();
     let keys: usize = r.keys.iter().sum();
@@ -130,6 +131,7 @@ fn scaling(c: &mut Criterion<CpuTime>) {
             cyclic: false,
             per_channel: false,
             threads: 1,
+            between: Default::default(),
         };
         group.throughput(Throughput::Elements(n as u64));
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |bench, _| {

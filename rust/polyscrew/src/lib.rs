@@ -88,7 +88,7 @@ pub use motion::subdivision::{
 };
 pub use motion::timing::{check_key_times, TimeMap, Timing};
 pub use reduce::{
-    reduce_keys, Group, HandleType, ReduceInput, ReduceOptions, Reduced, ReducedCurve, ReducedKey,
-    Tolerance,
+    reduce_keys, Between, Group, HandleType, ReduceInput, ReduceOptions, Reduced, ReducedCurve,
+    ReducedKey, Tolerance,
 };
 pub use sweep::{sweep, sweep_mesh, Body, Generator, SweepOptions, SweptMesh};

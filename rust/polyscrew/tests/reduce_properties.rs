@@ -148,6 +148,7 @@ fn options(distance: f64, angle: f64) -> ReduceOptions {
         cyclic: false,
         per_channel: false,
         threads: 1,
+        between: Default::default(),
     }
 }
 

@@ -151,6 +151,49 @@ pub struct ReduceInput<'a> {
     pub start: Option<&'a [[f64; 4]]>,
 }
 
+/// The dense motion between two dense frames, which the tolerance is measured against at
+/// the subframes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+pub enum Between {
+    /// The screw between the two poses (`s(P_i, u, P_i+1)`): what the source plays when it
+    /// is keyed on every frame with LINEAR keys (to first order), and the agreed default.
+    #[default]
+    Screw,
+    /// The cubic through the four poses around the span (two each side, fewer at the ends
+    /// of the clip and of CONSTANT spans), by Aitken-Neville's scheme with screws in place
+    /// of straight lines: `P_ij(t) = s(P_i,j-1(t), (t - t_i) / (t_j - t_i), P_i+1,j(t))`.
+    /// Smooth like the source's own playback when it is keyed on every frame with Bezier
+    /// keys (an `nla.bake`, an imported capture); screws are reproduced exactly and it is
+    /// coordinate-free like the screw.
+    Cubic,
+    /// The owner's channels (location, the rotation channels of its mode, unwrapped from
+    /// `start`) interpolated linearly between the two frames: exactly what the source plays
+    /// when it is keyed on every frame with LINEAR keys (a Smooth Motion bake). Not
+    /// coordinate-free (Euler channels are not).
+    Linear,
+}
+
+impl Between {
+    /// The names, in the order of the variants.
+    pub const NAMES: [&'static str; 3] = ["screw", "cubic", "linear"];
+
+    /// The variant named `name`.
+    ///
+    /// # Errors
+    /// [`Error::Invalid`] for another name.
+    pub fn from_name(name: &str) -> Result<Self> {
+        match name {
+            "screw" => Ok(Self::Screw),
+            "cubic" => Ok(Self::Cubic),
+            "linear" => Ok(Self::Linear),
+            _ => Err(invalid(
+                "between",
+                format!("{name:?} is not one of screw, cubic, linear"),
+            )),
+        }
+    }
+}
+
 /// How to reduce.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ReduceOptions {
@@ -163,6 +206,8 @@ pub struct ReduceOptions {
     pub per_channel: bool,
     /// Worker threads (0: as many as the machine has).
     pub threads: usize,
+    /// The dense motion between two frames.
+    pub between: Between,
 }
 
 /// One reduced F-curve.

@@ -5,7 +5,7 @@ use glam::{DQuat, DVec3};
 
 use super::compose::{jacobian, relative_angle, rotation, row_error, Keyed, ROT, SCALE, STRIDE};
 use super::{
-    interpolation, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
+    interpolation, Between, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
     SEARCH_MARGIN, SUBSAMPLES,
 };
 use crate::error::{Error, Result};
@@ -15,7 +15,7 @@ use crate::fcurve::{Extrapolation, FCurve, Interpolation, Key};
 use crate::memory::try_vec;
 use crate::motion::channels::{rotation_channels, RotationMode};
 use crate::motion::pose::Pose;
-use crate::motion::screw::Screw;
+use crate::motion::screw::{s, Screw};
 
 /// Channels of a cycle's last frame within this of the first frame's (relative to
 /// `1 + |value|`) are set equal to them, so the cycle's first and last keys are equal.
@@ -79,6 +79,7 @@ pub(crate) struct Context<'a> {
     tolerance: Tolerance,
     cyclic: bool,
     per_channel: bool,
+    between: Between,
     n: usize,
     times: Vec<f64>,
     times32: Vec<f32>,
@@ -112,6 +113,7 @@ impl<'a> Context<'a> {
             tolerance: options.tolerance,
             cyclic: options.cyclic,
             per_channel: options.per_channel,
+            between: options.between,
             n,
             times,
             times32,
@@ -157,10 +159,62 @@ impl<'a> Context<'a> {
         ws.local.clear();
         ws.local.reserve(m);
         ws.scale.clear();
+        let width = mode.width();
+        let start = self.input.start.map(|s| &s[o][..width]);
+        // LINEAR keys on every frame: the channels at the frames, interpolated.
+        let frame_channels = if self.between == Between::Linear {
+            ws.quats.clear();
+            ws.quats.extend(poses.iter().map(|p| p.rotation));
+            Some(rotation_channels(&ws.quats, mode, start)?)
+        } else {
+            None
+        };
         for f in 0..n - 1 {
             ws.local.push(poses[f]);
             if self.constant(o, f) {
                 ws.local.extend([poses[f]; SUBSAMPLES - 1]);
+            } else if let Some(ch) = &frame_channels {
+                let (a, b) = (
+                    &ch[f * width..(f + 1) * width],
+                    &ch[(f + 1) * width..(f + 2) * width],
+                );
+                for k in 1..SUBSAMPLES {
+                    let u = k as f64 / SUBSAMPLES as f64;
+                    let mut r = [0.0; 4];
+                    for i in 0..width {
+                        r[i] = a[i] + (b[i] - a[i]) * u;
+                    }
+                    ws.local.push(Pose {
+                        rotation: rotation(mode, &r),
+                        translation: poses[f].translation.lerp(poses[f + 1].translation, u),
+                    });
+                }
+            } else if self.between == Between::Cubic {
+                // Up to two poses each side, not across CONSTANT spans or the clip's ends.
+                let lo = if f > 0 && !self.constant(o, f - 1) {
+                    f - 1
+                } else {
+                    f
+                };
+                let hi = if f + 2 < n && !self.constant(o, f + 1) {
+                    f + 2
+                } else {
+                    f + 1
+                };
+                let t = &self.input.frames;
+                for k in 1..SUBSAMPLES {
+                    let time = t[f] + (t[f + 1] - t[f]) * (k as f64 / SUBSAMPLES as f64);
+                    let mut p = [Pose::IDENTITY; 4];
+                    let m = hi - lo + 1;
+                    p[..m].copy_from_slice(&poses[lo..=hi]);
+                    for level in 1..m {
+                        for i in 0..m - level {
+                            let (ti, tj) = (t[lo + i], t[lo + i + level]);
+                            p[i] = s(&p[i], (time - ti) / (tj - ti), &p[i + 1]);
+                        }
+                    }
+                    ws.local.push(p[0]);
+                }
             } else {
                 // 1/4, 1/2, 3/4 of the screw, without trigonometry.
                 let screw = Screw::between(&poses[f], &poses[f + 1]);
@@ -217,8 +271,6 @@ impl<'a> Context<'a> {
         // Channels, continuous along the samples.
         ws.quats.clear();
         ws.quats.extend(ws.target.iter().map(|p| p.rotation));
-        let width = mode.width();
-        let start = self.input.start.map(|s| &s[o][..width]);
         let rot = rotation_channels(&ws.quats, mode, start)?;
         ws.v.clear();
         ws.v.reserve(m);
@@ -287,7 +339,9 @@ impl<'a> Context<'a> {
                 .iter()
                 .map(|&c| curve_of(&fitter, o, c, &spans))
                 .collect::<Result<Vec<_>>>()?;
-            (curves, spans.len() + 1, d, a)
+            // An owner that keys nothing has no key frames.
+            let keys = if cols.is_empty() { 0 } else { spans.len() + 1 };
+            (curves, keys, d, a)
         };
         let world = if keep_world {
             let mut reduced = try_vec(m, "world poses")?;
