@@ -8,6 +8,7 @@
 #     of one subdivision;
 #   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
 #   - scripts/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
+#   - scripts/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
 #   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
 #     NVIDIA Warp, against a dense-stamp reference), with scripts/bench-requirements.txt
 #     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv.
@@ -141,6 +142,19 @@ else
   PYTHONPATH="$pylib" "$py" scripts/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
     | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
   [ -f "$run/sweep.json" ] || echo "scripts/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
+fi
+
+stage "reduce: Reduce Keys vs graph.decimate (five clips, three tolerances)"
+if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
+  echo "the wheel or the Blender module is missing" | tee "$run/reduce.missing"
+elif ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "reduce_keys") else 1)' 2>/dev/null; then
+  echo "polyscrew.reduce_keys is not in this build" | tee "$run/reduce.missing"
+else
+  [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
+  reduce_args=(--json "$run/reduce.json"); [ "$quick" = 1 ] && reduce_args+=(--quick)
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
+    || true
+  [ -f "$run/reduce.json" ] || echo "scripts/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
 fi
 
 stage "write BENCHMARKS.md"

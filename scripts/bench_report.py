@@ -545,7 +545,107 @@ class Report:
 
     def later_sections(self) -> None:
         self.sweep_section()
+        self.reduce_section()
         self.papers_section()
+
+    def reduce_section(self) -> None:
+        """Reduce Keys against graph.decimate, from scripts/bench_reduce.py's JSON (issue 26)."""
+        self.w("## Reduce Keys against graph.decimate", "")
+        js = self.run / "reduce.json"
+        if not js.exists():
+            path = self.run / "reduce.missing"
+            self.w("not available: " + (path.read_text().strip() if path.exists() else "not run"), "")
+            self.targets.append(("Reduce Keys <= 0.6x the keys of the best graph.decimate margin", "not measured", "n/a"))
+            return
+        d = json.loads(js.read_text())
+        self.w(f"`scripts/bench_reduce.py`, Blender {d['blender']}. Ours: the Reduce Keys operator (all of it: read, "
+               "one `polyscrew.reduce_keys` call, write). Theirs: `graph.decimate` in ERROR mode, every other option at "
+               f"its default, its margin bisected ({d['steps']} steps in log scale) for the largest value whose result "
+               "meets the same world-space tolerance; its time is one decimate call at that margin. Both results "
+               "checked by Blender's own playback (`frame_set` at every frame and 3 subframes between frames, every "
+               "owner's world matrix) against the dense clip's playback: the largest distance of a point of the body "
+               "(bounding box corners, a bone's head and tail) and the largest rotation angle. Keys: keyframe points "
+               "over the transform curves; % of frames: distinct key frames per owner over the frames of its key range. "
+               f"Within: the share of (owner, sample) pairs within the tolerance (+{d['slack']:g} for float32 "
+               "world matrices).", "",
+               "Ours twice: an owner's channels keyed on shared frames (the default) and Per Channel. Ratios: "
+               "key frames, ours (shared) / decimate; keys (keyframe points), ours (per channel) / decimate.", "",
+               "| clip | tolerance | ours: key frames (% of frames) | keys | per channel: keys | decimate: margin | "
+               "key frames (% of frames) | keys | key frames ours / decimate | keys per channel / decimate | "
+               "error ours, per channel, decimate (mm / deg) | within ours, per channel, decimate | "
+               "time ours, per channel, decimate | time ours / decimate |",
+               "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        key_ratios, point_ratios, time_ratios, within, captured_share, frames_note = [], [], [], [], [], []
+        for clip in d["clips"]:
+            for c in clip["cases"]:
+                o, t, pc = c["ours"], c["decimate"], c.get("ours_per_channel", c["ours"])
+                within += [o["within"], pc["within"]]
+                if clip["captured"] and c["distance"] == 0.001:
+                    captured_share.append((clip["name"], o["fraction"]))
+                tol = f"{1000 * c['distance']:g} mm / {c['angle']:g} deg"
+                err = lambda r: f"{1000 * r['distance']:.3g} / {r['angle']:.3g}"  # noqa: E731
+                if t is None:
+                    self.w(f"| {clip['label']} | {tol} | {o['keyframes']:,} ({100 * o['fraction']:.1f} %) | "
+                           f"{o['points']:,} | {pc['points']:,} | no margin meets it | - | - | - | - | "
+                           f"{err(o)}, {err(pc)}, - | {100 * o['within']:.2f} %, {100 * pc['within']:.2f} %, - | "
+                           f"{fmt_seconds(o['time'])}, {fmt_seconds(pc['time'])}, - | - |")
+                    continue
+                kr, pr, tr = o["keyframes"] / t["keyframes"], pc["points"] / t["points"], o["time"] / t["time"]
+                if "within_frames" in o and o["within"] < 1.0:
+                    frames_note.append(f"{clip['label']}, {tol}: ours {100 * o['within_frames']:.2f} % within at whole "
+                                       f"frames (largest {1000 * o['distance_frames']:.3g} mm / {o['angle_frames']:.3g} "
+                                       "deg there)")
+                key_ratios.append((clip["name"], kr))
+                point_ratios.append((clip["name"], pr))
+                time_ratios.append((clip["name"], max(tr, pc["time"] / t["time"])))
+                self.w(f"| {clip['label']} | {tol} | {o['keyframes']:,} ({100 * o['fraction']:.1f} %) | {o['points']:,} | "
+                       f"{pc['points']:,} | {t['margin']:.3g} | {t['keyframes']:,} ({100 * t['fraction']:.1f} %) | "
+                       f"{t['points']:,} | {kr:.2f} | {pr:.2f} | {err(o)}, {err(pc)}, {err(t)} | "
+                       f"{100 * o['within']:.2f} %, {100 * pc['within']:.2f} %, {100 * t['within']:.2f} % | "
+                       f"{fmt_seconds(o['time'])}, {fmt_seconds(pc['time'])}, {fmt_seconds(t['time'])} | {tr:.2f} |")
+        self.w("")
+        if frames_note:
+            self.w("Where ours misses the tolerance, at the whole frames alone: " + "; ".join(frames_note) + ".", "")
+        windowed = [c for c in d["clips"] if c.get("searched_on", "the clip") != "the clip"]
+        for c in windowed:
+            self.w(f"{c['label']}: one decimate call on the whole clip takes a minute or more here, so its margin was "
+                   f"searched on the clip's {c['searched_on']} (the same motion) and then run once on the whole clip "
+                   "(x0.7 smaller, up to twice, where the whole clip missed the tolerance).")
+        if windowed:
+            self.w("")
+        smooth = d.get("smooth", [])
+        if smooth:
+            self.w("Smooth Motion with Keys: Reduced (default tolerance, 1 mm / 0.5 deg) against Every Step, the whole "
+                   "operator, median of runs:", "", "| case | Every Step | keys | Reduced | keys | Reduced / Every Step |",
+                   "| --- | --- | --- | --- | --- | --- |")
+            for s_ in smooth:
+                self.w(f"| {s_['case']} | {fmt_seconds(s_['every_step'])} | {s_['every_keys']:,} | "
+                       f"{fmt_seconds(s_['reduced'])} | {s_['reduced_keys']:,} | {s_['reduced'] / s_['every_step']:.2f} |")
+            self.w("")
+        self.w(f"The whole benchmark ran in {d['seconds']:.0f} s.", "")
+        if key_ratios:
+            worst = max(key_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys <= 0.6x the key frames of the best graph.decimate margin (every clip, "
+                                 "every tolerance)", f"at most {worst[1]:.2f}x ({worst[0]})", verdict(worst[1] <= 0.6)))
+        if point_ratios:
+            worst = max(point_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys (Per Channel) <= 0.6x the keyframe points of the best graph.decimate "
+                                 "margin", f"at most {worst[1]:.2f}x ({worst[0]})", verdict(worst[1] <= 0.6)))
+        if captured_share:
+            self.targets.append(("<= 10 % of frames on captured motion at 1 mm / 0.5 deg",
+                                 ", ".join(f"{n} {100 * f:.1f} %" for n, f in captured_share),
+                                 verdict(max(f for _, f in captured_share) <= 0.10)))
+        if within:
+            self.targets.append(("Reduce Keys within the tolerance at 100 % of checked samples",
+                                 f"at least {100 * min(within):.2f} %", verdict(min(within) >= 1.0)))
+        if time_ratios:
+            worst = max(time_ratios, key=lambda r: r[1])
+            self.targets.append(("Reduce Keys <= 2x graph.decimate's time", f"at most {worst[1]:.2f}x ({worst[0]})",
+                                 verdict(worst[1] <= 2.0)))
+        if smooth:
+            worst = max(s_["reduced"] / s_["every_step"] for s_ in smooth)
+            self.targets.append(("Smooth Motion with Reduced no slower than Every Step", f"at most {worst:.2f}x",
+                                 verdict(worst <= 1.0)))
 
     def sweep_section(self) -> None:
         self.w("## Sweep against peers", "")

@@ -14,16 +14,19 @@ drawing. The features:
 - Swept regions and clearance: :mod:`swept` + :mod:`swept_ops`.
 - Angular-velocity editing: :mod:`angvel` + :mod:`angvel_ops`.
 - Remove Noise (captured keys): :mod:`denoise` + :mod:`denoise_ops`.
+- Reduce Keys (dense keys -> the fewest within a world-space tolerance): :mod:`reduce` +
+  :mod:`reduce_ops`.
 """
 
 from __future__ import annotations
 
 import bpy
 
-from . import angvel_ops, bake_ops, denoise_ops, preview_ops, swept_ops
+from . import angvel_ops, bake_ops, denoise_ops, preview_ops, reduce_ops, swept_ops
 
 _register_classes, _unregister_classes = bpy.utils.register_classes_factory(
     bake_ops.classes + angvel_ops.classes + swept_ops.classes + preview_ops.classes + denoise_ops.classes
+    + reduce_ops.classes
 )
 
 
@@ -32,9 +35,11 @@ def register() -> None:
     bake_ops.register_properties()
     preview_ops.register_properties()
     denoise_ops.register_properties()
+    reduce_ops.register_properties()
 
 
 def unregister() -> None:
+    reduce_ops.unregister_properties()
     denoise_ops.unregister_properties()
     preview_ops.unregister_properties()
     bake_ops.unregister_properties()

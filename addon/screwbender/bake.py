@@ -112,6 +112,11 @@ class Options:
     #: Turns (:data:`intent.TURNS`): "AUTO" (typed spins as Blender plays them, flips the
     #: short way), "BLENDER" (every span as Blender plays it) or "SHORTEST".
     turns: str = "AUTO"
+    #: "EVERY_STEP" (one key per baked frame) or "REDUCED" (the fewest keys within the
+    #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
+    key_mode: str = "EVERY_STEP"
+    key_distance: float = 0.001
+    key_angle: float = 0.008726646259971648
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -136,6 +141,9 @@ def options_from(settings, scene: bpy.types.Scene) -> Options:
         stiffness=settings.stiffness,
         smooth_result=getattr(settings, "smooth_result", False),
         turns=getattr(settings, "turns", "AUTO"),
+        key_mode=getattr(settings, "key_mode", "EVERY_STEP"),
+        key_distance=getattr(settings, "key_distance", 0.001),
+        key_angle=getattr(settings, "key_angle", 0.008726646259971648),
     )
 
 
@@ -163,6 +171,8 @@ class Baked:
     #: (property, array index) of channels the source did not key and the smoothed motion
     #: leaves constant (to float32): not written, they stay unkeyed.
     unkeyed: frozenset = frozenset()
+    #: Keys: Reduced: the reduced curves (:class:`reduce.Reduced`), written instead of `values`.
+    reduced: object | None = None
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -566,6 +576,15 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
         for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
         for part in bake.parts:
+            if part.reduced is not None:
+                from . import reduce
+
+                reduce.write_reduced(bag, part.reduced, part.cycle_modes, part.cyclic)
+                for (prop, index), stack in (part.motion.modifiers or {}).items():
+                    fcurve = channels.find_fcurve(bag, part.owner.path(prop), index)
+                    if stack and fcurve is not None and (prop, index) in part.reduced.curves:
+                        modifiers.copy_onto(stack, fcurve)
+                continue
             for prop, values in part.values.items():
                 columns = part.columns(prop)
                 if not columns:
@@ -881,6 +900,10 @@ def smooth(
         )
     if resmoothed:
         notes.append(f"re-smoothed the original keys of {_names(resmoothed)} (replacing the earlier result)")
+    if options.key_mode == "REDUCED" and bakes:
+        from . import reduce
+
+        notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
     with contextlib.ExitStack() as stack:
         if t is None:
             t = stack.enter_context(transaction.atomic())

@@ -6,7 +6,7 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, channels, feature, intent, owners, transaction
+from . import bake, channels, feature, intent, owners, reduce, reduce_ops, transaction
 from .keys import SmoothError
 
 
@@ -76,6 +76,7 @@ def draw_options(layout: bpy.types.UILayout, settings) -> None:
         col.prop(settings, "frame_start")
         col.prop(settings, "frame_end")
     layout.prop(settings, "step")
+    reduce_ops.draw_key_options(layout, settings)
     layout.prop(settings, "armature")
     layout.prop(settings, "smooth_result")
 
@@ -189,10 +190,23 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
         "options, replacing the earlier result (one Revert returns to the original); a result edited "
         "since it was made (keys moved, added or deleted) is smoothed as it is and kept, never deleted",
     )
+    key_mode: EnumProperty(
+        name="Keys",
+        items=reduce.KEY_MODES,
+        default="EVERY_STEP",
+        description="Every Step: one key per baked frame. Reduced: the fewest Bezier keys within the tolerance "
+        "(editable keys), in the same operator",
+    )
+    key_distance: reduce_ops.distance_property()
+    key_angle: reduce_ops.angle_property()
 
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
         return owners.poll_selection(cls, context)
+
+    def invoke(self, context: bpy.types.Context, event) -> set[str]:
+        reduce_ops.set_default_distance(self, context, "key_distance")
+        return self.execute(context)
 
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
@@ -259,7 +273,7 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
 _OPTION_NAMES = (
     "method", "parametrization", "approximate", "stiffness",
     "scheme", "levels", "timing", "closed", "range_mode", "frame_start", "frame_end", "step",
-    "armature", "smooth_result", "turns",
+    "armature", "smooth_result", "turns", "key_mode", "key_distance", "key_angle",
 )
 
 
@@ -287,6 +301,9 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
     armature: _same_property("armature")
     smooth_result: _same_property("smooth_result")
     turns: _same_property("turns")
+    key_mode: _same_property("key_mode")
+    key_distance: _same_property("key_distance")
+    key_angle: _same_property("key_angle")
 
 
 class _SmoothPanel:

@@ -51,6 +51,11 @@ class Options:
     #: On an action that is already a result of Remove Noise: smooth that result (else the
     #: original keys again).
     smooth_result: bool = False
+    #: "EVERY_STEP" (the keys stay keys) or "REDUCED" (then the fewest keys within the
+    #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
+    key_mode: str = "EVERY_STEP"
+    key_distance: float = 0.001
+    key_angle: float = 0.008726646259971648
 
 
 @dataclass
@@ -405,6 +410,11 @@ def remove_noise(
                 by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
                 for part in parts:
                     _edit_keys(by_owner.get(part.owner.bone, []), part)
+                if options.key_mode == "REDUCED":
+                    from . import reduce
+
+                    results = reduce.reduce_bag(bag, [p.owner for p in parts], options.key_distance, options.key_angle)
+                    notes.append(reduce.summary(results))
 
             actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise"))
             if progress is not None:

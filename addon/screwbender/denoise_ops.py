@@ -7,7 +7,7 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
-from . import bake, bake_ops, channels, denoise, owners, transaction
+from . import bake, bake_ops, channels, denoise, owners, reduce, reduce_ops, transaction
 from .keys import SmoothError
 
 
@@ -59,6 +59,15 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         description="On an action that is already a result of Remove Noise, smooth that result "
         "(else the original keys again, replacing the earlier result)",
     )
+    key_mode: EnumProperty(
+        name="Keys",
+        items=reduce.KEY_MODES,
+        default="EVERY_STEP",
+        description="Every Step: the keys stay keys. Reduced: then the fewest Bezier keys within the tolerance "
+        "(editable keys), in the same operator",
+    )
+    key_distance: reduce_ops.distance_property()
+    key_angle: reduce_ops.angle_property()
     # Shown after the run (the redo panel): what Auto chose, or what was used.
     rotation_strength: FloatProperty(
         name="Rotation Strength", description="The strength used for rotation, frames (output)"
@@ -70,6 +79,10 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
     @classmethod
     def poll(cls, context: bpy.types.Context) -> bool:
         return owners.poll_selection(cls, context)
+
+    def invoke(self, context: bpy.types.Context, event) -> set[str]:
+        reduce_ops.set_default_distance(self, context, "key_distance")
+        return self.execute(context)
 
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
@@ -86,6 +99,7 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             col.prop(self, "frame_end")
         layout.prop(self, "armature")
         layout.prop(self, "smooth_result")
+        reduce_ops.draw_key_options(layout, self)
         col = layout.column()
         col.enabled = False
         col.prop(self, "rotation_strength")
@@ -102,6 +116,9 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
             strength=None if self.auto_strength else self.strength,
             frame_range=frame_range,
             smooth_result=self.smooth_result,
+            key_mode=self.key_mode,
+            key_distance=self.key_distance,
+            key_angle=self.key_angle,
         )
 
     def execute(self, context: bpy.types.Context) -> set[str]:

@@ -1,0 +1,830 @@
+# SPDX-License-Identifier: GPL-3.0-or-later
+"""Reduce Keys: a dense motion (a Smooth Motion or Remove Noise result, an `nla.bake` result,
+an imported capture) -> the fewest Bezier keys whose playback by Blender stays within a
+tolerance of it in world space, `polyscrew.reduce_keys`.
+
+The pipeline, as for every writing operator of the add-on:
+
+1. read: every selected owner's transform curves once (:func:`keys.read`, which packs them
+   for `polyscrew.evaluate_fcurves` with one `foreach_get` per attribute and curve), then the
+   dense motion as Blender plays it (the owner's `polyscrew.Playback`) at every frame of the
+   key range, plus its subframe keys: rigid poses in channel space (an object's parent
+   space, a bone's `matrix_basis`), scale apart;
+2. compute: ONE `polyscrew.reduce_keys` call for all owners of the operator keyed over the
+   same frames (a rig, a capture; owners keyed over other ranges are a call each, so that
+   each keeps its own range, which a Cycles modifier repeats). Bones whose parent
+   bone is reduced with them are given `parents` and `offsets` (the rest matrices: Blender's
+   `parent.matrix_local^-1 @ bone.matrix_local`), a root bone the armature object when that
+   is reduced too (`offset = bone.matrix_local`), so the tolerance holds in world space along
+   every chain (up to the owners' scale, which is not a rigid motion); objects are roots;
+3. write: a copy of the current action whose reduced transform curves replace the dense ones
+   (key values, Bezier handles and handle types, interpolation and easing as `reduce_keys`
+   returned them; each curve's extrapolation, Cycles modifier, group, colour and flags kept),
+   every other curve copied; the source kept and recorded for Revert (:func:`bake.new_result`,
+   made by "reduce"), all or nothing.
+
+Smooth Motion and Remove Noise with *Keys: Reduced* call :func:`reduce_bakes` (on Smooth
+Motion's dense channels, before anything is written) and :func:`reduce_bag` (on the keys
+Remove Noise has just written, inside its transaction).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import bpy
+import numpy as np
+import polyscrew
+
+from . import bake, channels, keys, owners, transaction
+from .keys import SmoothError
+
+#: The default tolerance: 1 mm (at the scene's unit scale, :func:`default_distance`) and half
+#: a degree: below what an animator sees at any usual framing.
+DEFAULT_DISTANCE_M = 0.001
+DEFAULT_ANGLE = math.radians(0.5)
+
+#: Smooth Motion and Remove Noise: which keys they write.
+KEY_MODES = (
+    ("EVERY_STEP", "Every Step", "One key per baked frame (per Step), as nla.bake writes them"),
+    (
+        "REDUCED",
+        "Reduced",
+        "The fewest Bezier keys whose playback stays within the tolerance of the result in world space "
+        "(editable keys), in the same operator",
+    ),
+)
+
+#: Most dense frames one Reduce Keys reads per owner (a longer range is refused).
+MAX_FRAMES = 1_000_000
+
+
+@dataclass
+class Options:
+    """What Reduce Keys needs besides the owners."""
+
+    #: Largest distance (Blender units) any point of the body may move from the dense motion.
+    distance: float = DEFAULT_DISTANCE_M
+    #: Largest rotation difference (radians).
+    angle: float = DEFAULT_ANGLE
+    #: On an action that is already a result of Reduce Keys: reduce that result (else the
+    #: original keys again, replacing the earlier result).
+    reduce_result: bool = False
+    #: Each channel keyed on frames of its own (fewer keys in all); default: an owner's
+    #: channels keyed on the same frames (fewer key frames, one column per pose).
+    per_channel: bool = False
+
+
+def default_distance(scene: bpy.types.Scene) -> float:
+    """1 mm in Blender units at the scene's unit scale (`unit_settings.scale_length`)."""
+    scale = float(scene.unit_settings.scale_length)
+    return DEFAULT_DISTANCE_M / scale if scale > 0.0 else DEFAULT_DISTANCE_M
+
+
+def body_radius(owner: owners.Owner) -> float:
+    """How far the owner's body reaches from its origin: an object's bounding box corner
+    furthest from its origin (its scale applied), an empty's display size, a bone's length."""
+    if owner.bone:
+        return float(owner.obj.data.bones[owner.bone].length)
+    obj = owner.obj
+    if obj.type == "EMPTY":
+        return float(obj.empty_display_size) * float(max(abs(s) for s in obj.scale))
+    corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float64) * np.abs(np.array(obj.scale))
+    return float(np.max(np.linalg.norm(corners, axis=1))) if len(corners) else 0.0
+
+
+@dataclass
+class Item:
+    """One owner's dense motion, ready for `polyscrew.reduce_keys`."""
+
+    owner: owners.Owner
+    mode: str
+    #: (N, 4, 4) rigid poses in channel space and (N, 3) positive scales at the batch's frames.
+    poses: np.ndarray
+    scales: np.ndarray
+    #: Which of location, rotation, scale the owner keys.
+    channels: np.ndarray
+    #: (N - 1,) spans that are steps (CONSTANT pops) in the source.
+    constant: np.ndarray
+    #: The rotation channel values at the first frame (4,), as the source has them.
+    start: np.ndarray
+    radius: float
+    #: (property, index) of the curves to write.
+    written: list[tuple[str, int]]
+    #: Key frames before (distinct frames over its transform curves).
+    keys_before: int = 0
+    #: Whether its curves repeat (Cycles modifier).
+    cyclic: bool = False
+    #: Blender's playback at the probes of every span (:func:`departure`), when read.
+    probe_poses: np.ndarray | None = None
+    probe_scales: np.ndarray | None = None
+    #: (N - 1,) spans Blender plays as a straight line in channel space (LINEAR keys).
+    linear: np.ndarray | None = None
+    #: Whole frames among the dense frames (quarter frames aside), for the report.
+    whole: int = 0
+
+
+@dataclass
+class Curve:
+    """One reduced F-curve: keys (K, 2) and handles, enums as Blender's RNA identifiers' codes."""
+
+    co: np.ndarray
+    handle_left: np.ndarray
+    handle_right: np.ndarray
+    interpolation: np.ndarray
+    easing: np.ndarray
+    handle_type: np.ndarray
+
+
+@dataclass
+class Reduced:
+    """One owner's reduced curves and what was measured."""
+
+    item: Item
+    #: (property, index) -> its curve (only those in `item.written`).
+    curves: dict[tuple[str, int], Curve]
+    keys: int
+    distance_error: float
+    angle_error: float
+
+
+def _rigid(matrix) -> np.ndarray:
+    """A 4x4 rigid matrix from a Blender matrix (float32 rest matrices: rotation made exactly
+    orthonormal by the polar decomposition, translation kept)."""
+    m = np.array(matrix, dtype=np.float64)
+    u, _, vt = np.linalg.svd(m[:3, :3])
+    rot = u @ vt
+    if np.linalg.det(rot) < 0:
+        u[:, -1] *= -1
+        rot = u @ vt
+    out = np.eye(4)
+    out[:3, :3], out[:3, 3] = rot, m[:3, 3]
+    return out
+
+
+def _mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """`a @ b` for (stacks of) 4x4 matrices (`np.matmul`: of `einsum`, a sum of products and
+    `matmul`, the fastest on stacks of 3,000 here)."""
+    return np.matmul(a, b)
+
+
+def _rigid_inverse(m: np.ndarray) -> np.ndarray:
+    """The inverse of a rigid 4x4 matrix: `[R^T, -R^T t]`."""
+    out = np.eye(4)
+    out[:3, :3] = m[:3, :3].T
+    out[:3, 3] = -m[:3, :3].T @ m[:3, 3]
+    return out
+
+
+def parents_of(items: list[Item]) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """`parents` and `offsets` for `polyscrew.reduce_keys`: a bone whose parent bone is in the
+    batch (and inherits its rotation) is that bone's child through the rest matrices; a root
+    bone is the armature object's child when that is in the batch. None when no owner has a
+    parent in the batch."""
+    index = {(it.owner.obj.as_pointer(), it.owner.bone): i for i, it in enumerate(items)}
+    parents = np.full(len(items), -1, dtype=np.int64)
+    offsets = np.tile(np.eye(4), (len(items), 1, 1))
+    for i, it in enumerate(items):
+        if not it.owner.bone:
+            continue
+        bone = it.owner.obj.data.bones[it.owner.bone]
+        if not bone.use_inherit_rotation:
+            continue
+        ptr = it.owner.obj.as_pointer()
+        if bone.parent is not None:
+            j = index.get((ptr, bone.parent.name))
+            if j is not None:
+                parents[i] = j
+                offsets[i] = _mul(_rigid_inverse(_rigid(bone.parent.matrix_local)), _rigid(bone.matrix_local))
+        else:
+            j = index.get((ptr, ""))
+            if j is not None:
+                parents[i], offsets[i] = j, _rigid(bone.matrix_local)
+    if not (parents >= 0).any():
+        return None, None
+    return parents, offsets
+
+
+def _pad4(values: np.ndarray) -> np.ndarray:
+    out = np.zeros(4)
+    out[: len(values)] = values
+    return out
+
+
+def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool = False) -> list[Reduced]:
+    """One `polyscrew.reduce_keys` call for every item (all at `frames`). Raises SmoothError
+    with polyscrew's message."""
+    parents, offsets = parents_of(items)
+    scaled = any(it.channels[2] for it in items)
+    try:
+        r = polyscrew.reduce_keys(
+            np.stack([it.poses for it in items]),
+            np.ascontiguousarray(frames, dtype=np.float64),
+            [it.mode for it in items],
+            # (one owner: a float; a size-1 array would be tried as a scalar first, which numpy
+            # deprecates)
+            float(items[0].radius) if len(items) == 1 else np.array([it.radius for it in items], dtype=np.float64),
+            float(options.distance),
+            float(options.angle),
+            scales=np.stack([it.scales for it in items]) if scaled else None,
+            channels=np.stack([it.channels for it in items]),
+            parents=parents,
+            offsets=offsets,
+            constant=np.stack([it.constant for it in items]) if any(it.constant.any() for it in items) else None,
+            cyclic=cyclic,
+            start=np.stack([it.start for it in items]),
+            per_channel=bool(options.per_channel),
+        )
+    except (ValueError, TypeError, MemoryError) as err:
+        names = ", ".join(it.owner.name for it in items[:3]) + (" ..." if len(items) > 3 else "")
+        raise SmoothError(f"{names}: {err}") from err
+    offsets_ = np.asarray(r["offsets"])
+    owner_of = np.asarray(r["owner"])
+    wanted = [set(it.written) for it in items]
+    curves: list[dict] = [{} for _ in items]
+    for c, (b, path, index) in enumerate(zip(owner_of.tolist(), r["path"], np.asarray(r["index"]).tolist())):
+        if (path, index) not in wanted[b]:
+            continue
+        lo, hi = int(offsets_[c]), int(offsets_[c + 1])
+        curves[b][path, index] = Curve(
+            co=np.asarray(r["co"])[lo:hi],
+            handle_left=np.asarray(r["handle_left"])[lo:hi],
+            handle_right=np.asarray(r["handle_right"])[lo:hi],
+            interpolation=np.asarray(r["interpolation"])[lo:hi],
+            easing=np.asarray(r["easing"])[lo:hi],
+            handle_type=np.asarray(r["handle_type"])[lo:hi],
+        )
+    return [
+        Reduced(
+            item=it, curves=curves[b], keys=int(r["keys"][b]),
+            distance_error=float(r["distance_error"][b]), angle_error=float(r["angle_error"][b]),
+        )
+        for b, it in enumerate(items)
+    ]
+
+
+# Reading ---------------------------------------------------------------------------------
+
+
+def dense_frames(key_frames: list[np.ndarray]) -> np.ndarray:
+    """Every whole frame from the first key to the last of all owners, plus every key frame
+    (subframe keys included), strictly increasing (frames closer than
+    :data:`keys.FRAME_TOLERANCE` are one)."""
+    first = min(float(f[0]) for f in key_frames)
+    last = max(float(f[-1]) for f in key_frames)
+    if last - first > MAX_FRAMES:
+        raise SmoothError(f"keys from frame {first:g} to {last:g}: Reduce Keys reads at most {MAX_FRAMES:,} frames")
+    whole = np.arange(math.ceil(first), math.floor(last) + 1, dtype=np.float64)
+    merged = np.unique(np.concatenate([whole] + [np.asarray(f, dtype=np.float64) for f in key_frames]))
+    keep = np.concatenate(([True], np.diff(merged) > keys.FRAME_TOLERANCE))
+    return merged[keep]
+
+
+#: Fractions of a span between two dense frames where Blender's playback of the dense keys
+#: is compared with the screw between the frames (the core's reference between them).
+PROBES = (0.25, 0.5, 0.75)
+
+#: A span whose playback by Blender departs from the screw between its frames by more than
+#: this share of the tolerance (the ease of a first or last key, a fast swing) gets the
+#: playback at :data:`PROBES` as dense poses too; the largest departure of the other spans is
+#: taken off the tolerance given to the core, so that the reduced keys stay within the
+#: tolerance of Blender's own playback of the dense keys at every frame and at the probes.
+#: (Between the frames of Bezier keys on every frame, Blender's playback and the screw differ
+#: by a third of a millimetre on a body 3.7 m across moving a few centimetres a frame, by a
+#: millimetre on a leg swinging 6 degrees a frame: the share trades dense frames, up to four
+#: times as many, against tolerance left to the core.)
+DEPARTURE_SHARE = 0.25
+
+
+def _probe_times(frames: np.ndarray) -> np.ndarray:
+    """The probes of every span, fraction by fraction: (len(PROBES) * (N - 1),)."""
+    a, width = frames[:-1], np.diff(frames)
+    return np.concatenate([a + f * width for f in PROBES])
+
+
+def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> Item:
+    """The owner's dense motion at `frames` as Blender plays its curves, and its playback at
+    the probes of every span (one `Playback` call for both)."""
+    source = motion.source
+    mode = motion.rotation_mode
+    rot_path = keys.rotation_path(mode)
+    n = len(frames)
+    probes = _probe_times(frames)
+    before_end = frames[1:] - np.minimum(1e-3, 0.01 * np.diff(frames))
+    played = source.channels(np.concatenate([frames, probes, before_end]))
+    location = played["location"] if motion.located else np.zeros_like(played["location"])
+    rotation = played[rot_path]
+    scale = played["scale"]
+    for label, values in (("location", location), (rot_path, rotation), ("scale", scale)):
+        if not np.all(np.isfinite(values)):
+            raise SmoothError(f"{owner.name}: {label} is not finite between the keys: skipped")
+    scale_axes = motion.scale_axes
+    if np.any((scale <= 0.0) & scale_axes):
+        raise SmoothError(f"{owner.name}: keyed scale reaches zero or below: Reduce Keys needs a positive scale: skipped")
+    # Steps: the channels hold the first frame's values exactly through the span (at the
+    # probes and just before its end) and jump at its end (a CONSTANT pop).
+    stacked = np.concatenate([location, rotation, scale], axis=1)
+    at, inside = stacked[:n], stacked[n:].reshape(len(PROBES) + 1, n - 1, -1)
+    steps = np.all(inside == at[None, :-1], axis=(0, 2)) & np.any(at[1:] != at[:-1], axis=1)
+    # Linear spans: the channels at the probes on the straight line between the frames
+    chord = np.stack([at[:-1] + f * (at[1:] - at[:-1]) for f in PROBES])
+    linear = np.all(np.abs(inside[: len(PROBES)] - chord) <= 1e-6 * (1.0 + np.abs(chord)), axis=(0, 2))
+    columns = set(source.columns)
+    located = motion.located and any(p == "location" for p, _ in columns)
+    rotated = any(p == rot_path for p, _ in columns)
+    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
+    written = [("location", i) for i in range(3)] if located else []
+    written += [(rot_path, i) for i in range(size)] if rotated else []
+    written += [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
+    poses = keys.compose(location, keys.rotation_matrices(rotation, mode))
+    scales = np.where(scale_axes, scale, 1.0)
+    m = n + len(probes)
+    return Item(
+        owner=owner,
+        mode=mode,
+        poses=poses[:n],
+        scales=scales[:n],
+        channels=np.array([located, rotated, bool(scale_axes.any())]),
+        constant=steps,
+        start=_pad4(rotation[0]),
+        radius=body_radius(owner),
+        written=written,
+        keys_before=len(motion.frames),
+        cyclic=motion.cyclic,
+        probe_poses=poses[n:m],
+        probe_scales=scales[n:m],
+        linear=linear,
+        whole=int(np.sum(np.abs(frames - np.round(frames)) < keys.FRAME_TOLERANCE)),
+    )
+
+
+def _chain_order(parents: np.ndarray | None, count: int) -> list[int]:
+    """Owner indices, every parent before its children."""
+    if parents is None:
+        return list(range(count))
+    order, seen = [], set()
+
+    def visit(i: int) -> None:
+        if i in seen:
+            return
+        if parents[i] >= 0:
+            visit(int(parents[i]))
+        seen.add(i)
+        order.append(i)
+
+    for i in range(count):
+        visit(i)
+    return order
+
+
+def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per span between dense frames: how far Blender's playback of the dense keys at the
+    probes departs from the core's reference there (the screw between the frames, one
+    `polyscrew.sample` call per owner, levels 0, linear timing), over all owners, in world
+    space along the chains: (distance, angle) as the core measures them, `|dt| + 2 r sin(a/2)`
+    (+ `r |ds|` with scale) and `a`."""
+    probes = _probe_times(frames)
+    spans = len(frames) - 1
+    parents, offsets = parents_of(items)
+    world_ref, world_play = {}, {}
+    dist = np.zeros(spans)
+    ang = np.zeros(spans)
+    for i in _chain_order(parents, len(items)):
+        it = items[i]
+        ref = polyscrew.sample(it.poses, frames, probes, levels=0, timing="linear")
+        play = it.probe_poses
+        if parents is not None and parents[i] >= 0:
+            j = int(parents[i])
+            ref = _mul(world_ref[j], _mul(offsets[i], ref))
+            play = _mul(world_play[j], _mul(offsets[i], play))
+        world_ref[i], world_play[i] = ref, play
+        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
+        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
+        d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
+        if it.channels[2]:
+            lin = np.concatenate([it.scales[:-1] + f * np.diff(it.scales, axis=0) for f in PROBES])
+            d = d + it.radius * np.linalg.norm(it.probe_scales - lin, axis=1)
+        dist = np.maximum(dist, d.reshape(len(PROBES), spans).max(axis=0))
+        ang = np.maximum(ang, theta.reshape(len(PROBES), spans).max(axis=0))
+    return dist, ang
+
+
+def read_motion(owner: owners.Owner, fcurves: list, action=None, slot: str = "") -> keys.KeyedMotion:
+    """The owner's keys, read once (no analysis); refuses curves Blender plays in a way the
+    add-on cannot evaluate (the reduced keys must match Blender's playback)."""
+    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False)
+    if motion.source is None:
+        raise SmoothError(f"{owner.name}: {'; '.join(motion.kept)}; Reduce Keys needs Blender's playback: skipped")
+    return motion
+
+
+def _located_children(items: list[Item], members: list) -> list[Item]:
+    """Bones reduced with their parent whose location Blender plays (not connected) key their
+    location too, unkeyed in the source or not: the reduction keys there the small
+    translations that make up for their parents' errors, so that the tolerance holds in world
+    space (a bone that can only turn would carry its parent's error at its head)."""
+    parents, _ = parents_of(items)
+    if parents is None:
+        return items
+    for it, (_, motion), parent in zip(items, members, parents):
+        if parent >= 0 and motion.located and not it.channels[0]:
+            it.channels[0] = True
+            it.written = [("location", i) for i in range(3)] + it.written
+    return items
+
+
+@dataclass
+class Batch:
+    """Owners reduced together: their items at the batch's dense frames."""
+
+    items: list[Item]
+    frames: np.ndarray
+    #: Whether the batch is one cycle.
+    cyclic: bool
+    #: The largest departure of Blender's playback from the core's reference left in the
+    #: batch (distance, angle): taken off the tolerance given to the core.
+    margin: tuple[float, float] = (0.0, 0.0)
+
+
+def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options) -> list[Batch]:
+    """The (owner, motion) pairs as items at their dense frames, one batch per set of dense
+    frames (owners keyed over the same range: a rig, a capture, are one batch; an owner keeps
+    its own range, which a Cycles modifier repeats). Spans where Blender's playback departs
+    from the screw between the frames by more than :data:`DEPARTURE_SHARE` of the tolerance
+    get their probes as dense frames too; the departure left is the batch's margin. A batch
+    is one cycle when every owner's curves repeat and its first pose is its last."""
+    grouped: dict[bytes, tuple[np.ndarray, list]] = {}
+    for owner, motion in pairs:
+        frames = dense_frames([motion.frames])
+        grouped.setdefault(frames.tobytes(), (frames, []))[1].append((owner, motion))
+    out = []
+    for frames, members in grouped.values():
+        items = _located_children([_item(o, m, frames) for o, m in members], members)
+        dist, ang = departure(items, frames)
+        steps = np.any([it.constant for it in items], axis=0)
+        # LINEAR keys on every frame (a bake): the in-between is a straight line in channel
+        # space, samples of a motion rather than a curve meant between them; the screw between
+        # the frames is the reference there, as for steps
+        linear = np.all([it.linear for it in items], axis=0)
+        flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
+        flagged &= ~linear
+        # the departure left: at the probes of the spans kept whole (a cut span's probes are
+        # dense frames now; steps are the core's own)
+        kept = ~flagged & ~steps & ~linear
+        margin = (float(dist[kept].max(initial=0.0)), float(ang[kept].max(initial=0.0)))
+        if flagged.any():
+            probes = _probe_times(frames).reshape(len(PROBES), -1)[:, flagged].ravel()
+            frames = np.sort(np.concatenate([frames, probes]))
+            items = _located_children([_item(o, m, frames) for o, m in members], members)
+        cyclic = all(
+            it.cyclic
+            and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
+            and np.allclose(it.scales[0], it.scales[-1], atol=1e-6)
+            for it in items
+        )
+        out.append(Batch(items=items, frames=frames, cyclic=cyclic, margin=margin))
+    return out
+
+
+def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarray]:
+    """Per owner: the largest error of the reduced curves against the core's reference (the
+    dense poses at the frames, the screw between two frames, a step held), at every frame
+    and at the probes, in world space along the chains, measured here independently of the
+    core: the curves played by `polyscrew.evaluate_fcurves` (Blender's evaluation, one call
+    for the batch), channels not written held at their dense values (a connected bone's
+    location: none, as Blender plays it), composed with the parents' played poses."""
+    items, frames = batch.items, batch.frames
+    probes = _probe_times(frames)
+    times = np.concatenate([frames, probes])
+    packed = [(b, key, c) for b, r in enumerate(results) for key, c in r.curves.items()]
+    values = {}
+    if packed:
+        counts = [len(c.co) for _, _, c in packed]
+        offsets = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+        played = polyscrew.evaluate_fcurves(
+            times, offsets=offsets,
+            co=np.concatenate([c.co for _, _, c in packed]),
+            handle_left=np.concatenate([c.handle_left for _, _, c in packed]),
+            handle_right=np.concatenate([c.handle_right for _, _, c in packed]),
+            interpolation=np.concatenate([c.interpolation for _, _, c in packed]),
+            easing=np.concatenate([c.easing for _, _, c in packed]),
+        )
+        values = {(b, key): played[k] for k, (b, key, _) in enumerate(packed)}
+    parents, offsets_ = parents_of(items)
+    n = len(frames)
+    world_ref, world_play = {}, {}
+    dist, ang = np.zeros(len(items)), np.zeros(len(items))
+    for i in _chain_order(parents, len(items)):
+        it = items[i]
+        ref = np.concatenate([it.poses, polyscrew.sample(it.poses, frames, probes, levels=0, timing="linear")])
+        held = np.tile(it.constant, len(PROBES))
+        ref[n:][held] = np.tile(it.poses[:-1], (len(PROBES), 1, 1))[held]
+        dense = np.concatenate([it.poses, ref[n:]])
+        location = np.stack([values.get((i, ("location", k)), dense[:, k, 3]) for k in range(3)], axis=1)
+        rot_path = keys.rotation_path(it.mode)
+        size = 4 if it.mode in ("QUATERNION", "AXIS_ANGLE") else 3
+        if all((i, (rot_path, k)) in values for k in range(size)):
+            rotation = keys.rotation_matrices(np.stack([values[i, (rot_path, k)] for k in range(size)], axis=1), it.mode)
+        else:
+            rotation = dense[:, :3, :3]
+        play = keys.compose(location, rotation)
+        if parents is not None and parents[i] >= 0:
+            j = int(parents[i])
+            ref = _mul(world_ref[j], _mul(offsets_[i], ref))
+            play = _mul(world_play[j], _mul(offsets_[i], play))
+        world_ref[i], world_play[i] = ref, play
+        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
+        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
+        d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
+        dist[i], ang[i] = float(d.max()), float(theta.max())
+    return dist, ang
+
+
+#: Most times :func:`solve_batch` asks the core again, with a smaller tolerance, when the
+#: reduced curves measured here exceed it (the chains of connected bones: a bone that cannot
+#: move its head carries its parent's error there).
+RETRIES = 2
+
+
+def solve_batch(batch: Batch, options: Options) -> list[Reduced]:
+    """:func:`solve` with the batch's margin taken off the tolerance, the result measured
+    here (:func:`measured`) and asked again with a tolerance scaled down where it misses.
+    The errors reported are those measured plus the margin (a bound of the error against
+    Blender's playback of the dense keys at every frame and at the probes)."""
+    distance = max(options.distance - batch.margin[0], 0.5 * options.distance)
+    angle = max(options.angle - batch.margin[1], 0.5 * options.angle)
+    inner = Options(distance=distance, angle=angle, per_channel=options.per_channel)
+    for attempt in range(RETRIES + 1):
+        results = solve(batch.items, batch.frames, inner, batch.cyclic)
+        dist, ang = measured(batch, results)
+        over = max(dist.max() / distance, ang.max() / angle)
+        if over <= 1.0 + 1e-6 or attempt == RETRIES:
+            break
+        inner = Options(
+            distance=inner.distance * 0.95 / over, angle=inner.angle * 0.95 / over, per_channel=options.per_channel
+        )
+    for r, d, a in zip(results, dist, ang):
+        r.distance_error = float(d) + batch.margin[0]
+        r.angle_error = float(a) + batch.margin[1]
+    return results
+
+
+# Writing ---------------------------------------------------------------------------------
+
+
+def _enum_values(prop: str, names: tuple[str, ...]) -> np.ndarray:
+    """Blender's RNA values of `Keyframe.<prop>` for polyscrew's codes (index into `names`)."""
+    items = bpy.types.Keyframe.bl_rna.properties[prop].enum_items
+    return np.array([items[name].value for name in names], dtype=np.int64)
+
+
+_ENUMS: dict[str, np.ndarray] = {}
+
+
+def _enum(prop: str) -> np.ndarray:
+    if prop not in _ENUMS:
+        names = {
+            "interpolation": polyscrew.INTERPOLATIONS,
+            "easing": polyscrew.EASINGS,
+            "handle_left_type": polyscrew.HANDLE_TYPES,
+        }[prop]
+        _ENUMS[prop] = _enum_values(prop, tuple(names))
+    return _ENUMS[prop]
+
+
+#: F-curve properties kept when a curve's keys are replaced.
+_KEPT = ("extrapolation", "color_mode", "color", "hide", "lock", "select", "auto_smoothing")
+
+
+def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, cycle: tuple | None = None) -> None:
+    """Replaces the curve (`prop`, `index`) of `owner` in `bag` (made when missing) by the
+    reduced keys: co, handles, interpolation, easing, handle types (one `foreach_set` each).
+    The old curve's extrapolation, modifiers, group, colour and flags are kept; `cycle`
+    (mode_before, mode_after) adds a Cycles modifier to a new curve."""
+    path = owner.path(prop)
+    old = channels.find_fcurve(bag, path, index)
+    kept, group = {}, owner.group
+    if old is not None:
+        kept = {name: getattr(old, name) for name in _KEPT if hasattr(old, name)}
+        kept["color"] = tuple(old.color)
+        group = old.group.name if old.group is not None else ""
+        # the old modifiers' settings, read before the curve goes, set on the new one below
+        snapshot = []
+        for m in old.modifiers:
+            values = {}
+            for p in m.bl_rna.properties:
+                if p.is_readonly or p.identifier in ("rna_type", "type"):
+                    continue
+                if p.type in ("BOOLEAN", "INT", "FLOAT", "ENUM"):
+                    value = getattr(m, p.identifier)
+                    values[p.identifier] = tuple(value) if hasattr(value, "__len__") and not isinstance(value, str) else value
+            snapshot.append((m.type, values))
+        channels.remove_fcurve(bag, old)
+    else:
+        snapshot = [("CYCLES", {"mode_before": cycle[0], "mode_after": cycle[1]})] if cycle else []
+    fc = channels.new_fcurve(bag, path, index, group)
+    n = len(curve.co)
+    points = fc.keyframe_points
+    points.add(n)
+    points.foreach_set("co", np.asarray(curve.co, dtype=np.float32).ravel())
+    points.foreach_set("handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
+    points.foreach_set("handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
+    points.foreach_set("interpolation", tuple(_enum("interpolation")[curve.interpolation].tolist()))
+    if np.any(curve.easing != 0):
+        points.foreach_set("easing", tuple(_enum("easing")[curve.easing].tolist()))
+    types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
+    points.foreach_set("handle_left_type", types)
+    points.foreach_set("handle_right_type", types)
+    for name, value in kept.items():
+        with contextlib.suppress(AttributeError, TypeError, ValueError):
+            setattr(fc, name, value)
+    for kind, values in snapshot:
+        modifier = fc.modifiers.new(kind)
+        for name, value in values.items():
+            with contextlib.suppress(AttributeError, TypeError, ValueError):
+                setattr(modifier, name, value)
+    # Keys are sorted and their handles are the fitted ones: no fcurve.update(), which would
+    # recompute them.
+
+
+def write_reduced(bag, reduced: Reduced, cycle_modes: dict | None = None, cyclic: bool = False) -> None:
+    """Every reduced curve of one owner into `bag`."""
+    for (prop, index), curve in reduced.curves.items():
+        cycle = None
+        if cycle_modes and (prop, index) in cycle_modes:
+            cycle = cycle_modes[prop, index]
+        elif cyclic:
+            cycle = ("REPEAT", "REPEAT")
+        write_curve(bag, reduced.item.owner, prop, index, curve, cycle)
+
+
+# The operator's pipeline -----------------------------------------------------------------
+
+
+@dataclass
+class Result:
+    """What Reduce Keys did."""
+
+    actions: list[bpy.types.Action]
+    owners: list[str]
+    skipped: list[str]
+    notes: list[str] = field(default_factory=list)
+    keys_before: int = 0
+    keys_after: int = 0
+    frames: int = 0
+    distance_error: float = 0.0
+    angle_error: float = 0.0
+
+
+def reduce_keys(
+    selection: Iterable,
+    options: Options,
+    progress: Callable[[int, int], None] | None = None,
+    t: transaction.Transaction | None = None,
+) -> Result:
+    """Reduces the keys of the owners in `selection` (objects or :class:`owners.Owner`s);
+    owners animated by one action get one new action. Everything is read and reduced (one
+    `polyscrew.reduce_keys` call) before anything is written; the writing is all or nothing."""
+    selection = [owners.as_owner(item) for item in selection]
+    groups: dict[tuple, list[owners.Owner]] = {}
+    skipped = []
+    for owner in selection:
+        adt = owner.obj.animation_data
+        if adt is None or adt.action is None:
+            skipped.append(f"{owner.name}: no animation (no active action): skipped")
+            continue
+        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
+    pairs, plans, notes, rerun = [], [], [], []
+    for members in groups.values():
+        first = members[0].obj
+        current = first.animation_data.action
+        identifier = channels.slot_identifier(first)
+        source, slot = current, identifier
+        found = bake.original_of(current, "reduce")
+        if found is not None and not options.reduce_result:
+            source, slot = found
+        by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
+        done = []
+        for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
+            try:
+                motion = read_motion(owner, by_owner.get(owner.bone, []), None if source is current else source, slot)
+            except SmoothError as err:
+                skipped.append(str(err))
+                continue
+            pairs.append((owner, motion))
+            done.append(owner)
+        if done:
+            plans.append((bake.users_of(current, identifier) or [first], source, current, identifier, done))
+            if source is not current:
+                rerun.append(first.name)
+    if rerun:
+        notes.append(f"reduced the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
+    if not pairs:
+        return Result(actions=[], owners=[], skipped=skipped, notes=notes)
+    if progress is not None:
+        progress(1, 3)
+    reduced = {
+        (r.item.owner.obj.as_pointer(), r.item.owner.bone): r
+        for batch in batches(pairs, options)
+        for r in solve_batch(batch, options)
+    }
+    if progress is not None:
+        progress(2, 3)
+    actions = []
+    with contextlib.ExitStack() as stack:
+        if t is None:
+            t = stack.enter_context(transaction.atomic())
+        for objects, source, current, identifier, done in plans:
+            parts = [reduced[(o.obj.as_pointer(), o.bone)] for o in done]
+
+            def edit(bag, parts=parts) -> None:
+                for part in parts:
+                    write_reduced(bag, part)
+
+            actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce"))
+    parts = list(reduced.values())
+    return Result(
+        actions=actions,
+        owners=[p.item.owner.name for p in parts],
+        skipped=skipped,
+        notes=notes,
+        keys_before=sum(p.item.keys_before for p in parts),
+        keys_after=sum(p.keys for p in parts),
+        frames=sum(len(dense_frames([m.frames])) for _, m in pairs),
+        distance_error=max(p.distance_error for p in parts),
+        angle_error=max(p.angle_error for p in parts),
+    )
+
+
+# Smooth Motion and Remove Noise with Keys: Reduced -----------------------------------------
+
+
+def summary(results: list[Reduced]) -> str:
+    """The report's line for Keys: Reduced: key frames, the share of the frames, errors."""
+    frames = sum(r.item.whole or len(r.item.poses) for r in results)
+    keys_ = sum(r.keys for r in results)
+    return (
+        f"keys reduced to {keys_:,} key frames ({100.0 * keys_ / max(frames, 1):.1f} % of {frames:,} frames); largest "
+        f"error {max(r.distance_error for r in results):.3g} and {math.degrees(max(r.angle_error for r in results)):.3g} degrees"
+    )
+
+
+def reduce_bakes(bakes: list, distance: float, angle: float) -> str:
+    """Smooth Motion, Keys: Reduced: reduces the dense channels of every part of `bakes`
+    (:class:`bake.ActionBake`) before anything is written, setting each part's `reduced`.
+    One `polyscrew.reduce_keys` call per set of baked frames (usually one: all owners of the
+    operator). Returns the report's line (:func:`summary`)."""
+    batches: dict[tuple, list] = {}
+    joined = []
+    for action_bake in bakes:
+        for part in action_bake.parts:
+            if part.join is not None:  # a Frame Range narrower than the keys: written dense, joined
+                joined.append(part.owner.name)
+                continue
+            batches.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
+    options = Options(distance=distance, angle=angle)
+    for (_, cyclic), parts in batches.items():
+        items = []
+        for part in parts:
+            motion, owner = part.motion, part.owner
+            mode = motion.rotation_mode
+            rotation = part.values[keys.rotation_path(mode)]
+            n = len(part.frames)
+            location = part.values.get("location", np.zeros((n, 3)))
+            scales = np.ones((n, 3))
+            if "scale" in part.values:
+                scales[:, motion.scale_axes] = part.values["scale"]
+            constant = np.zeros(n - 1, dtype=bool) if part.constant is None else np.asarray(part.constant[:-1], bool)
+            items.append(
+                Item(
+                    owner=owner, mode=mode, poses=keys.compose(location, keys.rotation_matrices(rotation, mode)),
+                    scales=scales, channels=np.array(["location" in part.values, True, "scale" in part.values]),
+                    constant=constant, start=_pad4(rotation[0]), radius=body_radius(owner), written=part.written,
+                )
+            )
+        for part, result in zip(parts, solve(items, parts[0].frames, options, cyclic)):
+            part.reduced = result
+    results = [part.reduced for b in bakes for part in b.parts if part.reduced is not None]
+    line = summary(results) if results else "keys not reduced"
+    if joined:
+        line += (
+            f"; {', '.join(joined[:3])}{' ...' if len(joined) > 3 else ''}: every step kept inside the Frame Range "
+            "(a range narrower than the keys joins the source's keys: Reduce Keys can reduce the result)"
+        )
+    return line
+
+
+def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) -> list[Reduced]:
+    """Remove Noise, Keys: Reduced: the transform curves of `members` in `bag` (the new
+    action, just written) replaced by their reduction (one `polyscrew.reduce_keys` call).
+    Raises SmoothError (the caller's transaction undoes everything)."""
+    by_owner = owners.curves_by_owner(channels.fcurves(bag))
+    pairs = [(o, read_motion(o, by_owner.get(o.bone, []))) for o in members]
+    options = Options(distance=distance, angle=angle)
+    results = [r for batch in batches(pairs, options) for r in solve_batch(batch, options)]
+    for result in results:
+        write_reduced(bag, result)
+    return results
