@@ -21,7 +21,7 @@
 //!   does the same under a [`Turns`] choice and tells the **flips** ([`turns`]: Euler wraps
 //!   and quaternion sign flips, which Blender plays the long way round and [`Turns::Auto`]
 //!   takes the short way) from the spins the animator typed.
-//! - [`departure`]: per frame, how far a smoothed result's channels are from the playback
+//! - [`mod@departure`]: per frame, how far a smoothed result's channels are from the playback
 //!   (distance of the origins, rotation angle), for the report.
 //! - [`keys_parameters`]: timing "Keys". Within each span, the motion parameter of an output
 //!   frame is the one at which the smoothed motion has travelled the same fraction of the
