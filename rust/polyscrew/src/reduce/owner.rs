@@ -798,13 +798,20 @@ impl Fitter<'_> {
             let first = (key / SUBSAMPLES + 1) * SUBSAMPLES;
             let count = (b - first) / SUBSAMPLES + 1;
             let pos = |k: usize| first + k * SUBSAMPLES;
-            let model = |e: usize, out: &mut [Pose]| {
-                self.try_span(key, e, cols, tol, false, out).0.is_some()
+            // The span of the longest model success so far (that of `lo` below), so that
+            // the exact check does not fit it again.
+            let mut fitted: Option<Span> = None;
+            let mut ok = |k: usize, out: &mut [Pose]| {
+                let span = self.try_span(key, pos(k - 1), cols, tol, false, out).0;
+                let pass = span.is_some();
+                if pass {
+                    fitted = span;
+                }
+                pass
             };
             // The longest span by the model: from the previous span's length, exponential
             // steps out to the first failure, then binary search (indices shifted by one:
             // 0 means no whole-frame span fits).
-            let ok = |k: usize, out: &mut [Pose]| model(pos(k - 1), out);
             let g = guess.clamp(1, count);
             let (mut lo, mut hi) = if ok(g, out) {
                 let (mut lo, mut hi) = (g, count + 1);
@@ -838,7 +845,12 @@ impl Fitter<'_> {
             // Blender's evaluation of the chosen span; shorter ones while it fails.
             let mut accepted: Option<(Span, f64, f64)> = None;
             if let Some(lo) = best {
-                if let (Some(span), d, a) = self.try_span(key, pos(lo), cols, tol, true, out) {
+                // `lo` only ever takes a model success, each longer than the last: `fitted`
+                // is the span ending at `pos(lo)`, fitted and passed by the model.
+                let span = fitted.expect("the longest model success is kept");
+                debug_assert_eq!(span.e, pos(lo));
+                let (pass, d, a) = self.exact(&span, cols, tol, out);
+                if pass {
                     accepted = Some((span, d, a));
                 } else {
                     let (mut good, mut bad) = (None, lo);
