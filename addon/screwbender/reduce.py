@@ -208,6 +208,15 @@ def parents_of(items: list[Item]) -> tuple[np.ndarray | None, np.ndarray | None]
     return parents, offsets
 
 
+def _body_error(ref: np.ndarray, play: np.ndarray, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Per pose of `ref` and `play` (n, 4, 4): the bound on how far a point within `radius` of
+    the origin moves between them, ``|dt| + 2 radius sin(theta / 2)``, and the rotation angle
+    `theta` between them (the measure `polyscrew.reduce_keys` keeps within its tolerance)."""
+    trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
+    theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
+    return np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * radius * np.sin(0.5 * theta), theta
+
+
 def _pad4(values: np.ndarray) -> np.ndarray:
     out = np.zeros(4)
     out[: len(values)] = values
@@ -401,9 +410,7 @@ def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.nda
             ref = _mul(world_ref[j], _mul(offsets[i], ref))
             play = _mul(world_play[j], _mul(offsets[i], play))
         world_ref[i], world_play[i] = ref, play
-        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
-        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
-        d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
+        d, theta = _body_error(ref, play, it.radius)
         if it.channels[2]:
             lin = np.concatenate([it.scales[:-1] + f * np.diff(it.scales, axis=0) for f in PROBES])
             d = d + it.radius * np.linalg.norm(it.probe_scales - lin, axis=1)
@@ -536,9 +543,7 @@ def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarr
             ref = _mul(world_ref[j], _mul(offsets_[i], ref))
             play = _mul(world_play[j], _mul(offsets_[i], play))
         world_ref[i], world_play[i] = ref, play
-        trace = np.sum(ref[:, :3, :3] * play[:, :3, :3], axis=(1, 2))  # trace(ref_R^T play_R)
-        theta = np.arccos(np.clip((trace - 1.0) / 2.0, -1.0, 1.0))
-        d = np.linalg.norm(ref[:, :3, 3] - play[:, :3, 3], axis=1) + 2.0 * it.radius * np.sin(0.5 * theta)
+        d, theta = _body_error(ref, play, it.radius)
         dist[i], ang[i] = float(d.max()), float(theta.max())
     return dist, ang
 
