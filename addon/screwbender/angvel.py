@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, feature, keys, owners, transaction
+from . import bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: Custom property (on the sphere helper) whose F-curve is the magnitude sketch, rad/s.
@@ -123,7 +123,7 @@ def _set_curve_points(curve_obj: bpy.types.Object, points: np.ndarray) -> None:
     spline.points.add(len(points) - 1)
     co = np.ones((len(points), 4))
     co[:, :3] = points
-    spline.points.foreach_set("co", co.ravel())
+    bulk.put(spline.points, "co", co.ravel())
     data.update_tag()
 
 
@@ -185,7 +185,7 @@ def add_sketch(context: bpy.types.Context, obj: bpy.types.Object, t: transaction
     co = np.empty((len(frames), 2))
     co[:, 0] = frames
     co[:, 1] = np.linalg.norm(omega, axis=1)
-    points.foreach_set("co", co.ravel())
+    bulk.put(points, "co", co.ravel())
     fcurve.update()
     sphere[SKETCH_KEY] = sketch
     sphere[RANGE_KEY] = [start, end]
@@ -207,13 +207,13 @@ def _spline_points(spline) -> np.ndarray:
     tessellated (BEZIER_SAMPLES points per segment, as drawn)."""
     if spline.type != "BEZIER":
         co = np.empty(4 * len(spline.points))
-        spline.points.foreach_get("co", co)
+        bulk.get(spline.points, "co", co)
         return co.reshape(-1, 4)[:, :3]
     n = len(spline.bezier_points)
     co, left, right = (np.empty(3 * n) for _ in range(3))
-    spline.bezier_points.foreach_get("co", co)
-    spline.bezier_points.foreach_get("handle_left", left)
-    spline.bezier_points.foreach_get("handle_right", right)
+    bulk.get(spline.bezier_points, "co", co)
+    bulk.get(spline.bezier_points, "handle_left", left)
+    bulk.get(spline.bezier_points, "handle_right", right)
     co, left, right = co.reshape(n, 3), left.reshape(n, 3), right.reshape(n, 3)
     s = np.linspace(0.0, 1.0, BEZIER_SAMPLES, endpoint=False)[:, None]
     parts = [

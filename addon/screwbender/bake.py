@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import channels, feature, intent, keys, modifiers, owners, range_join, sampling, transaction
+from . import bulk, channels, feature, intent, keys, modifiers, owners, range_join, sampling, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -452,8 +452,8 @@ def _write_curves(
         points = fcurve.keyframe_points
         points.add(len(frames))
         co[:, 1] = values[:, column]
-        points.foreach_set("co", co.ravel())
-        points.foreach_set("interpolation", interpolation)
+        bulk.put(points, "co", co.ravel())
+        bulk.put(points, "interpolation", interpolation)
         if digests is not None:
             digests[path, index] = curve_digest(co, kinds)
         if cyclic:
@@ -537,9 +537,9 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
         if sub is None:
             points = fcurve.keyframe_points
             co = np.empty(2 * len(points), dtype=np.float32)
-            points.foreach_get("co", co)
+            bulk.get(points, "co", co)
             interpolation = np.empty(len(points), dtype=np.uint8)
-            points.foreach_get("interpolation", interpolation)
+            bulk.get(points, "interpolation", interpolation)
             sub = curve_digest(co, interpolation)
         digest.update(f"{key[0]}[{key[1]}]:".encode())
         digest.update(sub)

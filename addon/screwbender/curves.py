@@ -34,6 +34,8 @@ import bpy
 import numpy as np
 import polyscrew
 
+from . import bulk
+
 
 class UnsupportedCurve(ValueError):
     """F-curves `polyscrew` cannot evaluate as Blender does.
@@ -201,7 +203,7 @@ def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.
     for c in curves:
         lo, hi = offsets[c], offsets[c + 1]
         if lo < hi:
-            points[c].foreach_get(name, out[width * lo : width * hi])
+            bulk.get(points[c], name, out[width * lo : width * hi])
 
 
 def read(fcurves: Sequence[bpy.types.FCurve], keys_only: bool = False) -> Packed:

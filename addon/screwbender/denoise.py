@@ -31,7 +31,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, denoise_data, feature, keys, owners, transaction
+from . import bake, bulk, channels, denoise_data, feature, keys, owners, transaction
 from .keys import SmoothError
 
 
@@ -110,7 +110,7 @@ def _points(fc, attr: str = "co") -> np.ndarray:
     """One keyframe property of every key of `fc`, (n, 2) float32 (one foreach_get)."""
     points = fc.keyframe_points
     out = np.empty(2 * len(points), dtype=np.float32)
-    points.foreach_get(attr, out)
+    bulk.get(points, attr, out)
     return out.reshape(-1, 2)
 
 
@@ -307,9 +307,9 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         left[edit, 1] += delta
         right[edit, 1] += delta
         co[edit, 1] = target  # exact, not the sum
-        points.foreach_set("co", co.ravel())
-        points.foreach_set("handle_left", left.ravel())
-        points.foreach_set("handle_right", right.ravel())
+        bulk.put(points, "co", co.ravel())
+        bulk.put(points, "handle_left", left.ravel())
+        bulk.put(points, "handle_right", right.ravel())
         fc.update()
         _keep_handles_outside(fc, ~(near & in_range[row]), left, right)
 
@@ -329,11 +329,11 @@ def _keep_handles_outside(fc, outside: np.ndarray, left: np.ndarray, right: np.n
     now_left[changed], now_right[changed] = left[changed], right[changed]
     for side in ("handle_left_type", "handle_right_type"):
         kinds = np.zeros(len(points), dtype=np.uint8)
-        points.foreach_get(side, kinds)
+        bulk.get(points, side, kinds)
         kinds[changed] = _FREE
-        points.foreach_set(side, tuple(kinds.tolist()))
-    points.foreach_set("handle_left", now_left.ravel())
-    points.foreach_set("handle_right", now_right.ravel())
+        bulk.put(points, side, tuple(kinds.tolist()))
+    bulk.put(points, "handle_left", now_left.ravel())
+    bulk.put(points, "handle_right", now_right.ravel())
 
 
 def remove_noise(

@@ -21,7 +21,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, keys, owners
+from . import bulk, channels, keys, owners
 
 #: Smoothing methods: (identifier, label, description).
 METHODS = (
@@ -75,11 +75,11 @@ def selected_frames(
         if owner.prop_of(fc.data_path) not in paths or (skip_muted and fc.mute) or not len(points):
             continue
         flags = np.empty(len(points), dtype=bool)
-        points.foreach_get("select_control_point", flags)
+        bulk.get(points, "select_control_point", flags)
         if not flags.any():
             continue
         co = np.empty(2 * len(points), dtype=np.float32)
-        points.foreach_get("co", co)
+        bulk.get(points, "co", co)
         index, hit = nearest_rows(frames, co[0::2][flags])
         chosen[index[hit]] = True
     return chosen
@@ -117,7 +117,7 @@ def feature_points(owner: owners.Owner | bpy.types.Object, scale: np.ndarray) ->
     if obj.type != "MESH" or len(obj.data.vertices) < 3:
         return None
     co = np.empty(3 * len(obj.data.vertices), dtype=np.float64)
-    obj.data.vertices.foreach_get("co", co)
+    bulk.get(obj.data.vertices, "co", co)
     try:
         return polyscrew.inertia_points(co.reshape(-1, 3) * scale)
     except ValueError:  # all vertices on a line: no rotation about it is defined by them

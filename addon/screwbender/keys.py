@@ -20,7 +20,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import channels, curves, intent, modifiers, owners
+from . import bulk, channels, curves, intent, modifiers, owners
 
 #: Rotation modes and the property holding the rotation in each.
 ROTATION_PATHS = {
@@ -160,7 +160,7 @@ def compose(locations: np.ndarray, rotations: np.ndarray, scales: np.ndarray | N
 def _key_points(fcurve: bpy.types.FCurve) -> np.ndarray:
     """(K, 2) key frames and values of an F-curve."""
     co = np.empty(2 * len(fcurve.keyframe_points), dtype=np.float32)
-    fcurve.keyframe_points.foreach_get("co", co)
+    bulk.get(fcurve.keyframe_points, "co", co)
     return co.reshape(-1, 2).astype(np.float64)
 
 

@@ -20,6 +20,8 @@ from __future__ import annotations
 
 import bpy
 
+from . import bulk
+
 #: Modifier types copied onto the baked curves (a first Cycles modifier is the bake's own).
 KEPT = ("NOISE", "STEPPED", "LIMITS", "GENERATOR", "FNGENERATOR", "ENVELOPE", "CYCLES")
 
@@ -135,8 +137,8 @@ def copy_onto(modifiers: list[bpy.types.FModifier], fcurve: bpy.types.FCurve) ->
                 new.control_points.add(point.frame)
             for name in ("min", "max"):
                 values = [0.0] * len(points)
-                points.foreach_get(name, values)
-                new.control_points.foreach_set(name, values)
+                bulk.get(points, name, values)
+                bulk.put(new.control_points, name, values)
         # twice: a restricted range's start and end clamp each other as they are set
         _copy_properties(mod, new)
         _copy_properties(mod, new)

@@ -33,7 +33,7 @@ from dataclasses import astuple, dataclass, field
 import bpy
 import numpy as np
 
-from . import bake, channels, feature, keys, owners
+from . import bake, bulk, channels, feature, keys, owners
 from .keys import SmoothError
 
 #: Default number of stroboscopic instances.
@@ -334,22 +334,22 @@ def key_hash(
         )
         for attr, width, dtype in _KEY_ATTRS:
             buf = np.empty(width * count, dtype=dtype)
-            points.foreach_get(attr, buf)
+            bulk.get(points, attr, buf)
             digest.update(buf.tobytes())
             if attr == "co" and frame is not None and count and not fc.mute:
                 at_key = at_key or bool(np.any(np.abs(buf[0::2] - frame) < keys.FRAME_TOLERANCE))
         if count and int(buf.max()) > _PLAIN_MAX:  # buf: the interpolations
             for attr, width, dtype in _EASING_ATTRS:
                 extra = np.empty(width * count, dtype=dtype)
-                points.foreach_get(attr, extra)
+                bulk.get(points, attr, extra)
                 digest.update(extra.tobytes())
         if feature_method and options.smooth.approximate:  # selected keys are approximated
             flags = np.empty(count, dtype=bool)
-            points.foreach_get("select_control_point", flags)
+            bulk.get(points, "select_control_point", flags)
             digest.update(flags.tobytes())
     if feature_method and not owner.bone and obj.type == "MESH":  # the feature points are the mesh's inertia points
         co = np.empty(3 * len(obj.data.vertices), dtype=np.float32)
-        obj.data.vertices.foreach_get("co", co)
+        bulk.get(obj.data.vertices, "co", co)
         digest.update(co.tobytes())
     # Unkeyed channels enter the key poses with their current (static) value.
     current = {}
@@ -530,18 +530,18 @@ def object_geometry(obj: bpy.types.Object, heavy_limit: int) -> Geometry:
         mesh = obj.data
         n = len(mesh.vertices)
         co = np.empty(3 * n, dtype=np.float32)
-        mesh.vertices.foreach_get("co", co)
+        bulk.get(mesh.vertices, "co", co)
         co = co.reshape(-1, 3)
         if n > heavy_limit:
             return Geometry(box_corners(co.min(axis=0), co.max(axis=0)), BOX_EDGES, BOX_TRIS, "BOX")
         edges = np.empty(2 * len(mesh.edges), dtype=np.int32)
-        mesh.edges.foreach_get("vertices", edges)
+        bulk.get(mesh.edges, "vertices", edges)
         tris_rna = mesh.loop_triangles
         if len(tris_rna) == 0 and len(mesh.polygons) > 0:
             mesh.calc_loop_triangles()  # runtime cache only, not saved data
             tris_rna = mesh.loop_triangles
         tris = np.empty(3 * len(tris_rna), dtype=np.int32)
-        tris_rna.foreach_get("vertices", tris)
+        bulk.get(tris_rna, "vertices", tris)
         return Geometry(co, edges.reshape(-1, 2), tris.reshape(-1, 3), "MESH")
     corners = np.array([tuple(c) for c in obj.bound_box], dtype=np.float32)
     if obj.type != "EMPTY" and np.ptp(corners, axis=0).max() > 0.0:

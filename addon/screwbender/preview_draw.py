@@ -31,7 +31,7 @@ from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 from mathutils import Matrix
 
-from . import bake, channels, owners, preview
+from . import bake, bulk, channels, owners, preview
 
 #: The object property that turns an object's preview on.
 OBJECT_PROP = "screwbender_preview"
@@ -344,7 +344,7 @@ def _matrices(collection, name: str) -> np.ndarray:
     """(N, 4, 4) float64 of the 4x4 matrix property `name` of every item of `collection`, in
     one `foreach_get` (Blender stores matrices column by column)."""
     flat = np.empty(16 * len(collection), dtype=np.float32)
-    collection.foreach_get(name, flat)
+    bulk.get(collection, name, flat)
     return flat.reshape(-1, 4, 4).transpose(0, 2, 1).astype(np.float64)
 
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import keys
+from . import bulk, keys
 
 _ENUM = bpy.types.Keyframe.bl_rna.properties
 _INTERPOLATION = {name: _ENUM["interpolation"].enum_items[name].value for name in ("BEZIER", "LINEAR", "CONSTANT")}
@@ -79,9 +79,9 @@ def _span_table(fc: bpy.types.FCurve) -> tuple[np.ndarray, np.ndarray]:
     """Key frames and interpolation codes of `fc`."""
     n = len(fc.keyframe_points)
     co = np.zeros(2 * n, dtype=np.float32)
-    fc.keyframe_points.foreach_get("co", co)
+    bulk.get(fc.keyframe_points, "co", co)
     codes = np.zeros(n, dtype=np.uint8)
-    fc.keyframe_points.foreach_get("interpolation", codes)
+    bulk.get(fc.keyframe_points, "interpolation", codes)
     return co[0::2].astype(np.float64), codes
 
 
@@ -212,7 +212,7 @@ def _read_keys(fc: bpy.types.FCurve) -> dict[str, np.ndarray]:
     out = {}
     for name, dtype, width in _FIELDS:
         values = np.zeros(n * width, dtype=dtype)
-        points.foreach_get(name, values)
+        bulk.get(points, name, values)
         out[name] = values.reshape(n, width) if width > 1 else values
     return out
 
@@ -346,7 +346,7 @@ def write(fcurve: bpy.types.FCurve, join: Join, frames: np.ndarray, values: np.n
     points.add(len(table["co"]))
     for name, dtype, width in _FIELDS:
         data = table[name]
-        points.foreach_set(name, data.ravel() if dtype == np.float32 else tuple(data.tolist()))
+        bulk.put(points, name, data.ravel() if dtype == np.float32 else tuple(data.tolist()))
 
 
 def _cut_before(keys_, x, start, baked, kept) -> bool:

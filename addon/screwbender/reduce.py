@@ -39,7 +39,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, owners, transaction
+from . import bake, bulk, channels, keys, owners, transaction
 from .keys import SmoothError
 
 #: The default tolerance: 1 mm (at the scene's unit scale, :func:`default_distance`) and half
@@ -634,15 +634,15 @@ def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, c
     n = len(curve.co)
     points = fc.keyframe_points
     points.add(n)
-    points.foreach_set("co", np.asarray(curve.co, dtype=np.float32).ravel())
-    points.foreach_set("handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
-    points.foreach_set("handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
-    points.foreach_set("interpolation", tuple(_enum("interpolation")[curve.interpolation].tolist()))
+    bulk.put(points, "co", np.asarray(curve.co, dtype=np.float32).ravel())
+    bulk.put(points, "handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
+    bulk.put(points, "handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
+    bulk.put(points, "interpolation", tuple(_enum("interpolation")[curve.interpolation].tolist()))
     if np.any(curve.easing != 0):
-        points.foreach_set("easing", tuple(_enum("easing")[curve.easing].tolist()))
+        bulk.put(points, "easing", tuple(_enum("easing")[curve.easing].tolist()))
     types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
-    points.foreach_set("handle_left_type", types)
-    points.foreach_set("handle_right_type", types)
+    bulk.put(points, "handle_left_type", types)
+    bulk.put(points, "handle_right_type", types)
     for name, value in kept.items():
         with contextlib.suppress(AttributeError, TypeError, ValueError):
             setattr(fc, name, value)

@@ -32,7 +32,7 @@ import polyscrew
 from mathutils import Matrix, Vector
 from mathutils.bvhtree import BVHTree
 
-from . import bake, channels, owners, transaction
+from . import bake, bulk, channels, owners, transaction
 
 #: Name of the collection that receives swept regions.
 COLLECTION = "Swept Regions"
@@ -70,9 +70,9 @@ def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np
     try:
         mesh.calc_loop_triangles()
         verts = np.empty(3 * len(mesh.vertices), dtype=np.float64)
-        mesh.vertices.foreach_get("co", verts)
+        bulk.get(mesh.vertices, "co", verts)
         tris = np.empty(3 * len(mesh.loop_triangles), dtype=np.int64)
-        mesh.loop_triangles.foreach_get("vertices", tris)
+        bulk.get(mesh.loop_triangles, "vertices", tris)
     finally:
         evaluated.to_mesh_clear()
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
@@ -247,7 +247,7 @@ def _key_frames(fcurves: list) -> list[float]:
     found = []
     for fc in fcurves:
         co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
-        fc.keyframe_points.foreach_get("co", co)
+        bulk.get(fc.keyframe_points, "co", co)
         found.append(co[0::2])
     if not found:
         return []
@@ -354,13 +354,13 @@ def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> 
     corner_vert = mesh.attributes.get(".corner_vert")
     if position is not None and corner_vert is not None:
         # The generic attributes take raw buffers (MeshLoop.vertex_index goes item by item).
-        position.data.foreach_set("vector", co)
-        corner_vert.data.foreach_set("value", corners)
+        bulk.put(position.data, "vector", co)
+        bulk.put(corner_vert.data, "value", corners)
     else:
-        mesh.vertices.foreach_set("co", co)
-        mesh.loops.foreach_set("vertex_index", corners)
+        bulk.put(mesh.vertices, "co", co)
+        bulk.put(mesh.loops, "vertex_index", corners)
     mesh.polygons.add(n)
-    mesh.polygons.foreach_set("loop_start", np.arange(0, 3 * n, 3, dtype=np.int32))
+    bulk.put(mesh.polygons, "loop_start", np.arange(0, 3 * n, 3, dtype=np.int32))
     mesh.update(calc_edges=True)
     return mesh
 
@@ -404,9 +404,9 @@ def mesh_triangles(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (V, 3) and loop triangles (T, 3) of `mesh` (bulk foreach_get)."""
     mesh.calc_loop_triangles()
     verts = np.empty(3 * len(mesh.vertices), dtype=np.float64)
-    mesh.vertices.foreach_get("co", verts)
+    bulk.get(mesh.vertices, "co", verts)
     tris = np.empty(3 * len(mesh.loop_triangles), dtype=np.int64)
-    mesh.loop_triangles.foreach_get("vertices", tris)
+    bulk.get(mesh.loop_triangles, "vertices", tris)
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
 
 
@@ -499,5 +499,5 @@ def select_faces(obj: bpy.types.Object, faces: list[int]) -> None:
     mesh = obj.data
     mask = np.zeros(len(mesh.polygons), dtype=bool)
     mask[[f for f in faces if f < len(mask)]] = True
-    mesh.polygons.foreach_set("select", mask)
+    bulk.put(mesh.polygons, "select", mask)
     mesh.update()

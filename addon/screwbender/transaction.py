@@ -28,7 +28,7 @@ from typing import Any
 import bpy
 import numpy as np
 
-from . import channels
+from . import bulk, channels
 
 #: `bpy.data` collections whose new members a failed operator removes, in removal order
 #: (users first: objects before the meshes and curves they use, collections last).
@@ -58,7 +58,7 @@ _MISSING = object()
 def _enum_values(points, name: str) -> np.ndarray:
     """Enum keyframe properties through `foreach_get` as integers (their RNA values)."""
     out = np.empty(len(points), dtype=np.int32)
-    points.foreach_get(name, out)
+    bulk.get(points, name, out)
     return out
 
 
@@ -139,7 +139,7 @@ class Transaction:
                 saved[name] = _enum_values(points, name)
             else:
                 values = np.empty(n * width, dtype=dtype)
-                points.foreach_get(name, values)
+                bulk.get(points, name, values)
                 saved[name] = values
 
         def undo() -> None:
@@ -149,7 +149,7 @@ class Transaction:
             if len(points) < n:
                 points.add(n - len(points))
             for name, values in saved.items():
-                points.foreach_set(name, values)
+                bulk.put(points, name, values)
             fcurve.update()
 
         self.on_rollback(undo)
@@ -171,10 +171,10 @@ class Transaction:
     def keep_face_selection(self, mesh: bpy.types.Mesh) -> None:
         """Snapshots the face selection of `mesh`; put back on failure."""
         mask = np.empty(len(mesh.polygons), dtype=bool)
-        mesh.polygons.foreach_get("select", mask)
+        bulk.get(mesh.polygons, "select", mask)
 
         def undo() -> None:
-            mesh.polygons.foreach_set("select", mask)
+            bulk.put(mesh.polygons, "select", mask)
             mesh.update()
 
         self.on_rollback(undo)
