@@ -9,9 +9,10 @@ from __future__ import annotations
 import bpy
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
+
 from bake_helpers import curve_points, fcurves, key_poses, new_object, rigid, select_only
 from conftest import addon_module
-from scipy.spatial.transform import Rotation
 
 FPS = 24
 N_KEYS = 20

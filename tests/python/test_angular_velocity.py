@@ -3,10 +3,9 @@ orientations and angular velocities against scipy's Rotation (finite differences
 returned quaternions), the spinning top of the paper's figure 3 built here from scratch."""
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
-
-import polyscrew
 
 SPIN = 2 * np.pi  # rad/s about the top's axis
 PRECESSION = 2 * np.pi / 4  # rad/s about world z

@@ -15,22 +15,24 @@ The huge requests run in children under a 4 GB address-space cap (`capped.run_ca
 
 from __future__ import annotations
 
+import inspect
 import re
 
 import numpy as np
+import polyscrew
 import pytest
 
-import polyscrew
 from capped import run_capped
 
+
 # One BEZIER curve of K keys, as `evaluate_fcurves` and `Playback` take it.
-CURVE = """
 def curve(k=3):
     co = np.c_[np.arange(k, dtype=float), np.arange(k) % 7]
     return dict(offsets=[0, k], co=co, handle_left=co - [0.3, 0], handle_right=co + [0.3, 0],
                 interpolation=np.full(k, 2), easing=np.zeros(k, dtype=np.int64))
-"""
-exec(CURVE)  # the same helper in this process
+
+
+CURVE = "\n" + inspect.getsource(curve)  # the same helper in the capped children
 
 
 def test_fcurve_evaluation_counts_its_bezier_segments_against_the_budget():

@@ -1,9 +1,8 @@
 """Every bad input raises ValueError naming the offending index and the reason."""
 
 import numpy as np
-import pytest
-
 import polyscrew
+import pytest
 
 
 def keys(n=4):

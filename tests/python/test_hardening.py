@@ -15,9 +15,9 @@ import threading
 import time
 
 import numpy as np
+import polyscrew
 import pytest
 
-import polyscrew
 from capped import run_capped
 
 EYE2 = "np.tile(np.eye(4), (2, 1, 1))"

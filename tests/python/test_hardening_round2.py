@@ -11,13 +11,12 @@ measures.
 
 from __future__ import annotations
 
-
 import json  # noqa: F401  (the helpers print JSON in the child)
 
 import numpy as np
+import polyscrew
 import pytest
 
-import polyscrew
 from capped import run_capped
 
 MB = 1 << 20
