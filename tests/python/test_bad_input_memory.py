@@ -29,32 +29,40 @@ import numpy as np
 import polyscrew
 import pytest
 
-from capped import run_capped
+from capped import KEYS, NEED, run_capped
 from fcurve_args import curve
 
 EYE2 = "np.tile(np.eye(4), (2, 1, 1))"
 
 
+# Child code: a UV sphere of `seg` segments x `rings` rings, and `n` poses along a tumbling helix.
+UV_SPHERE_AND_HELIX = """
+def uv_sphere(seg, rings):
+    th = np.pi * np.arange(1, rings) / rings
+    ph = 2 * np.pi * np.arange(seg) / seg
+    v = [[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]]
+    v = np.array(v, float)
+    idx = lambda r, s: 1 + r * seg + s % seg
+    t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
+    for r in range(rings - 2):
+        for s in range(seg):
+            t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
+    t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
+    return v, np.array(t)
+
+def helix_poses(n):
+    def pose(i):
+        a = 0.05 * i
+        c, s = np.cos(a), np.sin(a)
+        return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
+    return np.stack([pose(i) for i in range(n)])
+"""
+
 # A UV sphere of 40 segments x 20 rings: 1,520 triangles; 100 poses along a tumbling helix.
-SPHERE_AND_MOTION = """
-seg, rings = 40, 20
-th = np.pi * np.arange(1, rings) / rings
-ph = 2 * np.pi * np.arange(seg) / seg
-v = [[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]]
-v = np.array(v, float)
-idx = lambda r, s: 1 + r * seg + s % seg
-t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
-for r in range(rings - 2):
-    for s in range(seg):
-        t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
-t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
-t = np.array(t)
+SPHERE_AND_MOTION = UV_SPHERE_AND_HELIX + """
+v, t = uv_sphere(40, 20)
 assert len(t) == 1520
-def pose(i):
-    a = 0.05 * i
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
-poses = np.stack([pose(i) for i in range(100)])
+poses = helix_poses(100)
 """
 
 
@@ -301,9 +309,8 @@ MB = 1 << 20
 
 # Helpers run in the capped child: the peak growth of one call, and the estimate of a call
 # (what it says it would need, refused with a budget of 0).
-PEAK = r"""
-import re, time
-UNITS = {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9, "TB": 1e12, "PB": 1e15, "EB": 1e18}
+PEAK = NEED + r"""
+import time
 K2 = np.tile(np.eye(4), (2, 1, 1))
 
 def _status(key):
@@ -319,19 +326,6 @@ def peak_of(call):
     cpu = time.process_time() - start
     print(json.dumps({"growth": _status("VmHWM") - before, "cpu": cpu}), flush=True)
     return out
-
-def need(call):
-    '''The bytes `call` says it would need, from its refusal with a budget of 0.'''
-    old = ps.set_memory_budget(0)
-    try:
-        call()
-    except ValueError as e:
-        m = re.search(r"would need ([0-9.]+) (B|kB|MB|GB|TB|PB|EB), over the memory budget", str(e))
-        assert m, str(e)
-        return float(m.group(1)) * UNITS[m.group(2)]
-    finally:
-        ps.set_memory_budget(old)
-    raise AssertionError("not refused with a budget of 0")
 
 def curve(k=3):
     co = np.c_[np.arange(k, dtype=float), np.arange(k) % 7]
@@ -518,15 +512,7 @@ peak_of(lambda: ps.rotation_channels(r, 'XYZ'))
 
 # --- 4. estimates hold -------------------------------------------------------------------
 
-ESTIMATE_SETUP = r"""
-def keys(n, seed=0):
-    rng = np.random.default_rng(seed)
-    out = np.tile(np.eye(4), (n, 1, 1))
-    a = rng.uniform(0, 2, n)
-    out[:, 0, 0] = out[:, 1, 1] = np.cos(a)
-    out[:, 0, 1], out[:, 1, 0] = -np.sin(a), np.sin(a)
-    out[:, :3, 3] = rng.normal(size=(n, 3)) + np.arange(n)[:, None]
-    return out
+ESTIMATE_SETUP = KEYS + r"""
 
 def noisy(n, seed=0):
     rng = np.random.default_rng(seed)
@@ -596,23 +582,9 @@ def test_sweep_peak_memory_stays_within_its_stated_estimate():
     span: its stated estimate is the body's plus 48 bytes per output vertex and 36 per output
     triangle (the module documentation). A 20,480-triangle sphere over 64 screws."""
     lines = run_peak(
-        """
-seg, rings = 128, 81
-th = np.pi * np.arange(1, rings) / rings
-ph = 2 * np.pi * np.arange(seg) / seg
-v = np.array([[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]], float)
-idx = lambda r, s: 1 + r * seg + s % seg
-t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
-for r in range(rings - 2):
-    for s in range(seg):
-        t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
-t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
-t = np.array(t)
-def pose(i):
-    a = 0.05 * i
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
-poses = np.stack([pose(i) for i in range(65)])
+        UV_SPHERE_AND_HELIX + """
+v, t = uv_sphere(128, 81)
+poses = helix_poses(65)
 print(json.dumps({"triangles": len(t), "estimate": need(lambda: ps.sweep(v, t, poses, steps=8))}))
 out = peak_of(lambda: ps.sweep(v, t, poses, steps=8))
 print(json.dumps({"vertices": len(out[0]), "triangles": len(out[1])}))
