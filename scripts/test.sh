@@ -2,9 +2,10 @@
 # The project's one test command: installs what it needs into .venv (scripts/bootstrap.sh),
 # then the lint gates (cargo fmt --check, clippy -D warnings, ruff check: a failure stops the
 # run with one line saying which gate and how to fix it), runs the Rust tests, builds the
-# polyscrew wheel (release, once: abi3 for CPython 3.11 and later, manylinux_2_28 on Linux) and the extension zip from it, runs the Python tests of
-# the module, the packaging tests, and the Blender tests headless under every
-# Blender version of scripts/blender_matrix.sh (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
+# polyscrew wheel (release, once: abi3 for CPython 3.11 and later, manylinux_2_28 on Linux)
+# and the extension zip from it, runs the Python tests of the module, the packaging tests,
+# and the Blender tests headless under every Blender version of scripts/blender_matrix.sh
+# (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
 # A version whose CPython or bpy is missing fails the run (it is never skipped).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
