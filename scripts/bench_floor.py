@@ -69,10 +69,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import bench_report  # noqa: E402
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
+from bench_denoise import graph_context as _graph_context  # noqa: E402  (the Graph Editor, headless)
 
 SLOTTED = bpy.app.version >= (4, 4, 0)
 READ_ATTRS = (("co", 2, np.float32), ("interpolation", 1, np.uint8))
@@ -87,12 +89,7 @@ COUNTERPART = {"smooth": "nla_bake", "denoise": "gaussian_smooth", "reduce": "de
 #: The operators' bpy.ops names (screwbender.*).
 IDNAMES = {"smooth": "smooth", "revert": "revert", "denoise": "denoise", "reduce": "reduce_keys",
            "insert_key": "insert_key", "sweep": "sweep"}
-OPERATORS = ("smooth", "revert", "denoise", "reduce", "insert_key", "sweep")
-LABELS = {
-    "smooth": "Smooth Motion", "revert": "Revert Smoothing", "denoise": "Remove Noise", "reduce": "Reduce Keys",
-    "insert_key": "Insert Key on Motion", "sweep": "Build Swept Region", "nla_bake": "nla.bake",
-    "gaussian_smooth": "graph.gaussian_smooth", "decimate": "graph.decimate",
-}
+OPERATORS, LABELS = bench_report.FLOOR_OPERATORS, bench_report.FLOOR_LABELS
 
 #: (family, owners, frames, keys): sparse families keyed at `keys` uneven frames, dense ones on every frame.
 FULL_CASES = (
@@ -388,8 +385,8 @@ def floor_sweep(objects, made: list[dict]) -> None:
         mesh.vertices.foreach_get("co", np.empty(3 * len(mesh.vertices), dtype=np.float32))
         mesh.loop_triangles.foreach_get("vertices", np.empty(3 * len(mesh.loop_triangles), dtype=np.int32))
     scene = bpy.context.scene
-    for m in made:
-        mesh = bpy.data.meshes.new("FloorSwept")
+    for i, m in enumerate(made):  # names of their own: Blender's search for a free name grows with each clash
+        mesh = bpy.data.meshes.new(f"FloorSwept{i:05d}")
         mesh.vertices.add(len(m["co"]) // 3)
         mesh.loops.add(len(m["vertex_index"]))
         mesh.polygons.add(len(m["loop_start"]))
@@ -397,7 +394,7 @@ def floor_sweep(objects, made: list[dict]) -> None:
         mesh.loops.foreach_set("vertex_index", m["vertex_index"])
         mesh.polygons.foreach_set("loop_start", m["loop_start"])
         mesh.update()
-        scene.collection.objects.link(bpy.data.objects.new("FloorSwept", mesh))
+        scene.collection.objects.link(bpy.data.objects.new(mesh.name, mesh))
 
 
 def made_meshes(stage: Stage) -> list[dict]:
@@ -421,12 +418,7 @@ def made_meshes(stage: Stage) -> list[dict]:
 
 
 def graph_context() -> dict:
-    win = bpy.context.window_manager.windows[0]
-    area = max(win.screen.areas, key=lambda a: a.width * a.height)
-    area.type = "GRAPH_EDITOR"
-    area.spaces.active.dopesheet.show_only_selected = False
-    region = next(r for r in area.regions if r.type == "WINDOW")
-    return dict(window=win, area=area, region=region)
+    return _graph_context(bpy)
 
 
 def nla_bake(objects, frames: int) -> set:
