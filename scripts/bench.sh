@@ -17,7 +17,8 @@
 #     against owners and frames: issue 27; about 10 minutes);
 #   - scripts/bench_denoise.py, scripts/bench_denoise_rig.py (Remove Noise vs Blender's filters).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
-# and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt).
+# and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
+# a refresh's: log-<parts>.txt).
 # Env: BENCH_QUICK=1 for a smoke run (short criterion times, small Python runs; the
 #      BENCHMARKS.md it writes says so); BPY=.venv/bpy/5.0 selects the Blender module.
 #      BENCH_ONLY=<part>[,<part>] runs only those parts and rewrites only their sections of

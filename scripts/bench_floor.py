@@ -42,8 +42,8 @@ Scenes (--quick: a smoke run of seconds with the smallest of each):
                   noise (a clean capture): 1, 20, 100, 500, 2,000 objects x 50 frames, 100 x 200;
   dense rigs      every bone's XYZ Euler and the root's location keyed so: 20, 100, 300 bones x
                   250 frames, 30 and 100 bones x 1,000 frames.
-Build Swept Region runs on the sparse objects up to 100 objects (above 20 in the first run
-only), Reduce Keys and graph.decimate on scenes of up to 200,000 keys, and the scenes of 2,000
+Build Swept Region runs on the sparse objects up to 25,000 objects x frames (above 1,000 in the
+first run only: 100 objects x 50 and 250 frames), Reduce Keys and graph.decimate on scenes of up to 200,000 keys, and the scenes of 2,000
 objects run once: the full run takes about ten minutes on a quiet 2-core machine.
 
 Each operator's time is given as a multiple of its floor (median over median of the same
@@ -101,9 +101,10 @@ FULL_CASES = (
 )
 QUICK_CASES = [("objects", 1, 50, 2), ("objects", 20, 50, 2), ("objects", 20, 100, 2), ("rig", 20, 100, 10),
                ("dense_objects", 1, 50, 0), ("dense_objects", 20, 50, 0), ("dense_rig", 20, 100, 0)]
-#: Build Swept Region runs up to this many objects, in every run up to SWEEP_EVERY_RUN, above it
-#: in the first run only (its own sweep takes about a third of a second per object here).
-SWEEP_MAX_OWNERS, SWEEP_EVERY_RUN = 100, 20
+#: Build Swept Region runs on scenes of up to this many objects x frames, in every run up to
+#: SWEEP_EVERY_RUN, above it in the first run only (on a busy 2-core machine its own sweep took
+#: about half a second per object over 50 frames, and grows with the frames).
+SWEEP_MAX_OBJECT_FRAMES, SWEEP_EVERY_RUN = 25_000, 1_000
 #: Reduce Keys and graph.decimate run on scenes of up to this many source keys (decimate takes
 #: about 0.1 ms per key; scripts/bench_reduce.py compares the two in full).
 REDUCE_MAX_KEYS = 200_000
@@ -566,7 +567,7 @@ def run_case(family: str, owners: int, frames: int, keys: int, repeat: int, swee
     reduce = source_keys <= REDUCE_MAX_KEYS
     start = time.perf_counter()
     for run in range(1 if owners >= ONE_RUN_OWNERS else repeat):
-        sweep = family == "objects" and owners <= sweep_max and (run == 0 or owners <= SWEEP_EVERY_RUN)
+        sweep = family == "objects" and owners * frames <= sweep_max and (run == 0 or owners * frames <= SWEEP_EVERY_RUN)
         one_repetition(stage, family, frames, record, sweep, reduce)
     case = {"family": family, "owners": owners, "frames": frames, "keys": keys, "curves": curves,
             "source_keys": source_keys, "repeat": 1 if owners >= ONE_RUN_OWNERS else repeat, "seconds": time.perf_counter() - start, "ops": {}}
@@ -629,7 +630,7 @@ def main() -> None:
         one_repetition(stage, family, 20, Record(), family == "objects")
     results = []
     for family, owners, frames, keys in cases:
-        case = run_case(family, owners, frames, keys, repeat, 1 if args.quick else SWEEP_MAX_OWNERS)
+        case = run_case(family, owners, frames, keys, repeat, 50 if args.quick else SWEEP_MAX_OBJECT_FRAMES)
         print_case(case)
         results.append(case)
     out = {"blender": bpy.app.version_string, "quick": args.quick, "repeat": repeat, "reduce_max_keys": REDUCE_MAX_KEYS,

@@ -790,7 +790,7 @@ class Report:
                 return "-"
             if med(e) is None:
                 return "failed: " + e.get("error", "?").replace("|", "/")
-            text = fmt_seconds(med(e))
+            text = fmt_seconds(med(e)) + (", 1 run" if len(e.get("op", [])) == 1 < case.get("repeat", 1) else "")
             if counterpart_of:
                 ours = case["ops"].get(counterpart_of, {})
                 return text + (f" ({fmt_ratio(med(e) / med(ours))} ours)" if med(ours) else "")
