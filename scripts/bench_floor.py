@@ -623,6 +623,7 @@ def main() -> None:
         cases = [c for c in cases if c[0].startswith(args.only)]
     start = time.perf_counter()
     load0 = os.getloadavg()
+    date = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     print(f"Blender {bpy.app.version_string}: operators against their floor, {repeat} run(s) per case", flush=True)
     # One untimed pass over the smallest scene first: modules imported, caches warm.
     for family in ("objects", "dense_objects"):
@@ -634,7 +635,7 @@ def main() -> None:
         print_case(case)
         results.append(case)
     out = {"blender": bpy.app.version_string, "quick": args.quick, "repeat": repeat, "reduce_max_keys": REDUCE_MAX_KEYS,
-           "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+           "date": date, "date_end": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
            "load_start": " ".join(f"{x:.2f}" for x in load0),
            "load_end": " ".join(f"{x:.2f}" for x in os.getloadavg()),
            "seconds": time.perf_counter() - start, "cases": results}

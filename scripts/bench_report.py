@@ -769,8 +769,9 @@ class Report:
             self.targets.append(("every writing operator within 2x its floor", "not measured", "n/a"))
             return
         d = json.loads(js.read_text())
+        when = f"{d['date']} to {d['date_end']}" if "date_end" in d else f"ended {d['date']}"
         self.w(f"`scripts/bench_floor.py`{' (quick: a smoke run)' if d.get('quick') else ''}, Blender {d['blender']}, "
-               f"{d['date']}, load average {d['load_start']} at its start, {d['seconds']:.0f} s in all. Each operator "
+               f"{when}, load average {d['load_start']} at its start, {d['seconds']:.0f} s in all. Each operator "
                "through `bpy.ops` with its defaults, against its *floor*: only the Blender calls no implementation "
                "through Blender's Python API can avoid (one `foreach_get` of `co` and of `interpolation` per source "
                "F-curve; the result action with its slot and channelbag where the version has them, its curves, one "
@@ -1086,9 +1087,9 @@ def main() -> None:
     stamp = None
     if only is not None:
         env = json.loads((args.run / "machine.json").read_text()) if (args.run / "machine.json").exists() else {}
-        stamp = (f"_Refreshed alone (`BENCH_ONLY={','.join(sorted(only))} scripts/bench.sh`), "
-                 f"{env.get('date', 'date unknown')} UTC, load average {env.get('load_start', '?')} at its start; "
-                 "the machine table is the last full run's._")
+        stamp = (f"_Refreshed alone (BENCH_ONLY={','.join(sorted(only))}): measured from "
+                 f"{env.get('date', 'an unknown date')} UTC, load average {env.get('load_start', '?')} at its start; "
+                 "the other sections and the machine table are the last full run's._")
     args.out.write_text(compose(rep, only, old, stamp))
     print(f"bench_report: wrote {args.out}" + (f" (refreshed: {', '.join(sorted(only))})" if only else ""))
 
