@@ -69,11 +69,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import bench_report  # noqa: E402
 import demo_common  # noqa: E402
+
+import bench_report  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
+
 from bench_denoise import graph_context as _graph_context  # noqa: E402  (the Graph Editor, headless)
 
 SLOTTED = bpy.app.version >= (4, 4, 0)

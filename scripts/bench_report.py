@@ -769,7 +769,9 @@ class Report:
             self.targets.append(("every writing operator within 2x its floor", "not measured", "n/a"))
             return
         d = json.loads(js.read_text())
-        when = f"{d['date']} to {d['date_end']}" if "date_end" in d else f"ended {d['date']}"
+        end_ = d.get("date_end", "")
+        when = (f"{d['date']} to {end_[11:] if end_[:10] == d['date'][:10] else end_}" if end_
+                else f"ended {d['date']}")
         self.w(f"`scripts/bench_floor.py`{' (quick: a smoke run)' if d.get('quick') else ''}, Blender {d['blender']}, "
                f"{when}, load average {d['load_start']} at its start, {d['seconds']:.0f} s in all. Each operator "
                "through `bpy.ops` with its defaults, against its *floor*: only the Blender calls no implementation "
@@ -1021,7 +1023,7 @@ def parts_at_hand(run: Path, crit: dict) -> set[str]:
     return have
 
 
-def compose(rep: "Report", only: set[str] | None, old_text: str | None, stamp: str | None = None) -> str:
+def compose(rep: Report, only: set[str] | None, old_text: str | None, stamp: str | None = None) -> str:
     """BENCHMARKS.md from the run in `rep`: every block (`only` None), or only the blocks that
     show a part of `only`, the others kept from `old_text` as they are. A block that shows a
     refreshed part and another part whose results are not at hand is kept too (and said)."""
@@ -1037,8 +1039,12 @@ def compose(rep: "Report", only: set[str] | None, old_text: str | None, stamp: s
                   f"in {rep.run} (refresh {missing} with it)")
             fresh = False
         if not fresh and name in old_blocks:
-            texts.append(old_blocks[name])
-            targets += old_targets.get(name, [])
+            kept = old_targets.get(name, []) + (old_targets.get("unknown", []) if name == "machine" else [])
+            text = old_blocks[name]
+            if kept and TARGETS_NOTE not in text:  # a block from a file without markers: its rows go with it
+                text = text[:-len(end(name))] + TARGETS_NOTE + json.dumps([list(t) for t in kept]) + " -->\n" + end(name)
+            texts.append(text)
+            targets += kept
             continue
         if not fresh:
             continue
@@ -1055,7 +1061,6 @@ def compose(rep: "Report", only: set[str] | None, old_text: str | None, stamp: s
             lines.append(TARGETS_NOTE + json.dumps([list(t) for t in rep.targets]) + " -->")
         texts.append("\n".join(lines + [end(name)]))
         targets += rep.targets
-    targets += old_targets.get("unknown", []) if only is not None else []
     head = ["# Benchmarks", "", "Written by `scripts/bench.sh` (rerun it to reproduce; about 18 minutes on 2 cores for "
             "everything; `BENCH_ONLY=<part>[,<part>] scripts/bench.sh` refreshes only those parts' sections and "
             "keeps the others). Every figure below was measured in one run unless marked as a figure from another "
@@ -1087,8 +1092,9 @@ def main() -> None:
     stamp = None
     if only is not None:
         env = json.loads((args.run / "machine.json").read_text()) if (args.run / "machine.json").exists() else {}
+        date, _, quick = env.get("date", "an unknown date").partition(" (")
         stamp = (f"_Refreshed alone (BENCH_ONLY={','.join(sorted(only))}): measured from "
-                 f"{env.get('date', 'an unknown date')} UTC, load average {env.get('load_start', '?')} at its start; "
+                 f"{date} UTC{' (' + quick if quick else ''}, load average {env.get('load_start', '?')} at its start; "
                  "the other sections and the machine table are the last full run's._")
     args.out.write_text(compose(rep, only, old, stamp))
     print(f"bench_report: wrote {args.out}" + (f" (refreshed: {', '.join(sorted(only))})" if only else ""))

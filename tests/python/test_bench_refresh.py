@@ -162,3 +162,22 @@ def test_bench_sh_refuses_an_unknown_part(tmp_path):
                           timeout=60)
     assert done.returncode == 2 and "unknown part 'nope'" in done.stdout
     assert not (tmp_path / "bench").exists()  # refused before touching anything
+
+
+def test_a_second_refresh_keeps_the_target_rows_of_a_file_without_markers(tmp_path):
+    legacy = "\n".join([
+        "# Benchmarks", "", "## Targets (issue 7)", "", "| target | measured | |", "| --- | --- | --- |",
+        "| s >= 20 M/s on one core | 14.6 M/s | **missed** |", "| an old goal | 3 | met |", "",
+        "## Machine and versions", "", "| date | x |", "", "## s(a, t, b): one screw interpolation", "", "68 ns", ""])
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "floor.json").write_text(json.dumps(floor_json([case("objects", 500, 50, {"revert": op(0.05, 0.001)})])))
+    once = report.compose(report.Report(run, {}), {"floor"}, legacy, "_Refreshed alone._")
+    twice = report.compose(report.Report(run, {}), {"floor"}, once, "_Refreshed alone._")
+    for text in (once, twice):
+        rows = [line for line in text.splitlines() if line.startswith("| ") and line.endswith(" |")]
+        assert "| s >= 20 M/s on one core | 14.6 M/s | **missed** |" in rows
+        assert "| an old goal | 3 | met |" in rows
+        assert "| Revert of 500 objects < 100 ms | 50.00 ms | met |" in rows
+        assert "68 ns" in block(text, "s")
+    assert twice == once
