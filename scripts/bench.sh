@@ -14,7 +14,7 @@
 #     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv;
 #   - scripts/bench_floor.py (every writing operator against its floor, the Blender calls it
 #     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
-#     against owners and frames: issue 27; about 10 minutes);
+#     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
 #   - scripts/bench_denoise.py, scripts/bench_denoise_rig.py (Remove Noise vs Blender's filters).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
 # and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
@@ -24,7 +24,7 @@
 #      BENCH_ONLY=<part>[,<part>] runs only those parts and rewrites only their sections of
 #      BENCHMARKS.md, keeping the others as they are (each refreshed section says so). Parts:
 #      criterion, callgrind, python, bake, reduce, floor, denoise, sweep. E.g.
-#      BENCH_ONLY=floor scripts/bench.sh (about 10 minutes; the reduce part alone takes ~22).
+#      BENCH_ONLY=floor scripts/bench.sh (the floor part; the reduce part alone takes ~22 minutes).
 #      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
 #      other parts' results in target/bench; a section that shows a refreshed part and another
 #      part whose results are not there is kept as it was (bench_report.py says which).

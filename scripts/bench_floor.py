@@ -44,7 +44,8 @@ Scenes (--quick: a smoke run of seconds with the smallest of each):
                   250 frames, 30 and 100 bones x 1,000 frames.
 Build Swept Region runs on the sparse objects up to 25,000 objects x frames (above 1,000 in the
 first run only: 100 objects x 50 and 250 frames), Reduce Keys and graph.decimate on scenes of up to 200,000 keys, and the scenes of 2,000
-objects run once: the full run takes about ten minutes on a quiet 2-core machine.
+objects run once: the full run took 31 minutes on the shared 2-core machine at load 15 to 20
+(about ten minutes expected on a quiet one, not measured); --case runs chosen scenes.
 
 Each operator's time is given as a multiple of its floor (median over median of the same
 run), Smooth Motion and Remove Noise also against Blender's counterpart; the growth
