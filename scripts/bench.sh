@@ -11,45 +11,85 @@
 #   - scripts/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
 #   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
 #     NVIDIA Warp, against a dense-stamp reference), with scripts/bench-requirements.txt
-#     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv.
+#     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv;
+#   - scripts/bench_floor.py (every writing operator against its floor, the Blender calls it
+#     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
+#     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
+#   - scripts/bench_denoise.py, scripts/bench_denoise_rig.py (Remove Noise vs Blender's filters).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
-# and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt).
+# and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
+# a refresh's: log-<parts>.txt).
 # Env: BENCH_QUICK=1 for a smoke run (short criterion times, small Python runs; the
 #      BENCHMARKS.md it writes says so); BPY=.venv/bpy/5.0 selects the Blender module.
+#      BENCH_ONLY=<part>[,<part>] runs only those parts and rewrites only their sections of
+#      BENCHMARKS.md, keeping the others as they are (each refreshed section says so). Parts:
+#      criterion, callgrind, python, bake, reduce, floor, denoise, sweep. E.g.
+#      BENCH_ONLY=floor scripts/bench.sh (the floor part; the reduce part alone takes ~22 minutes).
+#      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
+#      other parts' results in target/bench; a section that shows a refreshed part and another
+#      part whose results are not there is kept as it was (bench_report.py says which).
 set -uo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
 export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$root/target}
 run="$CARGO_TARGET_DIR/bench"
-rm -rf "$run" "$CARGO_TARGET_DIR/criterion" "$CARGO_TARGET_DIR/criterion-reuse"
+only=${BENCH_ONLY:-}
+parts="criterion callgrind python bake reduce floor denoise sweep"
+for p in ${only//,/ }; do
+  case " $parts " in *" $p "*) ;; *) echo "bench: unknown part '$p' in BENCH_ONLY (the parts: $parts)"; exit 2 ;; esac
+done
+want() { [ -z "$only" ] || case ",$only," in *",$1,"*) true ;; *) false ;; esac; }
+if [ -z "$only" ]; then
+  rm -rf "$run" "$CARGO_TARGET_DIR/criterion" "$CARGO_TARGET_DIR/criterion-reuse"
+else  # a refresh: only the named parts' results are removed, the others kept for the report
+  mkdir -p "$run"
+  want criterion && rm -rf "$CARGO_TARGET_DIR/criterion" "$CARGO_TARGET_DIR/criterion-reuse"
+  want callgrind && rm -f "$run"/callgrind-* "$run"/branches-* "$run"/time-10000x8.txt
+  want python && rm -f "$run/python.json" "$run/blender.json"
+  want bake && rm -f "$run"/bake.*
+  want reduce && rm -f "$run"/reduce.*
+  want floor && rm -f "$run"/floor.*
+  want denoise && rm -f "$run"/denoise.* "$run"/denoise_rig.json
+  want sweep && rm -f "$run"/sweep.*
+  rm -rf "$run/wheel" "$run/pylib" "$run/extension.txt"
+fi
 mkdir -p "$run"
-exec > >(tee "$run/log.txt") 2>&1
+exec > >(tee "$run/log${only:+-${only//,/-}}.txt") 2>&1
 start=$(date +%s)
 stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
 load_start=$(cut -d' ' -f1-3 /proc/loadavg)
 date_start=$(date -u '+%Y-%m-%d %H:%M')
 quick=${BENCH_QUICK:-0}
 
-stage "bootstrap"
-scripts/bootstrap.sh || { echo "bench: bootstrap failed"; exit 1; }
+if [ -z "$only" ] || [ ! -x "$root/.venv/bin/python" ]; then
+  stage "bootstrap"
+  scripts/bootstrap.sh || { echo "bench: bootstrap failed"; exit 1; }
+fi
 py="$root/.venv/bin/python"
 bpy_dir=${BPY:-$root/.venv/bpy/5.0}
 peers_ok=1
-"$py" -m pip --disable-pip-version-check install -q -r scripts/bench-requirements.txt \
-  || { peers_ok=0; echo "bench: scripts/bench-requirements.txt did not install; the sweep comparison will be missing"; }
-
-stage "build the polyscrew wheel (release, once)"
-pylib="$run/pylib"
-wheel=""
-if "$root/.venv/bin/maturin" build --release --quiet -o "$run/wheel" 2>&1 | grep -v '^ *Compiling'; then :; fi
-wheel=$(ls "$run"/wheel/polyscrew-*.whl 2>/dev/null | head -1)
-if [ -n "$wheel" ]; then
-  "$py" -m pip --disable-pip-version-check install -q --no-deps --target "$pylib" "$wheel"
-else
-  echo "bench: the wheel did not build; the Python parts will be missing"
+if want sweep; then
+  "$py" -m pip --disable-pip-version-check install -q -r scripts/bench-requirements.txt \
+    || { peers_ok=0; echo "bench: scripts/bench-requirements.txt did not install; the sweep comparison will be missing"; }
 fi
 
+pylib="$run/pylib"
+wheel=""
+needs_wheel=0  # every part but criterion and callgrind runs the Python module
+for p in python bake reduce floor denoise sweep; do want "$p" && needs_wheel=1; done
+if [ "$needs_wheel" = 1 ]; then
+  stage "build the polyscrew wheel (release, once)"
+  if "$root/.venv/bin/maturin" build --release --quiet -o "$run/wheel" 2>&1 | grep -v '^ *Compiling'; then :; fi
+  wheel=$(ls "$run"/wheel/polyscrew-*.whl 2>/dev/null | head -1)
+  if [ -n "$wheel" ]; then
+    "$py" -m pip --disable-pip-version-check install -q --no-deps --target "$pylib" "$wheel"
+  else
+    echo "bench: the wheel did not build; the Python parts will be missing"
+  fi
+fi
+
+if want criterion; then
 # Every criterion bench of the core crate (core.rs, scaling.rs, and those the other issues add).
 benches=()
 for f in rust/polyscrew/benches/*.rs; do benches+=(--bench "$(basename "$f" .rs)"); done
@@ -67,7 +107,9 @@ CRITERION_HOME="$CARGO_TARGET_DIR/criterion-reuse" \
   GLIBC_TUNABLES=glibc.malloc.mmap_max=0:glibc.malloc.trim_threshold=4294967295 \
   cargo bench -p polyscrew --bench scaling -- "${crit_args[@]}" 'scaling/.*/10{3,4}x' 2>&1 \
   | grep --line-buffered -v -e '^ *Compiling' -e '^Gnuplot' -e 'Plotting' -e '^Benchmarking' || true
+fi
 
+if want callgrind; then
 stage "callgrind instruction counts"
 if command -v valgrind >/dev/null; then
   cargo build --profile bench -p polyscrew --example count_s --example count_subdivide 2>&1 | grep -v '^ *Compiling' || true
@@ -101,7 +143,9 @@ if [ -x /usr/bin/time ] && [ -x "$CARGO_TARGET_DIR/release/examples/count_subdiv
   /usr/bin/time -o "$run/time-10000x8.txt" -f "%U %S %R %M" \
     "$CARGO_TARGET_DIR/release/examples/count_subdivide" 1 10000 8 && cat "$run/time-10000x8.txt"
 fi
+fi
 
+if want python; then
 pyargs=(); [ "$quick" = 1 ] && pyargs=(--n 2000 --repeat 3)
 stage "Python: batch vs loops (pytransform3d)"
 PYTHONPATH="$pylib" "$py" scripts/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
@@ -113,7 +157,9 @@ if [ -d "$bpy_dir" ]; then
 else
   echo "not available: no Blender module at $bpy_dir"
 fi
+fi
 
+if want bake; then
 stage "bake: ScrewBender vs nla.bake vs a keyframe_insert loop"
 if [ ! -f scripts/bench_bake.py ]; then
   echo "scripts/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
@@ -130,7 +176,9 @@ else
     echo "scripts/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
   fi
 fi
+fi
 
+if want sweep; then
 stage "sweep: ours vs stroboscopic instancing, gpytoolbox, Warp"
 if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
   echo "polyscrew.sweep is not in this build" | tee "$run/sweep.missing"
@@ -143,7 +191,9 @@ else
     | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
   [ -f "$run/sweep.json" ] || echo "scripts/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
 fi
+fi
 
+if want reduce; then
 stage "reduce: Reduce Keys vs graph.decimate (five clips, three tolerances)"
 if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
   echo "the wheel or the Blender module is missing" | tee "$run/reduce.missing"
@@ -155,6 +205,33 @@ else
   PYTHONPATH="$bpy_dir" "$py" scripts/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
     || true
   [ -f "$run/reduce.json" ] || echo "scripts/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
+fi
+fi
+
+if want floor; then
+stage "floor: every writing operator against the Blender calls it cannot avoid, and its growth"
+if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
+  echo "the wheel or the Blender module is missing" | tee "$run/floor.missing"
+elif ! { [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1; }; then
+  echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/floor.missing"
+else
+  floor_args=(--out "$run/floor.json"); [ "$quick" = 1 ] && floor_args+=(--quick)
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench_floor.py "${floor_args[@]}" 2>&1 \
+    | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' -e '^ScrewBender: ' || true
+  [ -f "$run/floor.json" ] || echo "scripts/bench_floor.py failed (see target/bench/log.txt)" | tee "$run/floor.missing"
+fi
+fi
+
+# Remove Noise against Blender's own filters: its section (denoise.md in the run folder, put
+# into BENCHMARKS.md by bench_report.py) and docs/denoise_error.png; then the operator on a
+# 100-bone rig against graph.gaussian_smooth (printed, and kept in the run folder).
+if want denoise; then
+stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
+[ -z "$wheel" ] || [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
+PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise.py --json "$run/denoise.json" --benchmarks "$run/denoise.md" \
+  || echo "scripts/bench_denoise.py failed"
+stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench_denoise_rig.py failed"
 fi
 
 stage "write BENCHMARKS.md"
@@ -182,13 +259,5 @@ if os.path.exists(bpy_json):
 json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), indent=1)
 PY
 "$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
-  --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md
-
-# Remove Noise against Blender's own filters: its section of BENCHMARKS.md (between the
-# denoise markers) and docs/denoise_error.png; then the operator on a 100-bone rig against
-# graph.gaussian_smooth (printed, and kept in the run folder).
-stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise.py --json "$run/denoise.json" || echo "scripts/bench_denoise.py failed"
-stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench_denoise_rig.py failed"
+  --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md ${only:+--only "$only"}
 stage "done"

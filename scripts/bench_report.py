@@ -137,6 +137,11 @@ def fmt_rate(per_second: float) -> str:
     return f"{per_second:.0f} /s"
 
 
+def fmt_ratio(r: float) -> str:
+    """A ratio for a table cell: two decimals below 1 (0.07x), one above (12.4x)."""
+    return f"{r:.2f}x" if r < 1 else f"{r:.1f}x"
+
+
 def verdict(ok: bool | None) -> str:
     return "n/a" if ok is None else ("met" if ok else "**missed**")
 
@@ -543,11 +548,6 @@ class Report:
                    "1 for large outputs; with memory reused it is the \"memory reused\" column of the scaling table.",
                    "")
 
-    def later_sections(self) -> None:
-        self.sweep_section()
-        self.reduce_section()
-        self.papers_section()
-
     def reduce_section(self) -> None:
         """Reduce Keys against graph.decimate, from scripts/bench_reduce.py's JSON (issue 26)."""
         self.w("## Reduce Keys against graph.decimate", "")
@@ -747,10 +747,327 @@ class Report:
                "are not published; whole design, curves and registration, against their T_c + T_r) and "
                "`benches/angular_velocity.rs` (`top_20_keys`: the spinning top, 20 keys).", "")
 
-    def summary(self) -> list[str]:
-        out = ["## Targets (issue 7)", "", "| target | measured | |", "| --- | --- | --- |"]
-        out += [f"| {a} | {b} | {c} |" for a, b, c in self.targets]
-        return out + [""]
+    def denoise_section(self) -> None:
+        """The section scripts/bench_denoise.py wrote into the run folder (denoise.md)."""
+        path = self.run / "denoise.md"
+        text = path.read_text() if path.exists() else ""
+        if begin("denoise") in text and end("denoise") in text:
+            text = text[text.index(begin("denoise")) + len(begin("denoise")):text.index(end("denoise"))]
+            self.w(text.strip(), "")
+        else:
+            self.w("## Denoise (issue 19)", "", "not available: scripts/bench_denoise.py did not write its section "
+                   "(see the bench.sh log)", "")
+
+    def floor_section(self) -> None:
+        """Every writing operator against its floor and Blender's counterpart, and how each grows,
+        from scripts/bench_floor.py's JSON (issue 27)."""
+        self.w("## Operators against their floor", "")
+        js = self.run / "floor.json"
+        if not js.exists():
+            path = self.run / "floor.missing"
+            self.w("not available: " + (path.read_text().strip() if path.exists() else "not run"), "")
+            self.targets.append(("every writing operator within 2x its floor", "not measured", "n/a"))
+            return
+        d = json.loads(js.read_text())
+        end_ = d.get("date_end", "")
+        when = (f"{d['date']} to {end_[11:] if end_[:10] == d['date'][:10] else end_}" if end_
+                else f"ended {d['date']}")
+        self.w(f"`scripts/bench_floor.py`{' (quick: a smoke run)' if d.get('quick') else ''}, Blender {d['blender']}, "
+               f"{when}, load average {d['load_start']} at its start, {d['seconds']:.0f} s in all. Each operator "
+               "through `bpy.ops` with its defaults, against its *floor*: only the Blender calls no implementation "
+               "through Blender's Python API can avoid (one `foreach_get` of `co` and of `interpolation` per source "
+               "F-curve; the result action with its slot and channelbag where the version has them, its curves, one "
+               "`foreach_set` per written attribute, the assignment; Insert Key: one `keyframe_points.insert` per "
+               "keyed curve; Revert: assigning the previous action; Build Swept Region: the evaluated mesh read and "
+               "a new mesh object of the result's size), the result's shape being the one the operator wrote in the "
+               "same repetition. Blender's counterparts on the same keys and frames: `nla.bake` (OBJECT; POSE for "
+               "rigs), `graph.gaussian_smooth` and `graph.decimate` at their defaults. Cells: median wall-clock of "
+               f"{d['repeat']} run(s), A/B interleaved in one process; (x floor) is the operator over its floor, "
+               "(x ours) the counterpart over the operator: above 1 ours is faster.", "")
+        cases = d["cases"]
+        med = lambda e, k="op": e.get(f"{k}_median")  # noqa: E731
+
+        def cell(case, name, counterpart_of=None):
+            e = case["ops"].get(name)
+            if e is None:
+                return "-"
+            if med(e) is None:
+                return "failed: " + e.get("error", "?").replace("|", "/")
+            text = fmt_seconds(med(e)) + (", 1 run" if len(e.get("op", [])) == 1 < case.get("repeat", 1) else "")
+            if counterpart_of:
+                ours = case["ops"].get(counterpart_of, {})
+                return text + (f" ({fmt_ratio(med(e) / med(ours))} ours)" if med(ours) else "")
+            return text + (f" ({fmt_ratio(med(e) / med(e, 'floor'))} floor)" if med(e, "floor") else "")
+
+        what = {"objects": "objects", "rig": "bones", "dense_objects": "objects", "dense_rig": "bones"}
+        size = lambda c: (f"{c['owners']:,} {what[c['family']][:-1] if c['owners'] == 1 else what[c['family']]} "  # noqa: E731
+                          f"x {c['frames']:,} frames" + (" (one run)" if c.get("repeat", d["repeat"]) < d["repeat"] else ""))
+        sparse = [c for c in cases if not c["family"].startswith("dense")]
+        dense = [c for c in cases if c["family"].startswith("dense")]
+        if sparse:
+            self.w("Key poses (objects: a tetrahedron each; rigs: chains of ten bones; location, XYZ Euler and a "
+                   "constant scale keyed at a few uneven frames):", "",
+                   "| scene | keys | Smooth Motion | Revert | Insert Key on Motion | Build Swept Region | nla.bake |",
+                   "| --- | --- | --- | --- | --- | --- | --- |")
+            for c in sparse:
+                self.w(f"| {size(c)} | {c['source_keys']:,} | {cell(c, 'smooth')} | {cell(c, 'revert')} | "
+                       f"{cell(c, 'insert_key')} | {cell(c, 'sweep')} | {cell(c, 'nla_bake', 'smooth')} |")
+            self.w("")
+        if dense:
+            self.w("Captured motion (XYZ Euler keyed on every frame, and location on objects and a rig's root, a "
+                   "slow motion with a little noise; Reduce Keys and graph.decimate only on scenes of up to "
+                   f"{d.get('reduce_max_keys', 200_000):,} keys):", "",
+                   "| scene | keys | Remove Noise | graph.gaussian_smooth | Reduce Keys | graph.decimate |",
+                   "| --- | --- | --- | --- | --- | --- |")
+            for c in dense:
+                self.w(f"| {size(c)} | {c['source_keys']:,} | {cell(c, 'denoise')} | "
+                       f"{cell(c, 'gaussian_smooth', 'denoise')} | {cell(c, 'reduce')} | "
+                       f"{cell(c, 'decimate', 'reduce')} |")
+            self.w("")
+        # Growth against owners (frames fixed) and against frames (owners fixed).
+        rows, steep = [], []
+        ops = [n for n in ("smooth", "revert", "insert_key", "sweep", "denoise", "reduce", "nla_bake",
+                           "gaussian_smooth", "decimate") if any(n in c["ops"] for c in cases)]
+        for name in ops:
+            cells = []
+            for axis in ("owners", "frames"):
+                for family in ("objects", "rig", "dense_objects", "dense_rig"):
+                    fit = growth_of(cases, name, family, axis)
+                    if fit is None:
+                        continue
+                    p, n, lo, hi = fit
+                    flag = p > 1 + TARGET_EXPONENT_TOLERANCE
+                    if flag and name in FLOOR_OPERATORS:
+                        steep.append(f"{FLOOR_LABELS[name]} {p:.2f} ({what[family]}, {axis})")
+                    cells.append(f"{what[family]}{' (dense)' if family.startswith('dense') else ''} "
+                                 f"{axis} {lo:,}..{hi:,}: {'**' if flag else ''}{p:.2f}{'**' if flag else ''}")
+            if cells:
+                rows.append(f"| {FLOOR_LABELS[name]} | " + "; ".join(cells) + " |")
+        if rows:
+            self.w("Growth exponent p of the median time (least squares on log t = p log n + c; owners from 20 up, "
+                   "frames fixed; frames at fixed owners and keys); **bold** above linear (p > "
+                   f"{1 + TARGET_EXPONENT_TOLERANCE:g}):", "", "| | p |", "| --- | --- |", *rows, "")
+        # The goals of issue 27.
+        for name in FLOOR_OPERATORS:
+            ratios = [(med(c["ops"][name]) / med(c["ops"][name], "floor"), size(c)) for c in cases
+                      if name in c["ops"] and med(c["ops"][name]) and med(c["ops"][name], "floor")]
+            failed = [size(c) for c in cases if name in c["ops"] and med(c["ops"][name]) is None]
+            if ratios or failed:
+                worst = max(ratios) if ratios else None
+                self.targets.append((f"{FLOOR_LABELS[name]} within 2x its floor at every scale",
+                                     (f"at most {worst[0]:.1f}x ({worst[1]})" if worst else "")
+                                     + (f"; failed on {', '.join(failed)}" if failed else ""),
+                                     verdict(bool(worst) and worst[0] <= 2.0 and not failed)))
+        for family, owners, frames, goal, label in FLOOR_GOALS:
+            c = next((c for c in cases if (c["family"], c["owners"], c["frames"]) == (family, owners, frames)), None)
+            e = c and c["ops"]
+            if family.startswith("dense"):
+                ratio = med(e["denoise"]) / med(e["gaussian_smooth"]) if e and med(e.get("denoise", {})) \
+                    and med(e.get("gaussian_smooth", {})) else None
+                self.targets.append((label, f"{ratio:.2f}x" if ratio else "not measured", verdict(ratio <= goal)
+                                     if ratio else "n/a"))
+            else:
+                ratio = med(e["nla_bake"]) / med(e["smooth"]) if e and med(e.get("smooth", {})) \
+                    and med(e.get("nla_bake", {})) else None
+                self.targets.append((label, f"{ratio:.1f}x" if ratio else "not measured", verdict(ratio >= goal)
+                                     if ratio else "n/a"))
+        c = next((c for c in cases if (c["family"], c["owners"], c["frames"]) == ("objects", 500, 50)), None)
+        revert = med(c["ops"].get("revert", {})) if c else None
+        self.targets.append(("Revert of 500 objects < 100 ms", fmt_seconds(revert) if revert else "not measured",
+                             verdict(revert < TARGET_REVERT_500_S) if revert else "n/a"))
+        self.targets.append(("no operator grows faster than linearly", "; ".join(steep) if steep else
+                             ("all p <= " + f"{1 + TARGET_EXPONENT_TOLERANCE:g}" if rows else "not measured"),
+                             verdict(not steep) if rows else "n/a"))
+
+
+#: The writing operators measured against their floor (scripts/bench_floor.py), and labels.
+FLOOR_OPERATORS = ("smooth", "revert", "denoise", "reduce", "insert_key", "sweep")
+FLOOR_LABELS = {
+    "smooth": "Smooth Motion", "revert": "Revert", "denoise": "Remove Noise", "reduce": "Reduce Keys",
+    "insert_key": "Insert Key on Motion", "sweep": "Build Swept Region", "nla_bake": "nla.bake",
+    "gaussian_smooth": "graph.gaussian_smooth", "decimate": "graph.decimate",
+}
+#: Issue 27's goals against Blender: (family, owners, frames, ratio, label).
+FLOOR_GOALS = (
+    ("objects", 500, 50, 10.0, "Smooth Motion >= 10x nla.bake, 500 objects x 50 frames"),
+    ("objects", 300, 250, 10.0, "Smooth Motion >= 10x nla.bake, 300 objects x 250 frames"),
+    ("rig", 100, 1000, 20.0, "Smooth Motion >= 20x nla.bake POSE, 100-bone rig x 1,000 frames"),
+    ("dense_rig", 30, 1000, 2.0, "Remove Noise <= 2x graph.gaussian_smooth, 30 bones x 1,000 frames"),
+    ("dense_rig", 100, 1000, 2.0, "Remove Noise <= 2x graph.gaussian_smooth, 100 bones x 1,000 frames"),
+)
+TARGET_REVERT_500_S = 0.1
+#: Growth against owners is fitted from this many owners up (a single owner is mostly fixed cost).
+GROWTH_MIN_OWNERS = 20
+
+
+def growth_of(cases: list[dict], name: str, family: str, axis: str):
+    """The growth exponent of operator `name`'s median time in `family` against `axis`
+    ("owners" at the frame count with the most owner counts, or "frames" at the owner count
+    with the most frame counts; same keys per owner): ``(p, points, smallest, largest)``,
+    None when fewer than two sizes were measured."""
+    fixed = "frames" if axis == "owners" else "owners"
+    groups: dict[tuple, list[tuple[int, float]]] = {}
+    for c in cases:
+        e = c["ops"].get(name)
+        if c["family"] != family or not e or e.get("op_median") is None:
+            continue
+        if axis == "owners" and c["owners"] < GROWTH_MIN_OWNERS:
+            continue
+        groups.setdefault((c[fixed], c["keys"]), []).append((c[axis], e["op_median"]))
+    best = max(groups.values(), key=lambda g: len({n for n, _ in g}), default=[])
+    if len({n for n, _ in best}) < 2:
+        return None
+    p, _ = growth_exponent([n for n, _ in best], [t for _, t in best])
+    return p, len(best), min(n for n, _ in best), max(n for n, _ in best)
+
+
+#: The parts of scripts/bench.sh (BENCH_ONLY=<part>[,<part>]).
+PARTS = ("criterion", "callgrind", "python", "bake", "reduce", "floor", "denoise", "sweep")
+#: The blocks of BENCHMARKS.md in order: (name, the parts whose results it shows, its methods).
+#: Each is written between ``<!-- name:begin -->`` and ``<!-- name:end -->``; a refresh of some
+#: parts rewrites the blocks that show them and keeps the others as they are.
+BLOCKS = (
+    ("machine", (), ("machine",)),
+    ("s", ("criterion", "callgrind"), ("s_section",)),
+    ("python", ("python",), ("python_section",)),
+    ("subdivision", ("criterion", "callgrind"), ("subdivision_section",)),
+    ("bake", ("bake",), ("bake_section", "bones_section")),
+    ("floor", ("floor",), ("floor_section",)),
+    ("criterion", ("criterion",), ("other_criterion",)),
+    ("limits", ("criterion", "callgrind"), ("limits_section",)),
+    ("sweep", ("sweep",), ("sweep_section",)),
+    ("reduce", ("reduce",), ("reduce_section",)),
+    ("papers", ("criterion",), ("papers_section",)),
+    ("denoise", ("denoise",), ("denoise_section",)),
+)
+#: A file written before the blocks had markers: the block of each "## " heading (prefix).
+LEGACY_HEADINGS = (
+    ("## Machine and versions", "machine"), ("## s(a, t, b)", "s"), ("## Through Python", "python"),
+    ("## Subdivision", "subdivision"), ("## Bake in Blender", "bake"), ("## Operators against their floor", "floor"),
+    ("## Other criterion benches", "criterion"), ("## What limits the targets", "limits"),
+    ("## Sweep against peers", "sweep"), ("## Reduce Keys against", "reduce"),
+    ("## Figures from other machines", "papers"), ("## Denoise", "denoise"),
+)
+#: ... and the block of each row of its targets table (label prefix).
+LEGACY_TARGETS = (
+    ("s >=", "s"), ("batch through Python", "python"), ("1,000 keys x 6 levels", "subdivision"),
+    ("subdivision linear", "subdivision"), ("bake", "bake"), ("key reduction", "criterion"),
+    ("Reduce Keys", "reduce"), ("<= 10 % of frames", "reduce"), ("Smooth Motion with Reduced", "reduce"),
+)
+TARGETS_NOTE = "<!-- targets: "
+
+
+def begin(name: str) -> str:
+    return f"<!-- {name}:begin -->"
+
+
+def end(name: str) -> str:
+    return f"<!-- {name}:end -->"
+
+
+def split_blocks(text: str) -> tuple[dict[str, str], dict[str, list[tuple[str, str, str]]]]:
+    """The blocks of an existing BENCHMARKS.md: ``{name: text between its markers (markers
+    included)}`` and ``{name: its target rows}``. A file without markers (written before
+    them) is split at its "## " headings and its targets table by label."""
+    blocks: dict[str, str] = {}
+    targets: dict[str, list[tuple[str, str, str]]] = {}
+    names = [name for name, _, _ in BLOCKS]
+    if any(begin(n) in text for n in names if n != "denoise"):
+        for name in names:
+            if begin(name) in text and end(name) in text:
+                i, j = text.index(begin(name)), text.index(end(name)) + len(end(name))
+                blocks[name] = text[i:j]
+                for line in blocks[name].splitlines():
+                    if line.startswith(TARGETS_NOTE):
+                        targets[name] = [tuple(r) for r in json.loads(line[len(TARGETS_NOTE):-len(" -->")])]
+        return blocks, targets
+    # Legacy: the denoise block has markers of its own; the rest goes by headings.
+    if begin("denoise") in text and end("denoise") in text:
+        i, j = text.index(begin("denoise")), text.index(end("denoise")) + len(end("denoise"))
+        blocks["denoise"] = text[i:j]
+        text = text[:i] + text[j:]
+    current, chunk = None, []
+    pieces: dict[str, list[str]] = {}
+    in_targets = False
+    for line in text.splitlines():
+        if line.startswith("## "):
+            in_targets = line.startswith("## Targets")
+            current = next((b for h, b in LEGACY_HEADINGS if line.startswith(h)), None)
+            chunk = pieces.setdefault(current, []) if current else []
+        if in_targets:
+            cells = [c.strip() for c in line.strip().strip("|").split("|")]
+            if line.startswith("| ") and len(cells) == 3 and cells[0] not in ("target", "---"):
+                block = next((b for prefix, b in LEGACY_TARGETS if cells[0].startswith(prefix)), "unknown")
+                targets.setdefault(block, []).append(tuple(cells))
+            continue
+        if current:
+            chunk.append(line)
+    for name, lines in pieces.items():
+        blocks[name] = "\n".join([begin(name)] + lines).rstrip() + "\n" + end(name)
+    return blocks, targets
+
+
+def parts_at_hand(run: Path, crit: dict) -> set[str]:
+    """The parts whose results are in the run folder (this run's or an earlier one's)."""
+    have = set()
+    if crit:
+        have.add("criterion")
+    if (run / "callgrind-n.txt").exists():
+        have.add("callgrind")
+    files = {"python": ("python.json", "blender.json"), "bake": ("bake.json", "bake.txt", "bake.missing"),
+             "sweep": ("sweep.json", "sweep.missing"), "reduce": ("reduce.json", "reduce.missing"),
+             "floor": ("floor.json", "floor.missing"), "denoise": ("denoise.md",)}
+    for part, names in files.items():
+        if any((run / n).exists() for n in names):
+            have.add(part)
+    return have
+
+
+def compose(rep: Report, only: set[str] | None, old_text: str | None, stamp: str | None = None) -> str:
+    """BENCHMARKS.md from the run in `rep`: every block (`only` None), or only the blocks that
+    show a part of `only`, the others kept from `old_text` as they are. A block that shows a
+    refreshed part and another part whose results are not at hand is kept too (and said)."""
+    old_blocks, old_targets = split_blocks(old_text) if old_text else ({}, {})
+    at_hand = parts_at_hand(rep.run, rep.crit)
+    texts: list[str] = []
+    targets: list[tuple[str, str, str]] = []
+    for name, parts, methods in BLOCKS:
+        fresh = only is None or bool(set(parts) & only)
+        if fresh and only is not None and not set(parts) - only <= at_hand:
+            missing = ", ".join(sorted(set(parts) - only - at_hand))
+            print(f"bench_report: kept the {name} block as it was: it also shows {missing}, whose results are not "
+                  f"in {rep.run} (refresh {missing} with it)")
+            fresh = False
+        if not fresh and name in old_blocks:
+            kept = old_targets.get(name, []) + (old_targets.get("unknown", []) if name == "machine" else [])
+            text = old_blocks[name]
+            if kept and TARGETS_NOTE not in text:  # a block from a file without markers: its rows go with it
+                text = text[:-len(end(name))] + TARGETS_NOTE + json.dumps([list(t) for t in kept]) + " -->\n" + end(name)
+            texts.append(text)
+            targets += kept
+            continue
+        if not fresh:
+            continue
+        rep.lines, rep.targets = [], []
+        for method in methods:
+            getattr(rep, method)()
+        body = "\n".join(rep.lines).rstrip()
+        if not body:
+            continue
+        lines = [begin(name), body]
+        if stamp and only is not None:
+            lines += ["", stamp]
+        if rep.targets:
+            lines.append(TARGETS_NOTE + json.dumps([list(t) for t in rep.targets]) + " -->")
+        texts.append("\n".join(lines + [end(name)]))
+        targets += rep.targets
+    head = ["# Benchmarks", "", "Written by `scripts/bench.sh` (rerun it to reproduce; about 18 minutes on 2 cores for "
+            "everything; `BENCH_ONLY=<part>[,<part>] scripts/bench.sh` refreshes only those parts' sections and "
+            "keeps the others). Every figure below was measured in one run unless marked as a figure from another "
+            "machine or as refreshed alone.", ""]
+    summary = ["## Targets", "", "| target | measured | |", "| --- | --- | --- |"]
+    summary += [f"| {a} | {b} | {c} |" for a, b, c in targets] + [""]
+    return "\n".join(head + summary + ["\n\n".join(texts)]).rstrip() + "\n"
 
 
 def main() -> None:
@@ -759,22 +1076,28 @@ def main() -> None:
     parser.add_argument("--criterion", type=Path, required=True)
     parser.add_argument("--criterion-reuse", type=Path, help="criterion results of the scaling rerun with memory reused")
     parser.add_argument("--out", type=Path, required=True)
+    parser.add_argument("--only", help="comma-separated parts (" + ", ".join(PARTS) + "): rewrite only the "
+                        "sections that show them, keep the rest of --out as it is")
     args = parser.parse_args()
+    only = None
+    if args.only:
+        only = {p.strip() for p in args.only.split(",") if p.strip()}
+        unknown = only - set(PARTS)
+        if unknown:
+            parser.error(f"unknown part(s) {', '.join(sorted(unknown))}; the parts: {', '.join(PARTS)}")
     reuse = read_criterion(args.criterion_reuse) if args.criterion_reuse and args.criterion_reuse.exists() else {}
-    rep = Report(args.run, read_criterion(args.criterion), reuse)
-    rep.machine()
-    rep.s_section()
-    rep.python_section()
-    rep.subdivision_section()
-    rep.bake_section()
-    rep.bones_section()
-    rep.other_criterion()
-    rep.limits_section()
-    rep.later_sections()
-    head = ["# Benchmarks", "", "Written by `scripts/bench.sh` (rerun it to reproduce; about 18 minutes on 2 cores). "
-            "Every figure below was measured in that one run unless marked as a figure from another machine.", ""]
-    args.out.write_text("\n".join(head + rep.summary() + rep.lines).rstrip() + "\n")
-    print(f"bench_report: wrote {args.out}")
+    crit = read_criterion(args.criterion) if args.criterion.exists() else {}
+    rep = Report(args.run, crit, reuse)
+    old = args.out.read_text() if only is not None and args.out.exists() else None
+    stamp = None
+    if only is not None:
+        env = json.loads((args.run / "machine.json").read_text()) if (args.run / "machine.json").exists() else {}
+        date, _, quick = env.get("date", "an unknown date").partition(" (")
+        stamp = (f"_Refreshed alone (BENCH_ONLY={','.join(sorted(only))}): measured from "
+                 f"{date} UTC{' (' + quick if quick else ''}, load average {env.get('load_start', '?')} at its start; "
+                 "the other sections and the machine table are the last full run's._")
+    args.out.write_text(compose(rep, only, old, stamp))
+    print(f"bench_report: wrote {args.out}" + (f" (refreshed: {', '.join(sorted(only))})" if only else ""))
 
 
 if __name__ == "__main__":
