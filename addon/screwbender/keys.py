@@ -301,7 +301,18 @@ def _read(
             found[prop, fc.array_index] = fc
     if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    points = {key: _key_points(fc) for key, fc in found.items()}
+    columns = list(found)
+    # Every curve's keys read once (issue 27): packed for polyscrew's playback when it can play
+    # them (the key coordinates taken from there), else the key coordinates alone.
+    try:
+        packed, unsupported = curves.read([found[c] for c in columns], keys_only=True), None
+    except curves.UnsupportedCurve as err:
+        packed, unsupported = None, err
+    if packed is not None:
+        bounds = packed.offsets.tolist()
+        points = {c: packed.co[bounds[k] : bounds[k + 1]].astype(np.float64) for k, c in enumerate(columns)}
+    else:
+        points = {key: _key_points(fc) for key, fc in found.items()}
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
@@ -314,10 +325,10 @@ def _read(
     stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
-    columns = list(found)
     notes = []
     try:
-        packed = curves.read([found[c] for c in columns], keys_only=True)
+        if unsupported is not None:
+            raise unsupported
         source = intent.Source(
             packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )
