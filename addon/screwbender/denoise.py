@@ -417,6 +417,7 @@ def remove_noise(
             continue
         groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
     prepared, plans, notes, rerun = [], [], [], []
+    sharers: dict[tuple[int, str], list[str]] = {}
     for i, members in enumerate(groups.values()):
         first = members[0].obj
         current = first.animation_data.action
@@ -431,7 +432,14 @@ def remove_noise(
         shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         users = bake.users_of(current, identifier)
         done = []
+        # Owners of the same curves (linked duplicates sharing the action): read and smoothed
+        # once, their names reported with the first's (they get the result action too).
+        first_of: dict[tuple[str, str], owners.Owner] = {}
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
+            twin = first_of.get((owner.bone, owner.rotation_mode))
+            if twin is not None:
+                sharers.setdefault((twin.obj.as_pointer(), twin.bone), []).append(owner.name)
+                continue
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
                                              action=None if source is current else source, slot=slot,
@@ -441,6 +449,7 @@ def remove_noise(
                 continue
             # the curves of the original keys, to write them back on a rerun (a first run edits a copy of them)
             prepared.append((owner, motion, rows, held, by_owner.get(owner.bone, []) if source is not current else []))
+            first_of[owner.bone, owner.rotation_mode] = owner
             done.append(owner)
             if motion.kept:
                 notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
@@ -487,7 +496,7 @@ def remove_noise(
         notes.extend(data_notes(c))
     return Denoised(
         actions=actions,
-        owners=[c.owner.name for c in parts],
+        owners=[name for key, c in cleaned.items() for name in (c.owner.name, *sharers.get(key, []))],
         skipped=skipped,
         notes=notes,
         strengths=[(c.rotation_strength, c.translation_strength) for c in parts],
