@@ -89,6 +89,9 @@ def selected_frames(
             co = np.empty(2 * len(points), dtype=np.float32)
             bulk.get(points, "co", co)
             at = co[0::2]
+        if len(at) == len(frames) and np.array_equal(at, frames):  # keyed on every frame: a capture
+            chosen |= flags
+            continue
         index, hit = nearest_rows(frames, at[flags])
         chosen[index[hit]] = True
     return chosen
