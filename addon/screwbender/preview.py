@@ -280,23 +280,11 @@ def key_hash(
     frame: float | None = None,
     auto_key: bool = False,
     fcurves: list | None = None,
-) -> tuple[bytes, LiveKey | None]:
-    """:func:`key_state` without the keys read: the digest and the live key."""
-    digest, live, _ = key_state(owner, options, frame, auto_key, fcurves)
-    return digest, live
-
-
-def key_state(
-    owner: owners.Owner | bpy.types.Object,
-    options: PreviewOptions,
-    frame: float | None = None,
-    auto_key: bool = False,
-    fcurves: list | None = None,
     memo: dict | None = None,
 ) -> tuple[bytes, LiveKey | None, tuple[list, curves_.Packed] | None]:
     """A digest of everything :func:`keys.read` reads from `owner` (an object or a pose
-    bone), and of `options`; and the live key at `frame` (see :class:`LiveKey`), which enters
-    the digest too.
+    bone), and of `options`; the live key at `frame` (see :class:`LiveKey`), which enters
+    the digest too; and the keys read (below).
 
     Raw F-curve data of the transform channels (key coordinates, handles, interpolation,
     easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
@@ -501,10 +489,10 @@ class PreviewCache:
         with auto-keying on (`auto_key`), the preview shows the motion with the owner's
         current pose as the key at that frame. `fcurves`: the owner's own transform curves
         when the caller has grouped them (:func:`owners.curves_by_owner`). `memo`: the keys
-        read so far in this refresh (:func:`key_state`): each curve is read once.
+        read so far in this refresh (:func:`key_hash`): each curve is read once.
         """
         owner = owners.as_owner(owner)
-        digest, live, read = key_state(owner, options, frame, auto_key, fcurves, memo)
+        digest, live, read = key_hash(owner, options, frame, auto_key, fcurves, memo)
         key = cache_key(owner)
         entry = self.entries.get(key)
         if entry is not None and entry.digest == digest:
