@@ -47,8 +47,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import bench_report  # noqa: E402
 import demo_common  # noqa: E402
+
+import bench_report  # noqa: E402
 
 bake = demo_common.blender_with_addon()
 import bpy  # noqa: E402

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import platform
 import subprocess
@@ -214,7 +213,7 @@ def mocap_channels():
     """A walk cycle: per joint (Z, X, Y) rotations in degrees, the root position (metres)."""
     t = np.arange(N) / FPS
     w = 2 * np.pi * 0.9 * t  # one stride per 1.1 s
-    s, c = np.sin(w), np.cos(w)
+    s = np.sin(w)
     zero = np.zeros(N)
     rot = {name: np.stack([zero, zero, zero], -1) for name, _, _ in SKELETON}
 

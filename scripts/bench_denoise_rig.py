@@ -34,6 +34,7 @@ import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
+
 from bench_denoise import fcurves  # noqa: E402  (the same curve lookup and Graph Editor context)
 from bench_denoise import graph_context as _graph_context  # noqa: E402
 

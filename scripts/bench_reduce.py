@@ -247,7 +247,7 @@ def write_bvh(path: Path, n: int) -> None:
     t = np.arange(n) / 30.0
     columns = [20 * np.sin(0.4 * t), 95 + 3 * np.sin(3.0 * t), 60 * t]
     columns = [c + rng.normal(0, 0.02, n) for c in columns]  # 0.2 mm
-    for k, (name, _, _) in enumerate(BVH_JOINTS):
+    for k, (_name, _, _) in enumerate(BVH_JOINTS):
         for axis in range(3):
             amp = 25.0 if axis == 1 else 12.0
             f1, f2 = 0.7 + 0.13 * ((k + axis) % 7), 1.9 + 0.11 * ((2 * k + axis) % 5)
@@ -651,7 +651,7 @@ def main() -> None:
                 case["decimate"] = measure(clip, ref, distance, angle, elapsed)
                 case["decimate"]["margin"] = margin
             else:
-                for attempt in range(3):  # smaller margins while the whole clip misses it
+                for _attempt in range(3):  # smaller margins while the whole clip misses it
                     elapsed = decimate(clip, margin)
                     case["decimate"] = measure(clip, ref, distance, angle, elapsed)
                     case["decimate"]["margin"] = margin

@@ -11,6 +11,11 @@
 # .venv/pip-cache (SCREWBENDER_PIP_CACHE: another folder, e.g. a cache another clone filled).
 #
 #   scripts/bootstrap.sh           everything (the tests, the demo, the benchmarks)
+#   BLENDER_VERSIONS=5.0 scripts/bootstrap.sh
+#                                  the same with only the bpy wheels of the versions named (full
+#                                  or major.minor, space-separated; scripts/blender_matrix.sh
+#                                  reads it): what scripts/demo.sh installs (one Blender, about
+#                                  350 MB, not four, about 1.4 GB); scripts/test.sh installs all
 #   scripts/bootstrap.sh --build   only what building the extension needs (what
 #                                  scripts/build_extension.sh runs when it misses it): maturin and
 #                                  ziglang in .venv, and Blender's extension tool (blender_ext.py

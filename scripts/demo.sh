@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The ScrewBender demo, one command on a fresh machine:
-#   1. scripts/bootstrap.sh: .venv with numpy, pytest, maturin and the bpy wheels;
+#   1. scripts/bootstrap.sh with BLENDER_VERSIONS=5.0: .venv with numpy, maturin and the one
+#      bpy wheel the demo runs (Blender 5.0, about 350 MB), not the four scripts/test.sh needs;
 #   2. scripts/build_extension.sh: the polyscrew wheel and the installable extension .zip;
 #   3. every scripts/demo/NN_*.py in order, each a standalone script run with the Blender 5.0
 #      bpy wheel and `--out-dir out`:
@@ -17,7 +18,7 @@ update_docs=0
 for arg in "$@"; do
   case "$arg" in
     --update-docs) update_docs=1 ;;
-    -h|--help) sed -n '2,13p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,15p' "$0"; exit 0 ;;
     *) echo "demo: unknown option $arg (try --help)" >&2; exit 2 ;;
   esac
 done
@@ -26,10 +27,11 @@ cd "$root"
 start=$(date +%s)
 stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
 
-stage "bootstrap"
-scripts/bootstrap.sh
+demo_blender=5.0  # the Blender whose bpy wheel runs the demo (a row of scripts/blender_matrix.sh)
+stage "bootstrap (bpy $demo_blender only)"
+BLENDER_VERSIONS=$demo_blender scripts/bootstrap.sh
 py="$root/.venv/bin/python"
-bpy_dir="$root/.venv/bpy/5.0"
+bpy_dir="$root/.venv/bpy/$demo_blender"
 [ -d "$bpy_dir" ] || { echo "demo: $bpy_dir missing (scripts/bootstrap.sh installs it)" >&2; exit 1; }
 
 stage "build the extension"

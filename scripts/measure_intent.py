@@ -125,8 +125,6 @@ def hold_case(kind: str) -> dict:
         obj.keyframe_insert("location", frame=f)
         obj.keyframe_insert("rotation_euler", frame=f)
     if kind == "constant":
-        for fc in obj.animation_data.action.fcurves if hasattr(obj.animation_data.action, "fcurves") else []:
-            pass
         for fc in fcurves(obj):
             for kp in fc.keyframe_points:
                 if kp.co[0] == 10:

@@ -20,10 +20,9 @@ Run: PYTHONPATH=<polyscrew> .venv/bin/python scripts/measure_reduce.py
 import time
 
 import numpy as np
+import polyscrew
 from scipy.interpolate import CubicSpline
 from scipy.spatial.transform import Rotation
-
-import polyscrew
 
 FPS = 30.0
 MM = 1e-3

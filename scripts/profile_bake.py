@@ -36,7 +36,8 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_bake  # noqa: E402  (installs the built extension into a temporary Blender)
 
-import bpy  # noqa: E402
+# isort: split
+import bpy  # noqa: E402  (after bench_bake: it must install the extension first)
 
 bake = bench_bake.bake
 keys = importlib.import_module(bake.__name__.rsplit(".", 1)[0] + ".keys")

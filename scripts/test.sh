@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # The project's one test command: installs what it needs into .venv (scripts/bootstrap.sh),
-# then runs the Rust tests, builds the polyscrew wheel (release, once: abi3 for CPython 3.11
-# and later, manylinux_2_28 on Linux) and the extension zip from it, runs the Python tests of
-# the module, the packaging tests, and the Blender tests headless under every
-# Blender version of scripts/blender_matrix.sh (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
+# then the lint gates (cargo fmt --check, clippy -D warnings, ruff check: a failure stops the
+# run with one line saying which gate and how to fix it), runs the Rust tests, builds the
+# polyscrew wheel (release, once: abi3 for CPython 3.11 and later, manylinux_2_28 on Linux)
+# and the extension zip from it, runs the Python tests of the module, the packaging tests,
+# and the Blender tests headless under every Blender version of scripts/blender_matrix.sh
+# (4.2, 4.5, 5.0 on CPython 3.11; 5.2 on 3.13).
 # A version whose CPython or bpy is missing fails the run (it is never skipped).
 set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
@@ -23,6 +25,18 @@ stage "bootstrap"
 scripts/bootstrap.sh
 py="$root/.venv/bin/python"
 scripts/test_blender.sh --check  # fails now, not after 10 minutes, when a version cannot run
+
+# Lint gates: each failure fails the run with one line naming the gate and the fix.
+gate() { # gate NAME FIX COMMAND...: runs COMMAND; on failure prints what failed and how to fix it
+  local name=$1 fix=$2; shift 2
+  "$@" || { echo "test.sh: gate '$name' failed: $fix" >&2; exit 1; }
+}
+stage "lint gates (cargo fmt, clippy -D warnings, ruff)"
+gate "cargo fmt" "run \`cargo fmt --all\` and commit the result" cargo fmt --all --check
+gate "clippy" "fix the warnings above (or allow one with a comment saying why)" \
+  cargo clippy --workspace --all-targets --quiet -- -D warnings
+gate "ruff" "fix the findings above (\`.venv/bin/ruff check --fix\` sorts imports; rules: pyproject.toml [tool.ruff])" \
+  "$root/.venv/bin/ruff" check --quiet addon tests scripts python
 
 stage "cargo test (workspace)"
 cargo test --workspace --quiet

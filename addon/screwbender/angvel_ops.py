@@ -7,8 +7,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty
 
-from .angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
 from . import transaction
+from .angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
 from .keys import SmoothError
 
 

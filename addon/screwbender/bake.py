@@ -677,7 +677,7 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
         if owner.bone not in group.bones:
             group.bones.append(owner.bone)
     # Every object the action animates through that slot keeps sharing it, selected or not.
-    for (pointer, identifier), group in groups.items():
+    for (_pointer, identifier), group in groups.items():
         for obj in users_of(group.objects[0].animation_data.action, identifier):
             if obj not in group.objects:
                 group.objects.append(obj)

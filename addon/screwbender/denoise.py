@@ -34,7 +34,6 @@ import polyscrew
 from . import bake, bulk, channels, denoise_data, feature, keys, owners, transaction
 from .keys import SmoothError
 
-
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).
 MIN_KEYS = 4
 

@@ -344,7 +344,7 @@ def write(fcurve: bpy.types.FCurve, join: Join, frames: np.ndarray, values: np.n
     table = _concat(parts)
     points = fcurve.keyframe_points
     points.add(len(table["co"]))
-    for name, dtype, width in _FIELDS:
+    for name, dtype, _width in _FIELDS:
         data = table[name]
         bulk.put(points, name, data.ravel() if dtype == np.float32 else tuple(data.tolist()))
 

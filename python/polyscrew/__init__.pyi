@@ -53,7 +53,8 @@ estimates beside the peaks measured for the largest uses (all below 160 MB).
 The module releases the GIL while it reads its input, computes and builds its output.
 """
 
-from typing import Literal, TypedDict, overload
+from collections.abc import Mapping, Sequence
+from typing import Any, Literal, TypedDict, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -475,9 +476,6 @@ def sample_feature(
     """
 
 # --- Blender's F-curve evaluation, issue 17 --------------------------------------------------
-
-from collections.abc import Mapping, Sequence
-from typing import Any
 
 InterpolationName = Literal[
     "CONSTANT", "LINEAR", "BEZIER", "SINE", "QUAD", "CUBIC", "QUART", "QUINT", "EXPO", "CIRC",

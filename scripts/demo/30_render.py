@@ -15,9 +15,8 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import demo_common  # noqa: E402
-
 import bpy  # noqa: E402
+import demo_common  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Euler, Matrix, Vector  # noqa: E402
 

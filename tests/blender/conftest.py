@@ -22,6 +22,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(Path(__file__).resolve().parent))  # the helpers module beside this file
+sys.path.insert(0, str(ROOT / "tests" / "fixtures"))  # helpers shared with tests/python (spinning_top)
 
 
 def extension_zip() -> Path:

@@ -9,41 +9,15 @@ from __future__ import annotations
 import bpy
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
+
 from bake_helpers import curve_points, fcurves, key_poses, new_object, rigid, select_only
 from conftest import addon_module
-from scipy.spatial.transform import Rotation
+from spinning_top import top_omega, top_rotation, top_target
 
 FPS = 24
 N_KEYS = 20
 LAST = 96.0  # keys every 5 frames, 1..96 (3.96 s at 24 fps)
-SPIN, PRECESSION, TILT = 2 * np.pi, 2 * np.pi / 4, np.radians(20)
-WOBBLE, LOOPS = np.radians(12), -2.0
-
-
-def top_rotation(t):
-    t = np.atleast_1d(t)
-    return (
-        Rotation.from_euler("z", (PRECESSION * t)[:, None])
-        * Rotation.from_euler("x", TILT)
-        * Rotation.from_euler("z", (SPIN * t)[:, None])
-    )
-
-
-def top_omega(t):
-    t = np.atleast_1d(t)
-    axis = (Rotation.from_euler("z", (PRECESSION * t)[:, None]) * Rotation.from_euler("x", TILT)).apply([0, 0, 1.0])
-    return PRECESSION * np.array([0, 0, 1.0]) + SPIN * axis
-
-
-def top_target(t):
-    w = top_omega(t)
-    speed = np.linalg.norm(w, axis=1, keepdims=True)
-    d = w / speed
-    u = np.cross([0, 0, 1.0], d)
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    v = np.cross(d, u)
-    phi = (2 * np.pi * LOOPS * np.atleast_1d(t))[:, None]
-    return speed * (np.cos(WOBBLE) * d + np.sin(WOBBLE) * (np.cos(phi) * u + np.sin(phi) * v))
 
 
 def angles_deg(a, b):

@@ -18,11 +18,11 @@ import bpy
 import numpy as np
 import polyscrew
 import pytest
-from conftest import addon_module
 from scipy.spatial.transform import Rotation
 
 import bake_helpers as h
 from bone_helpers import armature, bone_key_matrices, key_bone, random_poses, select_bones, world_pose
+from conftest import addon_module
 
 FRAMES = [1.0, 6.0, 14.0, 20.0, 33.0]
 CHAIN = ("Upper", "Fore", "Hand")

@@ -15,13 +15,13 @@ import bpy
 import numpy as np
 import polyscrew
 import pytest
-from conftest import addon_module
 from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 from scipy.spatial.transform import Rotation
 
 import bake_helpers as h
 from bone_helpers import armature, key_bone, random_poses
+from conftest import addon_module
 
 CUBE_V = [(x, y, z) for z in (-0.2, 0.2) for y in (-0.3, 0.3) for x in (-0.1, 0.1)]
 CUBE_F = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]

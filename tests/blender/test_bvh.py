@@ -21,9 +21,9 @@ import re
 import bpy
 import numpy as np
 import polyscrew
-from conftest import addon_module
 
 import bake_helpers as h
+from conftest import addon_module
 
 #: (name, parent, offset, channels): a small skeleton: hips (root, translated), spine, head,
 #: an arm of two bones, a leg of two bones.

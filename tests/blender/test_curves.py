@@ -19,6 +19,7 @@ import time
 import bpy
 import numpy as np
 import pytest
+
 from conftest import addon_module
 
 #: The agreement promised; the measured one is 0 (printed).

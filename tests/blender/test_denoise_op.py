@@ -3,7 +3,6 @@ sparse keys, Revert, undo, all or nothing; results compared with the known truth
 
 from __future__ import annotations
 
-import contextlib
 import math
 
 import bpy

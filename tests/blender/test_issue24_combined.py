@@ -374,7 +374,7 @@ def test_rerun_of_an_edited_result_with_modifiers_does_not_double_them(sb):
         now = {key: [properties(m) for m in fc.modifiers] for key, fc in curves_of(obj).items()}
         print(f"\nrun {run + 1}: modifiers per curve {[len(v) for v in now.values()]}")
         assert now == originals
-    for run in range(2):  # Smooth Result on, with a range: the result itself, twice
+    for _run in range(2):  # Smooth Result on, with a range: the result itself, twice
         assert bpy.ops.screwbender.smooth(smooth_result=True, range_mode="CUSTOM", frame_start=8, frame_end=25) == {"FINISHED"}
         now = {key: [properties(m) for m in fc.modifiers] for key, fc in curves_of(obj).items()}
         assert now == originals

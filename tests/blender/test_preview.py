@@ -15,9 +15,10 @@ import bpy
 import numpy as np
 import polyscrew
 import pytest
+from scipy.spatial.transform import Rotation
+
 from bake_helpers import baked_matrices, channel, fcurves, key_poses, new_object, rigid, select_only, snapshot_action
 from conftest import ADDON, addon_module
-from scipy.spatial.transform import Rotation
 
 FRAMES = [1.0, 7.0, 20.0, 26.0, 41.0, 61.0]
 

@@ -401,7 +401,7 @@ def test_unkeyed_bone_channels_stay_unkeyed(capsys):
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     after = _keyed_paths(rig, prefix)
     got = []
-    for i, f in enumerate(frames):
+    for f in frames:
         bpy.context.scene.frame_set(f)
         got.append((tuple(pb.location), tuple(pb.rotation_euler)))
     with capsys.disabled():

@@ -7,9 +7,9 @@ from pathlib import Path
 
 import bpy
 import numpy as np
-from read_count import counting_reads, read_more_than_once
 
 from conftest import addon_module
+from read_count import counting_reads, read_more_than_once
 
 ADDON = Path(__file__).resolve().parents[2] / "addon" / "screwbender"
 

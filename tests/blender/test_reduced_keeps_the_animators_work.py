@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import bpy
 import numpy as np
-from test_range_and_grid import curves_of, difference, grid, keyed, played
 
 import bake_helpers as h
 from conftest import addon_module
+from test_range_and_grid import curves_of, difference, grid, keyed, played
 
 
 def test_reduced_with_a_narrower_range_keeps_the_keys_outside(sb):

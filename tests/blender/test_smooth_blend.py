@@ -94,7 +94,7 @@ def test_failures_exit_non_zero_with_one_line(demo_source, tmp_path, args, reaso
 
 
 def test_named_object_that_cannot_be_smoothed_fails(tmp_path):
-    obj = h.new_object("Still", "EMPTY")
+    h.new_object("Still", "EMPTY")
     source = tmp_path / "still.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(source))
     done = run(SCRIPT, source, "--objects", "Still", "--out", tmp_path / "never.blend")

@@ -17,7 +17,7 @@ import bpy
 import numpy as np
 import polyscrew
 import pytest
-from mathutils import Matrix, Vector
+from mathutils import Vector
 from mathutils.bvhtree import BVHTree
 
 import bake_helpers as h

@@ -50,6 +50,38 @@ def report(call):
     return out
 """
 
+#: Child code: `need(call)`, the bytes `call` says it would need, read from its refusal with a
+#: memory budget of 0 (what `test_limits.py` and `test_bad_input_memory.py` measure against).
+NEED = r"""
+import re
+UNITS = {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9, "TB": 1e12, "PB": 1e15, "EB": 1e18}
+
+def need(call):
+    '''The bytes `call` says it would need, from its refusal with a budget of 0.'''
+    old = ps.set_memory_budget(0)
+    try:
+        call()
+    except ValueError as e:
+        m = re.search(r"would need ([0-9.]+) (B|kB|MB|GB|TB|PB|EB), over the memory budget", str(e))
+        assert m, str(e)
+        return float(m.group(1)) * UNITS[m.group(2)]
+    finally:
+        ps.set_memory_budget(old)
+    raise AssertionError("not refused with a budget of 0")
+"""
+
+#: Child code: `keys(n, seed)`, n rigid keys turning about z along a noisy line.
+KEYS = r"""
+def keys(n, seed=0):
+    rng = np.random.default_rng(seed)
+    out = np.tile(np.eye(4), (n, 1, 1))
+    a = rng.uniform(0, 2, n)
+    out[:, 0, 0] = out[:, 1, 1] = np.cos(a)
+    out[:, 0, 1], out[:, 1, 0] = -np.sin(a), np.sin(a)
+    out[:, :3, 3] = rng.normal(size=(n, 3)) + np.arange(n)[:, None]
+    return out
+"""
+
 
 def run_capped(code: str, timeout: float = 600) -> list[dict]:
     """Runs `code` after the prelude in a capped child; returns its `report` lines. Fails

@@ -1,9 +1,14 @@
 """Shared helpers for the polyscrew tests: random rigid poses and an independent screw."""
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 from pytransform3d import rotations as pr
 from pytransform3d import transformations as pt
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "fixtures"))  # helpers shared with tests/blender
 
 
 def rigid(axis, angle, translation):

@@ -51,11 +51,10 @@ GROUPS = [
 def worker(group: int, seed: int, examples: int) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (CAP, CAP))
     import numpy as np
+    import polyscrew as ps
     from hypothesis import HealthCheck, Phase, given, settings
     from hypothesis import seed as hypothesis_seed
     from hypothesis import strategies as st
-
-    import polyscrew as ps
 
     counts: dict[str, int] = {}
 

@@ -1,18 +1,14 @@
 """polyscrew.fit_angular_velocity (Xie et al. 2011) through Python, checked independently:
 orientations and angular velocities against scipy's Rotation (finite differences of the
-returned quaternions), the spinning top of the paper's figure 3 built here from scratch."""
+returned quaternions), the spinning top of the paper's figure 3 (tests/fixtures/spinning_top.py)."""
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
 
-import polyscrew
+from spinning_top import top_omega, top_rotation, top_target
 
-SPIN = 2 * np.pi  # rad/s about the top's axis
-PRECESSION = 2 * np.pi / 4  # rad/s about world z
-TILT = np.radians(20)
-WOBBLE = np.radians(12)  # angular radius of the sketched loops
-LOOPS = -2.0  # loops per second, drawn against the spin
 DURATION = 4.0
 
 
@@ -29,35 +25,6 @@ def rot(q_wxyz):
 def angle_between_rotations(a, b):
     """Angles (rad) of the rotations taking a to b."""
     return (rot(b) * rot(a).inv()).magnitude()
-
-
-def top_rotation(t):
-    t = np.atleast_1d(t)
-    return (
-        Rotation.from_euler("z", (PRECESSION * t)[:, None])
-        * Rotation.from_euler("x", TILT)
-        * Rotation.from_euler("z", (SPIN * t)[:, None])
-    )
-
-
-def top_omega(t):
-    t = np.atleast_1d(t)
-    axis = (Rotation.from_euler("z", (PRECESSION * t)[:, None]) * Rotation.from_euler("x", TILT)).apply(
-        [0.0, 0.0, 1.0]
-    )
-    return PRECESSION * np.array([0.0, 0.0, 1.0]) + SPIN * axis
-
-
-def top_target(t):
-    """The sketch: the original direction moved onto small loops around it, same speed."""
-    w = top_omega(t)
-    speed = np.linalg.norm(w, axis=1, keepdims=True)
-    d = w / speed
-    u = np.cross([0.0, 0.0, 1.0], d)
-    u /= np.linalg.norm(u, axis=1, keepdims=True)
-    v = np.cross(d, u)
-    phi = (2 * np.pi * LOOPS * np.atleast_1d(t))[:, None]
-    return speed * (np.cos(WOBBLE) * d + np.sin(WOBBLE) * (np.cos(phi) * u + np.sin(phi) * v))
 
 
 def finite_difference_omega(fit, times, h=1e-5):

@@ -2,10 +2,10 @@
 the paper's subdivision formulas, the linear masks, and the smoothness of figure 3."""
 
 import numpy as np
-import pytest
-from conftest import random_pose, reference_s, rigid
-
 import polyscrew
+import pytest
+
+from conftest import random_pose, reference_s, rigid
 
 SCHEMES = ("four_point", "bspline", "jarek")
 
@@ -127,7 +127,7 @@ def jumps(points, levels):
     h = 2.0 ** -levels
     d1 = (np.roll(points, -1, axis=0) - points) / h
     d2 = (np.roll(d1, -1, axis=0) - d1) / h
-    jump = lambda d: np.linalg.norm(np.roll(d, -1, axis=0) - d, axis=1).max()
+    jump = lambda d: np.linalg.norm(np.roll(d, -1, axis=0) - d, axis=1).max()  # noqa: E731
     return jump(d1), jump(d2)
 
 

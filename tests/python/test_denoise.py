@@ -12,11 +12,10 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.linalg import expm
 from scipy.spatial.transform import Rotation
-
-import polyscrew
 
 from conftest import random_pose
 

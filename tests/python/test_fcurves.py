@@ -14,10 +14,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.optimize import brentq
-
-import polyscrew
 
 F32 = np.finfo(np.float32).eps
 CODE = {name: i for i, name in enumerate(polyscrew.INTERPOLATIONS)}

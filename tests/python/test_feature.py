@@ -3,10 +3,10 @@ registration against scipy, the variational scheme's linear systems and limits, 
 frame invariance, smoothness, the paper's pose count, sampling and every bad input."""
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
 
-import polyscrew
 from conftest import random_pose, rigid
 
 INF = float("inf")

@@ -13,10 +13,9 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
-
-import polyscrew
 
 CODE = {name: i for i, name in enumerate(polyscrew.INTERPOLATIONS)}
 EASE = {name: i for i, name in enumerate(polyscrew.EASINGS)}

@@ -13,24 +13,9 @@ from __future__ import annotations
 
 import pytest
 
-from capped import run_capped
+from capped import KEYS, NEED, run_capped
 
-HELPERS = r"""
-import re
-UNITS = {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9, "TB": 1e12, "PB": 1e15, "EB": 1e18}
-
-def need(call):
-    '''The bytes `call` would need, from its refusal with a budget of 0.'''
-    old = ps.set_memory_budget(0)
-    try:
-        call()
-    except ValueError as e:
-        m = re.search(r"would need ([0-9.]+) (B|kB|MB|GB|TB|PB|EB), over the memory budget", str(e))
-        assert m, str(e)
-        return float(m.group(1)) * UNITS[m.group(2)]
-    finally:
-        ps.set_memory_budget(old)
-    raise AssertionError("not refused with a budget of 0")
+HELPERS = NEED + KEYS + r"""
 
 def limits(make, s1, s2):
     '''Sizes just under (98 %) and just over (103 %) the largest that the budget accepts.'''
@@ -39,15 +24,6 @@ def limits(make, s1, s2):
     largest = (ps.memory_budget() - (n1 - slope * s1)) / slope
     print(json.dumps({"largest": largest}))
     return int(largest * 0.98), int(largest * 1.03) + 1
-
-def keys(n, seed=0):
-    rng = np.random.default_rng(seed)
-    out = np.tile(np.eye(4), (n, 1, 1))
-    a = rng.uniform(0, 2, n)
-    out[:, 0, 0] = out[:, 1, 1] = np.cos(a)
-    out[:, 0, 1], out[:, 1, 0] = -np.sin(a), np.sin(a)
-    out[:, :3, 3] = rng.normal(size=(n, 3)) + np.arange(n)[:, None]
-    return out
 
 def at_limits(make, s1, s2):
     ok, over = limits(make, s1, s2)

@@ -16,10 +16,9 @@ import inspect
 from pathlib import Path
 
 import numpy as np
+import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
-
-import polyscrew
 
 from conftest import reference_s
 

@@ -13,11 +13,11 @@ from __future__ import annotations
 import time
 
 import numpy as np
+import polyscrew
 import pytest
 
-import polyscrew
 from conftest import rigid
-from raster import View, depth_image, fibonacci_directions, instances_depth_image, instances_depth_images
+from raster import View, depth_image, fibonacci_directions, instances_depth_images
 
 INSTANCES = 2000
 VIEWS = 20

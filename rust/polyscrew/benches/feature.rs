@@ -1,5 +1,5 @@
-//! Criterion benchmarks of feature-point motion design (Hofer-Pottmann-Ravani `004_*`,
-//! Table 1: 6 closed keys, 7 levels, 768 poses; their Matlab took 0.16 s + 0.55 s = 0.71 s)
+//! Criterion benchmarks of feature-point motion design (Hofer-Pottmann-Ravani, *From curve
+//! design algorithms to the design of rigid body motions*, Table 1: 6 closed keys, 7 levels, 768 poses; their Matlab took 0.16 s + 0.55 s = 0.71 s)
 //! against screw subdivision (Jarek) of the same keys, in the same run.
 //!
 //! Group `hofer_table1`: the four cases of the paper's Table 1 (m = 7 subdivision steps), with

@@ -1,4 +1,4 @@
-//! Angular-velocity editing (Xie, Xu, Yu, Weng, *Sketch-based rotation editing*, `002_*`
+//! Angular-velocity editing (Xie, Xu, Yu, Weng, *Sketch-based rotation editing*,
 //! section 2): a Hermite quaternion spline through key orientations is refitted so that its
 //! angular velocity `omega = 2 q' q^-1` follows a sketched target, with chosen keys held
 //! exactly and variable frames inserted where the fit stays poor.

@@ -1,5 +1,5 @@
 //! The six inertia points of a point cloud and the four-point affine shortcut
-//! (Hofer-Pottmann-Ravani, `004_*` sections 2.1 and 4.3).
+//! (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, sections 2.1 and 4.3).
 //!
 //! Registration of a cloud `X` to an affine image `A X + a` depends only on the barycentre
 //! `xbar` and the inertia tensor `J = sum_k x'_k x'_k^T` of `X` (Proposition 2), and the six

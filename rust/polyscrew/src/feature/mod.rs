@@ -1,5 +1,5 @@
 //! Motion design from feature points (Hofer-Pottmann-Ravani, *From curve design algorithms
-//! to the design of rigid body motions*, `004_*`): run a curve scheme on the homologous
+//! to the design of rigid body motions*): run a curve scheme on the homologous
 //! positions of a body's feature points (section 3), then register the rigid body to the
 //! distorted points at every sample (Horn's quaternion method, section 2).
 //!

@@ -1,5 +1,5 @@
-//! Motion design from feature points (Hofer-Pottmann-Ravani, `004_*` sections 3 and 4.3):
-//! run a curve scheme on the homologous positions of feature points of the key poses, then
+//! Motion design from feature points (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*,
+//! sections 3 and 4.3): run a curve scheme on the homologous positions of feature points of the key poses, then
 //! register the rigid body to the distorted points at every output sample.
 //!
 //! ```text
@@ -72,7 +72,7 @@ pub enum CurveScheme {
     /// Jarek on points: approximating, C2.
     Jarek,
     /// Kobbelt's variational subdivision: interpolating, or approximating with per-key
-    /// springs; uniform or centripetal; C2 (`004_*` section 4).
+    /// springs; uniform or centripetal; C2 (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, section 4).
     #[default]
     Variational,
 }

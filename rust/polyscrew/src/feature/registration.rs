@@ -1,5 +1,5 @@
 //! Registration with known correspondences: the rigid motion that brings one point cloud
-//! closest to another in the least-squares sense (Hofer-Pottmann-Ravani, `004_*` section 2,
+//! closest to another in the least-squares sense (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, section 2,
 //! after Horn 1987, "Closed-form solution of absolute orientation using unit quaternions").
 //!
 //! Minimise `sum_k w_k |R x_k + t - y_k|^2` over rotations `R` and translations `t`:
@@ -25,7 +25,7 @@
 //! For a unit quaternion `q`, `q^T N q = sum_k w_k y'_k . (R(q) x'_k)`, so the largest
 //! eigenvector maximises the correlation. When the largest eigenvalue is repeated the
 //! minimiser is not unique (collinear points, or a distorted cloud on the "medial axis" of
-//! the rigid motions, `004_*` section 3.3.2); then [`register`] returns an error rather than
+//! the rigid motions, Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, section 3.3.2); then [`register`] returns an error rather than
 //! an arbitrary rotation.
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(gap > tol)` also rejects NaN
@@ -55,7 +55,7 @@ fn power_of_two_scale(big: f64) -> f64 {
 }
 
 /// Weighted barycentre and cross-covariance `S = sum_k w_k x'_k y'_k^T` of two clouds
-/// (`004_*` eqs. 3-6), up to a positive power-of-two factor. `S` is returned with
+/// (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, eqs. 3-6), up to a positive power-of-two factor. `S` is returned with
 /// `S.col(b)[a] = S_ab`, so `S ~ sum w x' y'^T` as a glam matrix.
 ///
 /// The weights are scaled by a power of two to at most 1 and the centred points to below 1

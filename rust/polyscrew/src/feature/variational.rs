@@ -1,5 +1,5 @@
 //! Kobbelt's variational subdivision of polygons, interpolating and approximating, uniform
-//! and non-uniform (Hofer-Pottmann-Ravani, `004_*` sections 4.1-4.2, after Kobbelt 1996 and
+//! and non-uniform (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, sections 4.1-4.2, after Kobbelt 1996 and
 //! Kobbelt-Schroeder 1998).
 //!
 //! One level refines `v_0..v_{n-1}` into `w_0..w_{M-1}` (`M = 2n - 1` open, `2n` closed):

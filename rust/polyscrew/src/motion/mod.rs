@@ -3,8 +3,8 @@
 //! rotation channels.
 //!
 //! Sources: Rossignac-Kim, *Computing and visualizing pose-interpolating 3D motions*
-//! (`003_*`, "Screw motions": the minimal-angle screw `M` with `L1 = M L0` and
-//! `s(L0, t, L1) = M^t L0`); Powell-Rossignac, *ScrewBender* (`000_*` section 4, formulation
+//! (section "Screw motions": the minimal-angle screw `M` with `L1 = M L0` and
+//! `s(L0, t, L1) = M^t L0`); Powell-Rossignac, *ScrewBender: Smoothing Piecewise Helical Motions* (section 4, formulation
 //! A: the 4-point, cubic B-spline and Jarek Split&Tweak rules; section 1: the timing map).
 //!
 //! [`pose`] validates rigid poses, [`screw`] computes screws and `s`, [`subdivision`] refines

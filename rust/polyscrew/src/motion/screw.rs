@@ -1,6 +1,6 @@
 //! The screw between two poses and `s(a, t, b)`, the motion along it.
 //!
-//! Rossignac-Kim (`003_*`, "Screw motions"): for poses `L0`, `L1` there is a unique
+//! Rossignac-Kim (*Computing and visualizing pose-interpolating 3D motions*, section "Screw motions"): for poses `L0`, `L1` there is a unique
 //! minimal-angle screw `M` with `L1 = M L0`: a rotation by `r` in `[0, pi]` about an axis of
 //! unit direction `S` through a point `P`, plus a slide `d` along `S`. Then
 //! `s(L0, t, L1) = M^t L0` for any real `t` (`t = 0` gives `L0`, `t = 1` gives `L1`, outside

@@ -1,4 +1,4 @@
-//! Split&Tweak subdivision of polyscrews (ScrewBender, `000_*` section 4, formulation A),
+//! Split&Tweak subdivision of polyscrews (Powell-Rossignac, *ScrewBender: Smoothing Piecewise Helical Motions*, section 4, formulation A),
 //! and of polygons by the same code: the rules only need `s(a, t, b)`.
 //!
 //! With `s` the screw interpolation (or the straight line for points):

@@ -1,5 +1,5 @@
 //! Symmetric positive definite systems with half-bandwidth 2, optionally cyclic (the
-//! variational subdivision systems of `004_*` eqs. 23, 24, 26-27 and their closed and
+//! variational subdivision systems of Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, eqs. 23, 24, 26-27 and their closed and
 //! non-uniform versions).
 //!
 //! Open: a band Cholesky `H = L L^T` in `O(n)`. Cyclic: the last `b = 2` unknowns form a

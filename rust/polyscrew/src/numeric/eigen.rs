@@ -1,7 +1,7 @@
 //! Eigenvalues and eigenvectors of small symmetric matrices by cyclic Jacobi rotations.
 //!
 //! Registration needs the eigenvector of the largest eigenvalue of Horn's symmetric 4x4
-//! matrix (Hofer-Pottmann-Ravani, `004_*` section 2), and the inertia points need the
+//! matrix (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, section 2), and the inertia points need the
 //! principal axes of a 3x3 inertia tensor (section 2.1, eq. 10). Jacobi's method is the
 //! sturdy choice for such sizes: every rotation is orthogonal, so the eigenvectors come out
 //! orthonormal to rounding and the eigenvalues accurate to about `eps ||A||`, whatever their

@@ -5,7 +5,7 @@
 //! four `f64` lanes for batches (it depends on `fastmath`, not the other way round);
 //! [`eigen`] is Jacobi's method for small symmetric matrices (registration, inertia points);
 //! [`banded`] and [`cyclic_band`] solve the banded systems of spline fits and of variational
-//! subdivision (`004_*` eqs. 23-27).
+//! subdivision (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, eqs. 23-27).
 
 pub(crate) mod banded;
 pub(crate) mod cyclic_band;

@@ -2,7 +2,7 @@
 //! with unit face normals and edge adjacency (which faces meet at each edge, and whether the
 //! edge is convex, flat or concave).
 //!
-//! Rossignac-Kim (`003_*`, "Computing the characteristic curves and silhouette edges"):
+//! Rossignac-Kim (*Computing and visualizing pose-interpolating 3D motions*, section "Computing the characteristic curves and silhouette edges"):
 //! only convex edges can be silhouette edges; concave edges are not processed; a
 //! non-manifold edge may be split into pseudo-manifold edges. Here an edge with one face
 //! (the border of an open mesh) or with more than two faces or two faces of inconsistent

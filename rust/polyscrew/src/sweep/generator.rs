@@ -1,7 +1,7 @@
 //! The generator of a screw sweep: the grazing points of the body's boundary, where the
 //! velocity is tangent to the surface, as line segments in the body frame.
 //!
-//! Rossignac-Kim (`003_*`, "Swept volumes" and "Computing the characteristic curves and
+//! Rossignac-Kim (*Computing and visualizing pose-interpolating 3D motions*, sections "Swept volumes" and "Computing the characteristic curves and
 //! silhouette edges"): during a screw the velocity of a body point is constant in the body
 //! frame,
 //!

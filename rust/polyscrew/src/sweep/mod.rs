@@ -1,7 +1,7 @@
 //! The region swept by a triangle mesh moving along a polyscrew, as one indexed triangle
 //! mesh whose depth image from outside equals that of the union of all the body's instances.
 //!
-//! Rossignac-Kim (`003_*`, "Swept volumes" and "Sweeping and animating moving objects"):
+//! Rossignac-Kim (*Computing and visualizing pose-interpolating 3D motions*, sections "Swept volumes" and "Sweeping and animating moving objects"):
 //! instead of the boundary of the swept region `S(W, A, B)` display the superset
 //! `b(W@A) u b(W@B) u E(W, A, B)`, where the extrusion surface `E` is the sweep of a
 //! time-independent generator `G` (the grazing points, see [`generator`]) along the screw.

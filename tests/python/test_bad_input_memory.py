@@ -1,32 +1,316 @@
-"""Issue 28, hardening round 2: every byte an argument costs is in the budget, numpy's own
-errors come out named, estimates hold, time limits where memory does not bound the work,
-large `previous` angles, and the unnamed error.
+"""Huge input is refused before anything is reserved, and what is accepted stays within the
+memory the module says it needs (issue 15's promise: bad or huge input is a clear error,
+never an abort, a panic or a frozen Blender; issue 28: every byte an argument costs is in
+the budget, estimates hold, time limits where memory does not bound the work).
 
-Every reproducer runs in its own child process under a 4 GB address-space cap
-(`capped.run_capped`), which must exit normally. The child measures the growth of its peak
-resident memory over the call: it resets the peak (`/proc/self/clear_refs`), reads its
-resident size, runs the call and reads the peak (`VmHWM`). Each test prints the figures it
-measures.
+- The issue-15 reproducers (huge levels, fragments, steps, times) are refused with a clear
+  message; the budget is settable and restored.
+- Arguments that are not float64 are costed before numpy converts them; numpy's own
+  MemoryError comes out named; the F-curve evaluation counts its Bezier segments; sequences
+  (`held`, `constrained`, `channels`, `extrapolation`, `cycles`) are refused when too long
+  before anything is reserved for them (`range(2**62)`); a broadcast stiffness is expanded
+  only after the budget's check.
+- Calls whose work memory does not bound (`analyse_spans`, `rotation_channels`) have caps.
+- The peak memory measured stays within the estimate the module checks.
+
+Every huge request runs in its own child process under a 4 GB address-space cap
+(`capped.run_capped`), which must exit normally. Where the peak is measured the child resets
+it (`/proc/self/clear_refs`), reads its resident size, runs the call and reads the peak
+(`VmHWM`). Each test prints the figures it measures. The per-function tests at the
+documented limits are in `test_limits.py`, the fuzz suite in `fuzz.py`.
 """
 
 from __future__ import annotations
 
-
-import json  # noqa: F401  (the helpers print JSON in the child)
+import inspect
+import re
 
 import numpy as np
+import polyscrew
 import pytest
 
-import polyscrew
-from capped import run_capped
+from capped import KEYS, NEED, run_capped
+from fcurve_args import curve
+
+EYE2 = "np.tile(np.eye(4), (2, 1, 1))"
+
+
+# Child code: a UV sphere of `seg` segments x `rings` rings, and `n` poses along a tumbling helix.
+UV_SPHERE_AND_HELIX = """
+def uv_sphere(seg, rings):
+    th = np.pi * np.arange(1, rings) / rings
+    ph = 2 * np.pi * np.arange(seg) / seg
+    v = [[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]]
+    v = np.array(v, float)
+    idx = lambda r, s: 1 + r * seg + s % seg
+    t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
+    for r in range(rings - 2):
+        for s in range(seg):
+            t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
+    t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
+    return v, np.array(t)
+
+def helix_poses(n):
+    def pose(i):
+        a = 0.05 * i
+        c, s = np.cos(a), np.sin(a)
+        return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
+    return np.stack([pose(i) for i in range(n)])
+"""
+
+# A UV sphere of 40 segments x 20 rings: 1,520 triangles; 100 poses along a tumbling helix.
+SPHERE_AND_MOTION = UV_SPHERE_AND_HELIX + """
+v, t = uv_sphere(40, 20)
+assert len(t) == 1520
+poses = helix_poses(100)
+"""
+
+
+# (name, code run under the cap, expected exception type or None for a finite result,
+#  regex the message must match)
+REPRODUCERS = [
+    (
+        "fit, fragment_duration=1e-15 (asked for 32 PB)",
+        "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.zeros((2,3)), fragment_duration=1e-15))",
+        "ValueError",
+        r"fit_angular_velocity: fragment_duration: 1e-15 cuts the key range .* into 1e15 fragments, more than 1000000: use at least 1e-6",
+    ),
+    (
+        "subdivide 100,000 keys x 12 levels (22.9 GB)",
+        "report(lambda: ps.subdivide(np.tile(np.eye(4), (100000, 1, 1)), levels=12))",
+        "ValueError",
+        r"subdivide: the subdivided poses would need 86.8 GB, over the memory budget of 1.07 GB: use fewer levels or fewer keys",
+    ),
+    (
+        "fit, fragment_duration=1e-300 (capacity overflow panic)",
+        "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.zeros((2,3)), fragment_duration=1e-300))",
+        "ValueError",
+        r"fragment_duration: 1e-300 cuts .* more than 1000000",
+    ),
+    (
+        "rotation_channels of 1e8 broadcast rotations",
+        "report(lambda: ps.rotation_channels(np.broadcast_to(np.eye(3), (10**8, 3, 3)), 'XYZ'))",
+        "ValueError",
+        r"rotation_channels: the rotation channels would need 5.60 GB, over the memory budget .*convert fewer rotations",
+    ),
+    (
+        "sample at 1e8 times",
+        f"report(lambda: ps.sample({EYE2}, [0., 1], np.zeros(10**8)))",
+        "ValueError",
+        r"sample: the sampled poses would need 19.2 GB, over the memory budget .*sample fewer times",
+    ),
+    (
+        "interpolate at 1e8 t",
+        "report(lambda: ps.interpolate(np.eye(4), np.eye(4), np.broadcast_to(0.5, (10**8,))))",
+        "ValueError",
+        r"interpolate: the interpolated poses would need 19.2 GB, over the memory budget .*fewer t",
+    ),
+    (
+        "sample_channels at 1e8 times",
+        f"report(lambda: ps.sample_channels({EYE2}, [0., 1], np.broadcast_to(0.0, (10**8,)), 'XYZ'))",
+        "ValueError",
+        r"sample_channels: the sampled channels would need .* GB, over the memory budget",
+    ),
+    (
+        "sample_vectors at 1e8 times",
+        "report(lambda: ps.sample_vectors(np.eye(3)[:2], [0., 1], np.broadcast_to(0.0, (10**8,))))",
+        "ValueError",
+        r"sample_vectors: the sampled vectors would need .* GB, over the memory budget",
+    ),
+    (
+        "sample_feature at 1e8 times",
+        f"report(lambda: ps.sample_feature({EYE2}, [0., 1], np.broadcast_to(0.0, (10**8,)), levels=2))",
+        "ValueError",
+        r"sample_feature: the sampled feature-point motion would need .* GB, over the memory budget",
+    ),
+    (
+        "sweep of a 1,520-triangle sphere over 100 poses, steps=4096",
+        SPHERE_AND_MOTION + "report(lambda: ps.sweep(v, t, poses, steps=4096))",
+        "ValueError",
+        r"sweep: the swept mesh would need .* GB, over the memory budget .*fewer steps, fewer poses or a coarser mesh",
+    ),
+    (
+        "sample of a closed motion at +-1e308 (index out of bounds panic)",
+        f"report(lambda: ps.sample({EYE2}, [-1e308, -9e307], [1e308], closed=True))",
+        "ValueError",
+        r"sample: key time 0 \(-1e308\) is outside the working range \+-1e300",
+    ),
+    (
+        "fit with times +-1e308 (index out of bounds panic)",
+        "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [-1e308, 1e308], [-1e308, 1e308], np.zeros((2, 3))))",
+        "ValueError",
+        r"fit_angular_velocity: (target|key) time 0 \(-1e308\) is outside the working range \+-1e30",
+    ),
+    (
+        "subdivide_vectors of +-1e308 (NaN)",
+        "report(lambda: ps.subdivide_vectors([[1e308,0,0], [-1e308,0,0], [0,0,0]]))",
+        "ValueError",
+        r"subdivide_vectors: values: vector 0 \(1e308\) is outside the working range \+-1e150",
+    ),
+    (
+        "subdivide with translations near 1e308 (NaN)",
+        "k = np.tile(np.eye(4), (3, 1, 1)); k[:, 0, 3] = [1e308, -1e308, 5e307]\n"
+        "report(lambda: ps.subdivide(k))",
+        "ValueError",
+        r"subdivide: poses: pose 0: translation 1e308 is outside the working range \+-1e150",
+    ),
+    (
+        "sample with translations near 1e308 (NaN)",
+        "k = np.tile(np.eye(4), (3, 1, 1)); k[:, 1, 3] = [0, 1.7e308, -1.7e308]\n"
+        "report(lambda: ps.sample(k, [0., 1, 2], [0.5, 1.5]))",
+        "ValueError",
+        r"sample: poses: pose 1: translation 1.7e308 is outside the working range",
+    ),
+    (
+        "fit with a target of 1e160 rad/s ('converged' with NaN energy)",
+        "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.full((2, 3), 1e160)))",
+        "ValueError",
+        r"fit_angular_velocity: target angular velocity 0 \(1e160\) is outside the working range \+-1e30",
+    ),
+    (
+        "screw of a 1e155 translation (axis z, slide 0)",
+        "report(lambda: ps.screw(np.eye(4), np.eye(4) + np.eye(4, k=3)*1e155))",
+        "ValueError",
+        r"screw: b: translation 1e155 is outside the working range \+-1e150",
+    ),
+    (
+        "levels=2**63 (OverflowError)",
+        f"report(lambda: ps.subdivide({EYE2}, levels=2**63))",
+        "ValueError",
+        r"subdivide: levels 9223372036854775808 out of range 0\.\.=12",
+    ),
+    (
+        "steps=2**63 (OverflowError)",
+        "report(lambda: ps.sweep(np.eye(3), [[0, 1, 2]], np.tile(np.eye(4), (2, 1, 1)), steps=2**63))",
+        "ValueError",
+        r"sweep: steps 9223372036854775808 out of range 1\.\.=4096",
+    ),
+    (
+        "max_iterations=-1 (OverflowError)",
+        "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.zeros((2,3)), max_iterations=-1))",
+        "ValueError",
+        r"fit_angular_velocity: max_iterations -1 out of range 1\.\.=1000000",
+    ),
+    (
+        "float triangle indices (2.7 truncated)",
+        "report(lambda: ps.sweep(np.eye(3), [[0, 1, 2.7]], np.tile(np.eye(4), (2, 1, 1))))",
+        "ValueError",
+        r"sweep: triangles: entry \[0, 2\] is 2.7, not an integer",
+    ),
+    (
+        "complex input (imaginary part discarded)",
+        "report(lambda: ps.interpolate(np.eye(4) + 0j, np.eye(4), 0.5))",
+        "TypeError",
+        r"interpolate: a: expected real numbers, got complex128",
+    ),
+]
+
+
+@pytest.mark.parametrize("name, code, error, message", REPRODUCERS, ids=[r[0] for r in REPRODUCERS])
+def test_reproducer_is_refused_with_a_clear_message(name, code, error, message):
+    (outcome,) = run_capped(code)
+    assert outcome.get("error") == error, (name, outcome)
+    assert re.search(message, outcome["message"]), (name, outcome["message"])
+
+
+def test_memory_budget_is_settable_and_restored():
+    assert polyscrew.memory_budget() == polyscrew.DEFAULT_MEMORY_BUDGET == 1 << 30
+    keys = np.tile(np.eye(4), (3, 1, 1))
+    old = polyscrew.set_memory_budget(10_000)
+    try:
+        assert old == polyscrew.DEFAULT_MEMORY_BUDGET
+        assert polyscrew.memory_budget() == 10_000
+        # 3 keys read (168 bytes), two buffers of 65 and 33 poses (5,488), the (65, 4, 4)
+        # array (8,320).
+        with pytest.raises(ValueError, match=r"subdivide: the subdivided poses would need 14.0 kB, over the memory budget of 10.0 kB: use fewer levels or fewer keys"):
+            polyscrew.subdivide(keys, levels=5)
+        assert polyscrew.subdivide(keys, levels=4).shape == (33, 4, 4)
+    finally:
+        polyscrew.set_memory_budget(old)
+    assert polyscrew.subdivide(keys, levels=5).shape == (65, 4, 4)
+
+
+CURVE = "\n" + inspect.getsource(curve)  # the same helper in the capped children
+
+
+def test_fcurve_evaluation_counts_its_bezier_segments_against_the_budget():
+    """The check once counted the keys (40 bytes each) and the values only: a budget of
+    exactly that let the call allocate the prepared curves, Bezier segments, float32 times
+    and copies beyond it."""
+    k, t = 1000, 1000
+    times = np.linspace(0.0, k - 1, t)
+    keys_and_values = 40 * k + 8 * t
+    old = polyscrew.set_memory_budget(keys_and_values)
+    try:
+        with pytest.raises(ValueError, match=r"evaluate_fcurves: the F-curve evaluation would need .*, over the memory budget of 48.0 kB"):
+            polyscrew.evaluate_fcurves(times, **curve(k))
+        with pytest.raises(ValueError, match=r"Playback: the F-curve evaluation would need .*, over the memory budget"):
+            polyscrew.Playback(channels=[("location", 0)], unkeyed=np.zeros(9), mode="XYZ", **curve(k))
+    finally:
+        polyscrew.set_memory_budget(old)
+    values = polyscrew.evaluate_fcurves(times, **curve(k))
+    assert values.shape == (1, t) and np.isfinite(values).all()
+
+
+HUGE = 2**40
+
+
+EYE = "np.eye(4)"
+
+
+# (name, code run under the cap, expected exception, regex its message must match)
+CAPPED = [
+    ("co of 2**31 broadcast keys", "report(lambda: ps.evaluate_fcurves([0.], **{**curve(), 'co': np.broadcast_to(0.0, (2**31, 2))}))",
+     "ValueError", r"evaluate_fcurves: keys: 2147483648 keys exceed the limit of 67108864"),
+    ("interpolation of 2**40 broadcast codes", f"report(lambda: ps.evaluate_fcurves([0.], **{{**curve(), 'interpolation': np.broadcast_to(np.int64(2), ({HUGE},))}}))",
+     "ValueError", r"evaluate_fcurves: the F-curve evaluation would need .* over the memory budget"),
+    ("interpolation of 2**40 broadcast whole floats", f"report(lambda: ps.evaluate_fcurves([0.], **{{**curve(), 'interpolation': np.broadcast_to(2.0, ({HUGE},))}}))",
+     "ValueError", r"evaluate_fcurves: interpolation: the integer conversion would need .* over the memory budget"),
+    ("offsets of 2**40 broadcast entries", f"report(lambda: ps.evaluate_fcurves([0.], **{{**curve(), 'offsets': np.broadcast_to(np.int64(0), ({HUGE},))}}))",
+     "ValueError", r"evaluate_fcurves: times: 1099511627775 curves x 1 times exceed the limit of 134217728 values"),
+    ("Playback offsets of 2**40 broadcast entries", f"report(lambda: ps.Playback(channels=[('location', 0)], unkeyed=np.zeros(9), mode='XYZ', **{{**curve(), 'offsets': np.broadcast_to(np.int64(0), ({HUGE},))}}))",
+     "ValueError", r"Playback: the F-curve evaluation would need .* over the memory budget"),
+    ("back of 2**40 broadcast values", f"report(lambda: ps.evaluate_fcurves([0.], **{{**curve(), 'back': np.broadcast_to(1.0, ({HUGE},))}}))",
+     "ValueError", r"evaluate_fcurves: the F-curve evaluation would need .* over the memory budget"),
+    ("Playback handle_left of 2**40 broadcast pairs", f"report(lambda: ps.Playback(channels=[('location', 0)], unkeyed=np.zeros(9), mode='XYZ', **{{**curve(), 'handle_left': np.broadcast_to(0.0, ({HUGE}, 2))}}))",
+     "ValueError", r"Playback: the F-curve evaluation would need .* over the memory budget"),
+    ("extrapolation=range(2**62)", "report(lambda: ps.evaluate_fcurves([0.], **curve(), extrapolation=range(2**62)))",
+     "ValueError", r"evaluate_fcurves: extrapolation: expected 1 entries, got 4611686018427387904"),
+    ("cycles=range(2**62)", "report(lambda: ps.evaluate_fcurves([0.], **curve(), cycles=range(2**62)))",
+     "ValueError", r"evaluate_fcurves: cycles: expected 1 entries, got 4611686018427387904"),
+    ("channels=range(2**62)", "report(lambda: ps.Playback(channels=range(2**62), unkeyed=np.zeros(9), mode='XYZ', **curve()))",
+     "ValueError", r"Playback: channels: expected at most 9 entries, got 4611686018427387904"),
+    ("held=range(2**62)", "report(lambda: ps.denoise(np.tile(np.eye(4), (8, 1, 1)), np.arange(8.), held=range(2**62)))",
+     "ValueError", r"denoise: held: expected at most 8 entries, got 4611686018427387904"),
+    ("held=[range(2**62)] * 8", "report(lambda: ps.denoise(np.tile(np.eye(4), (8, 1, 1)), np.arange(8.), held=[range(2**62)] * 8))",
+     "(ValueError|MemoryError)", r"denoise: held"),
+    ("held of 2**40 broadcast booleans", f"report(lambda: ps.denoise(np.tile(np.eye(4), (8, 1, 1)), np.arange(8.), held=np.broadcast_to(True, ({HUGE},))))",
+     "ValueError", rf"denoise: held: expected at most 8 entries, got {HUGE}"),
+    ("constrained=range(2**62)", "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.zeros((2,3)), constrained=range(2**62)))",
+     "ValueError", r"fit_angular_velocity: constrained: expected at most 64 entries, got 4611686018427387904"),
+    ("stiffness 1.0 of 2**40 broadcast keys", f"report(lambda: ps.feature_motion(np.broadcast_to({EYE}, ({HUGE}, 4, 4)), stiffness=1.0))",
+     "ValueError", r"feature_motion: the feature-point motion would need .* over the memory budget"),
+    ("stiffness array(1.0) of 2**40 broadcast keys", f"report(lambda: ps.feature_motion(np.broadcast_to({EYE}, ({HUGE}, 4, 4)), levels=0, stiffness=np.array(1.0)))",
+     "ValueError", r"feature_motion: the feature-point motion would need .* over the memory budget"),
+    ("sample_feature stiffness 1.0 of 2**40 broadcast keys", f"report(lambda: ps.sample_feature(np.broadcast_to({EYE}, ({HUGE}, 4, 4)), [0., 1], [0.5], stiffness=1.0))",
+     "ValueError", r"sample_feature: the sampled feature-point motion would need .* over the memory budget"),
+]
+
+
+@pytest.mark.parametrize("name, code, error, message", CAPPED, ids=[c[0] for c in CAPPED])
+def test_huge_arguments_are_refused_before_anything_is_reserved(name, code, error, message):
+    (outcome,) = run_capped(CURVE + code)
+    assert re.fullmatch(error, outcome.get("error", "")), (name, outcome)
+    assert re.search(message, outcome["message"]), (name, outcome["message"])
+
 
 MB = 1 << 20
 
+
 # Helpers run in the capped child: the peak growth of one call, and the estimate of a call
 # (what it says it would need, refused with a budget of 0).
-PEAK = r"""
-import re, time
-UNITS = {"B": 1, "kB": 1e3, "MB": 1e6, "GB": 1e9, "TB": 1e12, "PB": 1e15, "EB": 1e18}
+PEAK = NEED + r"""
+import time
 K2 = np.tile(np.eye(4), (2, 1, 1))
 
 def _status(key):
@@ -42,19 +326,6 @@ def peak_of(call):
     cpu = time.process_time() - start
     print(json.dumps({"growth": _status("VmHWM") - before, "cpu": cpu}), flush=True)
     return out
-
-def need(call):
-    '''The bytes `call` says it would need, from its refusal with a budget of 0.'''
-    old = ps.set_memory_budget(0)
-    try:
-        call()
-    except ValueError as e:
-        m = re.search(r"would need ([0-9.]+) (B|kB|MB|GB|TB|PB|EB), over the memory budget", str(e))
-        assert m, str(e)
-        return float(m.group(1)) * UNITS[m.group(2)]
-    finally:
-        ps.set_memory_budget(old)
-    raise AssertionError("not refused with a budget of 0")
 
 def curve(k=3):
     co = np.c_[np.arange(k, dtype=float), np.arange(k) % 7]
@@ -78,6 +349,7 @@ def f32(shape) -> str:
 
 
 BUDGET = "(or raise the budget with set_memory_budget)"
+
 
 # --- 1. every byte an argument costs is in the budget ------------------------------------
 # (name, the call, its exact message). Each argument is not float64 (float32, bool, int32)
@@ -168,57 +440,6 @@ peak_of(lambda: ps.rotation_matrices({f32('(300_000_000, 3)')}, 'XYZ'))
     assert sample_peak["growth"] < 16 * MB and matrices_peak["growth"] < 16 * MB
 
 
-class Raises:
-    """An array-like whose conversion raises `error`."""
-
-    def __init__(self, error: BaseException):
-        self.error = error
-
-    def __array__(self, *args, **kwargs):
-        raise self.error
-
-
-@pytest.mark.parametrize(
-    "error, expected",
-    [
-        (RuntimeError("boom"), ValueError),
-        (KeyError("k"), ValueError),
-        (MemoryError("no room"), MemoryError),
-        (TypeError("not here"), TypeError),
-        (ValueError("bad"), ValueError),
-    ],
-)
-def test_any_exception_while_reading_is_named(error, expected):
-    with pytest.raises(expected) as info:
-        polyscrew.sample(np.tile(np.eye(4), (2, 1, 1)), [0.0, 1.0], Raises(error))
-    assert type(info.value) is expected
-    assert str(info.value) == f"sample: times: {error}"
-    assert info.value.__cause__ is not None
-
-
-def test_ragged_and_complex_input_are_still_named():
-    with pytest.raises(ValueError, match=r"^sample: times: setting an array element with a sequence"):
-        polyscrew.sample(np.tile(np.eye(4), (2, 1, 1)), [0.0, 1.0], [0.0, [1.0, 2.0]])
-    with pytest.raises(TypeError, match=r"^sample: times: expected real numbers, got complex128$"):
-        polyscrew.sample(np.tile(np.eye(4), (2, 1, 1)), [0.0, 1.0], np.zeros(3, complex))
-
-
-def test_keyboard_interrupt_passes_unchanged():
-    with pytest.raises(KeyboardInterrupt):
-        polyscrew.sample(np.tile(np.eye(4), (2, 1, 1)), [0.0, 1.0], Raises(KeyboardInterrupt()))
-
-
-# --- the unnamed error ---------------------------------------------------------------------
-
-def test_a_cycles_setting_that_is_not_a_str_is_named():
-    co = np.c_[np.arange(3.0), np.arange(3.0)]
-    curve = dict(offsets=[0, 3], co=co, handle_left=co - [0.3, 0], handle_right=co + [0.3, 0],
-                 interpolation=np.full(3, 2), easing=np.zeros(3, dtype=np.int64))
-    with pytest.raises(TypeError) as info:
-        polyscrew.evaluate_fcurves([0.0], **curve, cycles=[{1: "x"}])
-    assert str(info.value) == "evaluate_fcurves: cycles[0]: setting names must be str, got int"
-
-
 # --- 6. time limits where memory does not bound the work ---------------------------------
 
 SPINS = r"""
@@ -289,92 +510,9 @@ peak_of(lambda: ps.rotation_channels(r, 'XYZ'))
     assert at_cap_peak["cpu"] < 8.0
 
 
-# --- 7. large previous angles --------------------------------------------------------------
-
-RZ90 = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
-
-
-@pytest.mark.parametrize(
-    "call, message",
-    [
-        (lambda: polyscrew.rotation_channels(RZ90[None], "XYZ", previous=[0, 0, 1e17]),
-         "rotation_channels: previous value 2 (1e17) is outside the working range +-1e9"),
-        (lambda: polyscrew.rotation_channels(RZ90[None], "ZYX", previous=[-1.5e9, 0, 0]),
-         "rotation_channels: previous value 0 (-1.5e9) is outside the working range +-1e9"),
-        (lambda: polyscrew.rotation_channels(RZ90[None], "AXIS_ANGLE", previous=[1e16, 0, 0, 1]),
-         "rotation_channels: previous value 0 (1e16) is outside the working range +-1e9"),
-        (lambda: polyscrew.sample_channels(np.tile(np.eye(4), (2, 1, 1)), [0.0, 1.0], [0.5], "XYZ", previous=[0, 0, 1e17]),
-         "sample_channels: previous value 2 (1e17) is outside the working range +-1e9"),
-    ],
-)
-def test_previous_angles_beyond_the_range_are_refused(call, message):
-    with pytest.raises(ValueError) as info:
-        call()
-    assert str(info.value) == message
-
-
-EULER = ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"]
-PREVIOUS = [1e9, -1e9, 999_999_999.5, 123_456_789.123, -7.7e8, 1e6 + 0.25, 3e4, -2.5]
-
-
-def euler_reference(values: np.ndarray, mode: str) -> np.ndarray:
-    """Blender's Euler matrices by scipy (extrinsic axes in the order of the mode's name;
-    numpy's sin and cos reduce large arguments exactly)."""
-    from scipy.spatial.transform import Rotation
-
-    order = mode.lower()
-    return Rotation.from_euler(order, values[:, ["xyz".index(a) for a in order]]).as_matrix()
-
-
-@pytest.mark.parametrize("mode", EULER)
-def test_euler_channels_are_correct_and_continued_for_every_previous_in_range(mode, rng):
-    rotations = [np.eye(3), RZ90]
-    from scipy.spatial.transform import Rotation
-
-    rotations += list(Rotation.random(6, random_state=rng).as_matrix())
-    worst = 0.0
-    for p in PREVIOUS:
-        previous = np.array([p, -p / 3, p / 7])
-        for r in rotations:
-            got = polyscrew.rotation_channels(r[None], mode, previous=previous)
-            assert np.all(np.abs(got[0] - previous) <= np.pi + 1e-6), (mode, p, got, previous)
-            err = np.abs(euler_reference(got, mode)[0] - r).max()
-            worst = max(worst, err)
-    print(f"\n{mode}: worst matrix error {worst:.2e} for previous up to 1e9")
-    assert worst < 1e-6
-
-
-def test_axis_angle_and_sampled_channels_are_correct_for_every_previous_in_range(rng):
-    from scipy.spatial.transform import Rotation
-
-    worst = 0.0
-    for p in PREVIOUS:
-        for r in Rotation.random(6, random_state=rng).as_matrix():
-            got = polyscrew.rotation_channels(r[None], "AXIS_ANGLE", previous=[p, 0, 0, 1])[0]
-            assert abs(got[0] - p) <= np.pi + 1e-6, (p, got)
-            err = np.abs(Rotation.from_rotvec(got[0] * got[1:]).as_matrix() - r).max()
-            worst = max(worst, err)
-        poses = np.tile(np.eye(4), (2, 1, 1))
-        poses[1, :3, :3] = RZ90
-        loc, rot = polyscrew.sample_channels(poses, [0.0, 1.0], [0.0, 0.5, 1.0], "XYZ", previous=[p, p, p])
-        want = polyscrew.sample(poses, [0.0, 1.0], [0.0, 0.5, 1.0])[:, :3, :3]
-        assert np.all(np.abs(rot - p) <= np.pi + 1e-6)
-        worst = max(worst, np.abs(euler_reference(rot, "XYZ") - want).max())
-    print(f"\nAXIS_ANGLE and sample_channels: worst matrix error {worst:.2e}")
-    assert worst < 1e-6
-
-
 # --- 4. estimates hold -------------------------------------------------------------------
 
-ESTIMATE_SETUP = r"""
-def keys(n, seed=0):
-    rng = np.random.default_rng(seed)
-    out = np.tile(np.eye(4), (n, 1, 1))
-    a = rng.uniform(0, 2, n)
-    out[:, 0, 0] = out[:, 1, 1] = np.cos(a)
-    out[:, 0, 1], out[:, 1, 0] = -np.sin(a), np.sin(a)
-    out[:, :3, 3] = rng.normal(size=(n, 3)) + np.arange(n)[:, None]
-    return out
+ESTIMATE_SETUP = KEYS + r"""
 
 def noisy(n, seed=0):
     rng = np.random.default_rng(seed)
@@ -391,7 +529,9 @@ def estimate_and_peak(call):
     peak_of(call)
 """
 
+
 FIT = "ps.fit_angular_velocity([[1.0, 0, 0, 0], [np.cos(0.5), 0, 0, np.sin(0.5)]], [0.0, 1.0], [0.0, 1.0], [[0, 0, 1.0]] * 2)"
+
 
 # name: (setup, the call); each large enough that a constant overhead does not matter
 ESTIMATES = {
@@ -442,23 +582,9 @@ def test_sweep_peak_memory_stays_within_its_stated_estimate():
     span: its stated estimate is the body's plus 48 bytes per output vertex and 36 per output
     triangle (the module documentation). A 20,480-triangle sphere over 64 screws."""
     lines = run_peak(
-        """
-seg, rings = 128, 81
-th = np.pi * np.arange(1, rings) / rings
-ph = 2 * np.pi * np.arange(seg) / seg
-v = np.array([[0, 0, 1]] + [[np.sin(a) * np.cos(b), np.sin(a) * np.sin(b), np.cos(a)] for a in th for b in ph] + [[0, 0, -1]], float)
-idx = lambda r, s: 1 + r * seg + s % seg
-t = [[0, idx(0, s), idx(0, s + 1)] for s in range(seg)]
-for r in range(rings - 2):
-    for s in range(seg):
-        t += [[idx(r, s), idx(r + 1, s), idx(r + 1, s + 1)], [idx(r, s), idx(r + 1, s + 1), idx(r, s + 1)]]
-t += [[len(v) - 1, idx(rings - 2, s + 1), idx(rings - 2, s)] for s in range(seg)]
-t = np.array(t)
-def pose(i):
-    a = 0.05 * i
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0, 0.3 * i], [s, c, 0, np.sin(i)], [0, 0, 1, 0.1 * i], [0, 0, 0, 1.0]])
-poses = np.stack([pose(i) for i in range(65)])
+        UV_SPHERE_AND_HELIX + """
+v, t = uv_sphere(128, 81)
+poses = helix_poses(65)
 print(json.dumps({"triangles": len(t), "estimate": need(lambda: ps.sweep(v, t, poses, steps=8))}))
 out = peak_of(lambda: ps.sweep(v, t, poses, steps=8))
 print(json.dumps({"vertices": len(out[0]), "triangles": len(out[1])}))
