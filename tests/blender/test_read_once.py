@@ -12,11 +12,11 @@ import math
 
 import bpy
 import numpy as np
-from conftest import addon_module
-from read_count import counting_reads, read_more_than_once
 
 import bake_helpers as h
 from bone_helpers import armature, key_bone, random_poses, select_bones
+from conftest import addon_module
+from read_count import counting_reads, read_more_than_once
 
 FRAMES = 60
 
