@@ -69,8 +69,9 @@ class Cleaned:
     poses: np.ndarray
     #: The held keys among them.
     held: np.ndarray
-    #: The owner's curves holding the original keys (in the action Remove Noise starts from):
-    #: every key of the result is written from them (a rerun replaces the earlier result).
+    #: On a rerun, the owner's curves holding the original keys (in the action Remove Noise
+    #: starts from): every key of the result is written from them (a rerun replaces the earlier
+    #: result). Empty on a first run: the result is a copy of those keys, read once already.
     originals: list = field(default_factory=list)
     #: What polyscrew chose.
     rotation_strength: float = 0.0
@@ -113,10 +114,37 @@ def _points(fc, attr: str = "co") -> np.ndarray:
     return out.reshape(-1, 2)
 
 
-def selected_frames(owner: owners.Owner, fcurves: list, frames: np.ndarray) -> np.ndarray:
+def selected_frames(owner: owners.Owner, fcurves: list, frames: np.ndarray, known: dict | None = None) -> np.ndarray:
     """Per key frame of `frames`: whether a key is selected there on the owner's transform
-    curves."""
-    return feature.selected_frames(owner, fcurves, frames)
+    curves (`known`: their key frames already read, per `fc.as_pointer()`)."""
+    return feature.selected_frames(owner, fcurves, frames, known=known)
+
+
+def read_keys(motion: keys.KeyedMotion) -> dict[tuple[str, int], tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """The keys :func:`keys.read` read for `motion`, per (property, array index): co,
+    handle_left and handle_right, (K, 2) float32 each (views of its one read of each curve:
+    copy before changing them); empty when the curves could not be packed (then read again)."""
+    source = motion.source
+    if source is None:
+        return {}
+    packed = source.packed
+    bounds = packed.offsets.tolist()
+    return {
+        column: tuple(a[bounds[k] : bounds[k + 1]] for a in (packed.co, packed.handle_left, packed.handle_right))
+        for k, column in enumerate(source.columns)
+    }
+
+
+def _known_frames(owner: owners.Owner, fcurves: list, motion: keys.KeyedMotion) -> dict[int, np.ndarray]:
+    """The key frames of the curves among `fcurves` that :func:`keys.read` read for `motion`,
+    per `fc.as_pointer()`."""
+    read = read_keys(motion)
+    known = {}
+    for fc in fcurves:
+        points = read.get((owner.prop_of(fc.data_path), fc.array_index))
+        if points is not None and not fc.mute and len(points[0]) == len(fc.keyframe_points):
+            known[fc.as_pointer()] = points[0][:, 0]
+    return known
 
 
 def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.ndarray:
@@ -142,7 +170,9 @@ def prepare(
     refused = denoise_data.refusal(owner.name, motion.frames[rows], options.strength is None)
     if refused is not None:
         raise SmoothError(refused)
-    selected = selected_frames(owner, fcurves if shown is None else shown, motion.frames)[rows]
+    shown = fcurves if shown is None else shown
+    known = _known_frames(owner, shown, motion) if shown is fcurves else None  # (a rerun: the result shown)
+    selected = selected_frames(owner, shown, motion.frames, known)[rows]
     held = ~selected if selected.any() else np.zeros(len(rows), dtype=bool)
     if held.all():
         raise SmoothError(f"{owner.name}: every key in the frame range is unselected (held): nothing to smooth: skipped")
@@ -247,11 +277,31 @@ def _like_original(new: np.ndarray, original: np.ndarray, mode: str) -> np.ndarr
     return np.where(use_other[:, None], near[1], near[0])
 
 
+def _rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`nearest_rows`, at once when the keys `at` are the key frames `frames` themselves
+    (a curve keyed on every key frame: a capture)."""
+    if len(at) == len(frames) and np.array_equal(at, frames):
+        return np.arange(len(frames)), np.ones(len(frames), dtype=bool)
+    return nearest_rows(frames, at)
+
+
 def _original_rotation(motion: keys.KeyedMotion) -> np.ndarray:
     """The original rotation channel values at every key frame of `motion` (K, k)."""
     mode = motion.rotation_mode
     if motion.source is not None:
-        return np.asarray(motion.source.channels(motion.frames)[keys.rotation_path(mode)], dtype=np.float64)
+        path = keys.rotation_path(mode)
+        read, static = read_keys(motion), motion.source.static[path]
+        cycles = dict(zip(motion.source.columns, motion.source.packed.cycles))
+        out = np.empty((len(motion.frames), len(static)))
+        for i in range(len(static)):
+            points = read.get((path, i))
+            if points is None:
+                out[:, i] = static[i]  # unkeyed: its own value
+            elif cycles[path, i] is None and len(points[0]) == len(motion.frames) and np.array_equal(points[0][:, 0], motion.frames):
+                out[:, i] = points[0][:, 1]  # keyed on every key frame: Blender plays its key values there
+            else:
+                return np.asarray(motion.source.channels(motion.frames)[path], dtype=np.float64)
+        return out
     # Curves the add-on cannot evaluate: continuity from the first key's values.
     return polyscrew.rotation_channels(motion.poses, mode, previous=None if mode == "AXIS_ANGLE" else motion.first_rotation)
 
@@ -281,23 +331,33 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         values["location"] = location
     euler = mode not in ("QUATERNION", "AXIS_ANGLE")
     originals = {(fc.data_path, fc.array_index): fc for fc in cleaned.originals}
+    # What keys.read read (one foreach_get per property and curve): the original keys, and on
+    # a first run also those of the result's curves (a copy of them): nothing is read again.
+    read = read_keys(motion)
     for fc in fcurves:
         prop = owner.prop_of(fc.data_path)
         if fc.mute or prop not in values or fc.array_index >= values[prop].shape[1] or not len(fc.keyframe_points):
             continue
         points = fc.keyframe_points
-        co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
+        was = read.get((prop, fc.array_index))
+        if was is None or len(was[0]) != len(points):
+            was = None
+        if originals or was is None:  # a rerun: the result is a copy of an earlier result
+            co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
+        else:
+            co, left, right = (a.copy() for a in was)
         source = originals.get((fc.data_path, fc.array_index))
         if source is not None and source != fc and len(source.keyframe_points):
             # The original keys back (this curve is a copy of an earlier result).
-            was = _points(source)
-            order = np.argsort(was[:, 0], kind="stable")
-            index, hit = nearest_rows(was[order, 0], co[:, 0])
+            if was is None or len(was[0]) != len(source.keyframe_points):
+                was = (_points(source), _points(source, "handle_left"), _points(source, "handle_right"))
+            order = np.argsort(was[0][:, 0], kind="stable")
+            index, hit = nearest_rows(was[0][order, 0], co[:, 0])
             index = order[index[hit]]
-            co[hit, 1] = was[index, 1]
-            left[hit] = _points(source, "handle_left")[index]
-            right[hit] = _points(source, "handle_right")[index]
-        row, near = nearest_rows(motion.frames, co[:, 0])
+            co[hit, 1] = was[0][index, 1]
+            left[hit] = was[1][index]
+            right[hit] = was[2][index]
+        row, near = _rows(motion.frames, co[:, 0])
         edit = near & smoothed[row]
         target = values[prop][row[edit], fc.array_index]
         if euler and prop == path:  # within half a turn of the key's own original value
@@ -310,7 +370,9 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         bulk.put(points, "handle_left", left.ravel())
         bulk.put(points, "handle_right", right.ravel())
         fc.update()
-        _keep_handles_outside(fc, ~(near & in_range[row]), left, right)
+        outside = ~(near & in_range[row])
+        if outside.any():  # (else no handle can have changed outside the range)
+            _keep_handles_outside(fc, outside, left, right)
 
 
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
@@ -354,6 +416,7 @@ def remove_noise(
             continue
         groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
     prepared, plans, notes, rerun = [], [], [], []
+    sharers: dict[tuple[int, str], list[str]] = {}
     for i, members in enumerate(groups.values()):
         first = members[0].obj
         current = first.animation_data.action
@@ -368,7 +431,14 @@ def remove_noise(
         shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         users = bake.users_of(current, identifier)
         done = []
+        # Owners of the same curves (linked duplicates sharing the action): read and smoothed
+        # once, their names reported with the first's (they get the result action too).
+        first_of: dict[tuple[str, str], owners.Owner] = {}
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
+            twin = first_of.get((owner.bone, owner.rotation_mode))
+            if twin is not None:
+                sharers.setdefault((twin.obj.as_pointer(), twin.bone), []).append(owner.name)
+                continue
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
                                              action=None if source is current else source, slot=slot,
@@ -376,7 +446,9 @@ def remove_noise(
             except SmoothError as err:
                 skipped.append(str(err))
                 continue
-            prepared.append((owner, motion, rows, held, by_owner.get(owner.bone, [])))
+            # the curves of the original keys, to write them back on a rerun (a first run edits a copy of them)
+            prepared.append((owner, motion, rows, held, by_owner.get(owner.bone, []) if source is not current else []))
+            first_of[owner.bone, owner.rotation_mode] = owner
             done.append(owner)
             if motion.kept:
                 notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
@@ -423,7 +495,7 @@ def remove_noise(
         notes.extend(data_notes(c))
     return Denoised(
         actions=actions,
-        owners=[c.owner.name for c in parts],
+        owners=[name for key, c in cleaned.items() for name in (c.owner.name, *sharers.get(key, []))],
         skipped=skipped,
         notes=notes,
         strengths=[(c.rotation_strength, c.translation_strength) for c in parts],

@@ -63,11 +63,17 @@ def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def selected_frames(
-    owner: owners.Owner, fcurves: list, frames: np.ndarray, props: tuple[str, ...] | None = None, skip_muted: bool = False
+    owner: owners.Owner,
+    fcurves: list,
+    frames: np.ndarray,
+    props: tuple[str, ...] | None = None,
+    skip_muted: bool = False,
+    known: dict | None = None,
 ) -> np.ndarray:
     """Per key frame of `frames`: whether a key is selected there on the owner's curves among
     `fcurves` of the properties `props` (default: its transform properties), muted curves
-    left out with `skip_muted`. One foreach_get per curve, no loop over keys."""
+    left out with `skip_muted`. One foreach_get per curve, no loop over keys; `known`: the
+    key frames the caller has read already, per curve (`fc.as_pointer()`), not read again."""
     chosen = np.zeros(len(frames), dtype=bool)
     paths = set(keys.transform_paths(owner.rotation_mode) if props is None else props)
     for fc in fcurves:
@@ -78,9 +84,15 @@ def selected_frames(
         bulk.get(points, "select_control_point", flags)
         if not flags.any():
             continue
-        co = np.empty(2 * len(points), dtype=np.float32)
-        bulk.get(points, "co", co)
-        index, hit = nearest_rows(frames, co[0::2][flags])
+        at = None if known is None else known.get(fc.as_pointer())
+        if at is None:
+            co = np.empty(2 * len(points), dtype=np.float32)
+            bulk.get(points, "co", co)
+            at = co[0::2]
+        if len(at) == len(frames) and np.array_equal(at, frames):  # keyed on every frame: a capture
+            chosen |= flags
+            continue
+        index, hit = nearest_rows(frames, at[flags])
         chosen[index[hit]] = True
     return chosen
 

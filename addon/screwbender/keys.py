@@ -240,6 +240,7 @@ def read(
     fcurves: list | None = None,
     analyse: bool = True,
     turns: str = "AUTO",
+    packed: tuple[list, curves.Packed] | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -256,7 +257,9 @@ def read(
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
     scanning all its curves for each bone). `turns` is the option Turns (:data:`intent.TURNS`):
     which spans Blender's playback turns the long way round are followed (spins) and which
-    are taken the short way (flips, reported in `removed`).
+    are taken the short way (flips, reported in `removed`). `packed`: (curves, their keys) that
+    the caller has read with `curves.read(curves, keys_only=True)` already (the preview's key
+    hash): used, not read again, when `curves` are the transform curves read here.
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
     `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
@@ -264,7 +267,7 @@ def read(
     """
     owner = owners.as_owner(owner)
     try:
-        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns)
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, packed)
     except SmoothError:
         raise
     except ValueError as err:  # polyscrew refusing the curves or the key poses
@@ -280,6 +283,7 @@ def _read(
     fcurves: list | None,
     analyse: bool,
     turns: str = "AUTO",
+    given: tuple[list, curves.Packed] | None = None,
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner)
@@ -301,7 +305,22 @@ def _read(
             found[prop, fc.array_index] = fc
     if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    points = {key: _key_points(fc) for key, fc in found.items()}
+    columns = list(found)
+    # Every curve's keys read once (issue 27): packed for polyscrew's playback when it can play
+    # them (the key coordinates taken from there), else the key coordinates alone.
+    chosen = [found[c] for c in columns]
+    try:
+        if given is not None and [fc.as_pointer() for fc in given[0]] == [fc.as_pointer() for fc in chosen]:
+            packed, unsupported = given[1], None
+        else:
+            packed, unsupported = curves.read(chosen, keys_only=True), None
+    except curves.UnsupportedCurve as err:
+        packed, unsupported = None, err
+    if packed is not None:
+        bounds = packed.offsets.tolist()
+        points = {c: packed.co[bounds[k] : bounds[k + 1]].astype(np.float64) for k, c in enumerate(columns)}
+    else:
+        points = {key: _key_points(fc) for key, fc in found.items()}
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
@@ -314,10 +333,10 @@ def _read(
     stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
-    columns = list(found)
     notes = []
     try:
-        packed = curves.read([found[c] for c in columns], keys_only=True)
+        if unsupported is not None:
+            raise unsupported
         source = intent.Source(
             packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )

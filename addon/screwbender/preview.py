@@ -34,6 +34,7 @@ import bpy
 import numpy as np
 
 from . import bake, bulk, channels, feature, keys, owners
+from . import curves as curves_
 from .keys import SmoothError
 
 #: Default number of stroboscopic instances.
@@ -279,10 +280,11 @@ def key_hash(
     frame: float | None = None,
     auto_key: bool = False,
     fcurves: list | None = None,
-) -> tuple[bytes, LiveKey | None]:
+    memo: dict | None = None,
+) -> tuple[bytes, LiveKey | None, tuple[list, curves_.Packed] | None]:
     """A digest of everything :func:`keys.read` reads from `owner` (an object or a pose
-    bone), and of `options`; and the live key at `frame` (see :class:`LiveKey`), which enters
-    the digest too.
+    bone), and of `options`; the live key at `frame` (see :class:`LiveKey`), which enters
+    the digest too; and the keys read (below).
 
     Raw F-curve data of the transform channels (key coordinates, handles, interpolation,
     easing, extrapolation, mute, modifiers), the rotation mode, the values of unkeyed
@@ -293,6 +295,12 @@ def key_hash(
     on) and it differs from the curves there, so playing or scrubbing the timeline never
     recomputes anything. `fcurves`: the owner's curves when the caller has grouped them
     already (:func:`owners.curves_by_owner`), else the object's curves are searched.
+
+    The keys are read as :func:`keys.read` reads them (`curves.read`, one `foreach_get` per
+    property and curve) and returned with the digest, (curves, packed keys), for
+    :func:`keys.read` to use: a recomputed preview reads each curve once. `memo` (a dict kept
+    over one refresh) holds the keys read so far: owners sharing an action (linked duplicates)
+    read its curves once.
     """
     owner = owners.as_owner(owner)
     obj, target = owner.obj, owner.target
@@ -319,6 +327,7 @@ def key_hash(
     feature_method = options.smooth.method == "FEATURE"
     curves = {}
     at_key = False
+    listed = []
     for fc in channels.object_fcurves(obj) if fcurves is None else fcurves:
         if fc.data_path not in paths:
             continue
@@ -326,12 +335,36 @@ def key_hash(
         if prop == "location" and not located:
             continue  # a connected bone's location is not read
         curves[(prop, fc.array_index)] = fc
-        points = fc.keyframe_points
-        count = len(points)
+        listed.append(fc)
         digest.update(
-            f"|{fc.data_path}[{fc.array_index}]{count}{fc.mute}{fc.extrapolation}"
+            f"|{fc.data_path}[{fc.array_index}]{len(fc.keyframe_points)}{fc.mute}{fc.extrapolation}"
             f"{[(m.type, m.mute) for m in fc.modifiers]}".encode()
         )
+    # The curves keys.read reads (not muted, keyed), packed as it packs them.
+    played = [fc for fc in listed if not fc.mute and len(fc.keyframe_points)]
+    memo = {} if memo is None else memo
+    handle = tuple(fc.as_pointer() for fc in played)
+    if handle not in memo:
+        try:
+            memo[handle] = curves_.read(played, keys_only=True) if played else None
+        except curves_.UnsupportedCurve:
+            memo[handle] = None  # (keys.read reads them its own way; hashed below)
+    packed = memo[handle]
+    if packed is not None:
+        for name in ("offsets", "co", "handle_left", "handle_right", "interpolation", "easing", "back", "amplitude", "period"):
+            digest.update(np.ascontiguousarray(getattr(packed, name)).tobytes())
+        digest.update(f"{packed.cycles}".encode())
+        if frame is not None:
+            at_key = bool(np.any(np.abs(packed.co[:, 0] - frame) < keys.FRAME_TOLERANCE))
+    for fc in listed:
+        points = fc.keyframe_points
+        count = len(points)
+        if packed is not None and not fc.mute and count:
+            if feature_method and options.smooth.approximate:  # selected keys are approximated
+                flags = np.empty(count, dtype=bool)
+                bulk.get(points, "select_control_point", flags)
+                digest.update(flags.tobytes())
+            continue
         for attr, width, dtype in _KEY_ATTRS:
             buf = np.empty(width * count, dtype=dtype)
             bulk.get(points, attr, buf)
@@ -370,7 +403,7 @@ def key_hash(
     if changed:
         live = LiveKey(frame, current[props[0]], current[props[1]], current[props[2]])
         digest.update(np.concatenate([[frame], live.location, live.rotation, live.scale]).tobytes())
-    return digest.digest(), live
+    return digest.digest(), live, (None if packed is None else (played, packed))
 
 
 def with_live_key(motion: keys.KeyedMotion, live: LiveKey) -> keys.KeyedMotion:
@@ -447,6 +480,7 @@ class PreviewCache:
         frame: float | None = None,
         auto_key: bool = False,
         fcurves: list | None = None,
+        memo: dict | None = None,
     ) -> tuple[PreviewEntry, bool]:
         """The preview of `owner` (an object or a bone) and whether it was recomputed now
         (its hash changed).
@@ -454,10 +488,11 @@ class PreviewCache:
         `frame` is the current frame: when the owner is being moved there, at a key frame or
         with auto-keying on (`auto_key`), the preview shows the motion with the owner's
         current pose as the key at that frame. `fcurves`: the owner's own transform curves
-        when the caller has grouped them (:func:`owners.curves_by_owner`).
+        when the caller has grouped them (:func:`owners.curves_by_owner`). `memo`: the keys
+        read so far in this refresh (:func:`key_hash`): each curve is read once.
         """
         owner = owners.as_owner(owner)
-        digest, live = key_hash(owner, options, frame, auto_key, fcurves)
+        digest, live, read = key_hash(owner, options, frame, auto_key, fcurves, memo)
         key = cache_key(owner)
         entry = self.entries.get(key)
         if entry is not None and entry.digest == digest:
@@ -465,7 +500,8 @@ class PreviewCache:
         name = owner.name
         try:
             motion = keys.read(
-                owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves, turns=options.smooth.turns
+                owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves,
+                turns=options.smooth.turns, packed=read,
             )
             if live is not None:
                 motion = with_live_key(motion, live)

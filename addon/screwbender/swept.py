@@ -230,41 +230,52 @@ def carried_matrix(obj: bpy.types.Object, driver: BoneDriver | None) -> np.ndarr
     return rig @ deform @ np.linalg.inv(rig) @ world
 
 
-def _carrier_frames(driver: BoneDriver) -> list[float]:
+def _carrier_frames(driver: BoneDriver, read: dict | None = None) -> list[float]:
     """The key frames of the smoothed action of the bone's armature that move the bone: its
-    own transform curves, its parent bones' and the armature object's."""
+    own transform curves, its parent bones' and the armature object's (`read`: see
+    :func:`_key_frames`)."""
     rig = driver.armature
     chain, bone = {""}, rig.data.bones[driver.bone]
     while bone is not None:
         chain.add(bone.name)
         bone = bone.parent
     grouped = owners.curves_by_owner(channels.object_fcurves(rig))
-    return _key_frames([fc for key in chain for fc in grouped.get(key, [])])
+    return _key_frames([fc for key in chain for fc in grouped.get(key, [])], read)
 
 
-def _key_frames(fcurves: list) -> list[float]:
-    """The sorted distinct key frames (rounded to 1e-6) of `fcurves`: one foreach_get per curve."""
+def _key_frames(fcurves: list, read: dict | None = None) -> list[float]:
+    """The sorted distinct key frames (rounded to 1e-6) of `fcurves`: one foreach_get per curve.
+    `read` (a dict the caller keeps over one run, by `fc.as_pointer()`) holds the frames of
+    the curves read so far: meshes sharing an action or riding one rig read its curves once."""
     found = []
     for fc in fcurves:
-        co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
-        bulk.get(fc.keyframe_points, "co", co)
-        found.append(co[0::2])
+        frames = None if read is None else read.get(fc.as_pointer())
+        if frames is None:
+            co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
+            bulk.get(fc.keyframe_points, "co", co)
+            frames = co[0::2]
+            if read is not None:
+                read[fc.as_pointer()] = frames
+        found.append(frames)
     if not found:
         return []
     return np.unique(np.round(np.concatenate(found).astype(np.float64), 6)).tolist()
 
 
-def motion_frames(obj: bpy.types.Object, scene: bpy.types.Scene, driver: BoneDriver | None = None) -> np.ndarray:
+def motion_frames(
+    obj: bpy.types.Object, scene: bpy.types.Scene, driver: BoneDriver | None = None, read: dict | None = None
+) -> np.ndarray:
     """The frames to sample: the keys of the smoothed action (Smooth Motion bakes one key per
     step, subframes included) where there is one (for a mesh carried by a bone, the keys of
-    its armature's smoothed action moving that bone), else every frame of the scene's range."""
+    its armature's smoothed action moving that bone), else every frame of the scene's range.
+    `read`: the key frames read so far in this run (:func:`_key_frames`)."""
     if driver is not None:
         if bake.source_of(driver.armature) is not None:
-            frames = _carrier_frames(driver)
+            frames = _carrier_frames(driver, read)
             if len(frames) >= 2:
                 return np.asarray(frames, dtype=np.float64)
     elif bake.source_of(obj) is not None:
-        frames = _key_frames(channels.object_fcurves(obj))
+        frames = _key_frames(channels.object_fcurves(obj), read)
         if len(frames) >= 2:
             return np.asarray(frames, dtype=np.float64)
     return np.arange(scene.frame_start, scene.frame_end + 1, dtype=np.float64)
@@ -295,11 +306,17 @@ def world_poses(
 
 
 def compute(
-    obj: bpy.types.Object, context: bpy.types.Context, steps: int, caps: bool, tolerance: float | None = None
+    obj: bpy.types.Object,
+    context: bpy.types.Context,
+    steps: int,
+    caps: bool,
+    tolerance: float | None = None,
+    read: dict | None = None,
 ) -> Swept:
     """The swept mesh of `obj` along its world motion (nothing is created): each screw in the
     fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
-    bounding radius; 0: exactly `steps`)."""
+    bounding radius; 0: exactly `steps`). `read`: a dict kept over one run of several objects
+    (the key frames read so far: each curve is read once, :func:`_key_frames`)."""
     scene = context.scene
     if obj.type != "MESH":
         raise SweepError(f"{obj.name}: not a mesh object")
@@ -310,7 +327,7 @@ def compute(
         # bone carries, `C^-1 O v` (C: carried_matrix now, O: the mesh's world matrix).
         to_body = np.linalg.inv(carried_matrix(obj, driver)) @ np.array(obj.matrix_world, dtype=np.float64)
         verts = verts @ to_body[:3, :3].T + to_body[:3, 3]
-    frames = motion_frames(obj, scene, driver)
+    frames = motion_frames(obj, scene, driver, read)
     if len(frames) < 2:
         raise SweepError(f"{obj.name}: the frame range has a single frame; a motion needs two poses")
     poses, scale = world_poses(obj, scene, frames, driver)
@@ -408,6 +425,16 @@ def mesh_triangles(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray]:
     tris = np.empty(3 * len(mesh.loop_triangles), dtype=np.int64)
     bulk.get(mesh.loop_triangles, "vertices", tris)
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
+
+
+def created_triangles(swept: Swept, mesh: bpy.types.Mesh, remeshed: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Vertices (V, 3) and triangles (T, 3) of the mesh made from `swept` by
+    :func:`create_object`: what was written into it (float32, as the mesh holds it), not read
+    back; read (:func:`mesh_triangles`) when a voxel remesh made it (`remeshed`)."""
+    if remeshed:
+        return mesh_triangles(mesh)
+    vertices = np.ascontiguousarray(swept.vertices, dtype=np.float32).astype(np.float64)
+    return vertices, np.asarray(swept.triangles, dtype=np.int64)
 
 
 # --- clearance ----------------------------------------------------------------------------

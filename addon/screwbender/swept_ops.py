@@ -79,11 +79,12 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         start = time.perf_counter()
         try:
             tolerance = self.tolerance if self.tolerance > 0.0 else None
-            computed = [swept.compute(o, context, self.steps, self.caps, tolerance) for o in objects]
+            read: dict = {}  # each key curve read once, also when meshes share an action or a rig
+            computed = [swept.compute(o, context, self.steps, self.caps, tolerance, read) for o in objects]
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, self.closed, self.voxel_size, t) for s in computed]
                 # Area, volume (a closed result) and the tolerance met, on each new object.
-                found = [sweep_report.measures(*swept.mesh_triangles(o.data)) for o in created]
+                found = [sweep_report.measures(*swept.created_triangles(s, o.data, self.closed)) for s, o in zip(computed, created)]
                 for obj, s, m in zip(created, computed, found):
                     obj["screwbender_tolerance"] = s.tolerance
                     obj["screwbender_error_bound"] = s.error_bound
