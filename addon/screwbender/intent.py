@@ -197,7 +197,8 @@ def frame_runs(frames: np.ndarray, limit: int = 4) -> str:
         gaps = np.diff(frames)
         step = np.min(gaps) if len(gaps) else 1.0
         cut = np.flatnonzero(gaps > 1.5 * step) + 1
-        starts, ends = frames[np.r_[0, cut]], frames[np.r_[cut - 1, len(frames) - 1]]
+        starts = frames[np.concatenate(([0], cut))]
+        ends = frames[np.concatenate((cut - 1, [len(frames) - 1]))]
     words = [f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in zip(starts[:limit], ends[:limit])]
     more = f" and {len(starts) - limit} more" if len(starts) > limit else ""
     return ", ".join(words) + more

@@ -99,6 +99,8 @@ class KeyedMotion:
     #: F-curve modifiers copied onto the baked curves, per (property, index): every modifier
     #: of the source curve but a first Cycles one (:mod:`modifiers`).
     modifiers: dict = field(default_factory=dict)
+    #: (property, array index) of the curves the keys were read from (keyed, not muted).
+    keyed: frozenset = frozenset()
 
     @property
     def scale_keyed(self) -> bool:
@@ -240,6 +242,7 @@ def read(
     fcurves: list | None = None,
     analyse: bool = True,
     turns: str = "AUTO",
+    cache: dict | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -256,7 +259,9 @@ def read(
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
     scanning all its curves for each bone). `turns` is the option Turns (:data:`intent.TURNS`):
     which spans Blender's playback turns the long way round are followed (spins) and which
-    are taken the short way (flips, reported in `removed`).
+    are taken the short way (flips, reported in `removed`). `cache`, a dict the caller keeps
+    for one run, holds the keys read per set of curves: objects sharing an action (linked
+    duplicates) read its curves once.
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
     `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
@@ -264,7 +269,7 @@ def read(
     """
     owner = owners.as_owner(owner)
     try:
-        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns)
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, cache)
     except SmoothError:
         raise
     except ValueError as err:  # polyscrew refusing the curves or the key poses
@@ -280,6 +285,7 @@ def _read(
     fcurves: list | None,
     analyse: bool,
     turns: str = "AUTO",
+    cache: dict | None = None,
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner)
@@ -301,32 +307,50 @@ def _read(
             found[prop, fc.array_index] = fc
     if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    points = {key: _key_points(fc) for key, fc in found.items()}
+    # Each curve's keys are read once (issue 27): packed for Blender's playback, and the key
+    # frames and values taken from that; only curves it cannot play are read for their keys alone.
+    columns = list(found)
+    notes = []
+    read_key = tuple((key, fc.as_pointer()) for key, fc in found.items()) if cache is not None else None
+    if read_key is not None and read_key in cache:
+        packed, note, points = cache[read_key]
+    else:
+        note = None
+        try:
+            packed = curves.read([found[c] for c in columns], keys_only=True)
+        except curves.UnsupportedCurve as err:
+            packed = None
+            note = f"{err}: smoothed from the key values alone (spins, holds and easing not read)"
+            points = {key: _key_points(fc) for key, fc in found.items()}
+        else:
+            co, bounds = packed.co.astype(np.float64), packed.offsets.tolist()
+            points = {key: co[bounds[i] : bounds[i + 1]] for i, key in enumerate(columns)}
+        if read_key is not None:
+            cache[read_key] = (packed, note, points)
+    if note is not None:
+        notes.append(note)
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
     # F-curve modifiers: smoothing works on what the keys make, the modifiers are kept on top
     key_range = (float(frames[0]), float(frames[-1]))
-    for (prop, index), fc in found.items():
+    modified = {key: fc for key, fc in found.items() if len(fc.modifiers)}
+    for (prop, index), fc in modified.items():
         reason = modifiers.refusal(fc, key_range)
         if reason is not None:
             raise SmoothError(f"{name}: {owner.path(prop)}[{index}]: {reason}: skipped")
-    stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
+    stacked = {key: stack for key, stack in ((key, modifiers.kept(fc)) for key, fc in modified.items()) if stack}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
-    columns = list(found)
-    notes = []
-    try:
-        packed = curves.read([found[c] for c in columns], keys_only=True)
-        source = intent.Source(
-            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
-        )
-    except curves.UnsupportedCurve as err:
-        source = None
-        notes.append(f"{err}: smoothed from the key values alone (spins, holds and easing not read)")
-    except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
-        named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
-        raise SmoothError(f"{name}: {named}: skipped") from err
+    source = None
+    if packed is not None:
+        try:
+            source = intent.Source(
+                packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
+            )
+        except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
+            named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
+            raise SmoothError(f"{name}: {named}: skipped") from err
 
     def evaluate(path: str, size: int) -> np.ndarray:
         """The channels at the key frames (source-less: a loop over keys, not frames)."""
@@ -335,7 +359,7 @@ def _read(
             fc = found.get((path, i))
             if fc is None:
                 out[:, i] = statics[path][i]
-            elif len(fc.modifiers) == 0 and np.array_equal(points[path, i][:, 0], frames):
+            elif (path, i) not in modified and np.array_equal(points[path, i][:, 0], frames):
                 out[:, i] = points[path, i][:, 1]  # keyed on every key frame: its key values
             else:
                 out[:, i] = [fc.evaluate(f) for f in frames]
@@ -363,7 +387,7 @@ def _read(
 
     poses = compose(location, rotation_matrices(rotation, mode))
     modes = {}  # (property, index) -> Cycles modifier (mode_before, mode_after)
-    for key, fc in found.items():
+    for key, fc in modified.items():
         for modifier in fc.modifiers:
             if modifier.type == "CYCLES" and not modifier.mute:
                 modes[key] = (modifier.mode_before, modifier.mode_after)
@@ -409,10 +433,12 @@ def _read(
         held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
         followed = ~held & ((~flips & (mode != "QUATERNION")) if turns == "AUTO" else (turns == "BLENDER"))
         # Shortest: typed turns whose short screw turns less far than Blender's playback
-        relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
-        short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
-        longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
-        shortened = ~held & longer & ~flips & (turns == "SHORTEST")
+        shortened = np.zeros(len(held), dtype=bool)
+        if turns == "SHORTEST":
+            relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
+            short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+            longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
+            shortened = ~held & longer & ~flips
         spans = np.stack([frames[:-1], frames[1:]], axis=1)
         if bake_range is not None:  # an extended cycle: report the keys' own period once
             once = (spans[:, 0] >= bake_range[0]) & (spans[:, 0] < bake_range[1])
@@ -515,6 +541,7 @@ def _read(
         removed=removed,
         causes=causes,
         modifiers=stacked,
+        keyed=frozenset(found),
     )
 
 

@@ -68,7 +68,8 @@ pub fn departure(
     let located = playback.located();
     for start in (0..t).step_by(CHUNK) {
         let end = (start + CHUNK).min(t);
-        playback.channels_into(&frames[start..end], &mut rows)?;
+        // location and rotation only: the scale curves do not enter the departure
+        playback.pose_channels_into(&frames[start..end], &mut rows)?;
         for (j, row) in rows.chunks_exact(width).enumerate() {
             let i = start + j;
             if located {
