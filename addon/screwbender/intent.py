@@ -199,7 +199,7 @@ def frame_runs(frames: np.ndarray, limit: int = 4) -> str:
         cut = np.flatnonzero(gaps > 1.5 * step) + 1
         starts = frames[np.concatenate(([0], cut))]
         ends = frames[np.concatenate((cut - 1, [len(frames) - 1]))]
-    words = [f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in zip(starts[:limit], ends[:limit])]
+    words = [f"{a:g}" if a == b else f"{a:g}-{b:g}" for a, b in zip(starts[:limit].tolist(), ends[:limit].tolist())]
     more = f" and {len(starts) - limit} more" if len(starts) > limit else ""
     return ", ".join(words) + more
 

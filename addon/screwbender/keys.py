@@ -195,17 +195,32 @@ def no_action(name: str, adt) -> str:
     )
 
 
-def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
+def check_editable(owner: owners.Owner | bpy.types.Object, checked: dict | None = None) -> None:
     """Raises :class:`SmoothError` unless `owner` (an object or a pose bone, see
-    :mod:`owners`) has an editable action driving its transform."""
+    :mod:`owners`) has an editable action driving its transform. `checked`, a dict kept for
+    one run, remembers the objects that passed the checks of the object (its bones are then
+    checked for themselves alone: many bones of one rig)."""
     owner = owners.as_owner(owner)
     obj = owner.obj
     name = owner.name
     if not owner.exists():
         raise SmoothError(f"{name}: no such bone any more: skipped")
+    adt = obj.animation_data
+    passed = ("editable", obj.as_pointer())
+    if checked is None or passed not in checked:
+        _check_object(obj, adt, name)
+        if checked is not None:
+            checked[passed] = True
+    paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
+    driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
+    if driven:
+        raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
+
+
+def _check_object(obj: bpy.types.Object, adt, name: str) -> None:
+    """:func:`check_editable`'s checks of the object (`adt` its animation data), the owner named `name`."""
     if obj.library is not None or getattr(obj, "override_library", None) is not None:
         raise SmoothError(f"{name}: object is linked from a library and cannot be edited: skipped")
-    adt = obj.animation_data
     if adt is None or adt.action is None:
         raise SmoothError(no_action(name, adt))
     action = adt.action
@@ -227,10 +242,6 @@ def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
             f"{name}: has {strips} NLA strip(s) that play under the action; the baked action would not be "
             "what the NLA plays (mute their tracks to smooth the action alone): skipped"
         )
-    paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
-    driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
-    if driven:
-        raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
 
 
 def read(
@@ -288,7 +299,7 @@ def _read(
     cache: dict | None = None,
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
-    check_editable(owner)
+    check_editable(owner, cache)
     obj, target = owner.obj, owner.target
     name = owner.name
     mode = owner.rotation_mode
