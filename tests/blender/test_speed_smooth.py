@@ -128,20 +128,22 @@ def many(count: int) -> list[bpy.types.Object]:
     return out
 
 
-@pytest.mark.parametrize("count", [300])
+@pytest.mark.parametrize("count", [500])
 def test_revert_of_many_objects_costs_less_than_smoothing_them(count):
     objects = many(count)
     sources = [o.animation_data.action for o in objects]
     h.select_only(*objects)
-    start = time.perf_counter()
+    # CPU seconds of the process (every thread): the wall clock of a shared machine is noise
+    start = time.process_time()
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
-    smoothed = time.perf_counter() - start
-    start = time.perf_counter()
+    smoothed = time.process_time() - start
+    start = time.process_time()
     assert bpy.ops.screwbender.revert() == {"FINISHED"}
-    reverted = time.perf_counter() - start
-    print(f"{count} objects x 50 frames: Smooth Motion {smoothed * 1e3:.0f} ms, Revert {reverted * 1e3:.0f} ms "
+    reverted = time.process_time() - start
+    print(f"{count} objects x 50 frames: Smooth Motion {smoothed * 1e3:.0f} ms, Revert {reverted * 1e3:.0f} ms CPU "
           f"({reverted / smoothed:.2f} of it)")
     assert [o.animation_data.action for o in objects] == sources
-    # Revert writes no keys: it must cost a fraction of the smoothing (before this change it
-    # scanned every object of the scene once per reverted action: quadratic, 2.3 s at 500)
-    assert reverted < 0.5 * smoothed
+    # Revert writes no keys: it costs a small fraction of the smoothing (before, it scanned
+    # every object of the scene and the file once per reverted action: quadratic, 0.27 of the
+    # smoothing at 300 objects and 0.4 at 500; now 0.15 at both)
+    assert reverted < 0.25 * smoothed

@@ -13,7 +13,7 @@ const CHUNK: usize = 4096;
 
 /// Frames per worker below which [`departure`] runs on one thread (a thread costs more than
 /// measuring fewer frames).
-pub(crate) const PARALLEL_FRAMES: usize = 16_384;
+pub(crate) const PARALLEL_FRAMES: usize = 4_096;
 
 /// Per frame, how far a result is from the playback (see [`departure`]).
 #[derive(Debug, Clone, PartialEq)]
