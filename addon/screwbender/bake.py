@@ -470,7 +470,7 @@ def _write_curves(
         bulk.put(points, "interpolation", interpolation)
         if digests is not None:
             digest = prefix.copy()
-            digest.update(co.tobytes())
+            digest.update(co)  # (C-contiguous float32: hashed in place, the bytes tobytes() gives)
             digest.update(kinds)
             digests[path, index] = digest.digest()
         if cyclic:
@@ -836,7 +836,8 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
         return None
     mode = motion.rotation_mode
     found = intent.departure(
-        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)]
+        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)],
+        motion.frames,
     )
     causes = list(motion.causes)
     if options.method == "FEATURE" and options.approximate:

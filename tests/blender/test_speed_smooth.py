@@ -147,3 +147,38 @@ def test_revert_of_many_objects_costs_less_than_smoothing_them(count):
     # every object of the scene and the file once per reverted action: quadratic, 0.27 of the
     # smoothing at 300 objects and 0.4 at 500; now 0.15 at both)
     assert reverted < 0.25 * smoothed
+
+
+def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
+    """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
+    frames: the largest departure and the frames over the thresholds agree with measuring
+    every frame (a screw between two keys against Blender's independent channel curves)."""
+    intent = addon_module("intent")
+    bake = addon_module("bake")
+    obj = h.new_object("Long")
+    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
+        obj.location = (x, 0.3 * x, 0.0)
+        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
+        obj.keyframe_insert("location", frame=frame)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    actions, skipped, _ = bake.prepare([obj], bake.Options())
+    part = actions[0].parts[0]
+    motion = part.motion
+    args = (motion.source, motion.size, part.frames, part.values["location"], part.values["rotation_euler"])
+    start = time.process_time()
+    every = intent.departure(*args)
+    whole = time.process_time() - start
+    start = time.process_time()
+    sampled = intent.departure(*args, motion.frames)
+    spans = time.process_time() - start
+    print(f"{len(part.frames)} frames: every frame {every.degrees:.4f} deg {every.distance:.6f} units, "
+          f"{len(every.frames)} frames over, {whole * 1e3:.1f} ms; per span {sampled.degrees:.4f} deg "
+          f"{sampled.distance:.6f} units, {len(sampled.frames)} frames over, {spans * 1e3:.1f} ms")
+    assert len(every.frames) > 100, "the case departs (else it proves nothing)"
+    assert abs(sampled.degrees - every.degrees) <= 1e-3 * every.degrees
+    assert abs(sampled.distance - every.distance) <= 1e-3 * every.distance
+    # the frames over the thresholds: the same but within a sample spacing at the ends of runs
+    spacing = 3000 / (intent.DEPARTURE_SPAN_FRAMES - 1)
+    differ = np.setxor1d(every.frames, sampled.frames)
+    assert len(differ) <= 4 * spacing, (len(differ), spacing)
+    assert intent.frame_runs(sampled.frames).count("-") == intent.frame_runs(every.frames).count("-")
