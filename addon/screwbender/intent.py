@@ -119,7 +119,7 @@ DEPARTURE_FRACTION = 0.05
 #: (its first and last included): between two keys the result and Blender's playback are
 #: smooth, and a bake of 100,000 frames then costs no more to measure than one of a few
 #: thousand. A frame not measured departs as its nearest measured frame does.
-DEPARTURE_SPAN_FRAMES = 256
+DEPARTURE_SPAN_FRAMES = 64
 
 #: Cycles modifier modes whose playback beyond the keys is not the keys repeated: the
 #: motion is extended by Blender's playback and baked with the same modifier.
@@ -255,18 +255,20 @@ def departure(
 
 def _measured(frames: np.ndarray, key_frames: np.ndarray, most: int) -> np.ndarray | None:
     """Indices of the frames (sorted) measured: every frame of a key span (of `key_frames`)
-    baked at no more than `most` frames, `most` evenly spaced ones of a longer span (its first
-    and last frame included); None when that is every frame. One step per span, not per frame."""
+    baked at no more than `most` frames; of a span of `c > most` frames, the `most` frames
+    `round(k (c - 1) / (most - 1))` (evenly spaced, its first and last included). None when
+    that is every frame. Arrays over the frames, no Python step per frame or span."""
     span = np.searchsorted(np.asarray(key_frames, dtype=np.float64), frames, side="right")
-    starts = np.flatnonzero(np.concatenate(([True], span[1:] != span[:-1])))
+    first = np.concatenate(([True], span[1:] != span[:-1]))
+    starts = np.flatnonzero(first)
     counts = np.diff(np.append(starts, len(frames)))
     if not len(counts) or counts.max() <= most:
         return None
-    picks = [
-        np.arange(s, s + c) if c <= most else s + np.unique(np.round(np.linspace(0, c - 1, most)).astype(np.int64))
-        for s, c in zip(starts.tolist(), counts.tolist())
-    ]
-    return np.concatenate(picks)
+    run = np.cumsum(first) - 1
+    c, i = counts[run], np.arange(len(frames)) - starts[run]
+    step = np.maximum(c - 1, 1) / (most - 1)
+    # (steps longer than a frame: frame i is picked when the nearest k picks it back)
+    return np.flatnonzero((c <= most) | (np.round(np.round(i / step) * step) == i))
 
 
 def departure_note(name: str, found: Departure, size: float, causes: list[str]) -> str | None:
