@@ -537,8 +537,9 @@ def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> bytes:
     """A digest of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
     interpolations (Blender's enum values, as `foreach_get` gives them)."""
     digest = hashlib.sha256(f"{len(interpolation)}:".encode())
-    digest.update(np.ascontiguousarray(co, dtype=np.float32).tobytes())
-    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes())
+    # (the arrays' bytes hashed in place: no copy when they are float32 / uint8 already)
+    digest.update(np.ascontiguousarray(co, dtype=np.float32))
+    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8))
     return digest.digest()
 
 
