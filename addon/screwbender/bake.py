@@ -181,9 +181,12 @@ class Baked:
 
     def columns(self, prop: str) -> list[tuple[int, int]]:
         """(column of `values[prop]`, array index) of every curve of `prop` the bake writes."""
-        values = self.values[prop]
-        indices = np.flatnonzero(self.motion.scale_axes) if prop == "scale" else range(values.shape[1])
-        return [(c, int(i)) for c, i in enumerate(indices) if (prop, int(i)) not in self.unkeyed]
+        if prop == "scale":
+            indices = [i for i, keyed in enumerate(self.motion.scale_axes.tolist()) if keyed]
+        else:
+            indices = range(self.values[prop].shape[1])
+        unkeyed = self.unkeyed
+        return [(c, i) for c, i in enumerate(indices) if not unkeyed or (prop, i) not in unkeyed]
 
     @property
     def written(self) -> list[tuple[str, int]]:
@@ -281,6 +284,9 @@ def with_key_frames(grid: np.ndarray, key_frames: np.ndarray) -> np.ndarray:
     key_frames = np.asarray(key_frames, dtype=np.float64)
     inside = key_frames[(key_frames > grid[0] + tol) & (key_frames < grid[-1] - tol)]
     if not len(inside):
+        return grid
+    at = np.minimum(np.searchsorted(grid, inside), len(grid) - 1)
+    if np.array_equal(grid[at], inside):  # every key frame is a grid frame already
         return grid
     inside = np.unique(inside)
     # grid frames near a key frame are that key frame
@@ -397,11 +403,15 @@ def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion
     """(property, index) of the baked channels the source did not key (no curve with keys,
     or a muted one) whose baked values all equal the owner's own value in float32: the
     smoothed motion leaves them where they are, so they are not keyed."""
-    keyed = set()
-    for fc in source_curves:
-        prop = owner.prop_of(fc.data_path)
-        if prop is not None and not fc.mute and len(fc.keyframe_points):
-            keyed.add((prop, fc.array_index))
+    keyed = motion.keyed
+    if not keyed:  # (a motion not made by keys.read)
+        keyed = set()
+        for fc in source_curves:
+            prop = owner.prop_of(fc.data_path)
+            if prop is not None and not fc.mute and len(fc.keyframe_points):
+                keyed.add((prop, fc.array_index))
+    if all((prop, column) in keyed for prop, baked in values.items() if prop != "scale" for column in range(baked.shape[1])):
+        return frozenset()  # every baked channel keyed: nothing to leave unkeyed
     out = set()
     for prop, baked in values.items():
         if prop == "scale":
@@ -422,7 +432,7 @@ def _write_curves(
     frames: np.ndarray,
     values: np.ndarray,
     cyclic: bool,
-    indices: np.ndarray | None = None,
+    indices: list[int] | np.ndarray | None = None,
     group: str = channels.TRANSFORM_GROUP,
     constant: np.ndarray | None = None,
     cycle_modes: dict | None = None,
@@ -443,9 +453,13 @@ def _write_curves(
     # for an enum property (measured in Blender 4.2 and 5.0).
     if constant is None or not constant.any():
         interpolation = (_LINEAR,) * len(frames)
+        kinds = np.full(len(frames), _LINEAR, dtype=np.uint8)
     else:
-        interpolation = tuple(np.where(constant, _CONSTANT, _LINEAR).tolist())
-    kinds = np.array(interpolation, dtype=np.uint8) if digests is not None else None
+        kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
+        interpolation = tuple(kinds.tolist())
+    if digests is not None:  # (:func:`curve_digest` of each curve, its shared parts hashed once)
+        prefix = hashlib.sha256(f"{len(frames)}:".encode())
+        kinds = kinds.tobytes()
     for column in range(values.shape[1]):
         index = int(indices[column]) if indices is not None else column
         fcurve = channels.new_fcurve(bag, path, index, group)
@@ -455,7 +469,10 @@ def _write_curves(
         bulk.put(points, "co", co.ravel())
         bulk.put(points, "interpolation", interpolation)
         if digests is not None:
-            digests[path, index] = curve_digest(co, kinds)
+            digest = prefix.copy()
+            digest.update(co)  # (C-contiguous float32: hashed in place, the bytes tobytes() gives)
+            digest.update(kinds)
+            digests[path, index] = digest.digest()
         if cyclic:
             fcurve.modifiers.new("CYCLES")
         elif cycle_modes and (prop, index) in cycle_modes:
@@ -520,8 +537,9 @@ def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> bytes:
     """A digest of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
     interpolations (Blender's enum values, as `foreach_get` gives them)."""
     digest = hashlib.sha256(f"{len(interpolation)}:".encode())
-    digest.update(np.ascontiguousarray(co, dtype=np.float32).tobytes())
-    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes())
+    # (the arrays' bytes hashed in place: no copy when they are float32 / uint8 already)
+    digest.update(np.ascontiguousarray(co, dtype=np.float32))
+    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8))
     return digest.digest()
 
 
@@ -592,10 +610,11 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
                 if part.join is not None:
                     _write_joined(bag, part, prop, columns)
                     continue
+                if len(columns) < values.shape[1]:  # channels left unkeyed are not written
+                    values = values[:, [c for c, _ in columns]]
                 _write_curves(
-                    bag, part.owner.path(prop), part.frames, values[:, [c for c, _ in columns]], part.cyclic,
-                    np.array([i for _, i in columns]), part.owner.group, part.constant, part.cycle_modes, prop,
-                    part.motion.modifiers, digests,
+                    bag, part.owner.path(prop), part.frames, values, part.cyclic, [i for _, i in columns],
+                    part.owner.group, part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
                 )
 
     digests: dict = {}
@@ -625,17 +644,29 @@ def write_one(baked: Baked, t: transaction.Transaction) -> bpy.types.Action:
     return write(ActionBake([obj], [baked], action, action, channels.slot_identifier(obj)), t)
 
 
+def _unused(action: bpy.types.Action) -> bool:
+    """Whether nothing uses `action` (no user, no fake user); False when it is removed already."""
+    try:
+        return action.users == 0 and not action.use_fake_user
+    except ReferenceError:  # removed already
+        return False
+
+
 def _remove_if_unused(action: bpy.types.Action) -> bool:
     """Removes `action` when nothing uses it (a replaced result of Smooth Motion); returns
     whether it did (not when it is already removed)."""
-    try:
-        unused = action.users == 0 and not action.use_fake_user
-    except ReferenceError:  # removed already
-        return False
-    if unused:
+    if _unused(action):
         bpy.data.actions.remove(action)
         return True
     return False
+
+
+def remove_unused(actions: list[bpy.types.Action]) -> None:
+    """Removes those of `actions` that nothing uses, in one `bpy.data.batch_remove` (removing
+    many data-blocks one by one scans the whole file for each: quadratic)."""
+    unused = list({a.as_pointer(): a for a in actions if _unused(a)}.values())
+    if unused:
+        bpy.data.batch_remove(unused)
 
 
 def _same_motion(a: keys.KeyedMotion, b: keys.KeyedMotion) -> bool:
@@ -676,9 +707,11 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
             group.objects.append(owner.obj)
         if owner.bone not in group.bones:
             group.bones.append(owner.bone)
-    # Every object the action animates through that slot keeps sharing it, selected or not.
-    for (_pointer, identifier), group in groups.items():
-        for obj in users_of(group.objects[0].animation_data.action, identifier):
+    # Every object the action animates through that slot keeps sharing it, selected or not
+    # (one pass over the scene's objects for all the actions).
+    users = users_by_slot({pointer for pointer, _ in groups})
+    for key, group in groups.items():
+        for obj in users.get(key, ()):
             if obj not in group.objects:
                 group.objects.append(obj)
     return list(groups.values()), skipped
@@ -686,13 +719,20 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
 
 def users_of(action: bpy.types.Action, identifier: str) -> list[bpy.types.Object]:
     """The objects `action` animates through the slot `identifier` ("" before 4.4)."""
-    return [
-        o
-        for o in bpy.data.objects
-        if o.animation_data is not None
-        and o.animation_data.action == action
-        and channels.slot_identifier(o) == identifier
-    ]
+    return users_by_slot({action.as_pointer()}).get((action.as_pointer(), identifier), [])
+
+
+def users_by_slot(pointers: set[int]) -> dict[tuple[int, str], list[bpy.types.Object]]:
+    """The objects animated by the actions whose `as_pointer()` is in `pointers`, per (action
+    pointer, slot identifier), in the order of `bpy.data.objects`: one pass over the objects
+    for many actions (:func:`users_of` of each would be one pass per action)."""
+    out: dict[tuple[int, str], list[bpy.types.Object]] = {}
+    for o in bpy.data.objects:
+        adt = o.animation_data
+        action = adt.action if adt is not None else None
+        if action is not None and action.as_pointer() in pointers:
+            out.setdefault((action.as_pointer(), channels.slot_identifier(o)), []).append(o)
+    return out
 
 
 def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[list[ActionBake], list, list[str]]:
@@ -726,6 +766,7 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     # The objects share the action: its curves grouped by owner once (not scanned per bone).
     listed = channels.object_fcurves(first) if read_from is None else channels.action_fcurves(read_from, source_slot)
     by_owner = owners.curves_by_owner(listed)
+    read_once: dict = {}  # the objects share the curves: each read once (keys.read's cache)
     for bone in group.bones:
         row = []
         for obj in group.objects:
@@ -734,7 +775,7 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
                 row.append(
                     keys.read(
                         owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range,
-                        fcurves=by_owner.get(bone, []), turns=options.turns,
+                        fcurves=by_owner.get(bone, []), turns=options.turns, cache=read_once,
                     )
                 )
             except SmoothError as err:
@@ -796,7 +837,8 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
         return None
     mode = motion.rotation_mode
     found = intent.departure(
-        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)]
+        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)],
+        motion.frames,
     )
     causes = list(motion.causes)
     if options.method == "FEATURE" and options.approximate:
@@ -944,24 +986,39 @@ def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
 
 
 def revert(
-    obj: bpy.types.Object, t: transaction.Transaction, kept: list[str] | None = None
+    obj: bpy.types.Object,
+    t: transaction.Transaction,
+    kept: list[str] | None = None,
+    users: dict[tuple[int, str], list[bpy.types.Object]] | None = None,
+    removals: list[bpy.types.Action] | None = None,
 ) -> list[bpy.types.Object]:
     """Gives `obj`, and every object sharing its smoothed action, back the action they had
     before smoothing (bones included: the whole action); drops the smoothed copy once nothing
     uses it, unless the animator edited it since it was made: that one is kept with a fake
-    user and its name appended to `kept`. Returns the objects."""
+    user and its name appended to `kept`. Returns the objects. `users`: the caller's
+    :func:`users_by_slot` of the smoothed actions, made before any was reverted (many objects
+    reverted at once: one pass over the scene's objects, not one per action); `removals`: a
+    list the caller passes to :func:`remove_unused` once `t` commits (else each smoothed copy
+    is removed on its own)."""
     source = source_of(obj)
     if source is None:
         raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
     smoothed = obj.animation_data.action
-    sharing = users_of(smoothed, channels.slot_identifier(obj))
+    identifier = channels.slot_identifier(obj)
+    if users is not None:
+        sharing = users.get((smoothed.as_pointer(), identifier)) or [obj]
+    else:
+        sharing = users_of(smoothed, identifier)
+    source_slot = smoothed.get(SOURCE_SLOT_KEY, "")
     for other in sharing:
-        t.assign_action(other, source, smoothed.get(SOURCE_SLOT_KEY, ""))
+        t.assign_action(other, source, source_slot)
     t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
-    if was_edited(smoothed, channels.slot_identifier(obj)):
+    if was_edited(smoothed, identifier):
         t.set(smoothed, "use_fake_user", True)  # an edit is never thrown away
         if kept is not None:
             kept.append(smoothed.name)
+    elif removals is not None:
+        removals.append(smoothed)
     else:
         t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
     return sharing

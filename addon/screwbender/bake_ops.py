@@ -256,9 +256,14 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
         kept: list[str] = []
         try:
             with transaction.atomic() as t:
-                for obj in sorted(context.selected_objects, key=lambda o: o.name):
-                    if obj.name not in reverted and bake.source_of(obj) is not None:
-                        reverted.update((o.name, o) for o in bake.revert(obj, t, kept))
+                chosen = [o for o in sorted(context.selected_objects, key=lambda o: o.name) if bake.source_of(o) is not None]
+                # who uses each smoothed action: one pass over the scene's objects for all of them
+                users = bake.users_by_slot({o.animation_data.action.as_pointer() for o in chosen})
+                removals: list[bpy.types.Action] = []  # the smoothed copies, removed at once
+                for obj in chosen:
+                    if obj.name not in reverted:
+                        reverted.update((o.name, o) for o in bake.revert(obj, t, kept, users, removals))
+                t.on_commit(lambda: bake.remove_unused(removals))
         except Exception as err:
             return transaction.report_failure(self, err, "Revert Smoothing")
         selected = {o.name for o in context.selected_objects}

@@ -99,6 +99,8 @@ class KeyedMotion:
     #: F-curve modifiers copied onto the baked curves, per (property, index): every modifier
     #: of the source curve but a first Cycles one (:mod:`modifiers`).
     modifiers: dict = field(default_factory=dict)
+    #: (property, array index) of the curves the keys were read from (keyed, not muted).
+    keyed: frozenset = frozenset()
 
     @property
     def scale_keyed(self) -> bool:
@@ -193,17 +195,32 @@ def no_action(name: str, adt) -> str:
     )
 
 
-def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
+def check_editable(owner: owners.Owner | bpy.types.Object, checked: dict | None = None) -> None:
     """Raises :class:`SmoothError` unless `owner` (an object or a pose bone, see
-    :mod:`owners`) has an editable action driving its transform."""
+    :mod:`owners`) has an editable action driving its transform. `checked`, a dict kept for
+    one run, remembers the objects that passed the checks of the object (its bones are then
+    checked for themselves alone: many bones of one rig)."""
     owner = owners.as_owner(owner)
     obj = owner.obj
     name = owner.name
     if not owner.exists():
         raise SmoothError(f"{name}: no such bone any more: skipped")
+    adt = obj.animation_data
+    passed = ("editable", obj.as_pointer())
+    if checked is None or passed not in checked:
+        _check_object(obj, adt, name)
+        if checked is not None:
+            checked[passed] = True
+    paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
+    driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
+    if driven:
+        raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
+
+
+def _check_object(obj: bpy.types.Object, adt, name: str) -> None:
+    """:func:`check_editable`'s checks of the object (`adt` its animation data), the owner named `name`."""
     if obj.library is not None or getattr(obj, "override_library", None) is not None:
         raise SmoothError(f"{name}: object is linked from a library and cannot be edited: skipped")
-    adt = obj.animation_data
     if adt is None or adt.action is None:
         raise SmoothError(no_action(name, adt))
     action = adt.action
@@ -225,10 +242,6 @@ def check_editable(owner: owners.Owner | bpy.types.Object) -> None:
             f"{name}: has {strips} NLA strip(s) that play under the action; the baked action would not be "
             "what the NLA plays (mute their tracks to smooth the action alone): skipped"
         )
-    paths = {owner.path(p) for p in transform_paths(owner.rotation_mode)}
-    driven = sorted(f"{d.data_path}[{d.array_index}]" for d in adt.drivers if d.data_path in paths)
-    if driven:
-        raise SmoothError(f"{name}: drivers on {', '.join(driven)}: skipped")
 
 
 def read(
@@ -241,6 +254,7 @@ def read(
     analyse: bool = True,
     turns: str = "AUTO",
     packed: tuple[list, curves.Packed] | None = None,
+    cache: dict | None = None,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -257,9 +271,11 @@ def read(
     owner, :func:`owners.curves_by_owner`: many bones of one action are then read without
     scanning all its curves for each bone). `turns` is the option Turns (:data:`intent.TURNS`):
     which spans Blender's playback turns the long way round are followed (spins) and which
-    are taken the short way (flips, reported in `removed`). `packed`: (curves, their keys) that
-    the caller has read with `curves.read(curves, keys_only=True)` already (the preview's key
-    hash): used, not read again, when `curves` are the transform curves read here.
+    are taken the short way (flips, reported in `removed`). `cache`, a dict the caller keeps
+    for one run, holds the keys read per set of curves: objects sharing an action (linked
+    duplicates) read its curves once. `packed`: (curves, their keys) that the caller has read
+    with `curves.read(curves, keys_only=True)` already (the preview's key hash): used, not read
+    again, when `curves` are the transform curves read here.
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
     `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
@@ -267,7 +283,7 @@ def read(
     """
     owner = owners.as_owner(owner)
     try:
-        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, packed)
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, cache, packed)
     except SmoothError:
         raise
     except ValueError as err:  # polyscrew refusing the curves or the key poses
@@ -283,10 +299,11 @@ def _read(
     fcurves: list | None,
     analyse: bool,
     turns: str = "AUTO",
+    cache: dict | None = None,
     given: tuple[list, curves.Packed] | None = None,
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
-    check_editable(owner)
+    check_editable(owner, cache)
     obj, target = owner.obj, owner.target
     name = owner.name
     mode = owner.rotation_mode
@@ -305,47 +322,54 @@ def _read(
             found[prop, fc.array_index] = fc
     if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
+    # Each curve's keys are read once (issue 27): packed for Blender's playback, and the key
+    # frames and values taken from that; only curves it cannot play are read for their keys alone.
     columns = list(found)
-    # Every curve's keys read once (issue 27): packed for polyscrew's playback when it can play
-    # them (the key coordinates taken from there), else the key coordinates alone.
-    chosen = [found[c] for c in columns]
-    try:
-        if given is not None and [fc.as_pointer() for fc in given[0]] == [fc.as_pointer() for fc in chosen]:
-            packed, unsupported = given[1], None
-        else:
-            packed, unsupported = curves.read(chosen, keys_only=True), None
-    except curves.UnsupportedCurve as err:
-        packed, unsupported = None, err
-    if packed is not None:
-        bounds = packed.offsets.tolist()
-        points = {c: packed.co[bounds[k] : bounds[k + 1]].astype(np.float64) for k, c in enumerate(columns)}
+    notes = []
+    read_key = tuple((key, fc.as_pointer()) for key, fc in found.items()) if cache is not None else None
+    if read_key is not None and read_key in cache:
+        packed, note, points = cache[read_key]
     else:
-        points = {key: _key_points(fc) for key, fc in found.items()}
+        note = None
+        try:
+            chosen = [found[c] for c in columns]
+            if given is not None and [fc.as_pointer() for fc in given[0]] == [fc.as_pointer() for fc in chosen]:
+                packed = given[1]
+            else:
+                packed = curves.read(chosen, keys_only=True)
+        except curves.UnsupportedCurve as err:
+            packed = None
+            note = f"{err}: smoothed from the key values alone (spins, holds and easing not read)"
+            points = {key: _key_points(fc) for key, fc in found.items()}
+        else:
+            co, bounds = packed.co.astype(np.float64), packed.offsets.tolist()
+            points = {key: co[bounds[i] : bounds[i + 1]] for i, key in enumerate(columns)}
+        if read_key is not None:
+            cache[read_key] = (packed, note, points)
+    if note is not None:
+        notes.append(note)
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
     # F-curve modifiers: smoothing works on what the keys make, the modifiers are kept on top
     key_range = (float(frames[0]), float(frames[-1]))
-    for (prop, index), fc in found.items():
+    modified = {key: fc for key, fc in found.items() if len(fc.modifiers)}
+    for (prop, index), fc in modified.items():
         reason = modifiers.refusal(fc, key_range)
         if reason is not None:
             raise SmoothError(f"{name}: {owner.path(prop)}[{index}]: {reason}: skipped")
-    stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
+    stacked = {key: stack for key, stack in ((key, modifiers.kept(fc)) for key, fc in modified.items()) if stack}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
-    notes = []
-    try:
-        if unsupported is not None:
-            raise unsupported
-        source = intent.Source(
-            packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
-        )
-    except curves.UnsupportedCurve as err:
-        source = None
-        notes.append(f"{err}: smoothed from the key values alone (spins, holds and easing not read)")
-    except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
-        named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
-        raise SmoothError(f"{name}: {named}: skipped") from err
+    source = None
+    if packed is not None:
+        try:
+            source = intent.Source(
+                packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
+            )
+        except ValueError as err:  # polyscrew.Playback refuses the keys: say which curve ("curve 2")
+            named = _curves_named(str(err), [f"{owner.path(prop)}[{index}]" for prop, index in columns])
+            raise SmoothError(f"{name}: {named}: skipped") from err
 
     def evaluate(path: str, size: int) -> np.ndarray:
         """The channels at the key frames (source-less: a loop over keys, not frames)."""
@@ -354,7 +378,7 @@ def _read(
             fc = found.get((path, i))
             if fc is None:
                 out[:, i] = statics[path][i]
-            elif len(fc.modifiers) == 0 and np.array_equal(points[path, i][:, 0], frames):
+            elif (path, i) not in modified and np.array_equal(points[path, i][:, 0], frames):
                 out[:, i] = points[path, i][:, 1]  # keyed on every key frame: its key values
             else:
                 out[:, i] = [fc.evaluate(f) for f in frames]
@@ -382,7 +406,7 @@ def _read(
 
     poses = compose(location, rotation_matrices(rotation, mode))
     modes = {}  # (property, index) -> Cycles modifier (mode_before, mode_after)
-    for key, fc in found.items():
+    for key, fc in modified.items():
         for modifier in fc.modifiers:
             if modifier.type == "CYCLES" and not modifier.mute:
                 modes[key] = (modifier.mode_before, modifier.mode_after)
@@ -428,10 +452,12 @@ def _read(
         held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
         followed = ~held & ((~flips & (mode != "QUATERNION")) if turns == "AUTO" else (turns == "BLENDER"))
         # Shortest: typed turns whose short screw turns less far than Blender's playback
-        relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
-        short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
-        longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
-        shortened = ~held & longer & ~flips & (turns == "SHORTEST")
+        shortened = np.zeros(len(held), dtype=bool)
+        if turns == "SHORTEST":
+            relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
+            short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+            longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
+            shortened = ~held & longer & ~flips
         spans = np.stack([frames[:-1], frames[1:]], axis=1)
         if bake_range is not None:  # an extended cycle: report the keys' own period once
             once = (spans[:, 0] >= bake_range[0]) & (spans[:, 0] < bake_range[1])
@@ -534,6 +560,7 @@ def _read(
         removed=removed,
         causes=causes,
         modifiers=stacked,
+        keyed=frozenset(found),
     )
 
 

@@ -11,6 +11,10 @@ use crate::{Error, Result};
 /// Frames evaluated at once (bounds the work buffer whatever the number of frames).
 const CHUNK: usize = 4096;
 
+/// Frames per worker below which [`departure`] runs on one thread (a thread costs more than
+/// measuring fewer frames).
+pub(crate) const PARALLEL_FRAMES: usize = 4_096;
+
 /// Per frame, how far a result is from the playback (see [`departure`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Departure {
@@ -55,20 +59,76 @@ pub fn departure(
             index,
         });
     }
+    // Long bakes are measured on every core: the playback's curves are evaluated at every
+    // frame, the cost of this function (bounded: each worker has one chunk's buffer).
+    let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
+    let workers = cores.min(t / PARALLEL_FRAMES).max(1);
     check_footprint(
         t.saturating_mul(2)
-            .saturating_add(CHUNK.saturating_mul(width))
+            .saturating_add(workers.saturating_mul(CHUNK).saturating_mul(width))
             .saturating_mul(std::mem::size_of::<f64>()),
         "departure",
         "measure fewer frames",
     )?;
     let mut distance = filled(t, 0.0, "departure")?;
     let mut angle = filled(t, 0.0, "departure")?;
-    let mut rows = Vec::new();
+    if workers <= 1 {
+        measure(
+            playback,
+            frames,
+            location,
+            rotation,
+            &mut distance,
+            &mut angle,
+        )?;
+        return Ok(Departure { distance, angle });
+    }
+    let per = t.div_ceil(workers);
+    let parts = std::thread::scope(|scope| {
+        let handles: Vec<_> = distance
+            .chunks_mut(per)
+            .zip(angle.chunks_mut(per))
+            .enumerate()
+            .map(|(k, (d, a))| {
+                let range = k * per..k * per + d.len();
+                let (l, r) = (
+                    &location[3 * range.start..3 * range.end],
+                    &rotation[w * range.start..w * range.end],
+                );
+                let f = &frames[range];
+                scope.spawn(move || measure(playback, f, l, r, d, a))
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join()).collect::<Vec<_>>()
+    });
+    for part in parts {
+        // A worker only fails by a bug (the core does not panic on data): report it.
+        part.map_err(|_| Error::Invalid {
+            what: "frames",
+            reason: "a worker thread failed".into(),
+        })??;
+    }
+    Ok(Departure { distance, angle })
+}
+
+/// [`departure`] of the frames `frames` into `distance` and `angle` (one value per frame),
+/// `CHUNK` frames of the playback at a time.
+pub(crate) fn measure(
+    playback: &Playback,
+    frames: &[f64],
+    location: &[f64],
+    rotation: &[f64],
+    distance: &mut [f64],
+    angle: &mut [f64],
+) -> Result<()> {
+    let w = playback.mode().width();
+    let width = playback.width();
     let located = playback.located();
-    for start in (0..t).step_by(CHUNK) {
-        let end = (start + CHUNK).min(t);
-        playback.channels_into(&frames[start..end], &mut rows)?;
+    let mut rows = Vec::new();
+    for start in (0..frames.len()).step_by(CHUNK) {
+        let end = (start + CHUNK).min(frames.len());
+        // location and rotation only: the scale curves do not enter the departure
+        playback.pose_channels_into(&frames[start..end], &mut rows)?;
         for (j, row) in rows.chunks_exact(width).enumerate() {
             let i = start + j;
             if located {
@@ -79,5 +139,5 @@ pub fn departure(
             angle[i] = rotation_angle(&playback.rotation(row), &ours);
         }
     }
-    Ok(Departure { distance, angle })
+    Ok(())
 }

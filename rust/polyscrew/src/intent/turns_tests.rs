@@ -217,3 +217,27 @@ fn departure_is_zero_on_the_playback_and_measures_a_known_offset() {
         Err(crate::Error::NotFinite { .. })
     ));
 }
+
+#[test]
+fn departure_of_a_long_bake_on_several_threads_equals_the_serial_measure() {
+    let p = wrapped_z();
+    let t = 2 * super::departure::PARALLEL_FRAMES + 7;
+    let frames: Vec<f64> = (0..t).map(|i| 40.0 * i as f64 / t as f64).collect();
+    // a result off the playback: a wobble in location and rotation
+    let location: Vec<f64> = (0..t)
+        .flat_map(|i| [0.1 * (i as f64 * 1e-3).sin(), 0.0, 0.2])
+        .collect();
+    let rotation: Vec<f64> = (0..t)
+        .flat_map(|i| [0.0, 0.05, 3.0 * (i as f64 * 3e-4).cos()])
+        .collect();
+    let whole = departure(&p, &frames, &location, &rotation).unwrap();
+    let (mut distance, mut angle) = (vec![0.0; t], vec![0.0; t]);
+    super::departure::measure(&p, &frames, &location, &rotation, &mut distance, &mut angle)
+        .unwrap();
+    assert_eq!(whole.distance, distance);
+    assert_eq!(whole.angle, angle);
+    assert!(
+        angle.iter().any(|&a| a > 0.1),
+        "the measure is not trivially zero"
+    );
+}

@@ -1,0 +1,184 @@
+"""Smooth Motion and Revert at scene scale (issue 24's last criterion, issue 27).
+
+Each source curve's keys are read once per run (`read_count.counting_reads`: every
+`foreach_get` of the add-on goes through `bulk.get`), over objects that share an action and
+objects that do not, a rig in Pose Mode, and Revert; and Revert of many objects costs less
+than smoothing them (one pass over the scene's objects, not one per action).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import bake_helpers as h
+import bone_helpers as bh
+import bpy
+import numpy as np
+import pytest
+from read_count import counting_reads, read_more_than_once
+
+from conftest import addon_module
+
+
+def keyed(name: str, seed: int, mode: str = "XYZ", scale: bool = False) -> bpy.types.Object:
+    """An object keyed at five uneven frames (location, rotation, optionally scale)."""
+    obj = h.new_object(name, mode=mode)
+    rng = np.random.default_rng(seed)
+    poses = h.rigid(rng.uniform(-2, 2, (5, 3)), np.stack([np.eye(3)] * 5))
+    angles = np.cumsum(rng.uniform(0.2, 0.8, 5))
+    for i, a in enumerate(angles):
+        c, s = math.cos(a), math.sin(a)
+        poses[i, :3, :3] = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
+    h.key_poses(obj, [1, 4, 11, 15, 24], poses, rng.uniform(0.8, 1.2, (5, 3)) if scale else None)
+    return obj
+
+
+def transform_curves(action, owner_prefix: str = "") -> list[tuple[str, str, int]]:
+    """(action name, data path, index) of the keyed transform curves of `action` (legacy or
+    slotted: every channelbag), named before an operator may remove the action."""
+    out = []
+    for _identifier, bag in addon_channels().containers(action):
+        out += [(action.name, fc.data_path, fc.array_index) for fc in bag.fcurves if fc.data_path.startswith(owner_prefix)
+                and fc.data_path.rsplit(".", 1)[-1] in ("location", "rotation_euler", "rotation_quaternion", "scale")]
+    return out
+
+
+def addon_channels():
+    return addon_module("channels")
+
+
+def assert_read_once(reads, curves) -> None:
+    """Every curve of `curves` had its key positions read exactly once, and no keyframe
+    property of any curve was read twice."""
+    twice = read_more_than_once(reads)
+    print(f"keyframe-property reads: {sum(n for k, n in reads.items() if len(k) == 4)} over "
+          f"{len({k[:3] for k in reads if len(k) == 4})} curves; read more than once: {twice}")
+    assert twice == {}
+    missing = [curve for curve in curves if reads[(*curve, "co")] != 1]
+    assert missing == [], "source curves whose keys were not read (the test would prove nothing)"
+
+
+def test_smooth_reads_each_source_curve_once_shared_and_own_actions():
+    # two linked duplicates sharing one action, two objects with their own actions (one
+    # quaternion with scale), a third sharing nothing
+    a = keyed("Shared", 1)
+    twin = bpy.data.objects.new("SharedTwin", a.data)
+    bpy.context.scene.collection.objects.link(twin)
+    twin.animation_data_create()
+    addon_channels().assign(twin, a.animation_data.action, addon_channels().slot_identifier(a))
+    b = keyed("Own", 2, mode="QUATERNION", scale=True)
+    c = keyed("Other", 3)
+    sources = {o.name: o.animation_data.action for o in (a, b, c)}
+    curves = [fc for action in sources.values() for fc in transform_curves(action)]
+    assert len(curves) == 6 + 10 + 6
+    h.select_only(a, twin, b, c)
+    with counting_reads() as reads:
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    assert_read_once(reads, curves)
+    # the smoothing happened: every object has a new action, the twins still share one
+    assert all(o.animation_data.action is not sources[o.name] for o in (a, b, c))
+    assert twin.animation_data.action is a.animation_data.action
+
+
+def test_smooth_reads_each_source_curve_once_rig_in_pose_mode():
+    rig = bh.armature()
+    frames = [1, 6, 13, 20]
+    for n, bone in enumerate(("Upper", "Fore", "Hand")):
+        bh.key_bone(rig, bone, frames, bh.random_poses(len(frames), seed=10 + n, gentle=True))
+    action = rig.animation_data.action
+    curves = transform_curves(action, "pose.bones")
+    assert len(curves) == 6 + 3 + 6  # a connected bone has no location keys
+    h.select_only(rig)
+    bpy.ops.object.mode_set(mode="POSE")
+    bh.select_bones(rig, ["Upper", "Fore", "Hand"])
+    with counting_reads() as reads:
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    assert_read_once(reads, curves)
+    assert rig.animation_data.action is not action
+
+
+def test_revert_reads_each_result_curve_once():
+    objects = [keyed(f"Body{n}", 20 + n) for n in range(3)]
+    h.select_only(*objects)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    results = [o.animation_data.action for o in objects]
+    curves = [fc for action in results for fc in transform_curves(action)]
+    with counting_reads() as reads:
+        assert bpy.ops.screwbender.revert() == {"FINISHED"}
+    assert_read_once(reads, curves)  # (the edit check reads each result curve once)
+    assert all(o.animation_data.action is not r for o, r in zip(objects, results))
+
+
+def many(count: int) -> list[bpy.types.Object]:
+    """`count` objects with two keys each (a mesh shared by all), fast to make."""
+    mesh = bpy.data.meshes.new("Block")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1)], [], [(0, 1, 2)])
+    out = []
+    for n in range(count):
+        obj = bpy.data.objects.new(f"Many{n:04d}", mesh)
+        bpy.context.scene.collection.objects.link(obj)
+        for frame, x in ((1, 0.0), (50, 3.0)):
+            obj.location = (x, 0.01 * n, 0.0)
+            obj.rotation_euler = (0.0, 0.0, x / 2)
+            obj.keyframe_insert("location", frame=frame)
+            obj.keyframe_insert("rotation_euler", frame=frame)
+        out.append(obj)
+    return out
+
+
+@pytest.mark.parametrize("count", [500])
+def test_revert_of_many_objects_costs_less_than_smoothing_them(count):
+    objects = many(count)
+    sources = [o.animation_data.action for o in objects]
+    h.select_only(*objects)
+    # CPU seconds of the process (every thread): the wall clock of a shared machine is noise
+    start = time.process_time()
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    smoothed = time.process_time() - start
+    start = time.process_time()
+    assert bpy.ops.screwbender.revert() == {"FINISHED"}
+    reverted = time.process_time() - start
+    print(f"{count} objects x 50 frames: Smooth Motion {smoothed * 1e3:.0f} ms, Revert {reverted * 1e3:.0f} ms CPU "
+          f"({reverted / smoothed:.2f} of it)")
+    assert [o.animation_data.action for o in objects] == sources
+    # Revert writes no keys: it costs a small fraction of the smoothing (before, it scanned
+    # every object of the scene and the file once per reverted action: quadratic, 0.27 of the
+    # smoothing at 300 objects and 0.4 at 500; now 0.15 at both)
+    assert reverted < 0.25 * smoothed
+
+
+def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
+    """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
+    frames: the largest departure and the frames over the thresholds agree with measuring
+    every frame (a screw between two keys against Blender's independent channel curves)."""
+    intent = addon_module("intent")
+    bake = addon_module("bake")
+    obj = h.new_object("Long")
+    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
+        obj.location = (x, 0.3 * x, 0.0)
+        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
+        obj.keyframe_insert("location", frame=frame)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    actions, skipped, _ = bake.prepare([obj], bake.Options())
+    part = actions[0].parts[0]
+    motion = part.motion
+    args = (motion.source, motion.size, part.frames, part.values["location"], part.values["rotation_euler"])
+    start = time.process_time()
+    every = intent.departure(*args)
+    whole = time.process_time() - start
+    start = time.process_time()
+    sampled = intent.departure(*args, motion.frames)
+    spans = time.process_time() - start
+    print(f"{len(part.frames)} frames: every frame {every.degrees:.4f} deg {every.distance:.6f} units, "
+          f"{len(every.frames)} frames over, {whole * 1e3:.1f} ms; per span {sampled.degrees:.4f} deg "
+          f"{sampled.distance:.6f} units, {len(sampled.frames)} frames over, {spans * 1e3:.1f} ms")
+    assert len(every.frames) > 100, "the case departs (else it proves nothing)"
+    assert abs(sampled.degrees - every.degrees) <= 1e-3 * every.degrees
+    assert abs(sampled.distance - every.distance) <= 1e-3 * every.distance
+    # the frames over the thresholds: the same but within a sample spacing at the ends of runs
+    spacing = 3000 / (intent.DEPARTURE_SPAN_FRAMES - 1)
+    differ = np.setxor1d(every.frames, sampled.frames)
+    assert len(differ) <= 4 * spacing, (len(differ), spacing)
+    assert intent.frame_runs(sampled.frames).count("-") == intent.frame_runs(every.frames).count("-")
