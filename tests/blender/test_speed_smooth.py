@@ -11,14 +11,14 @@ from __future__ import annotations
 import math
 import time
 
-import bake_helpers as h
-import bone_helpers as bh
 import bpy
 import numpy as np
 import pytest
-from read_count import counting_reads, read_more_than_once
 
+import bake_helpers as h
+import bone_helpers as bh
 from conftest import addon_module
+from read_count import counting_reads, read_more_than_once
 
 
 def keyed(name: str, seed: int, mode: str = "XYZ", scale: bool = False) -> bpy.types.Object:
