@@ -223,35 +223,12 @@ pub struct Keyed {
 ///
 /// the largest distance any point within `r` of the body's origin can be from its place
 /// (`|(R1 - R2) p| = 2 sin(theta / 2) |p|` for the rotation, `|dS p| <= |ds| |p|` for the
-/// scale). Groups that are not keyed count as exact.
+/// scale). Groups that are not keyed count as exact. The angle comes as a [`Turn`]
+/// ([`Turn::angle`] gives it), so that a check over many samples computes it once, for the
+/// largest; the played rotation and translation come with it.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn row_error(
-    mode: RotationMode,
-    keyed: Keyed,
-    radius: f64,
-    y: &[f64; STRIDE],
-    rotation_target: DQuat,
-    translation_target: DVec3,
-    scale_target: DVec3,
-) -> (f64, f64, DQuat, DVec3) {
-    let (distance, turn, q, t) = row_error_turn(
-        mode,
-        keyed,
-        radius,
-        y,
-        rotation_target,
-        translation_target,
-        scale_target,
-    );
-    (distance, turn.angle(), q, t)
-}
-
-/// [`row_error`] with the rotation error as a [`Turn`] (its angle not yet computed; zero
-/// when rotation is not keyed).
-#[inline]
-#[allow(clippy::too_many_arguments)]
-pub fn row_error_turn(
     mode: RotationMode,
     keyed: Keyed,
     radius: f64,

@@ -4,7 +4,7 @@
 use glam::{DQuat, DVec3};
 
 use super::compose::{
-    jacobian, relative_angle, rotation, row_error, row_error_turn, Keyed, Turn, ROT, SCALE, STRIDE,
+    jacobian, relative_angle, rotation, row_error, Keyed, Turn, ROT, SCALE, STRIDE,
 };
 use super::{
     interpolation, Between, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
@@ -552,25 +552,11 @@ impl Sums {
 }
 
 impl Fitter<'_> {
+    /// [`row_error`] of channel row `y` at sample `j`.
     #[inline(always)]
-    fn error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, f64, DQuat, DVec3) {
+    fn error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, Turn, DQuat, DVec3) {
         let p = &self.target[j];
         row_error(
-            self.mode,
-            self.keyed,
-            self.radius,
-            y,
-            p.rotation,
-            p.translation,
-            self.scale[j],
-        )
-    }
-
-    /// [`Self::error`] with the rotation error as a [`Turn`].
-    #[inline(always)]
-    fn error_turn(&self, j: usize, y: &[f64; STRIDE]) -> (f64, Turn, DQuat, DVec3) {
-        let p = &self.target[j];
-        row_error_turn(
             self.mode,
             self.keyed,
             self.radius,
@@ -790,7 +776,7 @@ impl Fitter<'_> {
                     y[c] = segs[c].map_or(k0[c], |seg| seg.value_at(u)) as f64;
                 }
             }
-            let (d, turn, q, tr) = self.error_turn(j, &y);
+            let (d, turn, q, tr) = self.error(j, &y);
             finite &= !(d.is_nan() || turn.s.is_nan() || turn.c.is_nan());
             dmax = dmax.max(d);
             if turn.exceeds(tmax) {
@@ -1057,7 +1043,8 @@ impl Fitter<'_> {
                     e => e,
                 })?;
             }
-            let (d, a, q, t) = self.error(j, &y);
+            let (d, turn, q, t) = self.error(j, &y);
+            let a = turn.angle();
             dmax = dmax.max(d);
             amax = amax.max(a);
             *slot = Pose {
