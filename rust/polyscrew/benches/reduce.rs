@@ -10,12 +10,14 @@
 //! Group `reduce_scaling` (thread CPU time): one owner of 1,000, 10,000 and 100,000 frames:
 //! the time per frame should not grow with the clip (linear time).
 //!
-//! Run: `cargo bench -p polyscrew --bench reduce`.
+//! Run: `cargo bench -p polyscrew --bench reduce`. With `REDUCE_RIG_ONCE=1` in the
+//! environment the bench binary reduces the rig once on one thread and exits (no criterion):
+//! for instruction counts, `REDUCE_RIG_ONCE=1 valgrind --tool=callgrind <bench binary>`.
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::measurement::{Measurement, WallTime};
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use glam::{DQuat, DVec3};
 use polyscrew::reduce::{ReduceInput, ReduceOptions, Tolerance};
 use polyscrew::{reduce_keys, Pose, RotationMode};
@@ -56,7 +58,8 @@ fn rig(bones: usize, n: usize) -> (Vec<Pose>, Vec<f64>, Vec<Option<usize>>, Vec<
     (poses, frames, parents, offsets)
 }
 
-fn rig_bench<M: Measurement>(c: &mut Criterion<M>, group: &str, name: &str, threads: usize) {
+/// The rig bench's input and options on `threads` threads, handed to `f`.
+fn with_rig<R>(threads: usize, f: impl FnOnce(&ReduceInput<'_>, &ReduceOptions) -> R) -> R {
     let bones = 100;
     let (poses, frames, parents, offsets) = rig(bones, 1000);
     let modes = vec![RotationMode::Euler(polyscrew::EulerOrder::Xyz); bones];
@@ -83,18 +86,31 @@ fn rig_bench<M: Measurement>(c: &mut Criterion<M>, group: &str, name: &str, thre
         threads,
         between: Default::default(),
     };
-    let r = reduce_keys(&input, &options).unwrap();
+    f(&input, &options)
+}
+
+/// Key frames of the rig's reduction, and as a share of its frames.
+fn rig_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> (usize, f64) {
+    let r = reduce_keys(input, options).unwrap();
     let keys: usize = r.keys.iter().sum();
-    eprintln!(
-        "{group}: {keys} key frames over {bones} bones x 1000 frames ({:.1} % of frames)",
-        100.0 * keys as f64 / (bones * 1000) as f64
-    );
-    let mut g = c.benchmark_group(group);
-    g.throughput(Throughput::Elements(poses.len() as u64));
-    g.bench_function(name, |bench| {
-        bench.iter(|| black_box(reduce_keys(black_box(&input), &options).unwrap()))
-    });
-    g.finish();
+    (keys, keys as f64 / input.poses.len() as f64)
+}
+
+fn rig_bench<M: Measurement>(c: &mut Criterion<M>, group: &str, name: &str, threads: usize) {
+    with_rig(threads, |input, options| {
+        let (keys, share) = rig_keys(input, options);
+        eprintln!(
+            "{group}: {keys} key frames over {} bones x 1000 frames ({:.1} % of frames)",
+            input.modes.len(),
+            100.0 * share
+        );
+        let mut g = c.benchmark_group(group);
+        g.throughput(Throughput::Elements(input.poses.len() as u64));
+        g.bench_function(name, |bench| {
+            bench.iter(|| black_box(reduce_keys(black_box(input), options).unwrap()))
+        });
+        g.finish();
+    })
 }
 
 fn rig_cpu(c: &mut Criterion<CpuTime>) {
@@ -158,4 +174,16 @@ criterion_group! {
     config = config(WallTime);
     targets = rig_wall
 }
-criterion_main!(cpu, wall);
+fn main() {
+    if std::env::var_os("REDUCE_RIG_ONCE").is_some() {
+        let (keys, share) = with_rig(1, rig_keys);
+        println!(
+            "reduce_rig once: {keys} key frames ({:.2} % of frames)",
+            100.0 * share
+        );
+        return;
+    }
+    cpu();
+    wall();
+    Criterion::default().configure_from_args().final_summary();
+}

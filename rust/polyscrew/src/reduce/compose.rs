@@ -8,6 +8,7 @@
 use glam::{DQuat, DVec3};
 
 use crate::motion::channels::{EulerOrder, RotationMode};
+use crate::numeric::fastmath;
 
 /// Numbers per channel row: 3 location, up to 4 rotation, 3 scale.
 pub const STRIDE: usize = 10;
@@ -44,9 +45,14 @@ pub fn rotation(mode: RotationMode, r: &[f64]) -> DQuat {
             }
         }
         RotationMode::Euler(order) => {
-            let x = DQuat::from_rotation_x(r[0]);
-            let y = DQuat::from_rotation_y(r[1]);
-            let z = DQuat::from_rotation_z(r[2]);
+            // `from_rotation_x(a)` is `(sin(a / 2), 0, 0, cos(a / 2))`; the sines and cosines
+            // by the crate's one-reduction kernel (std's `sin_cos` is two library calls).
+            let (sx, cx) = fastmath::sin_cos(0.5 * r[0]);
+            let (sy, cy) = fastmath::sin_cos(0.5 * r[1]);
+            let (sz, cz) = fastmath::sin_cos(0.5 * r[2]);
+            let x = DQuat::from_xyzw(sx, 0.0, 0.0, cx);
+            let y = DQuat::from_xyzw(0.0, sy, 0.0, cy);
+            let z = DQuat::from_xyzw(0.0, 0.0, sz, cz);
             match order {
                 EulerOrder::Xyz => z * y * x,
                 EulerOrder::Xzy => y * z * x,
@@ -59,16 +65,66 @@ pub fn rotation(mode: RotationMode, r: &[f64]) -> DQuat {
     }
 }
 
+/// The turn between two rotations, kept as `(|q.xyz|, |q.w|)` of `q = a^-1 b`: its angle
+/// `theta = 2 atan2(|q.xyz|, |q.w|)` is only computed when asked ([`Turn::angle`]), so a
+/// check over many samples takes one `atan2` (of the largest turn) instead of one each.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Turn {
+    /// `|q.xyz|`.
+    pub s: f64,
+    /// `|q.w|`.
+    pub c: f64,
+}
+
+impl Default for Turn {
+    /// No turn (`q` the identity).
+    fn default() -> Self {
+        Self { s: 0.0, c: 1.0 }
+    }
+}
+
+impl Turn {
+    /// The turn taking unit `a` to unit `b`.
+    #[inline]
+    pub fn between(a: DQuat, b: DQuat) -> Self {
+        let q = a.conjugate() * b;
+        Self {
+            s: q.xyz().length(),
+            c: q.w.abs(),
+        }
+    }
+
+    /// `sin(theta / 2) = s / sqrt(s^2 + c^2)` (0 for a zero quaternion).
+    #[inline]
+    pub fn sin_half(self) -> f64 {
+        let norm = (self.s * self.s + self.c * self.c).sqrt();
+        if norm > 0.0 {
+            self.s / norm
+        } else {
+            0.0
+        }
+    }
+
+    /// `theta = 2 atan2(s, c)` in `[0, pi]` (no cancellation at small angles).
+    #[inline]
+    pub fn angle(self) -> f64 {
+        2.0 * self.s.atan2(self.c)
+    }
+
+    /// Whether this turn is larger than `other` (`s / c` larger, without dividing: the angle
+    /// grows with it).
+    #[inline]
+    pub fn exceeds(self, other: Self) -> bool {
+        self.s * other.c > other.s * self.c
+    }
+}
+
 /// `sin(theta / 2)` and `theta` (in `[0, pi]`) of the rotation taking unit `a` to unit `b`:
 /// with `q = a^-1 b`, `theta = 2 atan2(|q.xyz|, |q.w|)` (no cancellation at small angles).
 #[inline]
 pub fn relative_angle(a: DQuat, b: DQuat) -> (f64, f64) {
-    let q = a.conjugate() * b;
-    let s = q.xyz().length();
-    let c = q.w.abs();
-    let norm = (s * s + c * c).sqrt();
-    let sin_half = if norm > 0.0 { s / norm } else { 0.0 };
-    (sin_half, 2.0 * s.atan2(c))
+    let turn = Turn::between(a, b);
+    (turn.sin_half(), turn.angle())
 }
 
 /// The rotation channels' Jacobian at channel values `r` whose rotation is the unit `q`:
@@ -167,7 +223,9 @@ pub struct Keyed {
 ///
 /// the largest distance any point within `r` of the body's origin can be from its place
 /// (`|(R1 - R2) p| = 2 sin(theta / 2) |p|` for the rotation, `|dS p| <= |ds| |p|` for the
-/// scale). Groups that are not keyed count as exact.
+/// scale). Groups that are not keyed count as exact. The angle comes as a [`Turn`]
+/// ([`Turn::angle`] gives it), so that a check over many samples computes it once, for the
+/// largest; the played rotation and translation come with it.
 #[inline]
 #[allow(clippy::too_many_arguments)]
 pub fn row_error(
@@ -178,9 +236,9 @@ pub fn row_error(
     rotation_target: DQuat,
     translation_target: DVec3,
     scale_target: DVec3,
-) -> (f64, f64, DQuat, DVec3) {
+) -> (f64, Turn, DQuat, DVec3) {
     let mut distance = 0.0;
-    let mut angle = 0.0;
+    let mut turn = Turn::default();
     let t = DVec3::new(y[0], y[1], y[2]);
     let (q, t) = {
         let q = if keyed.rotation {
@@ -199,15 +257,14 @@ pub fn row_error(
         distance += (t - translation_target).length();
     }
     if keyed.rotation {
-        let (sin_half, theta) = relative_angle(rotation_target, q);
-        distance += 2.0 * radius * sin_half;
-        angle = theta;
+        turn = Turn::between(rotation_target, q);
+        distance += 2.0 * radius * turn.sin_half();
     }
     if keyed.scale {
         let s = DVec3::new(y[SCALE], y[SCALE + 1], y[SCALE + 2]);
         distance += radius * (s - scale_target).length();
     }
-    (distance, angle, q, t)
+    (distance, turn, q, t)
 }
 
 #[cfg(test)]
@@ -273,6 +330,25 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn the_largest_turn_is_the_largest_angle() {
+        let turns: Vec<Turn> = [0.0, 1e-9, 0.3, 0.2, 2.9, 3.1, 1.0]
+            .iter()
+            .map(|a| Turn::between(DQuat::IDENTITY, DQuat::from_rotation_z(*a)))
+            .collect();
+        let mut max = Turn::default();
+        assert_eq!(max.angle(), 0.0);
+        for t in &turns {
+            if t.exceeds(max) {
+                max = *t;
+            }
+        }
+        assert!((max.angle() - 3.1).abs() < 1e-12, "{}", max.angle());
+        let zero = Turn::between(DQuat::IDENTITY, DQuat::IDENTITY);
+        assert!(!zero.exceeds(Turn::default()) && !Turn::default().exceeds(zero));
+        assert!(turns[1].exceeds(Turn::default()), "any turn exceeds none");
     }
 
     #[test]

@@ -507,28 +507,31 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
     let mut results: Vec<Option<owner::OwnerResult>> = try_vec(b, "reduced owners")?;
     results.resize_with(b, || None);
     let threads = effective_threads(options.threads, b);
+    // One thread: one set of buffers for every owner of every level.
+    let mut single = owner::Workspace::default();
     for level in 0..=max_depth {
         let owners: Vec<usize> = (0..b).filter(|o| depth[*o] == level).collect();
-        let run = |part: &[usize]| -> Vec<(usize, Result<owner::OwnerResult>)> {
-            let mut ws = owner::Workspace::default();
+        let run = |part: &[usize],
+                   ws: &mut owner::Workspace|
+         -> Vec<(usize, Result<owner::OwnerResult>)> {
             part.iter()
                 .map(|&o| {
                     let parent = input.parents.and_then(|p| p[o]).map(|q| {
                         let r = results[q].as_ref().expect("parents first");
                         r.world.as_ref().expect("a parent keeps its world poses")
                     });
-                    (o, ctx.reduce_owner(&mut ws, o, parent, has_children[o]))
+                    (o, ctx.reduce_owner(ws, o, parent, has_children[o]))
                 })
                 .collect()
         };
         let done: Vec<(usize, Result<owner::OwnerResult>)> = if threads <= 1 || owners.len() <= 1 {
-            run(&owners)
+            run(&owners, &mut single)
         } else {
             let per = owners.len().div_ceil(threads);
             let parts = std::thread::scope(|scope| {
                 let handles: Vec<_> = owners
                     .chunks(per)
-                    .map(|chunk| scope.spawn(move || run(chunk)))
+                    .map(|chunk| scope.spawn(move || run(chunk, &mut owner::Workspace::default())))
                     .collect();
                 handles.into_iter().map(|h| h.join()).collect::<Vec<_>>()
             });
@@ -543,6 +546,15 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
                 Error::Invalid { what, reason } => invalid(what, format!("owner {o}: {reason}")),
                 e => e,
             })?);
+        }
+        // The owners one level up have no children left to reduce: their world poses go
+        // (their memory is reused by the next level's).
+        if let Some(up) = level.checked_sub(1) {
+            for o in (0..b).filter(|o| depth[*o] == up) {
+                if let Some(r) = results[o].as_mut() {
+                    r.world = None;
+                }
+            }
         }
     }
     let mut curves = Vec::new();

@@ -3,7 +3,9 @@
 
 use glam::{DQuat, DVec3};
 
-use super::compose::{jacobian, relative_angle, rotation, row_error, Keyed, ROT, SCALE, STRIDE};
+use super::compose::{
+    jacobian, relative_angle, rotation, row_error, Keyed, Turn, ROT, SCALE, STRIDE,
+};
 use super::{
     interpolation, Between, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
     SEARCH_MARGIN, SUBSAMPLES,
@@ -497,9 +499,62 @@ fn bernstein(u: f64) -> [f64; 4] {
     [w * w * w, 3.0 * u * w * w, 3.0 * u * u * w, u * u * u]
 }
 
+/// Running sums of the samples after a key, from which [`Fitter::fit_sums`] fits any span
+/// starting at the key in O(columns): with `tau_j = t_j - t_key`, `sum tau^p` (p = 1..6) and
+/// per column `sum tau^p v` (p = 1..3), over the samples `key + 1 ..= last`. A span's end
+/// only rescales them (`u = tau / D`), so the search extends one set of sums from its
+/// longest success instead of refitting every candidate over all its samples.
+#[derive(Debug, Clone, Copy)]
+struct Sums {
+    key: usize,
+    last: usize,
+    /// `sum tau^p`, `p = 0..7` (entry 0 unused).
+    powers: [f64; 7],
+    /// Per column, `sum tau^p v` for `p = 1, 2, 3`.
+    values: [[f64; 3]; STRIDE],
+}
+
+impl Sums {
+    /// No samples yet after `key`.
+    fn new(key: usize) -> Self {
+        Self {
+            key,
+            last: key,
+            powers: [0.0; 7],
+            values: [[0.0; 3]; STRIDE],
+        }
+    }
+
+    /// Adds the samples `self.last + 1 ..= last` of columns `cols`.
+    #[inline]
+    fn extend(&mut self, fitter: &Fitter<'_>, last: usize, cols: &[usize]) {
+        let t0 = fitter.times[self.key];
+        for j in self.last + 1..=last {
+            let tau = fitter.times[j] - t0;
+            let t2 = tau * tau;
+            let t3 = t2 * tau;
+            self.powers[1] += tau;
+            self.powers[2] += t2;
+            self.powers[3] += t3;
+            self.powers[4] += t2 * t2;
+            self.powers[5] += t2 * t3;
+            self.powers[6] += t3 * t3;
+            let v = &fitter.v[j];
+            for &c in cols {
+                let sum = &mut self.values[c];
+                sum[0] += tau * v[c];
+                sum[1] += t2 * v[c];
+                sum[2] += t3 * v[c];
+            }
+        }
+        self.last = self.last.max(last);
+    }
+}
+
 impl Fitter<'_> {
+    /// [`row_error`] of channel row `y` at sample `j`.
     #[inline(always)]
-    fn error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, f64, DQuat, DVec3) {
+    fn error(&self, j: usize, y: &[f64; STRIDE]) -> (f64, Turn, DQuat, DVec3) {
         let p = &self.target[j];
         row_error(
             self.mode,
@@ -563,7 +618,7 @@ impl Fitter<'_> {
 
     /// The inner handle values of the span `s..=e` for columns `cols`: least squares over
     /// the samples strictly inside, the key values fixed; a straight line when fewer than
-    /// three samples are inside.
+    /// three samples are inside ([`Sums`] from `s`, then [`Self::fit_sums`]).
     fn fit(
         &self,
         s: usize,
@@ -572,24 +627,51 @@ impl Fitter<'_> {
         h1: &mut [f64; STRIDE],
         h2: &mut [f64; STRIDE],
     ) {
+        let mut sums = Sums::new(s);
+        sums.extend(self, e - 1, cols);
+        self.fit_sums(&sums, e, cols, h1, h2);
+    }
+
+    /// [`Self::fit`] of the span from `sums.key` to `e` from the running sums `sums` of the
+    /// samples strictly inside (`sums.last == e - 1`): with `u = tau / D`, `D = t_e - t_key`,
+    /// `S_p = sum u^p` and `Q_p = sum u^p v`, the normal equations of the two inner Bernstein
+    /// coefficients are
+    ///
+    /// ```text
+    /// [a11 a12] [h1]   [r1]     a11 = sum b1^2 = 9 sum u^2 (1 - u)^4, a12 = sum b1 b2 = 9 sum u^3 (1 - u)^3,
+    /// [a12 a22] [h2] = [r2]     a22 = sum b2^2 = 9 sum u^4 (1 - u)^2,
+    /// r1 = sum b1 v - v0 sum b1 b0 - v3 sum b1 b3 = 3 (Q1 - 2 Q2 + Q3) - 3 v0 sum u (1 - u)^5 - 3 v3 sum u^4 (1 - u)^2,
+    /// r2 = sum b2 v - v0 sum b2 b0 - v3 sum b2 b3 = 3 (Q2 - Q3) - 3 v0 sum u^2 (1 - u)^4 - 3 v3 sum u^5 (1 - u),
+    /// ```
+    ///
+    /// each sum of powers of `u` expanded in `S_1 .. S_6`: O(columns) per span instead of
+    /// O(samples x columns).
+    fn fit_sums(
+        &self,
+        sums: &Sums,
+        e: usize,
+        cols: &[usize],
+        h1: &mut [f64; STRIDE],
+        h2: &mut [f64; STRIDE],
+    ) {
+        let s = sums.key;
+        debug_assert_eq!(sums.last + 1, e);
         let (v0, v3) = (&self.v[s], &self.v[e]);
-        let ts = self.times[s];
-        let inv = 1.0 / (self.times[e] - ts);
-        let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);
-        let mut r1 = [0.0; STRIDE];
-        let mut r2 = [0.0; STRIDE];
-        for j in s + 1..e {
-            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
-            a11 += b1 * b1;
-            a12 += b1 * b2;
-            a22 += b2 * b2;
-            let vj = &self.v[j];
-            for &c in cols {
-                let r = vj[c] - v0[c] * b0 - v3[c] * b3;
-                r1[c] += b1 * r;
-                r2[c] += b2 * r;
-            }
+        let d = self.times[e] - self.times[s];
+        let inv = 1.0 / d;
+        let mut scale = [1.0; 7];
+        for p in 1..7 {
+            scale[p] = scale[p - 1] * inv;
         }
+        let sp = |p: usize| sums.powers[p] * scale[p];
+        let (s1, s2, s3, s4, s5, s6) = (sp(1), sp(2), sp(3), sp(4), sp(5), sp(6));
+        // sum u^2 (1 - u)^4, u^3 (1 - u)^3, u^4 (1 - u)^2, u (1 - u)^5, u^5 (1 - u).
+        let p24 = s2 - 4.0 * s3 + 6.0 * s4 - 4.0 * s5 + s6;
+        let p33 = s3 - 3.0 * s4 + 3.0 * s5 - s6;
+        let p42 = s4 - 2.0 * s5 + s6;
+        let p15 = s1 - 5.0 * s2 + 10.0 * s3 - 10.0 * s4 + 5.0 * s5 - s6;
+        let p51 = s5 - s6;
+        let (a11, a12, a22) = (9.0 * p24, 9.0 * p33, 9.0 * p42);
         let det = a11 * a22 - a12 * a12;
         if e - s < 4 || det <= 1e-9 * a11 * a22 {
             for &c in cols {
@@ -600,8 +682,12 @@ impl Fitter<'_> {
         }
         let inv_det = 1.0 / det;
         for &c in cols {
-            h1[c] = (a22 * r1[c] - a12 * r2[c]) * inv_det;
-            h2[c] = (a11 * r2[c] - a12 * r1[c]) * inv_det;
+            let [q1, q2, q3] = sums.values[c];
+            let (q1, q2, q3) = (q1 * scale[1], q2 * scale[2], q3 * scale[3]);
+            let r1 = 3.0 * (q1 - 2.0 * q2 + q3) - 3.0 * v0[c] * p15 - 3.0 * v3[c] * p42;
+            let r2 = 3.0 * (q2 - q3) - 3.0 * v0[c] * p24 - 3.0 * v3[c] * p51;
+            h1[c] = (a22 * r1 - a12 * r2) * inv_det;
+            h2[c] = (a11 * r2 - a12 * r1) * inv_det;
         }
     }
 
@@ -670,8 +756,9 @@ impl Fitter<'_> {
         }
         let first = cols.first().and_then(|c| segs[*c]);
         let near = |a: f32, b: f32| (a - b).abs() <= KEY_THRESHOLD;
-        let (mut dmax, mut amax) = (0.0f64, 0.0f64);
-        let mut ok = true;
+        // The largest turn, its angle taken once at the end (one `atan2` per span).
+        let (mut dmax, mut tmax) = (0.0f64, Turn::default());
+        let mut finite = true;
         for j in s..=e {
             let t = self.times32[j];
             let mut y = self.v[j];
@@ -689,22 +776,25 @@ impl Fitter<'_> {
                     y[c] = segs[c].map_or(k0[c], |seg| seg.value_at(u)) as f64;
                 }
             }
-            let (d, a, q, tr) = self.error(j, &y);
+            let (d, turn, q, tr) = self.error(j, &y);
+            finite &= !(d.is_nan() || turn.s.is_nan() || turn.c.is_nan());
             dmax = dmax.max(d);
-            amax = amax.max(a);
-            if !(d <= limit.distance && a <= limit.angle) {
-                ok = false;
+            if turn.exceeds(tmax) {
+                tmax = turn;
             }
             out[j] = Pose {
                 rotation: q,
                 translation: tr,
             };
         }
+        let amax = tmax.angle();
+        let ok = finite && dmax <= limit.distance && amax <= limit.angle;
         (ok, dmax, amax)
     }
 
-    /// Fits the span `s..=e` and checks it by the model (`exact`: and by Blender's
-    /// evaluation): the span, and the exact errors when checked exactly.
+    /// Fits the span `s..=e` (from `sums`, the running sums of its inner samples, when
+    /// given) and checks it by the model (`exact`: and by Blender's evaluation): the span,
+    /// and the exact errors when checked exactly.
     #[allow(clippy::too_many_arguments)]
     fn try_span(
         &self,
@@ -714,6 +804,7 @@ impl Fitter<'_> {
         tol: Tolerance,
         exact: bool,
         out: &mut [Pose],
+        sums: Option<&Sums>,
     ) -> (Option<Span>, f64, f64) {
         let mut span = Span {
             s,
@@ -722,7 +813,10 @@ impl Fitter<'_> {
             h1: [0.0; STRIDE],
             h2: [0.0; STRIDE],
         };
-        self.fit(s, e, cols, &mut span.h1, &mut span.h2);
+        match sums {
+            Some(sums) => self.fit_sums(sums, e, cols, &mut span.h1, &mut span.h2),
+            None => self.fit(s, e, cols, &mut span.h1, &mut span.h2),
+        }
         let model = Tolerance {
             distance: tol.distance * SEARCH_MARGIN,
             angle: tol.angle * SEARCH_MARGIN,
@@ -801,11 +895,18 @@ impl Fitter<'_> {
             // The span of the longest model success so far (that of `lo` below), so that
             // the exact check does not fit it again.
             let mut fitted: Option<Span> = None;
+            // The running sums of that span's inner samples (none yet): every candidate is
+            // longer than the longest success so far, so its sums extend these.
+            let mut fitted_sums = Sums::new(key);
             let mut ok = |k: usize, out: &mut [Pose]| {
-                let span = self.try_span(key, pos(k - 1), cols, tol, false, out).0;
+                let e = pos(k - 1);
+                let mut sums = fitted_sums;
+                sums.extend(self, e - 1, cols);
+                let span = self.try_span(key, e, cols, tol, false, out, Some(&sums)).0;
                 let pass = span.is_some();
                 if pass {
                     fitted = span;
+                    fitted_sums = sums;
                 }
                 pass
             };
@@ -857,7 +958,7 @@ impl Fitter<'_> {
                     let mut lo2 = 0;
                     while lo2 < bad {
                         let mid = lo2 + (bad - lo2) / 2;
-                        match self.try_span(key, pos(mid), cols, tol, true, out) {
+                        match self.try_span(key, pos(mid), cols, tol, true, out, None) {
                             (Some(_), _, _) => {
                                 good = Some(mid);
                                 lo2 = mid + 1;
@@ -866,7 +967,7 @@ impl Fitter<'_> {
                         }
                     }
                     if let Some(g) = good {
-                        let (span, d, a) = self.try_span(key, pos(g), cols, tol, true, out);
+                        let (span, d, a) = self.try_span(key, pos(g), cols, tol, true, out, None);
                         accepted = span.map(|s| (s, d, a));
                     }
                 }
@@ -889,7 +990,9 @@ impl Fitter<'_> {
                             let (_, d, a) = self.exact(&span, cols, tol, out);
                             break (span, d, a);
                         }
-                        if let (Some(span), d, a) = self.try_span(key, e, cols, tol, true, out) {
+                        if let (Some(span), d, a) =
+                            self.try_span(key, e, cols, tol, true, out, None)
+                        {
                             break (span, d, a);
                         }
                         e -= 1;
@@ -940,7 +1043,8 @@ impl Fitter<'_> {
                     e => e,
                 })?;
             }
-            let (d, a, q, t) = self.error(j, &y);
+            let (d, turn, q, t) = self.error(j, &y);
+            let a = turn.angle();
             dmax = dmax.max(d);
             amax = amax.max(a);
             *slot = Pose {
@@ -949,5 +1053,116 @@ impl Fitter<'_> {
             };
         }
         Ok((dmax, amax))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The direct least-squares fit the running sums replace: the normal equations summed
+    /// sample by sample (the reduction's fit before [`Sums`]).
+    fn direct_fit(
+        times: &[f64],
+        v: &[[f64; STRIDE]],
+        s: usize,
+        e: usize,
+        cols: &[usize],
+    ) -> ([f64; STRIDE], [f64; STRIDE]) {
+        let (v0, v3) = (&v[s], &v[e]);
+        let ts = times[s];
+        let inv = 1.0 / (times[e] - ts);
+        let (mut a11, mut a12, mut a22) = (0.0, 0.0, 0.0);
+        let mut r1 = [0.0; STRIDE];
+        let mut r2 = [0.0; STRIDE];
+        for j in s + 1..e {
+            let [b0, b1, b2, b3] = bernstein((times[j] - ts) * inv);
+            a11 += b1 * b1;
+            a12 += b1 * b2;
+            a22 += b2 * b2;
+            for &c in cols {
+                let r = v[j][c] - v0[c] * b0 - v3[c] * b3;
+                r1[c] += b1 * r;
+                r2[c] += b2 * r;
+            }
+        }
+        let det = a11 * a22 - a12 * a12;
+        let (mut h1, mut h2) = ([0.0; STRIDE], [0.0; STRIDE]);
+        for &c in cols {
+            h1[c] = (a22 * r1[c] - a12 * r2[c]) / det;
+            h2[c] = (a11 * r2[c] - a12 * r1[c]) / det;
+        }
+        (h1, h2)
+    }
+
+    #[test]
+    fn running_sum_fit_equals_the_direct_fit() {
+        // Uneven frames far from 0 (so that tau, not t, must be summed), 4 samples per frame.
+        let frames: Vec<f64> = (0..200)
+            .map(|i| 1000.0 + i as f64 + 0.3 * (i as f64 * 0.7).sin())
+            .collect();
+        let mut times = Vec::new();
+        for w in frames.windows(2) {
+            for k in 0..SUBSAMPLES {
+                times.push(w[0] + (w[1] - w[0]) * k as f64 / SUBSAMPLES as f64);
+            }
+        }
+        times.push(*frames.last().unwrap());
+        let times32: Vec<f32> = times.iter().map(|t| *t as f32).collect();
+        let v: Vec<[f64; STRIDE]> = times
+            .iter()
+            .map(|t| {
+                let mut row = [0.0; STRIDE];
+                for (c, x) in row.iter_mut().enumerate() {
+                    *x = (0.05 * t * (1.0 + c as f64 * 0.1)).sin() * (1.0 + c as f64) + 30.0;
+                }
+                row
+            })
+            .collect();
+        let m = times.len();
+        let target = vec![Pose::IDENTITY; m];
+        let scale = vec![DVec3::ONE; m];
+        let fitter = Fitter {
+            times: &times,
+            times32: &times32,
+            v: &v,
+            target: &target,
+            scale: &scale,
+            jac: None,
+            mode: RotationMode::Quaternion,
+            keyed: Keyed {
+                location: true,
+                rotation: true,
+                scale: true,
+            },
+            radius: 1.0,
+        };
+        let cols: Vec<usize> = (0..STRIDE).collect();
+        for key in [0usize, 37, 400] {
+            // One set of sums extended span by span, as the search does.
+            let mut sums = Sums::new(key);
+            for len in [5usize, 9, 16, 40, 41, 120, 300] {
+                let e = key + len;
+                if e >= m {
+                    continue;
+                }
+                sums.extend(&fitter, e - 1, &cols);
+                let (mut h1, mut h2) = ([0.0; STRIDE], [0.0; STRIDE]);
+                fitter.fit_sums(&sums, e, &cols, &mut h1, &mut h2);
+                let (d1, d2) = direct_fit(&times, &v, key, e, &cols);
+                for c in 0..STRIDE {
+                    for (got, want) in [(h1[c], d1[c]), (h2[c], d2[c])] {
+                        assert!(
+                            (got - want).abs() <= 1e-9 * (1.0 + want.abs()),
+                            "key {key}, span {len}, column {c}: {got} vs {want}"
+                        );
+                    }
+                }
+                // And the fit from scratch agrees with the extended one.
+                let (mut g1, mut g2) = ([0.0; STRIDE], [0.0; STRIDE]);
+                fitter.fit(key, e, &cols, &mut g1, &mut g2);
+                assert_eq!((g1, g2), (h1, h2), "key {key}, span {len}");
+            }
+        }
     }
 }
