@@ -301,7 +301,16 @@ def _read(
             found[prop, fc.array_index] = fc
     if not found:
         raise SmoothError(f"{name}: no keyed transform channels (location, {paths[1]}, scale): skipped")
-    points = {key: _key_points(fc) for key, fc in found.items()}
+    columns = list(found)
+    try:  # every curve read once: the key points below are the packed keys'
+        packed = curves.read([found[c] for c in columns], keys_only=True)
+    except curves.UnsupportedCurve as err:
+        packed, unsupported = None, err
+    if packed is not None:
+        co = packed.co.astype(np.float64)
+        points = {key: co[packed.offsets[c] : packed.offsets[c + 1]] for c, key in enumerate(columns)}
+    else:
+        points = {key: _key_points(fc) for key, fc in found.items()}
     frames = _union([p[:, 0] for p in points.values()])
     if len(frames) < 2:
         raise SmoothError(f"{name}: only one key frame ({frames[0]:g}); smoothing needs at least two: skipped")
@@ -314,10 +323,10 @@ def _read(
     stacked = {key: modifiers.kept(fc) for key, fc in found.items() if modifiers.kept(fc)}
 
     statics = {path: np.array(getattr(target, path), dtype=np.float64) for path in paths}
-    columns = list(found)
     notes = []
     try:
-        packed = curves.read([found[c] for c in columns], keys_only=True)
+        if packed is None:
+            raise unsupported
         source = intent.Source(
             packed=packed, columns=columns, static=statics, mode=mode, rotation_path=paths[1], located=located
         )
