@@ -126,7 +126,7 @@ class Item:
     #: Whole frames among the dense frames (quarter frames aside), for the report.
     whole: int = 0
     #: The reference at the probes of every span when it is not the screw between the frames
-    #: (:func:`measured`): Blender's playback of LINEAR keys, the smoothed motion itself.
+    #: (:func:`measured`): Blender's playback of LINEAR keys there.
     probe_ref: np.ndarray | None = None
 
 
@@ -514,8 +514,8 @@ def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options
 def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarray]:
     """Per owner: the largest error of the reduced curves against the core's reference (the
     dense poses at the frames, the screw between two frames, a step held; the item's
-    `probe_ref` at the probes when it has one), at every frame and at the probes, in world space along the chains, measured here independently of the
-    core: the curves played by `polyscrew.evaluate_fcurves` (Blender's evaluation, one call
+    `probe_ref` at the probes when it has one), at every frame and at the probes, in world
+    space along the chains, measured here independently of the core: the curves played by `polyscrew.evaluate_fcurves` (Blender's evaluation, one call
     for the batch), channels not written held at their dense values (a connected bone's
     location: none, as Blender plays it), composed with the parents' played poses."""
     items, frames = batch.items, batch.frames
@@ -577,8 +577,9 @@ def solve_batch(batch: Batch, options: Options) -> list[Reduced]:
     here (:func:`measured`) and asked again with a tolerance scaled down where it misses.
     The errors reported are those measured plus the margin (a bound of the error against
     Blender's playback of the dense keys at every frame and at the probes); when every item
-    has its reference at the probes (`probe_ref`: the motion itself there), those measured,
-    against the whole tolerance."""
+    has its reference at the probes (`probe_ref`: Blender's playback there), those measured,
+    against the whole tolerance; with `between="cubic"` (no reference between frames here),
+    the core's own measure."""
     distance = max(options.distance - batch.margin[0], 0.5 * options.distance)
     angle = max(options.angle - batch.margin[1], 0.5 * options.angle)
     inner = Options(distance=distance, angle=angle, per_channel=options.per_channel)
@@ -586,7 +587,7 @@ def solve_batch(batch: Batch, options: Options) -> list[Reduced]:
     limit = (options.distance, options.angle) if exact else (distance, angle)
     for attempt in range(RETRIES + 1):
         results = solve(batch.items, batch.frames, inner, batch.cyclic, batch.between)
-        if batch.between == "cubic":  # (no reference between frames here: the core's own measure)
+        if batch.between == "cubic":
             dist = np.array([r.distance_error for r in results])
             ang = np.array([r.angle_error for r in results])
         else:
@@ -887,15 +888,16 @@ def reduce_bakes(bakes: list, distance: float, angle: float) -> str:
     (:class:`bake.ActionBake`) before anything is written, setting each part's `reduced`.
     One `polyscrew.reduce_keys` call per set of baked frames (usually one: all owners of the
     operator), asked again with a smaller tolerance where the result misses it
-    (:func:`solve_batch`), against the smoothed motion (:func:`smoothed_batch`). A part over a Frame Range narrower than the keys is reduced
-    inside the range (its writing joins the source keys kept outside it,
-    :func:`write_joined`). Returns the report's line (:func:`summary`)."""
-    batches_: dict[tuple, list] = {}
+    (:func:`solve_batch`), against the smoothed motion (:func:`smoothed_batch`). A part over
+    a Frame Range narrower than the keys is reduced inside the range (its writing joins the
+    source keys kept outside it, :func:`write_joined`). Returns the report's line
+    (:func:`summary`)."""
+    by_frames: dict[tuple, list] = {}
     for action_bake in bakes:
         for part in action_bake.parts:
-            batches_.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
+            by_frames.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
     options = Options(distance=distance, angle=angle)
-    for (_, cyclic), parts in batches_.items():
+    for (_, cyclic), parts in by_frames.items():
         batch = smoothed_batch(parts, cyclic)
         for part, result in zip(parts, solve_batch(batch, options)):
             part.reduced = result
