@@ -132,6 +132,11 @@ def test_smooth_motion_reduced_keeps_few_keys_of_a_sparse_motion(sb):
     assert keys_ <= 15  # (the screw between frames as the reference kept 29)
     assert d_f.max() <= DISTANCE + SLACK and a_f.max() <= ANGLE + SLACK
     assert d_q.max() <= DISTANCE + d_e.max() + SLACK
+    # unedited, it is replaced by a re-run (the digest of the reduced keys it wrote is Blender's)
+    name = reduced.animation_data.action.name
+    assert bpy.ops.screwbender.smooth(key_mode="REDUCED", key_distance=DISTANCE, key_angle=ANGLE) == {"FINISHED"}
+    assert reduced.animation_data.action.name == name
+    assert len([a for a in bpy.data.actions if a.name.startswith(name)]) == 1
 
 
 def test_a_rerun_keeps_an_edited_reduction(sb):
