@@ -48,6 +48,7 @@ import importlib
 import importlib.util
 import json
 import math
+import subprocess
 import sys
 import tempfile
 import time
@@ -547,9 +548,8 @@ def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, resolution: floa
     starts from the bracket the trials so far give. A bracket is found by steps of x4 from a
     guess (the tolerance's distance in metres, or the smaller tolerance's margin), then closed
     by regula falsi on log(margin) against log(error / tolerance) (decimate's error grows about
-    as a power of its margin), safeguarded to the inner 80 % of the bracket and followed by a
-    trial one resolution step across, so the bracket closes from both sides. About 5 trials per
-    tolerance where bisection over MARGINS took 8 to 10, at the same resolution. Each trial
+    as a power of its margin), each trial followed by one a resolution step across, so that the
+    bracket closes from both sides around the predicted margin. Each trial
     keeps its time and its decimated actions (checked by Blender's playback afterwards)."""
     cache: dict[float, tuple[float, float, int]] = {}
     kept: dict[float, tuple[float, dict]] = {}
@@ -598,22 +598,25 @@ def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, resolution: floa
             else:
                 hi = m
         while hi is not None and hi / lo > resolution:
+            # where log(error / tolerance) reaches 0 on the line through the bracket's ends (the
+            # error grows about as a power of the margin), kept a resolution step inside it
             a, b = math.log(lo), math.log(hi)
             ra, rb = math.log(ratio(lo)), math.log(ratio(hi))
             x = a + (b - a) * (0.0 - ra) / (rb - ra) if rb > ra else 0.5 * (a + b)
-            x = min(max(x, a + 0.1 * (b - a)), b - 0.1 * (b - a))
+            step = math.log(resolution)
+            if b - a <= 2.0 * step:
+                x = 0.5 * (a + b)
+            x = min(max(x, a + step), b - step)
             m = math.exp(x)
-            if ratio(m) <= 1.0:
-                lo = m
-                across = lo * resolution
+            if ratio(m) <= 1.0:  # and one resolution step up: the bracket may close there
+                lo, across = m, m * resolution
                 if across < hi:
                     if ratio(across) <= 1.0:
                         lo = across
                     else:
                         hi = across
             else:
-                hi = m
-                across = hi / resolution
+                hi, across = m, m / resolution
                 if across > lo:
                     if ratio(across) <= 1.0:
                         lo = across
@@ -665,11 +668,21 @@ def smooth_timing(runs: int) -> list[dict]:
     return out
 
 
+def window_search(out: Path, resolution: float) -> None:
+    """The margin search of the windowed clips (:data:`WINDOWED`, one per process: the
+    `--clips` given) on their first :data:`WINDOW` frames, written to `out` as JSON."""
+    name = next(n for n in WINDOWED if n in sys.argv)
+    window = Clip(globals()[f"clip_{name}"](n=WINDOW))
+    search = search_margin(window, fast_playback(window.owners, window.times), TOLERANCES, resolution)
+    out.write_text(json.dumps({"best": [[list(k), v] for k, v in search["best"].items()], "trials": search["trials"]}))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path)
     parser.add_argument("--quick", action="store_true", help="a coarser margin search, one timing run")
     parser.add_argument("--clips", nargs="*", help="only these clips (camera walk bvh demo rig100)")
+    parser.add_argument("--window-search", type=Path, help=argparse.SUPPRESS)  # (the child process below)
     args = parser.parse_args()
     # the margin's resolution: that of `steps` bisection steps over MARGINS (log scale)
     steps = 5 if args.quick else 8
@@ -677,8 +690,20 @@ def main() -> None:
     started = time.perf_counter()
     report = {"blender": bpy.app.version_string, "tolerances": TOLERANCES, "steps": steps, "slack": SLACK, "clips": [],
               "resolution": resolution}
+    if args.window_search is not None:
+        window_search(args.window_search, resolution)
+        return
     print(f"Blender {bpy.app.version_string}: Reduce Keys against graph.decimate (margin searched to a factor "
           f"{resolution:.3f}, the resolution of {steps} bisection steps)")
+    # The windowed clips' margin searches (minutes of decimate calls) run in a second Blender
+    # process meanwhile (the machine's second core): the figures are the same, the wall time
+    # about that of the longer of the two
+    children = {}
+    for name in WINDOWED:
+        if not args.clips or name in args.clips:
+            out = Path(tempfile.mkdtemp(prefix="bench-reduce-")) / f"{name}.json"
+            command = [sys.executable, __file__, "--window-search", str(out), "--clips", name]
+            children[name] = (subprocess.Popen(command + (["--quick"] if args.quick else [])), out)
     for build in CLIPS:
         if args.clips and build.__name__.removeprefix("clip_") not in args.clips:
             continue
@@ -687,9 +712,12 @@ def main() -> None:
         if name in WINDOWED:
             # decimate takes minutes on the whole clip: its margin is searched on the clip's
             # first WINDOW frames (the same motion), then checked on the whole clip
-            window = Clip(build(n=WINDOW))
-            fast_window = fast_playback(window.owners, window.times)
-            search = search_margin(window, fast_window, TOLERANCES, resolution)
+            process, out = children[name]
+            if process.wait() != 0:
+                sys.exit(f"bench_reduce: the margin search of {name} failed")
+            found = json.loads(out.read_text())
+            window = True
+            search = {"best": {tuple(k): v for k, v in found["best"]}, "trials": found["trials"], "kept": {}}
         clip = Clip(build())
         ref = blender_playback(clip.owners, clip.times)
         fast_ref = fast_playback(clip.owners, clip.times)
