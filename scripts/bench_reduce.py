@@ -18,13 +18,17 @@ whole operator), with the channels of an owner keyed on shared frames (the defau
 Per Channel. Theirs: `bpy.ops.graph.decimate(mode='ERROR', remove_error_margin=m)`, every
 other option at its default, headless through `bpy.context.temp_override` with the largest
 area of the Animation screen switched to the Graph Editor and its WINDOW region, every key
-selected, the dope sheet's `show_only_selected` off; its margin is searched by bisection (in
-log scale between 1e-6 and 0.1, 8 steps) for the largest value whose result still meets the same world-space
-tolerance (the search checks with `polyscrew.evaluate_fcurves`, Blender's own evaluation
-bit for bit, composed along the bone chains in numpy); the time is that of one decimate call
-at the best margin. On rig100 one decimate call takes a minute or more: its margin is
-searched on the clip's first 200 frames (the same motion) and then run once on the whole clip
-(a smaller margin, x0.7, up to twice, when the whole clip misses the tolerance). Both results are checked by Blender's own playback: `scene.frame_set`
+selected, the dope sheet's `show_only_selected` off; its margin is searched (between 1e-6
+and 0.1, to a factor of 1.046: the resolution of 8 bisection steps in log scale) for the
+largest value whose result still meets the same world-space tolerance, by regula falsi on
+the logarithms with every trial shared between tolerances (:func:`search_margin`: about
+half the decimate calls of bisection); the search checks with `polyscrew.evaluate_fcurves`,
+Blender's own evaluation bit for bit, composed along the bone chains in numpy; the time is
+that of one decimate call at the best margin. On rig100 one decimate call takes a minute or
+more (decimate works curve by curve, about 0.2 s per curve of 1,000 keys here, so running it
+per chain would not be faster): its margin is searched on the clip's first 200 frames (the
+same motion) and then run once on the whole clip per margin found (a smaller margin, x0.7,
+up to twice, when the whole clip misses the tolerance). Both results are checked by Blender's own playback: `scene.frame_set`
 at every frame and three subframes between frames, every owner's `matrix_world` (a bone:
 `matrix_world @ PoseBone.matrix`), against the dense clip's own playback at the same
 samples: the largest distance of any point of the body (an object's bounding box corners and
@@ -44,6 +48,7 @@ import importlib
 import importlib.util
 import json
 import math
+import subprocess
 import sys
 import tempfile
 import time
@@ -527,10 +532,25 @@ def measure(clip: Clip, ref: np.ndarray, distance: float, angle: float, elapsed:
             "distance_frames": float(dist[:, whole].max()), "angle_frames": float(math.degrees(ang[:, whole].max()))}
 
 
-def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, steps: int) -> dict:
-    """Per tolerance: the largest decimate margin (bisection in log scale) whose result meets
-    it, by the fast check; the trials are shared between tolerances. Each trial keeps its
-    time and its decimated actions (checked by Blender's playback afterwards)."""
+#: Decimate's margins are searched between these (log scale) ...
+MARGINS = (1e-6, 0.1)
+#: ... to this resolution: the largest margin that meets a tolerance and one at most this
+#: factor larger that does not (8 bisection steps over MARGINS: 10^5^(1/256)).
+RESOLUTION = 1e5 ** (1 / 256)
+
+
+def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, resolution: float = RESOLUTION) -> dict:
+    """Per tolerance: the largest decimate margin whose result meets it (by the fast check),
+    to `resolution`, and among the margins tried that meet it the one with the fewest keys.
+
+    The tolerances are taken from the smallest up and every trial is kept (decimate is
+    deterministic): a margin that meets a tolerance meets the larger ones, so each search
+    starts from the bracket the trials so far give. A bracket is found by steps of x4 from a
+    guess (the tolerance's distance in metres, or the smaller tolerance's margin), then closed
+    by regula falsi on log(margin) against log(error / tolerance) (decimate's error grows about
+    as a power of its margin), each trial followed by one a resolution step across, so that the
+    bracket closes from both sides around the predicted margin. Each trial
+    keeps its time and its decimated actions (checked by Blender's playback afterwards)."""
     cache: dict[float, tuple[float, float, int]] = {}
     kept: dict[float, tuple[float, dict]] = {}
 
@@ -544,22 +564,64 @@ def search_margin(clip: Clip, fast_ref: np.ndarray, tolerances, steps: int) -> d
         return cache[margin]
 
     best = {}
-    for distance, angle in tolerances:
-        def ok(m):
+    lowest, highest = MARGINS
+    for distance, angle in sorted(tolerances):
+        def ratio(m: float) -> float:
             d, a, _ = trial(m)
-            return d <= distance and a <= math.radians(angle)
-        lo, hi = math.log(1e-6), math.log(0.1)
-        if ok(math.exp(hi)):
-            lo = hi
-        elif not ok(math.exp(lo)):
+            return max(d / distance, a / math.radians(angle), 1e-12)
+
+        def known(feasible: bool) -> list[float]:
+            return sorted(m for m in cache if (max(cache[m][0] / distance, cache[m][1] / math.radians(angle)) <= 1.0)
+                          == feasible)
+
+        ok, bad = known(True), known(False)
+        lo = ok[-1] if ok else None
+        hi = next((m for m in bad if lo is None or m > lo), None)
+        if lo is None and hi is None:
+            m = min(max(distance, lowest), highest)
+            lo, hi = (m, None) if ratio(m) <= 1.0 else (None, m)
+        while lo is None:  # down from the smallest failing margin
+            m = max(hi / 4.0, lowest)
+            if ratio(m) <= 1.0:
+                lo = m
+            elif m <= lowest:
+                break
+            else:
+                hi = m
+        if lo is None:
             best[distance, angle] = None
             continue
-        for _ in range(steps):
-            mid = 0.5 * (lo + hi)
-            if ok(math.exp(mid)):
-                lo = mid
+        while hi is None and lo < highest:  # up from the largest margin that meets it
+            m = min(lo * 4.0, highest)
+            if ratio(m) <= 1.0:
+                lo = m
             else:
-                hi = mid
+                hi = m
+        while hi is not None and hi / lo > resolution:
+            # where log(error / tolerance) reaches 0 on the line through the bracket's ends (the
+            # error grows about as a power of the margin), kept a resolution step inside it
+            a, b = math.log(lo), math.log(hi)
+            ra, rb = math.log(ratio(lo)), math.log(ratio(hi))
+            x = a + (b - a) * (0.0 - ra) / (rb - ra) if rb > ra else 0.5 * (a + b)
+            step = math.log(resolution)
+            if b - a <= 2.0 * step:
+                x = 0.5 * (a + b)
+            x = min(max(x, a + step), b - step)
+            m = math.exp(x)
+            if ratio(m) <= 1.0:  # and one resolution step up: the bracket may close there
+                lo, across = m, m * resolution
+                if across < hi:
+                    if ratio(across) <= 1.0:
+                        lo = across
+                    else:
+                        hi = across
+            else:
+                hi, across = m, m / resolution
+                if across > lo:
+                    if ratio(across) <= 1.0:
+                        lo = across
+                    else:
+                        hi = across
         feasible = [(v[2], m) for m, v in cache.items() if v[0] <= distance and v[1] <= math.radians(angle)]
         best[distance, angle] = min(feasible)[1]  # the fewest keys among the margins that meet it
     return {"best": best, "trials": len(cache), "kept": kept}
@@ -606,16 +668,42 @@ def smooth_timing(runs: int) -> list[dict]:
     return out
 
 
+def window_search(out: Path, resolution: float) -> None:
+    """The margin search of the windowed clips (:data:`WINDOWED`, one per process: the
+    `--clips` given) on their first :data:`WINDOW` frames, written to `out` as JSON."""
+    name = next(n for n in WINDOWED if n in sys.argv)
+    window = Clip(globals()[f"clip_{name}"](n=WINDOW))
+    search = search_margin(window, fast_playback(window.owners, window.times), TOLERANCES, resolution)
+    out.write_text(json.dumps({"best": [[list(k), v] for k, v in search["best"].items()], "trials": search["trials"]}))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--json", type=Path)
-    parser.add_argument("--quick", action="store_true", help="fewer bisection steps, one timing run")
+    parser.add_argument("--quick", action="store_true", help="a coarser margin search, one timing run")
     parser.add_argument("--clips", nargs="*", help="only these clips (camera walk bvh demo rig100)")
+    parser.add_argument("--window-search", type=Path, help=argparse.SUPPRESS)  # (the child process below)
     args = parser.parse_args()
+    # the margin's resolution: that of `steps` bisection steps over MARGINS (log scale)
     steps = 5 if args.quick else 8
+    resolution = (MARGINS[1] / MARGINS[0]) ** (1 / 2**steps)
     started = time.perf_counter()
-    report = {"blender": bpy.app.version_string, "tolerances": TOLERANCES, "steps": steps, "slack": SLACK, "clips": []}
-    print(f"Blender {bpy.app.version_string}: Reduce Keys against graph.decimate (margin bisected, {steps} steps)")
+    report = {"blender": bpy.app.version_string, "tolerances": TOLERANCES, "steps": steps, "slack": SLACK, "clips": [],
+              "resolution": resolution}
+    if args.window_search is not None:
+        window_search(args.window_search, resolution)
+        return
+    print(f"Blender {bpy.app.version_string}: Reduce Keys against graph.decimate (margin searched to a factor "
+          f"{resolution:.3f}, the resolution of {steps} bisection steps)")
+    # The windowed clips' margin searches (minutes of decimate calls) run in a second Blender
+    # process meanwhile (the machine's second core): the figures are the same, the wall time
+    # about that of the longer of the two
+    children = {}
+    for name in WINDOWED:
+        if not args.clips or name in args.clips:
+            out = Path(tempfile.mkdtemp(prefix="bench-reduce-")) / f"{name}.json"
+            command = [sys.executable, __file__, "--window-search", str(out), "--clips", name]
+            children[name] = (subprocess.Popen(command + (["--quick"] if args.quick else [])), out)
     for build in CLIPS:
         if args.clips and build.__name__.removeprefix("clip_") not in args.clips:
             continue
@@ -624,20 +712,24 @@ def main() -> None:
         if name in WINDOWED:
             # decimate takes minutes on the whole clip: its margin is searched on the clip's
             # first WINDOW frames (the same motion), then checked on the whole clip
-            window = Clip(build(n=WINDOW))
-            fast_window = fast_playback(window.owners, window.times)
-            search = search_margin(window, fast_window, TOLERANCES, steps)
+            process, out = children[name]
+            if process.wait() != 0:
+                sys.exit(f"bench_reduce: the margin search of {name} failed")
+            found = json.loads(out.read_text())
+            window = True
+            search = {"best": {tuple(k): v for k, v in found["best"]}, "trials": found["trials"], "kept": {}}
         clip = Clip(build())
         ref = blender_playback(clip.owners, clip.times)
         fast_ref = fast_playback(clip.owners, clip.times)
         agreement = float(np.abs(fast_ref - ref).max())
         if window is None:
-            search = search_margin(clip, fast_ref, TOLERANCES, steps)
+            search = search_margin(clip, fast_ref, TOLERANCES, resolution)
         entry = {"name": clip.name, "label": clip.label, "owners": len(clip.owners), "frames": clip.frames,
                  "owner_frames": clip.owner_frames,
                  "captured": clip.captured, "samples": len(clip.times), "fast_agreement": agreement,
                  "decimate_trials": search["trials"], "searched_on": f"first {WINDOW} frames" if window else "the clip",
                  "cases": []}
+        whole: dict[float, tuple[float, dict]] = {}  # windowed: decimate on the whole clip, per margin
         for distance, angle in TOLERANCES:
             case = {"distance": distance, "angle": angle}
             case["ours"] = measure(clip, ref, distance, angle, ours(clip, distance, angle))
@@ -652,7 +744,12 @@ def main() -> None:
                 case["decimate"]["margin"] = margin
             else:
                 for _attempt in range(3):  # smaller margins while the whole clip misses it
-                    elapsed = decimate(clip, margin)
+                    if margin in whole:  # (another tolerance's margin: decimate's result is the same)
+                        elapsed, actions = whole[margin]
+                        clip.use(actions)
+                    else:
+                        elapsed = decimate(clip, margin)
+                        whole[margin] = (elapsed, {o.name: o.animation_data.action for o in clip.objects})
                     case["decimate"] = measure(clip, ref, distance, angle, elapsed)
                     case["decimate"]["margin"] = margin
                     if case["decimate"]["within"] >= 1.0:

@@ -499,15 +499,15 @@ def new_result(
     original keys) and assigned to every object of `objects`; `source` keeps a fake user and
     is recorded on the copy for :func:`revert`. When `current` is an earlier result of the same
     operator (`made_by`: "smooth", "denoise") it is replaced: removed once everything has
-    worked, if nothing uses it any more. A result of Smooth Motion records a digest of its
-    keys (:func:`keys_digest`; `digests`: those of the curves `edit` wrote, filled by `edit`),
-    so that a later edit is seen. Everything goes through the transaction `t`."""
+    worked, if nothing uses it any more. A result of Smooth Motion or Reduce Keys records a
+    digest of its keys (:func:`keys_digest`; `digests`: those of the curves `edit` wrote,
+    filled by `edit`), so that a later edit is seen. Everything goes through the transaction `t`."""
     suffix = f".{made_by}" if made_by != "smooth" else ".smooth"
     result = current.copy()
     result.name = f"{source.name}{suffix}"
     result.use_fake_user = False
     edit(channels.ensure_container(result, channels.find_slot(result, identifier)))
-    if made_by == "smooth":  # (what its re-runs and Revert compare with)
+    if made_by in ("smooth", "reduce"):  # (what its re-runs and Revert compare with)
         result[WRITTEN_KEY] = keys_digest(result, identifier, digests)
     elif WRITTEN_KEY in result:  # copied from an earlier Smooth Motion result: not this one's
         del result[WRITTEN_KEY]
@@ -597,7 +597,10 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
             if part.reduced is not None:
                 from . import reduce
 
-                reduce.write_reduced(bag, part.reduced, part.cycle_modes, part.cyclic)
+                if part.join is not None:  # a Frame Range narrower than the keys: joined to them
+                    reduce.write_joined(bag, part)
+                    continue
+                reduce.write_reduced(bag, part.reduced, part.cycle_modes, part.cyclic, digests)
                 for (prop, index), stack in (part.motion.modifiers or {}).items():
                     fcurve = channels.find_fcurve(bag, part.owner.path(prop), index)
                     if stack and fcurve is not None and (prop, index) in part.reduced.curves:

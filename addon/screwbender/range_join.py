@@ -56,6 +56,8 @@ _FIELDS = (
 )
 
 TAU = 2.0 * np.pi
+#: Blender's defaults of the easing parameters of a new key.
+_DEFAULTS = {"back": 1.70158, "amplitude": 0.8, "period": 4.1}
 
 
 @dataclass
@@ -307,17 +309,30 @@ def write(fcurve: bpy.types.FCurve, join: Join, frames: np.ndarray, values: np.n
     `interpolation` codes) and, outside the range, the source keys of that channel kept.
     `source_ends[prop]` holds the maps `(a, c)` of :func:`equivalence` at the start and end
     (`column`: the channel's column in them)."""
-    tol = keys.FRAME_TOLERANCE
     n = len(frames)
-    baked = {name: np.zeros((n, w) if w > 1 else n, dtype=dt) for name, dt, w in _FIELDS}
+    baked = {name: np.zeros((n, w) if w > 1 else n, dtype=dt) for name, dt, w in _FIELDS[:4]}
     baked["co"][:, 0] = frames
     baked["co"][:, 1] = values
     baked["handle_left"][:] = baked["co"]
     baked["handle_right"][:] = baked["co"]
     baked["interpolation"][:] = interpolation
-    baked["handle_left_type"][:] = _FREE
-    baked["handle_right_type"][:] = _FREE
-    baked["back"][:], baked["amplitude"][:], baked["period"][:] = 1.70158, 0.8, 4.1
+    baked["handle_left_type"] = np.full(n, _FREE, dtype=np.uint8)
+    baked["handle_right_type"] = np.full(n, _FREE, dtype=np.uint8)
+    write_keys(fcurve, join, baked, prop, index, column, source_ends)
+
+
+def write_keys(fcurve: bpy.types.FCurve, join: Join, baked: dict, prop: str, index: int, column: int,
+               source_ends: dict) -> None:
+    """:func:`write` for keys made elsewhere (Keys: Reduced: Bezier keys with their handles):
+    `baked` holds the keys inside the range as arrays named after :data:`_FIELDS` (missing
+    ones: Blender's defaults); edited in place at its ends."""
+    tol = keys.FRAME_TOLERANCE
+    n = len(baked["co"])
+    for name, dtype, width in _FIELDS:
+        if name not in baked:
+            baked[name] = np.zeros((n, width) if width > 1 else n, dtype=dtype)
+            if name in _DEFAULTS:
+                baked[name][:] = _DEFAULTS[name]
     parts = [baked]
     source = join.curves.get((prop, index))
     if source is not None:

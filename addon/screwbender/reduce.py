@@ -39,7 +39,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, bulk, channels, keys, owners, transaction
+from . import bake, bulk, channels, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
 
 #: The default tolerance: 1 mm (at the scene's unit scale, :func:`default_distance`) and half
@@ -125,6 +125,9 @@ class Item:
     linear: np.ndarray | None = None
     #: Whole frames among the dense frames (quarter frames aside), for the report.
     whole: int = 0
+    #: The reference at the probes of every span when it is not the screw between the frames
+    #: (:func:`measured`): Blender's playback of LINEAR keys there.
+    probe_ref: np.ndarray | None = None
 
 
 @dataclass
@@ -223,9 +226,11 @@ def _pad4(values: np.ndarray) -> np.ndarray:
     return out
 
 
-def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool = False) -> list[Reduced]:
-    """One `polyscrew.reduce_keys` call for every item (all at `frames`). Raises SmoothError
-    with polyscrew's message."""
+def solve(
+    items: list[Item], frames: np.ndarray, options: Options, cyclic: bool = False, between: str = "screw"
+) -> list[Reduced]:
+    """One `polyscrew.reduce_keys` call for every item (all at `frames`; `between`: the
+    core's reference between two frames). Raises SmoothError with polyscrew's message."""
     parents, offsets = parents_of(items)
     scaled = any(it.channels[2] for it in items)
     try:
@@ -246,6 +251,7 @@ def solve(items: list[Item], frames: np.ndarray, options: Options, cyclic: bool 
             cyclic=cyclic,
             start=np.stack([it.start for it in items]),
             per_channel=bool(options.per_channel),
+            between=between,
         )
     except (ValueError, TypeError, MemoryError) as err:
         names = ", ".join(it.owner.name for it in items[:3]) + (" ..." if len(items) > 3 else "")
@@ -454,6 +460,8 @@ class Batch:
     #: The largest departure of Blender's playback from the core's reference left in the
     #: batch (distance, angle): taken off the tolerance given to the core.
     margin: tuple[float, float] = (0.0, 0.0)
+    #: The core's reference between two frames (`polyscrew.reduce_keys`' `between`).
+    between: str = "screw"
 
 
 def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options) -> list[Batch]:
@@ -470,37 +478,44 @@ def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options
     out = []
     for frames, members in grouped.values():
         items = _located_children([_item(o, m, frames) for o, m in members], members)
-        dist, ang = departure(items, frames)
         steps = np.any([it.constant for it in items], axis=0)
-        # LINEAR keys on every frame (a bake): the in-between is a straight line in channel
-        # space, samples of a motion rather than a curve meant between them; the screw between
-        # the frames is the reference there, as for steps
-        linear = np.all([it.linear for it in items], axis=0)
-        flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
-        flagged &= ~linear
-        # the departure left: at the probes of the spans kept whole (a cut span's probes are
-        # dense frames now; steps are the core's own)
-        kept = ~flagged & ~steps & ~linear
-        margin = (float(dist[kept].max(initial=0.0)), float(ang[kept].max(initial=0.0)))
-        if flagged.any():
-            probes = _probe_times(frames).reshape(len(PROBES), -1)[:, flagged].ravel()
-            frames = np.sort(np.concatenate([frames, probes]))
-            items = _located_children([_item(o, m, frames) for o, m in members], members)
+        between, margin = "screw", (0.0, 0.0)
+        if np.all(np.all([it.linear for it in items], axis=0) | steps):
+            # LINEAR keys on every frame of every owner (a bake: Smooth Motion's Every Step,
+            # nla.bake): Blender plays the straight line in channel space between two frames,
+            # which is the core's "linear" reference, exactly; the reduced keys are measured
+            # against that playback (:func:`measured`)
+            between = "linear"
+            for it in items:
+                it.probe_ref = it.probe_poses
+        else:
+            # Bezier keys (a capture, keyframe_insert), LINEAR spans among them: the screw
+            # between the frames, and where Blender's playback departs from it, its probes
+            dist, ang = departure(items, frames)
+            flagged = ((dist > DEPARTURE_SHARE * options.distance) | (ang > DEPARTURE_SHARE * options.angle)) & ~steps
+            # the departure left: at the probes of the spans kept whole (a cut span's probes are
+            # dense frames now; steps are the core's own)
+            kept = ~flagged & ~steps
+            margin = (float(dist[kept].max(initial=0.0)), float(ang[kept].max(initial=0.0)))
+            if flagged.any():
+                probes = _probe_times(frames).reshape(len(PROBES), -1)[:, flagged].ravel()
+                frames = np.sort(np.concatenate([frames, probes]))
+                items = _located_children([_item(o, m, frames) for o, m in members], members)
         cyclic = all(
             it.cyclic
             and np.allclose(it.poses[0], it.poses[-1], atol=1e-6 * (1.0 + np.abs(it.poses[:, :3, 3]).max()))
             and np.allclose(it.scales[0], it.scales[-1], atol=1e-6)
             for it in items
         )
-        out.append(Batch(items=items, frames=frames, cyclic=cyclic, margin=margin))
+        out.append(Batch(items=items, frames=frames, cyclic=cyclic, margin=margin, between=between))
     return out
 
 
 def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarray]:
     """Per owner: the largest error of the reduced curves against the core's reference (the
-    dense poses at the frames, the screw between two frames, a step held), at every frame
-    and at the probes, in world space along the chains, measured here independently of the
-    core: the curves played by `polyscrew.evaluate_fcurves` (Blender's evaluation, one call
+    dense poses at the frames, the screw between two frames, a step held; the item's
+    `probe_ref` at the probes when it has one), at every frame and at the probes, in world
+    space along the chains, measured here independently of the core: the curves played by `polyscrew.evaluate_fcurves` (Blender's evaluation, one call
     for the batch), channels not written held at their dense values (a connected bone's
     location: none, as Blender plays it), composed with the parents' played poses."""
     items, frames = batch.items, batch.frames
@@ -526,9 +541,12 @@ def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarr
     dist, ang = np.zeros(len(items)), np.zeros(len(items))
     for i in _chain_order(parents, len(items)):
         it = items[i]
-        ref = np.concatenate([it.poses, polyscrew.sample(it.poses, frames, probes, levels=0, timing="linear")])
-        held = np.tile(it.constant, len(PROBES))
-        ref[n:][held] = np.tile(it.poses[:-1], (len(PROBES), 1, 1))[held]
+        if it.probe_ref is not None:
+            ref = np.concatenate([it.poses, it.probe_ref])
+        else:
+            ref = np.concatenate([it.poses, polyscrew.sample(it.poses, frames, probes, levels=0, timing="linear")])
+            held = np.tile(it.constant, len(PROBES))
+            ref[n:][held] = np.tile(it.poses[:-1], (len(PROBES), 1, 1))[held]
         dense = np.concatenate([it.poses, ref[n:]])
         location = np.stack([values.get((i, ("location", k)), dense[:, k, 3]) for k in range(3)], axis=1)
         rot_path = keys.rotation_path(it.mode)
@@ -558,22 +576,31 @@ def solve_batch(batch: Batch, options: Options) -> list[Reduced]:
     """:func:`solve` with the batch's margin taken off the tolerance, the result measured
     here (:func:`measured`) and asked again with a tolerance scaled down where it misses.
     The errors reported are those measured plus the margin (a bound of the error against
-    Blender's playback of the dense keys at every frame and at the probes)."""
+    Blender's playback of the dense keys at every frame and at the probes); when every item
+    has its reference at the probes (`probe_ref`: Blender's playback there), those measured,
+    against the whole tolerance; with `between="cubic"` (no reference between frames here),
+    the core's own measure."""
     distance = max(options.distance - batch.margin[0], 0.5 * options.distance)
     angle = max(options.angle - batch.margin[1], 0.5 * options.angle)
     inner = Options(distance=distance, angle=angle, per_channel=options.per_channel)
+    exact = all(it.probe_ref is not None for it in batch.items)
+    limit = (options.distance, options.angle) if exact else (distance, angle)
     for attempt in range(RETRIES + 1):
-        results = solve(batch.items, batch.frames, inner, batch.cyclic)
-        dist, ang = measured(batch, results)
-        over = max(dist.max() / distance, ang.max() / angle)
+        results = solve(batch.items, batch.frames, inner, batch.cyclic, batch.between)
+        if batch.between == "cubic":
+            dist = np.array([r.distance_error for r in results])
+            ang = np.array([r.angle_error for r in results])
+        else:
+            dist, ang = measured(batch, results)
+        over = max(dist.max() / limit[0], ang.max() / limit[1])
         if over <= 1.0 + 1e-6 or attempt == RETRIES:
             break
         inner = Options(
             distance=inner.distance * 0.95 / over, angle=inner.angle * 0.95 / over, per_channel=options.per_channel
         )
     for r, d, a in zip(results, dist, ang):
-        r.distance_error = float(d) + batch.margin[0]
-        r.angle_error = float(a) + batch.margin[1]
+        r.distance_error = float(d) + (0.0 if exact else batch.margin[0])
+        r.angle_error = float(a) + (0.0 if exact else batch.margin[1])
     return results
 
 
@@ -604,11 +631,15 @@ def _enum(prop: str) -> np.ndarray:
 _KEPT = ("extrapolation", "color_mode", "color", "hide", "lock", "select", "auto_smoothing")
 
 
-def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, cycle: tuple | None = None) -> None:
+def write_curve(
+    bag, owner: owners.Owner, prop: str, index: int, curve: Curve, cycle: tuple | None = None,
+    digests: dict | None = None,
+) -> None:
     """Replaces the curve (`prop`, `index`) of `owner` in `bag` (made when missing) by the
     reduced keys: co, handles, interpolation, easing, handle types (one `foreach_set` each).
     The old curve's extrapolation, modifiers, group, colour and flags are kept; `cycle`
-    (mode_before, mode_after) adds a Cycles modifier to a new curve."""
+    (mode_before, mode_after) adds a Cycles modifier to a new curve. `digests` gets the
+    curve's :func:`bake.curve_digest` per (data path, index), from the arrays written."""
     path = owner.path(prop)
     old = channels.find_fcurve(bag, path, index)
     kept, group = {}, owner.group
@@ -634,10 +665,14 @@ def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, c
     n = len(curve.co)
     points = fc.keyframe_points
     points.add(n)
-    bulk.put(points, "co", np.asarray(curve.co, dtype=np.float32).ravel())
+    co = np.asarray(curve.co, dtype=np.float32).ravel()
+    interpolation = _enum("interpolation")[curve.interpolation]
+    bulk.put(points, "co", co)
     bulk.put(points, "handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
     bulk.put(points, "handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
-    bulk.put(points, "interpolation", tuple(_enum("interpolation")[curve.interpolation].tolist()))
+    bulk.put(points, "interpolation", tuple(interpolation.tolist()))
+    if digests is not None:
+        digests[path, index] = bake.curve_digest(co, interpolation.astype(np.uint8))
     if np.any(curve.easing != 0):
         bulk.put(points, "easing", tuple(_enum("easing")[curve.easing].tolist()))
     types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
@@ -655,15 +690,44 @@ def write_curve(bag, owner: owners.Owner, prop: str, index: int, curve: Curve, c
     # recompute them.
 
 
-def write_reduced(bag, reduced: Reduced, cycle_modes: dict | None = None, cyclic: bool = False) -> None:
-    """Every reduced curve of one owner into `bag`."""
+def write_reduced(
+    bag, reduced: Reduced, cycle_modes: dict | None = None, cyclic: bool = False, digests: dict | None = None
+) -> None:
+    """Every reduced curve of one owner into `bag` (`digests`: see :func:`write_curve`)."""
     for (prop, index), curve in reduced.curves.items():
         cycle = None
         if cycle_modes and (prop, index) in cycle_modes:
             cycle = cycle_modes[prop, index]
         elif cyclic:
             cycle = ("REPEAT", "REPEAT")
-        write_curve(bag, reduced.item.owner, prop, index, curve, cycle)
+        write_curve(bag, reduced.item.owner, prop, index, curve, cycle, digests)
+
+
+def write_joined(bag, part) -> None:
+    """Smooth Motion, Keys: Reduced over a Frame Range narrower than the keys: each reduced
+    curve of `part` (:class:`bake.Baked`, its transform curves already removed from `bag`)
+    joined to the source keys kept outside the range as a dense bake is
+    (:func:`range_join.write_keys`: the span the range's end cuts split there); the handles of
+    the reduced keys at the range's ends are FREE (the joined handles stay as written)."""
+    free = _enum("handle_left_type")[polyscrew.HANDLE_TYPES.index("FREE")]
+    for (prop, index), curve in part.reduced.curves.items():
+        types = _enum("handle_left_type")[curve.handle_type].astype(np.uint8)
+        types[[0, -1]] = free
+        inner = {
+            "co": np.asarray(curve.co, dtype=np.float32),
+            "handle_left": np.asarray(curve.handle_left, dtype=np.float32),
+            "handle_right": np.asarray(curve.handle_right, dtype=np.float32),
+            "interpolation": _enum("interpolation")[curve.interpolation].astype(np.uint8),
+            "easing": _enum("easing")[curve.easing].astype(np.uint8),
+            "handle_left_type": types,
+            "handle_right_type": types.copy(),
+        }
+        fcurve = channels.new_fcurve(bag, part.owner.path(prop), index, part.owner.group)
+        column = next(c for c, i in part.columns(prop) if i == index)
+        range_join.write_keys(fcurve, part.join, inner, prop, index, column, part.end_maps or {})
+        stack = part.motion.modifiers.get((prop, index)) if part.motion.modifiers else None
+        if stack:
+            modifiers.copy_onto(stack, fcurve)
 
 
 # The operator's pipeline -----------------------------------------------------------------
@@ -702,7 +766,7 @@ def reduce_keys(
             skipped.append(f"{owner.name}: no animation (no active action): skipped")
             continue
         groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
-    pairs, plans, notes, rerun = [], [], [], []
+    pairs, plans, notes, rerun, edited = [], [], [], [], []
     for members in groups.values():
         first = members[0].obj
         current = first.animation_data.action
@@ -710,7 +774,11 @@ def reduce_keys(
         source, slot = current, identifier
         found = bake.original_of(current, "reduce")
         if found is not None and not options.reduce_result:
-            source, slot = found
+            if bake.was_edited(current, identifier):
+                # the animator changed the result: the edit is the new source, never thrown away
+                edited.append(f"'{current.name}'")
+            else:
+                source, slot = found
         by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
         done = []
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
@@ -727,6 +795,11 @@ def reduce_keys(
                 rerun.append(first.name)
     if rerun:
         notes.append(f"reduced the original keys of {bake.summary(rerun)} again (replacing the earlier result)")
+    if edited:
+        notes.append(
+            f"{bake.summary(edited)} edited after Reduce Keys made it (keys moved, added or deleted): reduced the "
+            "edited keys and kept them (Revert returns to them, a second Revert to the original)"
+        )
     if not pairs:
         return Result(actions=[], owners=[], skipped=skipped, notes=notes)
     if progress is not None:
@@ -745,11 +818,15 @@ def reduce_keys(
         for objects, source, current, identifier, done in plans:
             parts = [reduced[(o.obj.as_pointer(), o.bone)] for o in done]
 
-            def edit(bag, parts=parts) -> None:
-                for part in parts:
-                    write_reduced(bag, part)
+            digests: dict = {}
 
-            actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce"))
+            def edit(bag, parts=parts, digests=digests) -> None:
+                for part in parts:
+                    write_reduced(bag, part, digests=digests)
+
+            actions.append(
+                bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce", digests=digests)
+            )
     parts = list(reduced.values())
     return Result(
         actions=actions,
@@ -777,49 +854,55 @@ def summary(results: list[Reduced]) -> str:
     )
 
 
+def _bake_item(part) -> Item:
+    """A Smooth Motion part (:class:`bake.Baked`) as an item: its baked channels as poses."""
+    motion, owner = part.motion, part.owner
+    mode = motion.rotation_mode
+    rotation = part.values[keys.rotation_path(mode)]
+    n = len(part.frames)
+    location = part.values.get("location", np.zeros((n, 3)))
+    scales = np.ones((n, 3))
+    if "scale" in part.values:
+        scales[:, motion.scale_axes] = part.values["scale"]
+    constant = np.zeros(n - 1, dtype=bool) if part.constant is None else np.asarray(part.constant[:-1], bool)
+    return Item(
+        owner=owner, mode=mode, poses=keys.compose(location, keys.rotation_matrices(rotation, mode)),
+        scales=scales, channels=np.array(["location" in part.values, True, "scale" in part.values]),
+        constant=constant, start=_pad4(rotation[0]), radius=body_radius(owner), written=part.written, whole=n,
+    )
+
+
+def smoothed_batch(parts: list, cyclic: bool) -> Batch:
+    """Smooth Motion's parts baked at the same frames as one batch: the reference is the
+    smoothed motion at every baked frame and, between two frames, the cubic through the baked
+    poses each side (`between="cubic"`, checked by the core at 1/4, 1/2, 3/4 of every span):
+    the smooth curve the baked poses sample. (Not the screw between two frames: that has a
+    corner at every frame, which kept nearly every frame of a sparse motion; not the subdivided
+    polyscrew between frames either: after its levels it is a chain of screws with a corner
+    every 1/16 of a key span, which a smooth curve follows only with a key near every corner.)"""
+    return Batch(items=[_bake_item(part) for part in parts], frames=parts[0].frames, cyclic=cyclic, between="cubic")
+
+
 def reduce_bakes(bakes: list, distance: float, angle: float) -> str:
     """Smooth Motion, Keys: Reduced: reduces the dense channels of every part of `bakes`
     (:class:`bake.ActionBake`) before anything is written, setting each part's `reduced`.
     One `polyscrew.reduce_keys` call per set of baked frames (usually one: all owners of the
-    operator). Returns the report's line (:func:`summary`)."""
-    batches: dict[tuple, list] = {}
-    joined = []
+    operator), asked again with a smaller tolerance where the result misses it
+    (:func:`solve_batch`), against the smoothed motion (:func:`smoothed_batch`). A part over
+    a Frame Range narrower than the keys is reduced inside the range (its writing joins the
+    source keys kept outside it, :func:`write_joined`). Returns the report's line
+    (:func:`summary`)."""
+    by_frames: dict[tuple, list] = {}
     for action_bake in bakes:
         for part in action_bake.parts:
-            if part.join is not None:  # a Frame Range narrower than the keys: written dense, joined
-                joined.append(part.owner.name)
-                continue
-            batches.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
+            by_frames.setdefault((part.frames.tobytes(), bool(part.cyclic)), []).append(part)
     options = Options(distance=distance, angle=angle)
-    for (_, cyclic), parts in batches.items():
-        items = []
-        for part in parts:
-            motion, owner = part.motion, part.owner
-            mode = motion.rotation_mode
-            rotation = part.values[keys.rotation_path(mode)]
-            n = len(part.frames)
-            location = part.values.get("location", np.zeros((n, 3)))
-            scales = np.ones((n, 3))
-            if "scale" in part.values:
-                scales[:, motion.scale_axes] = part.values["scale"]
-            constant = np.zeros(n - 1, dtype=bool) if part.constant is None else np.asarray(part.constant[:-1], bool)
-            items.append(
-                Item(
-                    owner=owner, mode=mode, poses=keys.compose(location, keys.rotation_matrices(rotation, mode)),
-                    scales=scales, channels=np.array(["location" in part.values, True, "scale" in part.values]),
-                    constant=constant, start=_pad4(rotation[0]), radius=body_radius(owner), written=part.written,
-                )
-            )
-        for part, result in zip(parts, solve(items, parts[0].frames, options, cyclic)):
+    for (_, cyclic), parts in by_frames.items():
+        batch = smoothed_batch(parts, cyclic)
+        for part, result in zip(parts, solve_batch(batch, options)):
             part.reduced = result
     results = [part.reduced for b in bakes for part in b.parts if part.reduced is not None]
-    line = summary(results) if results else "keys not reduced"
-    if joined:
-        line += (
-            f"; {', '.join(joined[:3])}{' ...' if len(joined) > 3 else ''}: every step kept inside the Frame Range "
-            "(a range narrower than the keys joins the source's keys: Reduce Keys can reduce the result)"
-        )
-    return line
+    return summary(results) if results else "keys not reduced"
 
 
 def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) -> list[Reduced]:
