@@ -18,13 +18,13 @@ import math
 
 import bpy
 import numpy as np
-from read_count import counting_reads, read_more_than_once
 from scipy.spatial.transform import Rotation
-from test_range_and_grid import curves_of, difference, grid, keyed, played
-from test_reduce_keys import SLACK, check_within, dense_object, play, sample_times, transform_keys, world_errors
 
 import bake_helpers as h
 import bone_helpers as bh
+from read_count import counting_reads, read_more_than_once
+from test_range_and_grid import curves_of, difference, grid, keyed, played
+from test_reduce_keys import SLACK, check_within, dense_object, play, sample_times, transform_keys, world_errors
 
 DISTANCE, ANGLE = 0.001, math.radians(0.5)
 
