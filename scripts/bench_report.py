@@ -560,7 +560,7 @@ class Report:
         d = json.loads(js.read_text())
         self.w(f"`scripts/bench_reduce.py`, Blender {d['blender']}. Ours: the Reduce Keys operator (all of it: read, "
                "one `polyscrew.reduce_keys` call, write). Theirs: `graph.decimate` in ERROR mode, every other option at "
-               f"its default, its margin bisected ({d['steps']} steps in log scale) for the largest value whose result "
+               f"its default, its margin searched (regula falsi on the logarithms, to the resolution of {d['steps']} bisection steps in log scale) for the largest value whose result "
                "meets the same world-space tolerance; its time is one decimate call at that margin. Both results "
                "checked by Blender's own playback (`frame_set` at every frame and 3 subframes between frames, every "
                "owner's world matrix) against the dense clip's playback: the largest distance of a point of the body "
