@@ -4,7 +4,6 @@
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 // The defaults are written as literals so that Python's signature shows them; they are
@@ -21,9 +20,9 @@ use polyscrew::{
 };
 
 use crate::args::{self, FitAngularVelocity, Function, Most};
-use crate::{
-    check_budget, copy_of, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len,
-};
+use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::args::{copy_of, float_array};
+use crate::arrays::{read_rows3, read_vector, vector_len};
 use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::Error;
@@ -59,7 +58,7 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
     if let Some((shape, mask)) = args::bool_array(F, "constrained", c, most_indices)? {
         if !mask.is_empty() {
             if shape.len() != 1 || mask.len() != n {
-                return Err(PyValueError::new_err(format!(
+                return Err(crate::errors::invalid(format!(
                     "{F}: constrained: boolean mask has {} entries for {n} keys",
                     mask.len()
                 )));
@@ -73,7 +72,7 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
     for i in indices {
         let j = if i < 0 { i + n as i64 } else { i };
         if j < 0 || j >= n as i64 {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: constrained: index {i} out of range for {n} keys"
             )));
         }
@@ -381,7 +380,7 @@ fn fit_angular_velocity(
         let (kq, kt, tt, to, ts, st) = &views;
         let keys = read_quaternions("key_quaternions", kq)?;
         if keys.len() < 2 {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: key_quaternions: {} keys given, at least 2 needed",
                 keys.len()
             )));
@@ -425,9 +424,10 @@ fn fit_angular_velocity(
         Err(failure) => failure.to_string(),
         Ok(_) => String::from("fit failed"),
     };
-    let err = PyValueError::new_err(format!(
-        "{F}: {message}; the best result is the exception's `result` attribute"
-    ));
+    let err = crate::errors::raise(
+        crate::errors::Kind::FitFailed,
+        format!("{F}: {message}; the best result is the exception's `result` attribute"),
+    );
     err.value(py).setattr("result", Py::new(py, result)?)?;
     Err(err)
 }

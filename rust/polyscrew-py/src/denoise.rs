@@ -3,7 +3,6 @@
 
 use numpy::ndarray::{Array1, Array2, Array4, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
@@ -12,7 +11,8 @@ use polyscrew::memory::try_vec;
 use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
 
 use crate::args::Most;
-use crate::{read_vector, shape_err, to_py_err};
+use crate::errors::{shape_err, to_py_err};
+use crate::arrays::{read_vector};
 
 const F: &str = "denoise";
 
@@ -29,12 +29,12 @@ fn clip_shape(array: &ArrayViewD<'_, f64>) -> PyResult<(usize, usize, bool)> {
         _ => return Err(shape_err(F, "poses", "(N, 4, 4) or (B, N, 4, 4)", &shape)),
     };
     if n > MAX_DENOISE_POSES || bodies.saturating_mul(n) > MAX_DENOISE_BATCH {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {bodies} x {n} poses exceed the limits ({MAX_DENOISE_POSES} per clip, {MAX_DENOISE_BATCH} in all)"
         )));
     }
     if n < MIN_DENOISE_POSES {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {n} poses given, at least {MIN_DENOISE_POSES} needed"
         )));
     }
@@ -62,7 +62,7 @@ fn read_clips(
         let (b, i) = (g / n, g % n);
         poses.push(Pose::from_rows(&m, i).map_err(|e| {
             if batch {
-                PyValueError::new_err(format!("{F}: body {b}: {e}"))
+                crate::errors::invalid(format!("{F}: body {b}: {e}"))
             } else {
                 to_py_err(F, e)
             }
@@ -86,7 +86,7 @@ fn read_strength(strength: Option<&Bound<'_, PyAny>>) -> PyResult<Strength> {
         });
     }
     let pair: (f64, f64) = s.extract().map_err(|_| {
-        PyValueError::new_err(format!(
+        crate::errors::invalid(format!(
             "{F}: strength: expected None, a time or (rotation, translation) times"
         ))
     })?;
@@ -107,7 +107,7 @@ fn read_held(
         return Ok(None);
     };
     let err = || {
-        PyValueError::new_err(format!(
+        crate::errors::invalid(format!(
             "{F}: held: expected a boolean mask of shape ({n},) or ({bodies}, {n})"
         ))
     };
@@ -300,7 +300,7 @@ fn denoise(
     };
     let kinks = match kinks {
         Some(k) if !k.is_none() => k.extract::<bool>().map_err(|_| {
-            pyo3::exceptions::PyTypeError::new_err(format!("{F}: kinks: expected a bool"))
+            crate::errors::wrong_type(format!("{F}: kinks: expected a bool"))
         })?,
         _ => true,
     };
@@ -320,7 +320,7 @@ fn denoise(
         + times.copy()
         + polyscrew::Footprint::bytes(count.saturating_mul(BYTES_PER_POSE));
     const HINT: &str = "denoise fewer frames or fewer bodies in one call";
-    crate::check_budget(F, footprint, "the noise removal", HINT)?;
+    crate::errors::check_budget(F, footprint, "the noise removal", HINT)?;
     let (poses, times) = (poses.read()?, times.read()?);
     let input = poses.as_array();
     let shape = clip_shape(&input)?;
@@ -332,7 +332,7 @@ fn denoise(
     let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
     let times = read_vector(F, "times", &times.as_array())?;
     if times.len() != n {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: times: expected {n} entries, got {}",
             times.len()
         )));
@@ -352,7 +352,7 @@ fn denoise(
         match r {
             Ok(d) => out.push(d),
             Err(e) if batch => {
-                return Err(PyValueError::new_err(format!("{F}: body {b}: {e}")));
+                return Err(crate::errors::invalid(format!("{F}: body {b}: {e}")));
             }
             Err(e) => return Err(to_py_err(F, e)),
         }

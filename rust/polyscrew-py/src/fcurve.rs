@@ -7,7 +7,6 @@
 
 use numpy::ndarray::{Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray2};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 
@@ -19,7 +18,8 @@ use polyscrew::fcurve::{
 use polyscrew::memory::{try_vec, Footprint};
 
 use crate::args::{self, copy_of, float_array, int_array, FloatArg, Most};
-use crate::{read_vector, shape_err, to_py_err, vector_len};
+use crate::errors::{shape_err, to_py_err};
+use crate::arrays::{read_vector, vector_len};
 
 const F: &str = "evaluate_fcurves";
 
@@ -88,7 +88,7 @@ fn read_extrapolation(f: &str, arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec
     let mut out = try_vec(items.len(), "extrapolations").map_err(|e| to_py_err(f, e))?;
     for item in &items {
         let name = item.cast::<PyString>().map_err(|_| {
-            PyTypeError::new_err(format!("{f}: extrapolation: expected {expected}"))
+            crate::errors::wrong_type(format!("{f}: extrapolation: expected {expected}"))
         })?;
         out.push(parse(name.to_str()?)?);
     }
@@ -113,10 +113,10 @@ const CYCLES_KEYS: [&str; 11] = [
 /// Reads one Cycles settings dict (named as Blender's RNA properties; missing entries take
 /// the defaults of a new modifier).
 fn read_cycles(f: &str, c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
-    let err = |reason: String| PyValueError::new_err(format!("{f}: cycles[{c}]: {reason}"));
+    let err = |reason: String| crate::errors::invalid(format!("{f}: cycles[{c}]: {reason}"));
     for key in dict.keys() {
         let key: String = key.extract().map_err(|_| {
-            PyTypeError::new_err(format!(
+            crate::errors::wrong_type(format!(
                 "{f}: cycles[{c}]: setting names must be str, got {}",
                 key.get_type()
                     .name()
@@ -198,7 +198,7 @@ fn read_cycles_list(
         "a sequence of dicts or None, one per curve",
     )?;
     if items.len() != c {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{f}: cycles: expected {c} entries (one per curve), got {}",
             items.len()
         )));
@@ -211,7 +211,7 @@ fn read_cycles_list(
                 return Ok(None);
             }
             let dict = item.cast::<PyDict>().map_err(|_| {
-                PyTypeError::new_err(format!("{f}: cycles[{i}]: expected a dict or None"))
+                crate::errors::wrong_type(format!("{f}: cycles[{i}]: expected a dict or None"))
             })?;
             read_cycles(f, i, dict).map(Some)
         })
@@ -398,7 +398,7 @@ fn evaluate_fcurves<'py>(
         .detach(|| evaluate_packed(&packed, &times))
         .map_err(|e| to_py_err(F, e))?;
     let out = Array2::from_shape_vec((c, n), values)
-        .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+        .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
     Ok(out.into_pyarray(py))
 }
 

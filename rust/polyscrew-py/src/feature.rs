@@ -15,10 +15,9 @@ use polyscrew::{
 };
 
 use crate::args::{self, FeatureMotion, Function, SampleFeature};
-use crate::{
-    check_budget, copy_of, float_array, key_count, poses_to_array, read_keys, read_rows3,
-    read_vector, to_py_err, vec3s_to_array, vector_len,
-};
+use crate::errors::{check_budget, to_py_err};
+use crate::args::{copy_of, float_array};
+use crate::arrays::{key_count, poses_to_array, read_keys, read_rows3, read_vector, vec3s_to_array, vector_len};
 
 /// Reads `(K, 3)` points; finiteness and range are checked by the core, which names the
 /// point (no GIL needed).
@@ -27,7 +26,7 @@ fn read_points(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyRes
 }
 
 /// The feature points' count of an optional `(K, 3)` argument.
-fn points_len(points: Option<&crate::FloatArg<'_>>) -> usize {
+fn points_len(points: Option<&crate::args::FloatArg<'_>>) -> usize {
     points.map_or(6, |p| p.shape().first().copied().unwrap_or(0))
 }
 
@@ -39,7 +38,7 @@ enum StiffnessArg<'py> {
     /// One value for every key.
     Scalar(f64),
     /// One value per key (its length is checked by the core).
-    PerKey(crate::FloatArg<'py>),
+    PerKey(crate::args::FloatArg<'py>),
 }
 
 impl StiffnessArg<'_> {
@@ -103,7 +102,7 @@ fn read_feature_spec<'py>(
                     StiffnessArg::Scalar(value.unwrap_or(f64::NAN))
                 } else {
                     if a.ndim() != 1 {
-                        return Err(crate::shape_err(function, "stiffness", "(N,)", a.shape()));
+                        return Err(crate::errors::shape_err(function, "stiffness", "(N,)", a.shape()));
                     }
                     StiffnessArg::PerKey(a)
                 }

@@ -6,7 +6,6 @@
 
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use polyscrew::intent::{
@@ -21,10 +20,8 @@ use polyscrew::{Error, Pose, RotationMode};
 
 use crate::args::{self, float_array, Function, KeysParameters, Most};
 use crate::fcurve::CurveArgs;
-use crate::{
-    check_budget, key_count, pose_count, read_keys, read_poses, read_vector, shape_err, to_py_err,
-    vector_len,
-};
+use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
 
 /// How to ask these functions for less memory.
 const HINT: &str = "pass fewer frames or keys in one call";
@@ -42,7 +39,7 @@ fn playback_arg<'a, 'py>(
     obj: &'a Bound<'py, PyAny>,
 ) -> PyResult<&'a Bound<'py, PyPlayback>> {
     obj.cast::<PyPlayback>().map_err(|_| {
-        PyTypeError::new_err(format!("{function}: {what}: expected a polyscrew.Playback"))
+        crate::errors::wrong_type(format!("{function}: {what}: expected a polyscrew.Playback"))
     })
 }
 
@@ -103,7 +100,7 @@ impl PyPlayback {
             .iter()
             .map(|item| {
                 item.extract::<(String, i64)>().map_err(|_| {
-                    PyTypeError::new_err(format!("{F}: channels: expected {expected}"))
+                    crate::errors::wrong_type(format!("{F}: channels: expected {expected}"))
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
@@ -112,14 +109,14 @@ impl PyPlayback {
             .enumerate()
             .map(|(c, (property, index))| {
                 let index = usize::try_from(*index).map_err(|_| {
-                    PyValueError::new_err(format!("{F}: channels[{c}]: index {index} is negative"))
+                    crate::errors::invalid(format!("{F}: channels[{c}]: index {index} is negative"))
                 })?;
                 Channel::from_property(property, index, mode).map_err(|e| {
                     let reason = match e {
                         Error::Invalid { reason, .. } => reason,
                         e => e.to_string(),
                     };
-                    PyValueError::new_err(format!("{F}: channels[{c}]: {reason}"))
+                    crate::errors::invalid(format!("{F}: channels[{c}]: {reason}"))
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
@@ -404,7 +401,7 @@ fn keys_parameters<'py>(
     let period = match (closed, period) {
         (true, Some(p)) => Some(p),
         (true, None) => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: period: a closed motion needs its period"
             )))
         }
@@ -427,7 +424,7 @@ fn keys_parameters<'py>(
         (Some(p), None) => (float_array(F, "poses", p)?, true),
         (None, Some(s)) => (float_array(F, "smooth", s)?, false),
         _ => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: give either poses (the key poses) or smooth (the smoothed motion's poses)"
             )))
         }

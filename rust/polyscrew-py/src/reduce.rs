@@ -5,7 +5,6 @@
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
@@ -17,7 +16,7 @@ use polyscrew::reduce::{
 use polyscrew::{reduce_keys as core_reduce_keys, Pose, RotationMode};
 
 use crate::args::{bool_array, float_array, float_scalar, int_in, int_list, sequence, Most};
-use crate::{shape_err, to_py_err};
+use crate::errors::{shape_err, to_py_err};
 
 const F: &str = "reduce_keys";
 
@@ -34,7 +33,7 @@ fn read_poses(view: &ArrayViewD<'_, f64>, b: usize, n: usize) -> PyResult<Vec<Po
         }
         poses.push(
             Pose::from_rows(&m, g % n)
-                .map_err(|e| PyValueError::new_err(format!("{F}: poses: owner {}: {e}", g / n)))?,
+                .map_err(|e| crate::errors::invalid(format!("{F}: poses: owner {}: {e}", g / n)))?,
         );
     }
     Ok(poses)
@@ -45,7 +44,7 @@ fn read_modes(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<RotationMode>> {
     let parse = |o: Option<usize>, s: &str| {
         RotationMode::from_name(s).map_err(|e| {
             let at = o.map_or_else(String::new, |o| format!("owner {o}: "));
-            PyValueError::new_err(format!("{F}: modes: {at}{e}"))
+            crate::errors::invalid(format!("{F}: modes: {at}{e}"))
         })
     };
     if let Ok(s) = obj.cast::<PyString>() {
@@ -60,7 +59,7 @@ fn read_modes(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<RotationMode>> {
         "a mode name or a sequence of them",
     )?;
     if items.len() != b {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: modes: expected one name or {b} of them, got {}",
             items.len()
         )));
@@ -100,7 +99,7 @@ fn read_mask(
     };
     let expected = format!("{shape:?}").replace('[', "(").replace(']', ")");
     let Some((got, mask)) = bool_array(F, what, obj, Most::Exactly(shape[0]))? else {
-        return Err(PyTypeError::new_err(format!(
+        return Err(crate::errors::wrong_type(format!(
             "{F}: {what}: expected a boolean array of shape {expected}"
         )));
     };
@@ -167,7 +166,7 @@ fn reduce_keys<'py>(
     let flag = |what: &str, o: Option<&Bound<'py, PyAny>>| match o {
         Some(o) if !o.is_none() => o
             .extract::<bool>()
-            .map_err(|_| PyTypeError::new_err(format!("{F}: {what}: expected a bool"))),
+            .map_err(|_| crate::errors::wrong_type(format!("{F}: {what}: expected a bool"))),
         _ => Ok(false),
     };
     let cyclic = flag("cyclic", cyclic)?;
@@ -193,7 +192,7 @@ fn reduce_keys<'py>(
         ));
     }
     if n > MAX_REDUCE_FRAMES || b.saturating_mul(n) > MAX_REDUCE_POSES {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {b} owners x {n} frames exceed the limits ({MAX_REDUCE_FRAMES} frames per owner, {MAX_REDUCE_POSES} poses in all)"
         )));
     }
@@ -201,7 +200,7 @@ fn reduce_keys<'py>(
     // Before anything input-sized is copied: the copies of the input, the core's peak and
     // the output arrays (every channel keyed at every frame at most).
     let keys_bound = b.saturating_mul(n).saturating_mul(10);
-    crate::check_budget(
+    crate::errors::check_budget(
         F,
         poses.copy()
             + frames.copy()
@@ -232,7 +231,7 @@ fn reduce_keys<'py>(
                     -1 => None,
                     q if q >= 0 => Some(q as usize),
                     q => {
-                        return Err(PyValueError::new_err(format!(
+                        return Err(crate::errors::invalid(format!(
                             "{F}: parents: owner {o}: {q} is neither -1 nor an owner index"
                         )))
                     }
@@ -265,7 +264,7 @@ fn reduce_keys<'py>(
                         }
                     }
                     out.push(Pose::from_rows(&m, o).map_err(|e| {
-                        PyValueError::new_err(format!("{F}: offsets: owner {o}: {e}"))
+                        crate::errors::invalid(format!("{F}: offsets: owner {o}: {e}"))
                     })?);
                 }
                 Some(out)

@@ -2,7 +2,6 @@
 
 use numpy::ndarray::{Array2, ArrayViewD};
 use numpy::IntoPyArray;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -15,7 +14,9 @@ use polyscrew::sweep::{
 use polyscrew::{Error, Pose};
 
 use crate::args::{self, Function, Sweep};
-use crate::{check_budget, float_array, pose_count, read_poses, read_rows3, shape_err, to_py_err};
+use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::args::{float_array};
+use crate::arrays::{pose_count, read_poses, read_rows3};
 
 /// Reads `(T, 3)` integer triangles (no GIL needed).
 fn read_triangles(
@@ -74,7 +75,7 @@ fn sweep<'py>(
         Some(0.0) => Accuracy::Steps,
         Some(t) if t.is_finite() && t > 0.0 => Accuracy::Tolerance(t),
         Some(t) => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: tolerance: {t} is not a positive length (0: exactly `steps` per screw)"
             )))
         }
@@ -120,12 +121,12 @@ fn sweep<'py>(
             try_vec(out.vertices.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
         flat.extend(out.vertices.iter().flat_map(|q| q.to_array()));
         let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat)
-            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
         let mut flat =
             try_vec(out.triangles.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
         flat.extend(out.triangles.iter().flat_map(|t| t.map(i64::from)));
         let to = Array2::from_shape_vec((out.triangles.len(), 3), flat)
-            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
         Ok((
             vo,
             to,
