@@ -20,9 +20,9 @@ use polyscrew::{
 };
 
 use crate::args::{self, FitAngularVelocity, Function, Most};
-use crate::errors::{check_budget, shape_err, to_py_err};
 use crate::args::{copy_of, float_array};
 use crate::arrays::{read_rows3, read_vector, vector_len};
+use crate::errors::{check_budget, shape_err, to_py_err};
 use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::Error;

@@ -352,7 +352,8 @@ pub fn sequence<'py>(
         .map_err(|_| not_a_sequence())?;
     check_len(function, what, obj, max)?;
     let n = seq.len().map_err(|e| named(obj.py(), function, what, e))?;
-    let mut out = try_vec(n, "input sequence").map_err(|e| crate::errors::to_py_err(function, e))?;
+    let mut out =
+        try_vec(n, "input sequence").map_err(|e| crate::errors::to_py_err(function, e))?;
     for i in 0..n {
         out.push(
             seq.get_item(i)
@@ -386,7 +387,8 @@ pub fn bool_array(
         .check("the boolean mask", "pass a smaller mask")
         .map_err(|e| crate::errors::to_py_err(function, e))?;
     let readonly = array.readonly();
-    let mut out = try_vec(total, "boolean mask").map_err(|e| crate::errors::to_py_err(function, e))?;
+    let mut out =
+        try_vec(total, "boolean mask").map_err(|e| crate::errors::to_py_err(function, e))?;
     out.extend(readonly.as_array().iter().copied());
     Ok(Some((shape, out)))
 }
@@ -402,7 +404,12 @@ pub fn int_list(
     check_len(function, what, obj, max_len)?;
     let array = int_array(function, what, obj)?;
     if array.ndim() != 1 {
-        return Err(crate::errors::shape_err(function, what, "(N,)", array.shape()));
+        return Err(crate::errors::shape_err(
+            function,
+            what,
+            "(N,)",
+            array.shape(),
+        ));
     }
     if array.len() > max_len.count() {
         return Err(too_long(function, what, max_len, array.len().to_string()));

@@ -167,4 +167,3 @@ pub fn read_spec(
         timing,
     })
 }
-

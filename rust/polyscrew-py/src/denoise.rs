@@ -11,8 +11,8 @@ use polyscrew::memory::try_vec;
 use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
 
 use crate::args::Most;
+use crate::arrays::read_vector;
 use crate::errors::{shape_err, to_py_err};
-use crate::arrays::{read_vector};
 
 const F: &str = "denoise";
 
@@ -299,9 +299,9 @@ fn denoise(
         _ => 3,
     };
     let kinks = match kinks {
-        Some(k) if !k.is_none() => k.extract::<bool>().map_err(|_| {
-            crate::errors::wrong_type(format!("{F}: kinks: expected a bool"))
-        })?,
+        Some(k) if !k.is_none() => k
+            .extract::<bool>()
+            .map_err(|_| crate::errors::wrong_type(format!("{F}: kinks: expected a bool")))?,
         _ => true,
     };
     let threads = match threads {

@@ -43,9 +43,18 @@ pub enum Kind {
 
 /// The classes: the base, then one per [`Kind`] (their Python names and docstrings).
 const CLASSES: [(&str, &str); 6] = [
-    ("PolyscrewError", "Base of every error polyscrew raises about its arguments or its work."),
-    ("InvalidArgument", "An argument's value, shape, range or count is wrong (also a ValueError)."),
-    ("ArgumentTypeError", "An argument has the wrong type (also a TypeError)."),
+    (
+        "PolyscrewError",
+        "Base of every error polyscrew raises about its arguments or its work.",
+    ),
+    (
+        "InvalidArgument",
+        "An argument's value, shape, range or count is wrong (also a ValueError).",
+    ),
+    (
+        "ArgumentTypeError",
+        "An argument has the wrong type (also a TypeError).",
+    ),
     (
         "BudgetExceeded",
         "The call would need more memory than memory_budget() allows; refused before anything \
@@ -74,11 +83,26 @@ fn build(py: Python<'_>) -> PyResult<Family> {
     for (i, (name, doc)) in CLASSES.iter().enumerate() {
         let bases: Vec<Bound<'_, PyAny>> = match i {
             0 => vec![py.get_type::<PyException>().into_any()],
-            1 => vec![made[0].bind(py).clone().into_any(), py.get_type::<pyo3::exceptions::PyValueError>().into_any()],
-            2 => vec![made[0].bind(py).clone().into_any(), py.get_type::<PyTypeError>().into_any()],
-            3 => vec![made[1].bind(py).clone().into_any(), py.get_type::<PyMemoryError>().into_any()],
-            4 => vec![made[0].bind(py).clone().into_any(), py.get_type::<PyMemoryError>().into_any()],
-            _ => vec![made[0].bind(py).clone().into_any(), py.get_type::<pyo3::exceptions::PyValueError>().into_any()],
+            1 => vec![
+                made[0].bind(py).clone().into_any(),
+                py.get_type::<pyo3::exceptions::PyValueError>().into_any(),
+            ],
+            2 => vec![
+                made[0].bind(py).clone().into_any(),
+                py.get_type::<PyTypeError>().into_any(),
+            ],
+            3 => vec![
+                made[1].bind(py).clone().into_any(),
+                py.get_type::<PyMemoryError>().into_any(),
+            ],
+            4 => vec![
+                made[0].bind(py).clone().into_any(),
+                py.get_type::<PyMemoryError>().into_any(),
+            ],
+            _ => vec![
+                made[0].bind(py).clone().into_any(),
+                py.get_type::<pyo3::exceptions::PyValueError>().into_any(),
+            ],
         };
         let namespace = PyDict::new(py);
         namespace.set_item("__module__", "polyscrew")?;

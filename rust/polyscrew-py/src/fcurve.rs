@@ -18,8 +18,8 @@ use polyscrew::fcurve::{
 use polyscrew::memory::{try_vec, Footprint};
 
 use crate::args::{self, copy_of, float_array, int_array, FloatArg, Most};
-use crate::errors::{shape_err, to_py_err};
 use crate::arrays::{read_vector, vector_len};
+use crate::errors::{shape_err, to_py_err};
 
 const F: &str = "evaluate_fcurves";
 

@@ -15,9 +15,11 @@ use polyscrew::{
 };
 
 use crate::args::{self, FeatureMotion, Function, SampleFeature};
-use crate::errors::{check_budget, to_py_err};
 use crate::args::{copy_of, float_array};
-use crate::arrays::{key_count, poses_to_array, read_keys, read_rows3, read_vector, vec3s_to_array, vector_len};
+use crate::arrays::{
+    key_count, poses_to_array, read_keys, read_rows3, read_vector, vec3s_to_array, vector_len,
+};
+use crate::errors::{check_budget, to_py_err};
 
 /// Reads `(K, 3)` points; finiteness and range are checked by the core, which names the
 /// point (no GIL needed).
@@ -102,7 +104,12 @@ fn read_feature_spec<'py>(
                     StiffnessArg::Scalar(value.unwrap_or(f64::NAN))
                 } else {
                     if a.ndim() != 1 {
-                        return Err(crate::errors::shape_err(function, "stiffness", "(N,)", a.shape()));
+                        return Err(crate::errors::shape_err(
+                            function,
+                            "stiffness",
+                            "(N,)",
+                            a.shape(),
+                        ));
                     }
                     StiffnessArg::PerKey(a)
                 }

@@ -19,9 +19,9 @@ use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode};
 
 use crate::args::{self, float_array, Function, KeysParameters, Most};
-use crate::fcurve::CurveArgs;
-use crate::errors::{check_budget, shape_err, to_py_err};
 use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
+use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::fcurve::CurveArgs;
 
 /// How to ask these functions for less memory.
 const HINT: &str = "pass fewer frames or keys in one call";

@@ -588,7 +588,6 @@ fn rotation_channels<'py>(
     Ok(out.into_pyarray(py))
 }
 
-
 /// memory_budget() -> int
 ///
 /// The memory budget in bytes: the most one call may hold at its peak (output, working
@@ -608,7 +607,6 @@ fn set_memory_budget(bytes: &Bound<'_, PyAny>) -> PyResult<usize> {
     let bytes = args::int_in("set_memory_budget", "bytes", bytes, 0, i64::MAX)?;
     Ok(polyscrew::set_memory_budget(bytes as usize))
 }
-
 
 /// Adds the motion functions, `Screw`, the budget's functions and their constants.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

@@ -31,10 +31,10 @@ fn read_poses(view: &ArrayViewD<'_, f64>, b: usize, n: usize) -> PyResult<Vec<Po
                 *v = *it.next().expect("16 values per pose");
             }
         }
-        poses.push(
-            Pose::from_rows(&m, g % n)
-                .map_err(|e| crate::errors::invalid(format!("{F}: poses: owner {}: {e}", g / n)))?,
-        );
+        poses
+            .push(Pose::from_rows(&m, g % n).map_err(|e| {
+                crate::errors::invalid(format!("{F}: poses: owner {}: {e}", g / n))
+            })?);
     }
     Ok(poses)
 }
@@ -240,36 +240,35 @@ fn reduce_keys<'py>(
             Some(out)
         }
     };
-    let offsets =
-        match offsets.filter(|o| !o.is_none()) {
-            None => None,
-            Some(o) => {
-                let array = float_array(F, "offsets", o)?.read()?;
-                let view = array.as_array();
-                if view.shape() != [b, 4, 4] {
-                    return Err(shape_err(
-                        F,
-                        "offsets",
-                        &format!("({b}, 4, 4)"),
-                        view.shape(),
-                    ));
-                }
-                let mut out = Vec::with_capacity(b);
-                let mut it = view.iter();
-                for o in 0..b {
-                    let mut m = [[0.0; 4]; 4];
-                    for row in m.iter_mut() {
-                        for v in row.iter_mut() {
-                            *v = *it.next().expect("16 values per offset");
-                        }
-                    }
-                    out.push(Pose::from_rows(&m, o).map_err(|e| {
-                        crate::errors::invalid(format!("{F}: offsets: owner {o}: {e}"))
-                    })?);
-                }
-                Some(out)
+    let offsets = match offsets.filter(|o| !o.is_none()) {
+        None => None,
+        Some(o) => {
+            let array = float_array(F, "offsets", o)?.read()?;
+            let view = array.as_array();
+            if view.shape() != [b, 4, 4] {
+                return Err(shape_err(
+                    F,
+                    "offsets",
+                    &format!("({b}, 4, 4)"),
+                    view.shape(),
+                ));
             }
-        };
+            let mut out = Vec::with_capacity(b);
+            let mut it = view.iter();
+            for o in 0..b {
+                let mut m = [[0.0; 4]; 4];
+                for row in m.iter_mut() {
+                    for v in row.iter_mut() {
+                        *v = *it.next().expect("16 values per offset");
+                    }
+                }
+                out.push(Pose::from_rows(&m, o).map_err(|e| {
+                    crate::errors::invalid(format!("{F}: offsets: owner {o}: {e}"))
+                })?);
+            }
+            Some(out)
+        }
+    };
     let (poses, frames) = (poses.read()?, frames.read()?);
     let (pv, fv) = (poses.as_array(), frames.as_array());
     let reduced = py.detach(|| -> PyResult<polyscrew::Reduced> {

@@ -13,10 +13,10 @@ use polyscrew::sweep::{
 };
 use polyscrew::{Error, Pose};
 
+use crate::args::float_array;
 use crate::args::{self, Function, Sweep};
-use crate::errors::{check_budget, shape_err, to_py_err};
-use crate::args::{float_array};
 use crate::arrays::{pose_count, read_poses, read_rows3};
+use crate::errors::{check_budget, shape_err, to_py_err};
 
 /// Reads `(T, 3)` integer triangles (no GIL needed).
 fn read_triangles(
