@@ -200,6 +200,12 @@ functions!(
     Sweep = "sweep",
     FitAngularVelocity = "fit_angular_velocity",
     KeysParameters = "keys_parameters",
+    RotationChannels = "rotation_channels",
+    RotationMatrices = "rotation_matrices",
+    PlaybackNew = "Playback",
+    AnalyseSpans = "analyse_spans",
+    AnalyseTurns = "analyse_turns",
+    ReduceKeys = "reduce_keys",
 );
 
 /// The name of `obj`'s type, for messages.
@@ -571,17 +577,58 @@ pub fn str_arg<'a>(function: &str, what: &str, obj: &'a Bound<'_, PyAny>) -> PyR
         .to_str()
 }
 
-/// `scheme`, a str.
-pub fn scheme<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "scheme", obj)
+/// A core enumeration that a Python argument names by a str ([`Choice`]).
+pub trait Named: Sized + Copy {
+    /// The argument's name in messages (`"scheme"`).
+    const ARG: &'static str;
+    /// The value called `name` (the core's parser and its error).
+    fn from_name(name: &str) -> Result<Self, polyscrew::Error>;
 }
 
-/// `timing`, a str.
-pub fn timing<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "timing", obj)
+macro_rules! named {
+    ($($ty:ty = $arg:literal),* $(,)?) => {
+        $(
+            impl Named for $ty {
+                const ARG: &'static str = $arg;
+                fn from_name(name: &str) -> Result<Self, polyscrew::Error> {
+                    <$ty>::from_name(name)
+                }
+            }
+        )*
+    };
 }
 
-/// `parametrization`, a str.
-pub fn parametrization<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "parametrization", obj)
+named!(
+    polyscrew::Scheme = "scheme",
+    polyscrew::Timing = "timing",
+    polyscrew::RotationMode = "mode",
+    polyscrew::CurveScheme = "scheme",
+    polyscrew::Parametrization = "parametrization",
+    polyscrew::intent::Turns = "turns",
+    polyscrew::reduce::Between = "between",
+);
+
+/// An enumeration argument of function `F`, parsed when pyo3 extracts it: a str naming one
+/// of the core's values (`"jarek"`), or an `ArgumentTypeError` (`"{function}: {arg}:
+/// expected a str, got int"`) / `InvalidArgument` (`"{function}: {arg}: \"x\" is not one
+/// of ..."`, the core's message) naming the function and the argument. One implementation
+/// for every enumeration, so every one fails the same way.
+pub struct Choice<F: Function, T: Named>(pub T, std::marker::PhantomData<F>);
+
+impl<F: Function, T: Named> Choice<F, T> {
+    /// The choice `value` (a default in a `#[pyo3(signature)]`).
+    pub const fn of(value: T) -> Self {
+        Self(value, std::marker::PhantomData)
+    }
+}
+
+impl<'a, 'py, F: Function, T: Named> FromPyObject<'a, 'py> for Choice<F, T> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let name = str_arg(F::NAME, T::ARG, &obj)?;
+        T::from_name(name)
+            .map(Self::of)
+            .map_err(|e| crate::errors::to_py_err(F::NAME, e))
+    }
 }

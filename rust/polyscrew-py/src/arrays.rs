@@ -148,22 +148,19 @@ pub fn vec3s_to_array(v: &[DVec3]) -> Result<Array2<f64>, Error> {
     Ok(Array2::from_shape_vec((v.len(), 3), flat).expect("3 values per vector"))
 }
 
-/// Parses a scheme name and timing name shared by several functions.
+/// The motion spec shared by the subdivision and sampling functions.
 pub fn read_spec(
-    function: &str,
-    scheme: &str,
+    scheme: Scheme,
     levels: u32,
     closed: bool,
     period: Option<f64>,
-    timing: &str,
-) -> PyResult<MotionSpec> {
-    let scheme = Scheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
-    let timing = Timing::from_name(timing).map_err(|e| to_py_err(function, e))?;
-    Ok(MotionSpec {
+    timing: Timing,
+) -> MotionSpec {
+    MotionSpec {
         scheme,
         levels,
         closed,
         period,
         timing,
-    })
+    }
 }

@@ -14,7 +14,7 @@ use polyscrew::{
     InertiaFrame, Parametrization, Pose, Stiffness, Timing,
 };
 
-use crate::args::{self, FeatureMotion, Function, SampleFeature};
+use crate::args::{self, Choice, FeatureMotion, Function, SampleFeature};
 use crate::args::{copy_of, float_array};
 use crate::arrays::{
     key_count, poses_to_array, read_keys, read_rows3, read_vector, vec3s_to_array, vector_len,
@@ -80,16 +80,13 @@ impl StiffnessArg<'_> {
 #[allow(clippy::too_many_arguments)]
 fn read_feature_spec<'py>(
     function: &'static str,
-    scheme: &str,
+    scheme: CurveScheme,
     levels: u32,
     closed: bool,
-    parametrization: &str,
+    parametrization: Parametrization,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(FeatureSpec, StiffnessArg<'py>)> {
-    let scheme = CurveScheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
-    let parametrization =
-        Parametrization::from_name(parametrization).map_err(|e| to_py_err(function, e))?;
     let keys = match stiffness.filter(|s| !s.is_none()) {
         None => StiffnessArg::Absent,
         Some(s) => {
@@ -223,17 +220,21 @@ fn inertia_points<'py>(
 /// (N * 2**levels, 4, 4) closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose i * 2**levels
 /// belongs to key i.
 #[pyfunction]
-#[pyo3(signature = (poses, scheme="variational", levels=5, closed=false, feature_points=None,
-    parametrization="uniform", stiffness=None, inserted_stiffness=None))]
+#[pyo3(signature = (poses, scheme=Choice::of(CurveScheme::Variational), levels=5, closed=false,
+    feature_points=None, parametrization=Choice::of(Parametrization::Uniform), stiffness=None,
+    inserted_stiffness=None))]
+#[pyo3(
+    text_signature = "(poses, scheme='variational', levels=5, closed=False, feature_points=None, parametrization='uniform', stiffness=None, inserted_stiffness=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn feature_motion<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<FeatureMotion>)] scheme: &str,
+    scheme: Choice<FeatureMotion, CurveScheme>,
     #[pyo3(from_py_with = args::levels::<FeatureMotion>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<FeatureMotion>)] closed: bool,
     feature_points: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::parametrization::<FeatureMotion>)] parametrization: &str,
+    parametrization: Choice<FeatureMotion, Parametrization>,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
@@ -242,10 +243,10 @@ fn feature_motion<'py>(
     let n = key_count(F, &poses)?;
     let (mut spec, stiffness) = read_feature_spec(
         F,
-        scheme,
+        scheme.0,
         levels,
         closed,
-        parametrization,
+        parametrization.0,
         stiffness,
         inserted_stiffness,
     )?;
@@ -296,39 +297,43 @@ fn feature_motion<'py>(
 /// sits at `key_times[i]` (strictly increasing); `period`, `timing` and the screw between
 /// dense poses as in `sample`.
 #[pyfunction]
-#[pyo3(signature = (poses, key_times, times, scheme="variational", levels=5, closed=false,
-    feature_points=None, parametrization="uniform", stiffness=None,
-    inserted_stiffness=None, period=None, timing="smooth"))]
+#[pyo3(signature = (poses, key_times, times, scheme=Choice::of(CurveScheme::Variational),
+    levels=5, closed=false, feature_points=None,
+    parametrization=Choice::of(Parametrization::Uniform), stiffness=None,
+    inserted_stiffness=None, period=None, timing=Choice::of(Timing::Smooth)))]
+#[pyo3(
+    text_signature = "(poses, key_times, times, scheme='variational', levels=5, closed=False, feature_points=None, parametrization='uniform', stiffness=None, inserted_stiffness=None, period=None, timing='smooth')"
+)]
 #[allow(clippy::too_many_arguments)]
 fn sample_feature<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<SampleFeature>)] scheme: &str,
+    scheme: Choice<SampleFeature, CurveScheme>,
     #[pyo3(from_py_with = args::levels::<SampleFeature>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<SampleFeature>)] closed: bool,
     feature_points: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::parametrization::<SampleFeature>)] parametrization: &str,
+    parametrization: Choice<SampleFeature, Parametrization>,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
     period: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::timing::<SampleFeature>)] timing: &str,
+    timing: Choice<SampleFeature, Timing>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = SampleFeature::NAME;
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let (mut spec, stiffness) = read_feature_spec(
         F,
-        scheme,
+        scheme.0,
         levels,
         closed,
-        parametrization,
+        parametrization.0,
         stiffness,
         inserted_stiffness,
     )?;
     let period = args::optional_float(F, "period", period)?;
-    let timing = Timing::from_name(timing).map_err(|e| to_py_err(F, e))?;
+    let timing = timing.0;
     let key_times = float_array(F, "key_times", key_times)?;
     let times = float_array(F, "times", times)?;
     let n_key_times = vector_len(F, "key_times", &key_times)?;

@@ -16,9 +16,12 @@ use polyscrew::intent::{
     RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
-use polyscrew::{Error, Pose, RotationMode};
+use polyscrew::{Error, Pose, RotationMode, Scheme};
 
-use crate::args::{self, float_array, Function, KeysParameters, Most};
+use crate::args::{
+    self, float_array, AnalyseSpans, AnalyseTurns, Choice, Function, KeysParameters, Most,
+    PlaybackNew, RotationMatrices,
+};
 use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
 use crate::errors::{check_budget, shape_err, to_py_err};
 use crate::fcurve::CurveArgs;
@@ -70,7 +73,7 @@ impl PyPlayback {
         py: Python<'py>,
         channels: &Bound<'py, PyAny>,
         unkeyed: &Bound<'py, PyAny>,
-        mode: &Bound<'py, PyAny>,
+        mode: Choice<PlaybackNew, RotationMode>,
         #[pyo3(from_py_with = located)] located: bool,
         offsets: &Bound<'py, PyAny>,
         co: &Bound<'py, PyAny>,
@@ -85,8 +88,7 @@ impl PyPlayback {
         cycles: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         const F: &str = "Playback";
-        let mode = RotationMode::from_name(args::str_arg(F, "mode", mode)?)
-            .map_err(|e| to_py_err(F, e))?;
+        let mode = mode.0;
         // One curve per channel of the row at most (more drive a channel twice).
         let expected = "a sequence of (property, index) pairs";
         let items = args::sequence(
@@ -272,10 +274,9 @@ fn spans_of(
     function: &'static str,
     playback: &Bound<'_, PyAny>,
     frames: &Bound<'_, PyAny>,
-    turns: &str,
+    turns: Turns,
 ) -> PyResult<Spans> {
     let playback = playback_arg(function, "playback", playback)?;
-    let turns = Turns::from_name(turns).map_err(|e| to_py_err(function, e))?;
     let frames = float_array(function, "frames", frames)?;
     let k = vector_len(function, "frames", &frames)?;
     let inner = &playback.get().inner;
@@ -308,20 +309,21 @@ fn spans_of(
 /// no screw span of a spin `turns` follows turns more than `WIND_STEP` (`analyse_turns`).
 /// GIL released.
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns="AUTO"))]
+#[pyo3(signature = (playback, frames, turns=Choice::of(Turns::Auto)))]
+#[pyo3(text_signature = "(playback, frames, turns='AUTO')")]
 #[allow(clippy::type_complexity)]
 fn analyse_spans<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: &str,
+    turns: Choice<AnalyseSpans, Turns>,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 )> {
-    let spans = spans_of(py, "analyse_spans", playback, frames, turns)?;
+    let spans = spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
@@ -339,13 +341,14 @@ fn analyse_spans<'py>(
 /// takes flips (and quaternions) the short way; "BLENDER" follows every span as Blender
 /// plays it; "SHORTEST" follows none (nothing inserted). GIL released.
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns="AUTO"))]
+#[pyo3(signature = (playback, frames, turns=Choice::of(Turns::Auto)))]
+#[pyo3(text_signature = "(playback, frames, turns='AUTO')")]
 #[allow(clippy::type_complexity)]
 fn analyse_turns<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: &str,
+    turns: Choice<AnalyseTurns, Turns>,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
@@ -353,7 +356,7 @@ fn analyse_turns<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
 )> {
-    let spans = spans_of(py, "analyse_turns", playback, frames, turns)?;
+    let spans = spans_of(py, AnalyseTurns::NAME, playback, frames, turns.0)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
@@ -380,7 +383,10 @@ enum Smoothed {
 /// `poses` (K, 4, 4) by `scheme` and `levels`, or `smooth`, its poses at
 /// `pace_parameters(spans)`. `closed`: the keys are a cycle of `period` frames. GIL released.
 #[pyfunction]
-#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme="four_point", levels=4, smooth=None))]
+#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme=Choice::of(Scheme::FourPoint), levels=4, smooth=None))]
+#[pyo3(
+    text_signature = "(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme='four_point', levels=4, smooth=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn keys_parameters<'py>(
     py: Python<'py>,
@@ -391,7 +397,7 @@ fn keys_parameters<'py>(
     period: Option<&Bound<'py, PyAny>>,
     playback: Option<&Bound<'py, PyAny>>,
     poses: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::scheme::<KeysParameters>)] scheme: &str,
+    scheme: Choice<KeysParameters, Scheme>,
     #[pyo3(from_py_with = args::levels::<KeysParameters>)] levels: u32,
     smooth: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
@@ -407,7 +413,7 @@ fn keys_parameters<'py>(
         }
         (false, _) => None,
     };
-    let scheme = polyscrew::Scheme::from_name(scheme).map_err(|e| to_py_err(F, e))?;
+    let scheme = scheme.0;
     let playback = playback
         .filter(|p| !p.is_none())
         .map(|p| playback_arg(F, "playback", p))
@@ -505,11 +511,10 @@ fn pace_parameters<'py>(
 fn rotation_matrices<'py>(
     py: Python<'py>,
     values: &Bound<'py, PyAny>,
-    mode: &Bound<'py, PyAny>,
+    mode: Choice<RotationMatrices, RotationMode>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "rotation_matrices";
-    let mode =
-        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    const F: &str = RotationMatrices::NAME;
+    let mode = mode.0;
     let values = float_array(F, "values", values)?;
     let width = mode.width();
     let shape = values.shape();

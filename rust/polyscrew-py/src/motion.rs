@@ -10,13 +10,14 @@ use polyscrew::motion::screw::MAX_T;
 use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
     rotation_channels as core_rotation_channels, sample as core_sample,
-    subdivide as core_subdivide, subdivided_len, Error, Pose, RotationMode, Screw, MAX_LEVELS,
+    subdivide as core_subdivide, subdivided_len, Error, Pose, RotationMode, Scheme, Screw, Timing,
+    MAX_LEVELS,
 };
 use pyo3::prelude::*;
 
 use crate::args::{
-    self, copy_of, float_array, FloatArg, FloatArray, Function, Sample, SampleChannels,
-    SampleVectors, Subdivide, SubdivideVectors,
+    self, copy_of, float_array, Choice, FloatArg, FloatArray, Function, RotationChannels, Sample,
+    SampleChannels, SampleVectors, Subdivide, SubdivideVectors,
 };
 use crate::arrays::{
     fill, key_count, pose_count, poses_to_array, read_keys, read_poses, read_spec, read_vec3s,
@@ -195,16 +196,17 @@ fn keys_footprint(n: usize) -> Footprint {
 /// open sequence, whose first and last poses are kept exactly.
 /// Raises ValueError naming the bad pose index and the reason.
 #[pyfunction]
-#[pyo3(signature = (poses, scheme="jarek", levels=4, closed=false))]
+#[pyo3(signature = (poses, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false))]
+#[pyo3(text_signature = "(poses, scheme='jarek', levels=4, closed=False)")]
 fn subdivide<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<Subdivide>)] scheme: &str,
+    scheme: Choice<Subdivide, Scheme>,
     #[pyo3(from_py_with = args::levels::<Subdivide>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<Subdivide>)] closed: bool,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = Subdivide::NAME;
-    let spec = read_spec(F, scheme, levels, closed, None, "smooth")?;
+    let spec = read_spec(scheme.0, levels, closed, None, Timing::Smooth);
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let out_len = if n >= 2 {
@@ -278,22 +280,25 @@ impl<'py> TimedInput<'py> {
 /// `"linear"` maps each key span linearly. Open motions hold their end poses outside the
 /// keys' range. Between dense poses the motion is the screw joining them.
 #[pyfunction]
-#[pyo3(signature = (poses, key_times, times, scheme="jarek", levels=4, closed=false, period=None, timing="smooth"))]
+#[pyo3(signature = (poses, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
+#[pyo3(
+    text_signature = "(poses, key_times, times, scheme='jarek', levels=4, closed=False, period=None, timing='smooth')"
+)]
 #[allow(clippy::too_many_arguments)]
 fn sample<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<Sample>)] scheme: &str,
+    scheme: Choice<Sample, Scheme>,
     #[pyo3(from_py_with = args::levels::<Sample>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<Sample>)] closed: bool,
     period: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::timing::<Sample>)] timing: &str,
+    timing: Choice<Sample, Timing>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = Sample::NAME;
     let period = args::optional_float(F, "period", period)?;
-    let spec = read_spec(F, scheme, levels, closed, period, timing)?;
+    let spec = read_spec(scheme.0, levels, closed, period, timing.0);
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let input = read_timed(F, key_times, times)?;
@@ -328,7 +333,10 @@ fn sample<'py>(
 /// `rotation_channels(sample(...), mode, previous)`, without building and re-checking the
 /// (M, 4, 4) matrices in between. What a bake writes.
 #[pyfunction]
-#[pyo3(signature = (poses, key_times, times, mode, previous=None, scheme="jarek", levels=4, closed=false, period=None, timing="smooth"))]
+#[pyo3(signature = (poses, key_times, times, mode, previous=None, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
+#[pyo3(
+    text_signature = "(poses, key_times, times, mode, previous=None, scheme='jarek', levels=4, closed=False, period=None, timing='smooth')"
+)]
 #[allow(clippy::too_many_arguments)]
 #[allow(clippy::type_complexity)]
 fn sample_channels<'py>(
@@ -336,19 +344,18 @@ fn sample_channels<'py>(
     poses: &Bound<'py, PyAny>,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
-    mode: &Bound<'py, PyAny>,
+    mode: Choice<SampleChannels, RotationMode>,
     previous: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::scheme::<SampleChannels>)] scheme: &str,
+    scheme: Choice<SampleChannels, Scheme>,
     #[pyo3(from_py_with = args::levels::<SampleChannels>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<SampleChannels>)] closed: bool,
     period: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::timing::<SampleChannels>)] timing: &str,
+    timing: Choice<SampleChannels, Timing>,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
     const F: &str = SampleChannels::NAME;
-    let mode =
-        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    let mode = mode.0;
     let period = args::optional_float(F, "period", period)?;
-    let spec = read_spec(F, scheme, levels, closed, period, timing)?;
+    let spec = read_spec(scheme.0, levels, closed, period, timing.0);
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let input = read_timed(F, key_times, times)?;
@@ -407,16 +414,17 @@ fn sample_channels<'py>(
 /// The same schemes applied to plain vectors `values` (N, 3) (the linear masks of
 /// ScrewBender section 2); the output count is as in `subdivide`.
 #[pyfunction]
-#[pyo3(signature = (values, scheme="jarek", levels=4, closed=false))]
+#[pyo3(signature = (values, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false))]
+#[pyo3(text_signature = "(values, scheme='jarek', levels=4, closed=False)")]
 fn subdivide_vectors<'py>(
     py: Python<'py>,
     values: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<SubdivideVectors>)] scheme: &str,
+    scheme: Choice<SubdivideVectors, Scheme>,
     #[pyo3(from_py_with = args::levels::<SubdivideVectors>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<SubdivideVectors>)] closed: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     const F: &str = SubdivideVectors::NAME;
-    let spec = read_spec(F, scheme, levels, closed, None, "smooth")?;
+    let spec = read_spec(scheme.0, levels, closed, None, Timing::Smooth);
     let values = float_array(F, "values", values)?;
     let n = rows3_len(&values);
     let out_len = if n >= 2 {
@@ -449,22 +457,25 @@ fn subdivide_vectors<'py>(
 /// `sample` for plain vectors `values` (N, 3): linear subdivision, the same timing,
 /// straight lines between dense values. Used for log-scale smoothing. Returns (M, 3).
 #[pyfunction]
-#[pyo3(signature = (values, key_times, times, scheme="jarek", levels=4, closed=false, period=None, timing="smooth"))]
+#[pyo3(signature = (values, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
+#[pyo3(
+    text_signature = "(values, key_times, times, scheme='jarek', levels=4, closed=False, period=None, timing='smooth')"
+)]
 #[allow(clippy::too_many_arguments)]
 fn sample_vectors<'py>(
     py: Python<'py>,
     values: &Bound<'py, PyAny>,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<SampleVectors>)] scheme: &str,
+    scheme: Choice<SampleVectors, Scheme>,
     #[pyo3(from_py_with = args::levels::<SampleVectors>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<SampleVectors>)] closed: bool,
     period: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::timing::<SampleVectors>)] timing: &str,
+    timing: Choice<SampleVectors, Timing>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     const F: &str = SampleVectors::NAME;
     let period = args::optional_float(F, "period", period)?;
-    let spec = read_spec(F, scheme, levels, closed, period, timing)?;
+    let spec = read_spec(scheme.0, levels, closed, period, timing.0);
     let values = float_array(F, "values", values)?;
     let n = rows3_len(&values);
     let input = read_timed(F, key_times, times)?;
@@ -547,12 +558,11 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
 fn rotation_channels<'py>(
     py: Python<'py>,
     rotations: &Bound<'py, PyAny>,
-    mode: &Bound<'py, PyAny>,
+    mode: Choice<RotationChannels, RotationMode>,
     previous: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const F: &str = "rotation_channels";
-    let mode =
-        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    const F: &str = RotationChannels::NAME;
+    let mode = mode.0;
     let rotations = float_array(F, "rotations", rotations)?;
     let previous = previous
         .filter(|p| !p.is_none())

@@ -15,10 +15,13 @@ use polyscrew::reduce::{
 };
 use polyscrew::{reduce_keys as core_reduce_keys, Pose, RotationMode};
 
-use crate::args::{bool_array, float_array, float_scalar, int_in, int_list, sequence, Most};
+use crate::args::{
+    bool_array, float_array, float_scalar, int_in, int_list, sequence, Choice, Function, Most,
+    ReduceKeys,
+};
 use crate::errors::{shape_err, to_py_err};
 
-const F: &str = "reduce_keys";
+const F: &str = ReduceKeys::NAME;
 
 /// Reads `(B, N, 4, 4)` poses (no GIL needed), errors naming the owner and the frame.
 fn read_poses(view: &ArrayViewD<'_, f64>, b: usize, n: usize) -> PyResult<Vec<Pose>> {
@@ -156,13 +159,9 @@ fn reduce_keys<'py>(
     per_channel: Option<&Bound<'py, PyAny>>,
     start: Option<&Bound<'py, PyAny>>,
     threads: Option<&Bound<'py, PyAny>>,
-    between: Option<&Bound<'py, PyAny>>,
+    between: Option<Choice<ReduceKeys, Between>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let between = match between.filter(|b| !b.is_none()) {
-        Some(b) => Between::from_name(crate::args::str_arg(F, "between", b)?)
-            .map_err(|e| to_py_err(F, e))?,
-        None => Between::Screw,
-    };
+    let between = between.map_or(Between::Screw, |b| b.0);
     let flag = |what: &str, o: Option<&Bound<'py, PyAny>>| match o {
         Some(o) if !o.is_none() => o
             .extract::<bool>()
