@@ -6,13 +6,16 @@ use numpy::{IntoPyArray, PyArray1, PyArrayDyn};
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
-use polyscrew::denoise::{MAX_DENOISE_BATCH, MAX_DENOISE_POSES, MIN_DENOISE_POSES};
+use polyscrew::denoise::{
+    denoise_footprint, denoised_rows, DENOISE_HINT, MAX_DENOISE_BATCH, MAX_DENOISE_POSES,
+    MIN_DENOISE_POSES,
+};
 use polyscrew::memory::try_vec;
 use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
 
 use crate::args::Most;
 use crate::arrays::read_vector;
-use crate::errors::{shape_err, to_py_err};
+use crate::errors::{check_budget, shape_err, to_py_err};
 
 const F: &str = "denoise";
 
@@ -310,62 +313,56 @@ fn denoise(
     };
     let poses = crate::args::float_array(F, "poses", poses)?;
     let times = crate::args::float_array(F, "times", times)?;
-    // Before anything is copied: the conversions of the arguments, the input copy and the
-    // output (16 values each per pose), and the scratch of the solves (measured: 1,500 bytes
-    // per pose at the peak of a 400,000-pose clip with the strengths chosen automatically;
-    // 1,536 counted), against the memory budget.
-    const BYTES_PER_POSE: usize = 16 * 8 * 2 + 1536;
+    // Before anything is copied: the conversions of the arguments and what the call holds
+    // at its peak (the core's estimate per pose), against the memory budget.
     let count: usize = poses.shape().iter().rev().skip(2).product();
-    let footprint = poses.copy()
-        + times.copy()
-        + polyscrew::Footprint::bytes(count.saturating_mul(BYTES_PER_POSE));
-    const HINT: &str = "denoise fewer frames or fewer bodies in one call";
-    crate::errors::check_budget(F, footprint, "the noise removal", HINT)?;
+    check_budget(
+        F,
+        poses.copy() + times.copy() + denoise_footprint(count),
+        "the noise removal",
+        DENOISE_HINT,
+    )?;
     let (poses, times) = (poses.read()?, times.read()?);
-    let input = poses.as_array();
+    let (input, times) = (poses.as_array(), times.as_array());
     let shape = clip_shape(&input)?;
     let (bodies, n, batch) = shape;
-    // The mask first, so that the one pass over the poses keeps the held ones' matrices
-    // (at most 128 bytes per pose, within the measured margin of BYTES_PER_POSE): the
-    // caller's arrays are not read again once the work leaves the GIL.
     let held = read_held(held, bodies, n)?;
-    let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
-    let times = read_vector(F, "times", &times.as_array())?;
-    if times.len() != n {
-        return Err(crate::errors::invalid(format!(
-            "{F}: times: expected {n} entries, got {}",
-            times.len()
-        )));
-    }
     let strength = read_strength(strength)?;
     let options = DenoiseOptions {
         strength,
         order,
         kinks,
     };
-    let results = py
-        .detach(|| denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads))
-        .map_err(|e| to_py_err(F, e))?;
-    drop(poses);
-    let mut out = Vec::with_capacity(bodies);
-    for (b, r) in results.into_iter().enumerate() {
-        match r {
-            Ok(d) => out.push(d),
-            Err(e) if batch => {
-                return Err(crate::errors::invalid(format!("{F}: body {b}: {e}")));
-            }
-            Err(e) => return Err(to_py_err(F, e)),
+    // The one pass over the poses keeps the held ones' matrices as read: nothing is read
+    // from the caller's arrays twice, and everything after the mask runs without the GIL.
+    let (results, matrices) = py.detach(|| -> PyResult<(Vec<Denoised>, Vec<f64>)> {
+        let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
+        let times = read_vector(F, "times", &times)?;
+        if times.len() != n {
+            return Err(crate::errors::invalid(format!(
+                "{F}: times: expected {n} entries, got {}",
+                times.len()
+            )));
         }
-    }
-    let mut matrices = Array4::<f64>::zeros((bodies, n, 4, 4));
-    let flat = matrices.as_slice_mut().expect("a new array is contiguous");
-    let mut used = 0;
-    for (b, (r, dst)) in out.iter().zip(flat.chunks_exact_mut(16 * n)).enumerate() {
-        let h = held.as_ref().map(|h| &h[b * n..(b + 1) * n]);
-        used += r.write_rows(h, &held_rows[used..], dst);
-    }
+        let results = denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads)
+            .map_err(|e| to_py_err(F, e))?;
+        drop(poses);
+        let mut out = try_vec(bodies, "denoised bodies").map_err(|e| to_py_err(F, e))?;
+        for (b, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(d) => out.push(d),
+                Err(e) if batch => return Err(to_py_err(&format!("{F}: body {b}"), e)),
+                Err(e) => return Err(to_py_err(F, e)),
+            }
+        }
+        let matrices =
+            denoised_rows(&out, n, held.as_deref(), &held_rows).map_err(|e| to_py_err(F, e))?;
+        Ok((out, matrices))
+    })?;
+    let matrices = Array4::from_shape_vec((bodies, n, 4, 4), matrices)
+        .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
     Ok(PyDenoised {
-        results: out,
+        results,
         matrices,
         n,
         batch,

@@ -17,7 +17,7 @@ use polyscrew::fcurve::{
 };
 use polyscrew::memory::{try_vec, Footprint};
 
-use crate::args::{self, copy_of, float_array, int_array, FloatArg, Most};
+use crate::args::{self, copy_of, float_array, int_array, FloatArg, FloatArray, IntArray, Most};
 use crate::arrays::{read_vector, vector_len};
 use crate::errors::{shape_err, to_py_err};
 
@@ -49,20 +49,6 @@ fn filled<T: Clone>(f: &str, value: T, n: usize, what: &'static str) -> PyResult
     let mut out = try_vec(n, what).map_err(|e| to_py_err(f, e))?;
     out.resize(n, value);
     Ok(out)
-}
-
-/// A per-key float array, or `k` copies of `default` when it is not given.
-fn read_per_key(
-    f: &str,
-    what: &str,
-    array: Option<&FloatArg<'_>>,
-    k: usize,
-    default: f32,
-) -> PyResult<Vec<f64>> {
-    match array {
-        Some(a) => read_vector(f, what, &a.read()?.as_array()),
-        None => filled(f, default as f64, k, "per-key values"),
-    }
 }
 
 /// An optional float array-like (`None` stays `None`).
@@ -218,9 +204,45 @@ fn read_cycles_list(
         .collect()
 }
 
-/// The packed curves' arguments of `evaluate_fcurves`, read and owned: shared with the
-/// functions that take the same curves (`Playback`).
-pub(crate) struct CurveArgs {
+/// The packed curves' arguments of `evaluate_fcurves`, checked against the budget and read
+/// (numpy's conversions done, nothing copied yet): shared with the functions that take the
+/// same curves (`Playback`). [`CurveInput::views`] and [`CurveViews::to_args`] copy them
+/// with the GIL released.
+pub(crate) struct CurveInput<'py> {
+    function: &'static str,
+    k: usize,
+    offsets: IntArray<'py>,
+    co: FloatArray<'py>,
+    handle_left: FloatArray<'py>,
+    handle_right: FloatArray<'py>,
+    interpolation: IntArray<'py>,
+    easing: IntArray<'py>,
+    back: Option<FloatArray<'py>>,
+    amplitude: Option<FloatArray<'py>>,
+    period: Option<FloatArray<'py>>,
+    extrapolation: Vec<Extrapolation>,
+    cycles: Vec<Option<Cycles>>,
+}
+
+/// Views of a [`CurveInput`]'s arrays: what the copies read, without the GIL.
+pub(crate) struct CurveViews<'a> {
+    function: &'static str,
+    k: usize,
+    offsets: ArrayViewD<'a, i64>,
+    co: ArrayViewD<'a, f64>,
+    handle_left: ArrayViewD<'a, f64>,
+    handle_right: ArrayViewD<'a, f64>,
+    interpolation: ArrayViewD<'a, i64>,
+    easing: ArrayViewD<'a, i64>,
+    back: Option<ArrayViewD<'a, f64>>,
+    amplitude: Option<ArrayViewD<'a, f64>>,
+    period: Option<ArrayViewD<'a, f64>>,
+    extrapolation: &'a [Extrapolation],
+    cycles: &'a [Option<Cycles>],
+}
+
+/// The packed curves' arguments, copied: what [`CurveArgs::packed`] lends the core.
+pub(crate) struct CurveArgs<'a> {
     offsets: Vec<i64>,
     co: Vec<f64>,
     handle_left: Vec<f64>,
@@ -230,18 +252,18 @@ pub(crate) struct CurveArgs {
     back: Vec<f64>,
     amplitude: Vec<f64>,
     period: Vec<f64>,
-    extrapolation: Vec<Extrapolation>,
-    cycles: Vec<Option<Cycles>>,
+    extrapolation: &'a [Extrapolation],
+    cycles: &'a [Option<Cycles>],
 }
 
-impl CurveArgs {
+impl<'py> CurveInput<'py> {
     /// Reads the arguments (errors name `function` and the argument): every array through
     /// the module's readers ([`float_array`], [`int_array`]: no silent casts), then the
     /// batch's sizes and everything the call will hold (the core's [`check_batch_with`]:
-    /// the copies made here, `extra` bytes more the caller holds and the evaluation at
-    /// `times` times) checked before anything is copied.
+    /// the copies [`CurveViews::to_args`] makes, `extra` bytes more the caller holds and the
+    /// evaluation at `times` times) checked before anything is converted or copied.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn read<'py>(
+    pub(crate) fn read(
         function: &'static str,
         times: usize,
         extra: Footprint,
@@ -310,15 +332,17 @@ impl CurveArgs {
         check_batch_with(c, k, times, copies + extra).map_err(|e| to_py_err(f, e))?;
 
         Ok(Self {
-            offsets: read_ints(f, "offsets", offsets.read()?.as_array())?,
-            co: read_pairs(f, "co", co.read()?.as_array())?,
-            handle_left: read_pairs(f, "handle_left", handle_left.read()?.as_array())?,
-            handle_right: read_pairs(f, "handle_right", handle_right.read()?.as_array())?,
-            interpolation: read_ints(f, "interpolation", interpolation.read()?.as_array())?,
-            easing: read_ints(f, "easing", easing.read()?.as_array())?,
-            back: read_per_key(f, "back", back.as_ref(), k, DEFAULT_BACK)?,
-            amplitude: read_per_key(f, "amplitude", amplitude.as_ref(), k, DEFAULT_AMPLITUDE)?,
-            period: read_per_key(f, "period", period.as_ref(), k, DEFAULT_PERIOD)?,
+            function,
+            k,
+            offsets: offsets.read()?,
+            co: co.read()?,
+            handle_left: handle_left.read()?,
+            handle_right: handle_right.read()?,
+            interpolation: interpolation.read()?,
+            easing: easing.read()?,
+            back: back.as_ref().map(|a| a.read()).transpose()?,
+            amplitude: amplitude.as_ref().map(|a| a.read()).transpose()?,
+            period: period.as_ref().map(|a| a.read()).transpose()?,
             extrapolation: match extrapolation.filter(|e| !e.is_none()) {
                 Some(e) => read_extrapolation(f, e, c)?,
                 None => filled(f, Extrapolation::Constant, c, "extrapolations")?,
@@ -327,6 +351,52 @@ impl CurveArgs {
         })
     }
 
+    /// Views of the arrays, to copy without the GIL.
+    pub(crate) fn views(&self) -> CurveViews<'_> {
+        CurveViews {
+            function: self.function,
+            k: self.k,
+            offsets: self.offsets.as_array(),
+            co: self.co.as_array(),
+            handle_left: self.handle_left.as_array(),
+            handle_right: self.handle_right.as_array(),
+            interpolation: self.interpolation.as_array(),
+            easing: self.easing.as_array(),
+            back: self.back.as_ref().map(|a| a.as_array()),
+            amplitude: self.amplitude.as_ref().map(|a| a.as_array()),
+            period: self.period.as_ref().map(|a| a.as_array()),
+            extrapolation: &self.extrapolation,
+            cycles: &self.cycles,
+        }
+    }
+}
+
+impl<'a> CurveViews<'a> {
+    /// The arrays copied (allocated fallibly, no GIL needed: the budget was checked by
+    /// [`CurveInput::read`]); the per-key arrays not given are Blender's defaults.
+    pub(crate) fn to_args(&self) -> PyResult<CurveArgs<'a>> {
+        let (f, k) = (self.function, self.k);
+        let per_key = |what, a: &Option<ArrayViewD<'_, f64>>, default: f32| match a {
+            Some(a) => read_vector(f, what, a),
+            None => filled(f, default as f64, k, "per-key values"),
+        };
+        Ok(CurveArgs {
+            offsets: read_ints(f, "offsets", self.offsets.view())?,
+            co: read_pairs(f, "co", self.co.view())?,
+            handle_left: read_pairs(f, "handle_left", self.handle_left.view())?,
+            handle_right: read_pairs(f, "handle_right", self.handle_right.view())?,
+            interpolation: read_ints(f, "interpolation", self.interpolation.view())?,
+            easing: read_ints(f, "easing", self.easing.view())?,
+            back: per_key("back", &self.back, DEFAULT_BACK)?,
+            amplitude: per_key("amplitude", &self.amplitude, DEFAULT_AMPLITUDE)?,
+            period: per_key("period", &self.period, DEFAULT_PERIOD)?,
+            extrapolation: self.extrapolation,
+            cycles: self.cycles,
+        })
+    }
+}
+
+impl CurveArgs<'_> {
     /// The arguments as the core's packed curves.
     pub(crate) fn packed(&self) -> PackedCurves<'_> {
         PackedCurves {
@@ -339,8 +409,8 @@ impl CurveArgs {
             back: &self.back,
             amplitude: &self.amplitude,
             period: &self.period,
-            extrapolation: &self.extrapolation,
-            cycles: &self.cycles,
+            extrapolation: self.extrapolation,
+            cycles: self.cycles,
         }
     }
 }
@@ -375,7 +445,7 @@ fn evaluate_fcurves<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let times = float_array(F, "times", times)?;
     let n = vector_len(F, "times", &times)?;
-    let args = CurveArgs::read(
+    let input = CurveInput::read(
         F,
         n,
         times.copy() + Footprint::of::<f64>(n), // the times' conversion and copy
@@ -391,14 +461,16 @@ fn evaluate_fcurves<'py>(
         period,
         cycles,
     )?;
-    let times = read_vector(F, "times", &times.read()?.as_array())?;
-    let packed = args.packed();
-    let c = packed.len();
-    let values = py
-        .detach(|| evaluate_packed(&packed, &times))
-        .map_err(|e| to_py_err(F, e))?;
-    let out = Array2::from_shape_vec((c, n), values)
-        .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
+    let times = times.read()?;
+    let (times, curves) = (times.as_array(), input.views());
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let times = read_vector(F, "times", &times)?;
+        let args = curves.to_args()?;
+        let packed = args.packed();
+        let values = evaluate_packed(&packed, &times).map_err(|e| to_py_err(F, e))?;
+        Array2::from_shape_vec((packed.len(), n), values)
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))
+    })?;
     Ok(out.into_pyarray(py))
 }
 

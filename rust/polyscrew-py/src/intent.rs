@@ -24,7 +24,7 @@ use crate::args::{
 };
 use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
 use crate::errors::{check_budget, shape_err, to_py_err};
-use crate::fcurve::CurveArgs;
+use crate::fcurve::CurveInput;
 
 /// How to ask these functions for less memory.
 const HINT: &str = "pass fewer frames or keys in one call";
@@ -124,7 +124,7 @@ impl PyPlayback {
             .collect::<PyResult<Vec<_>>>()?;
         let unkeyed = float_array(F, "unkeyed", unkeyed)?;
         let width = vector_len(F, "unkeyed", &unkeyed)?;
-        let args = CurveArgs::read(
+        let input = CurveInput::read(
             F,
             0,
             unkeyed.copy() + Footprint::of::<f64>(width), // the owner's values and their copy
@@ -140,14 +140,14 @@ impl PyPlayback {
             period,
             cycles,
         )?;
-        let unkeyed = read_vector(F, "unkeyed", &unkeyed.read()?.as_array())?;
-        let packed = args.packed();
-        let inner = py
-            .detach(|| {
-                let curves = packed.to_curves()?;
-                Playback::new(curves, &channels, unkeyed, mode, located)
-            })
-            .map_err(|e| to_py_err(F, e))?;
+        let unkeyed = unkeyed.read()?;
+        let (unkeyed, curves) = (unkeyed.as_array(), input.views());
+        let inner = py.detach(|| -> PyResult<Playback> {
+            let unkeyed = read_vector(F, "unkeyed", &unkeyed)?;
+            let args = curves.to_args()?;
+            let curves = args.packed().to_curves().map_err(|e| to_py_err(F, e))?;
+            Playback::new(curves, &channels, unkeyed, mode, located).map_err(|e| to_py_err(F, e))
+        })?;
         Ok(Self { inner })
     }
 
@@ -497,7 +497,9 @@ fn pace_parameters<'py>(
     const F: &str = "pace_parameters";
     let spans = args::int_in(F, "spans", spans, 0, i64::MAX)?;
     let spans = usize::try_from(spans).unwrap_or(usize::MAX);
-    let out = core_pace_parameters(spans).map_err(|e| to_py_err(F, e))?;
+    let out = py
+        .detach(|| core_pace_parameters(spans))
+        .map_err(|e| to_py_err(F, e))?;
     Ok(out.into_pyarray(py))
 }
 

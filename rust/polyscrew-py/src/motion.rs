@@ -72,21 +72,27 @@ impl PyScrew {
     }
 }
 
-/// Reads exactly one pose.
-fn read_one_pose(
+/// A `(4, 4)` pose argument, its shape checked (read after the budget's check).
+fn one_pose_arg<'py>(
     function: &'static str,
     what: &'static str,
-    obj: &Bound<'_, PyAny>,
-) -> PyResult<Pose> {
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<FloatArg<'py>> {
     let array = float_array(function, what, obj)?;
     let (_, single) = pose_count(function, what, array.shape())?;
     if !single {
         return Err(shape_err(function, what, "(4, 4)", array.shape()));
     }
-    let array = array.read()?;
-    let view = array.as_array();
-    Ok(read_poses(function, what, &view)?[0])
+    Ok(array)
 }
+
+/// Reads the one pose of a [`one_pose_arg`] (no GIL needed).
+fn one_pose(function: &str, what: &str, view: &ArrayViewD<'_, f64>) -> PyResult<Pose> {
+    Ok(read_poses(function, what, view)?[0])
+}
+
+/// How to ask `screw` or `interpolate` for less memory.
+const POSE_HINT: &str = "pass (4, 4) float64 poses and fewer t at once";
 
 /// screw(a, b) -> Screw
 ///
@@ -96,12 +102,44 @@ fn read_one_pose(
 /// `a`, `b`: (4, 4) rigid matrices, translation in the last column.
 /// Raises ValueError for a non-rigid matrix, NaN or a wrong shape.
 #[pyfunction]
-fn screw(a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<PyScrew> {
-    let a = read_one_pose("screw", "a", a)?;
-    let b = read_one_pose("screw", "b", b)?;
-    Ok(PyScrew {
-        inner: Screw::between(&a, &b),
-    })
+fn screw(py: Python<'_>, a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<PyScrew> {
+    const F: &str = "screw";
+    let (a, b) = (one_pose_arg(F, "a", a)?, one_pose_arg(F, "b", b)?);
+    check_budget(
+        F,
+        a.copy() + b.copy() + Footprint::of::<Pose>(2),
+        "the poses",
+        POSE_HINT,
+    )?;
+    let (a, b) = (a.read()?, b.read()?);
+    let (a, b) = (a.as_array(), b.as_array());
+    let inner = py.detach(|| -> PyResult<Screw> {
+        let (a, b) = (one_pose(F, "a", &a)?, one_pose(F, "b", &b)?);
+        Ok(Screw::between(&a, &b))
+    })?;
+    Ok(PyScrew { inner })
+}
+
+/// `t` checked: within +-`MAX_T`, finite.
+fn check_t(index: usize, t: f64) -> Result<(), Error> {
+    if t.abs() <= MAX_T {
+        Ok(())
+    } else if t.is_finite() {
+        Err(Error::OutOfRange {
+            what: "t",
+            index,
+            value: t,
+            range: "+-1e12",
+        })
+    } else {
+        Err(Error::NotFinite { what: "t", index })
+    }
+}
+
+/// The `t` of `interpolate`: a real number, or an array of them (0-d: one number).
+enum TArg<'py> {
+    Scalar(f64),
+    Array(FloatArg<'py>),
 }
 
 /// interpolate(a, b, t) -> ndarray
@@ -117,69 +155,72 @@ fn interpolate<'py>(
     t: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyAny>> {
     const F: &str = "interpolate";
-    let a = read_one_pose(F, "a", a)?;
-    let b = read_one_pose(F, "b", b)?;
-    let sc = Screw::between(&a, &b);
-    let check_t = |index: usize, t: f64| {
-        if t.abs() <= MAX_T {
-            Ok(())
-        } else if t.is_finite() {
-            Err(to_py_err(
-                F,
-                Error::OutOfRange {
-                    what: "t",
-                    index,
-                    value: t,
-                    range: "+-1e12",
-                },
-            ))
+    let (a, b) = (one_pose_arg(F, "a", a)?, one_pose_arg(F, "b", b)?);
+    let t =
+        if t.is_instance_of::<pyo3::types::PyFloat>() || t.is_instance_of::<pyo3::types::PyInt>() {
+            TArg::Scalar(args::float_scalar(F, "t", t)?)
         } else {
-            Err(to_py_err(F, Error::NotFinite { what: "t", index }))
-        }
+            TArg::Array(float_array(F, "t", t)?)
+        };
+    let (m, single, t_copy) = match &t {
+        TArg::Scalar(_) => (1, true, Footprint::ZERO),
+        TArg::Array(ts) if ts.ndim() == 0 => (1, true, ts.copy()),
+        TArg::Array(ts) => (vector_len(F, "t", ts)?, false, ts.copy()),
     };
-    if t.is_instance_of::<pyo3::types::PyFloat>() || t.is_instance_of::<pyo3::types::PyInt>() {
-        let t = args::float_scalar(F, "t", t)?;
-        check_t(0, t)?;
-        let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
-        return Ok(out
-            .index_axis_move(numpy::ndarray::Axis(0), 0)
-            .into_pyarray(py)
-            .into_any());
-    }
-    let ts = float_array(F, "t", t)?;
-    if ts.ndim() == 0 {
-        let t = ts
-            .read()?
-            .as_array()
-            .iter()
-            .next()
-            .copied()
-            .unwrap_or(f64::NAN);
-        check_t(0, t)?;
-        let out = poses_to_array(&[sc.eval(t)]).map_err(|e| to_py_err(F, e))?;
-        return Ok(out
-            .index_axis_move(numpy::ndarray::Axis(0), 0)
-            .into_pyarray(py)
-            .into_any());
-    }
-    let m = vector_len(F, "t", &ts)?;
     check_budget(
         F,
-        ts.copy() + Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
+        a.copy()
+            + b.copy()
+            + t_copy
+            + Footprint::of::<Pose>(2)
+            + Footprint::of::<f64>(m).and::<Pose>(m).and::<[f64; 16]>(m),
         "the interpolated poses",
-        "pass fewer t at once",
+        POSE_HINT,
     )?;
-    let ts = ts.read()?;
-    let view = ts.as_array();
+    let (a, b) = (a.read()?, b.read()?);
+    let ts = match &t {
+        TArg::Array(ts) => Some(ts.read()?),
+        TArg::Scalar(_) => None,
+    };
+    let scalar = match t {
+        TArg::Scalar(t) => t,
+        TArg::Array(_) => f64::NAN,
+    };
+    let (a, b, ts) = (
+        a.as_array(),
+        b.as_array(),
+        ts.as_ref().map(|t| t.as_array()),
+    );
     let out = py.detach(|| -> PyResult<Array3<f64>> {
-        let ts = read_vector(F, "t", &view)?;
-        for (index, t) in ts.iter().enumerate() {
-            check_t(index, *t)?;
-        }
-        let mut poses = try_vec(ts.len(), "interpolated poses").map_err(|e| to_py_err(F, e))?;
-        poses.extend(ts.iter().map(|t| sc.eval(*t)));
-        poses_to_array(&poses).map_err(|e| to_py_err(F, e))
+        let (a, b) = (one_pose(F, "a", &a)?, one_pose(F, "b", &b)?);
+        let sc = Screw::between(&a, &b);
+        let many = match &ts {
+            Some(ts) if !single => Some(read_vector(F, "t", ts)?),
+            _ => None,
+        };
+        let run = || -> Result<Array3<f64>, Error> {
+            let Some(ts) = &many else {
+                let t = ts
+                    .as_ref()
+                    .map_or(scalar, |t| t.iter().next().copied().unwrap_or(f64::NAN));
+                check_t(0, t)?;
+                return poses_to_array(&[sc.eval(t)]);
+            };
+            for (index, t) in ts.iter().enumerate() {
+                check_t(index, *t)?;
+            }
+            let mut poses = try_vec(ts.len(), "interpolated poses")?;
+            poses.extend(ts.iter().map(|t| sc.eval(*t)));
+            poses_to_array(&poses)
+        };
+        run().map_err(|e| to_py_err(F, e))
     })?;
+    if single {
+        return Ok(out
+            .index_axis_move(numpy::ndarray::Axis(0), 0)
+            .into_pyarray(py)
+            .into_any());
+    }
     Ok(out.into_pyarray(py).into_any())
 }
 
