@@ -131,7 +131,10 @@ fn read_held(
     }
 }
 
-/// The result of `denoise`: the smooth poses and what was chosen.
+/// The result of ``denoise``: the smooth poses and what was chosen on the way.
+///
+/// For one clip the strengths, noises and iterations are floats (ints) and the pivot is
+/// (3,); for a batch of B clips they are (B,) arrays, the pivot (B, 3), the kinks a list.
 #[pyclass(frozen, module = "polyscrew", name = "Denoised")]
 pub struct PyDenoised {
     results: Vec<Denoised>,
@@ -159,7 +162,10 @@ impl PyDenoised {
 
 #[pymethods]
 impl PyDenoised {
-    /// The smooth poses, shape of the input ((N, 4, 4) or (B, N, 4, 4)); held ones exact.
+    /// poses -> FloatArray
+    ///
+    /// The smooth poses, in the input's shape ((N, 4, 4) or (B, N, 4, 4)), rigid;
+    /// held poses exactly as given.
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArrayDyn<f64>> {
         let out = self.matrices.clone().into_dyn();
@@ -171,31 +177,41 @@ impl PyDenoised {
         }
     }
 
-    /// The rotation's strength tau (a time, in the units of `times`): float, or (B,).
+    /// rotation_strength -> float | FloatArray
+    ///
+    /// The rotation's strength tau, a time in the units of ``times`` (chosen or given).
     #[getter]
     fn rotation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.rotation_strength)
     }
 
-    /// The translation's strength tau: float, or (B,).
+    /// translation_strength -> float | FloatArray
+    ///
+    /// The translation's strength tau.
     #[getter]
     fn translation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.translation_strength)
     }
 
-    /// Estimated rotation noise of the input, radians per axis: float, or (B,).
+    /// rotation_noise -> float | FloatArray
+    ///
+    /// Estimated rotation noise of the input: standard deviation per axis, radians.
     #[getter]
     fn rotation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.rotation_noise)
     }
 
-    /// Estimated position noise of the pivot, per axis, units of the poses: float, or (B,).
+    /// translation_noise -> float | FloatArray
+    ///
+    /// Estimated position noise of the pivot, per axis, in the units of the poses.
     #[getter]
     fn translation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.translation_noise)
     }
 
-    /// The pivot (body coordinates) whose world path was smoothed: (3,), or (B, 3).
+    /// pivot -> FloatArray
+    ///
+    /// The body point (body coordinates) whose world path was smoothed: (3,) or (B, 3).
     #[getter]
     fn pivot<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         let mut out = Array2::<f64>::zeros((self.results.len(), 3));
@@ -211,26 +227,35 @@ impl PyDenoised {
         }
     }
 
-    /// Samples where a kink in the rotation was let through: int array, or a list of them.
+    /// rotation_kinks -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the poses where an abrupt turn of the rotation was let through.
     #[getter]
     fn rotation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.rotation_kinks)
     }
 
-    /// Samples where a kink in the translation was let through.
+    /// translation_kinks -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the poses where an abrupt turn of the path was let through.
     #[getter]
     fn translation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.translation_kinks)
     }
 
-    /// Pops the clip was cut at (the first pose after each jump; the pieces between are
-    /// smoothed apart): int array, or a list of them.
+    /// pops -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the first pose after each pop (a jump far faster than the motion
+    /// around it) the clip was cut at; the pieces between are smoothed apart, each with its
+    /// own strengths (those reported are the longest piece's), and the jump is kept.
     #[getter]
     fn pops<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.pops)
     }
 
-    /// Gauss-Newton iterations of the rotation solve: int, or (B,).
+    /// iterations -> int | npt.NDArray[np.int64]
+    ///
+    /// Gauss-Newton iterations of the rotation solve.
     #[getter]
     fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         if self.batch {
@@ -241,7 +266,9 @@ impl PyDenoised {
         }
     }
 
-    /// Whether every rotation solve converged.
+    /// converged -> bool
+    ///
+    /// Whether every rotation solve converged (last step below 1e-9 rad).
     #[getter]
     fn converged(&self) -> bool {
         self.results.iter().all(|r| r.converged)
@@ -280,9 +307,45 @@ impl PyDenoised {
     }
 }
 
-/// denoise(poses, times, strength=None, held=None, order=3, kinks=True, threads=0) -> Denoised
+/// denoise(
+///     poses: ArrayLike,
+///     times: ArrayLike,
+///     strength: float | tuple[float, float] | None = None,
+///     held: ArrayLike | None = None,
+///     order: int = 3,
+///     kinks: bool = True,
+///     threads: int = 0,
+/// ) -> Denoised
 ///
-/// Removes noise from dense captured poses (see the stub for the full contract).
+/// Remove noise from a captured rigid motion (camera solve, motion capture, baked
+/// simulation): the smooth motion nearest to ``poses`` (N, 4, 4) at ``times`` (N,), or to
+/// each of B clips (B, N, 4, 4) at the same times, in one call.
+///
+/// Coordinate-free: ``denoise(G @ poses @ H)`` is ``G @ denoise(poses) @ H`` for rigid G, H,
+/// with the automatic strengths too; a screw motion (and any motion turning at constant
+/// angular velocity while one body point moves at constant velocity) comes back unchanged.
+/// The rotation is smoothed on the rotation group and the path of one body point (the
+/// ``pivot``, the point of least jitter) in space, each by a smoothing spline of ``order``
+/// 3 (quintic: constant acceleration is free; 2: cubic) on the given, possibly uneven, times.
+///
+/// ``strength``: None chooses the strengths from the data (generalised cross-validation,
+/// rotation and translation apart, reported back); a time tau (in the units of ``times``)
+/// or (rotation, translation) times: motion faster than about ``2 pi tau`` per cycle is
+/// removed, 0 leaves that part as is; any finite tau >= 0 is served, one above 100 median
+/// spacings of ``times`` acts as 100 spacings (the strength reported). The work is done in
+/// a normalised time: scaling ``times`` changes nothing but the strengths' unit. ``held``:
+/// boolean mask (N,) or (B, N); held poses are kept exactly (their matrices as given, read
+/// once) and the motion passes through them. ``kinks``: let abrupt turns (a prop stopping
+/// against a wall) through instead of rounding them, and cut the clip at pops (see
+/// ``Denoised.pops``). ``threads``: clips of a batch
+/// are spread over this many threads (0: all the machine has). A batch of no clips
+/// (0, N, 4, 4) is checked like any other and gives an empty result.
+///
+/// Raises ValueError for a wrong shape, fewer than 4 poses, more than 1,000,000 poses per
+/// clip or 20,000,000 in all, a non-rigid or non-finite pose (naming the index, and the
+/// body of a batch), times that are not finite and increasing, a held mask of the wrong
+/// shape, an order other than 2 or 3, a negative or non-finite strength, and values so
+/// large that the computation overflows.
 #[pyfunction]
 #[pyo3(signature = (poses, times, strength=None, held=None, order=None, kinks=None, threads=None))]
 #[pyo3(text_signature = "(poses, times, strength=None, held=None, order=3, kinks=True, threads=0)")]

@@ -129,6 +129,30 @@ fn class(py: Python<'_>, kind: Kind) -> PyResult<Bound<'_, PyType>> {
     Ok(family.0[i].bind(py).clone())
 }
 
+// stub:
+// stub: # --- The exception family: every error polyscrew raises about its arguments or its work ---
+// stub:
+// stub: class PolyscrewError(Exception):
+// stub:     """Base of every error polyscrew raises about its arguments or its work."""
+// stub:
+// stub: class InvalidArgument(PolyscrewError, ValueError):
+// stub:     """An argument's value, shape, range or count is wrong (also a ValueError)."""
+// stub:
+// stub: class ArgumentTypeError(PolyscrewError, TypeError):
+// stub:     """An argument has the wrong type (also a TypeError)."""
+// stub:
+// stub: class BudgetExceeded(InvalidArgument, MemoryError):
+// stub:     """The call would need more memory than memory_budget() allows; refused before anything
+// stub:     was allocated (an InvalidArgument, so a ValueError, and a MemoryError)."""
+// stub:
+// stub: class OutOfMemory(PolyscrewError, MemoryError):
+// stub:     """The system refused memory within the budget (also a MemoryError)."""
+// stub:
+// stub: class FitFailed(PolyscrewError, ValueError):
+// stub:     """fit_angular_velocity did not converge or stays above delta; the best fit is the
+// stub:     exception's `result` attribute (also a ValueError)."""
+// stub:
+// stub:     result: AngularVelocityFit
 /// Adds the family's classes to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();

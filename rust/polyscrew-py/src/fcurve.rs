@@ -415,16 +415,66 @@ impl CurveArgs<'_> {
     }
 }
 
-/// evaluate_fcurves(times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation="CONSTANT", back=None, amplitude=None, period=None, cycles=None) -> ndarray
+// stub:
+// stub: from collections.abc import Mapping, Sequence
+// stub: from typing import Any
+// stub:
+// stub: InterpolationName = Literal[
+// stub:     "CONSTANT", "LINEAR", "BEZIER", "SINE", "QUAD", "CUBIC", "QUART", "QUINT", "EXPO", "CIRC",
+// stub:     "BACK", "BOUNCE", "ELASTIC",
+// stub: ]
+// stub: EasingName = Literal["AUTO", "EASE_IN", "EASE_OUT", "EASE_IN_OUT"]
+// stub: ExtrapolationName = Literal["CONSTANT", "LINEAR"]
+// stub: CycleModeName = Literal["NONE", "REPEAT", "REPEAT_OFFSET", "MIRROR"]
+/// evaluate_fcurves(
+///     times: ArrayLike,
+///     *,
+///     offsets: ArrayLike,
+///     co: ArrayLike,
+///     handle_left: ArrayLike,
+///     handle_right: ArrayLike,
+///     interpolation: ArrayLike,
+///     easing: ArrayLike,
+///     extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+///     back: ArrayLike | None = None,
+///     amplitude: ArrayLike | None = None,
+///     period: ArrayLike | None = None,
+///     cycles: Sequence[Mapping[str, Any] | None] | None = None,
+/// ) -> FloatArray
 ///
-/// Blender's F-curve evaluation of C curves at T times in one call: `(C, T)` float64, each
-/// value exactly Blender's `FCurve.evaluate(time)` (float32 arithmetic mirrored). Curve `c`
-/// owns keys `offsets[c]:offsets[c + 1]` of the packed per-key arrays (`co`, `handle_left`,
-/// `handle_right` (K, 2); `interpolation`, `easing` (K,) integer codes indexing
-/// `INTERPOLATIONS` and `EASINGS`; `back`, `amplitude`, `period` (K,), default Blender's
-/// defaults). `extrapolation`: one of `EXTRAPOLATIONS` for all curves or one per curve.
-/// `cycles`: None, or one entry per curve, None or a dict of the Cycles modifier's RNA
-/// properties. GIL released. Raises ValueError naming the argument, curve and key.
+/// C keyframed F-curves at T ``times`` as Blender evaluates them: (C, T) float64.
+///
+/// Each value is exactly Blender's ``FCurve.evaluate(time)`` (4.2 and later): every step
+/// is done in float32 (and float64 where Blender uses double) in Blender's order, so the
+/// result is Blender's float32 value, widened. Times may be in any order and are rounded to
+/// float32, as Blender's frame is.
+///
+/// Keys are packed one curve after the other (K keys in all); curve ``c`` owns keys
+/// ``offsets[c]:offsets[c + 1]`` (``offsets`` (C + 1,), from 0 to K, non-decreasing; every
+/// curve needs a key):
+///
+/// - ``co``, ``handle_left``, ``handle_right``: (K, 2) ``(frame, value)``; frames of a
+///   curve's keys must not decrease;
+/// - ``interpolation``: (K,) integer codes, indices into ``INTERPOLATIONS`` (the segment
+///   from each key to the next); ``easing``: (K,) indices into ``EASINGS`` (AUTO is
+///   ease-out for BACK, BOUNCE, ELASTIC and ease-in for the others, as in Blender);
+/// - ``back``, ``amplitude``, ``period``: (K,), default Blender's 1.70158, 0.8, 4.1.
+///
+/// ``extrapolation``: one name of ``EXTRAPOLATIONS`` for every curve or one per curve
+/// (default ``"CONSTANT"``). ``cycles``: None, or C entries, each None (no modifier) or a
+/// dict of the Cycles modifier's RNA properties: ``mode_before``, ``mode_after`` (names
+/// of ``CYCLE_MODES``, default ``"REPEAT"``), ``cycles_before``, ``cycles_after`` (0:
+/// unlimited), ``use_restricted_range`` with ``frame_start``, ``frame_end``, ``blend_in``,
+/// ``blend_out``, ``use_influence`` with ``influence``. Other modifiers, drivers and muted
+/// curves are not evaluated (the add-on's ``curves.py`` refuses them).
+///
+/// The GIL is released. Raises ValueError naming the argument, curve and key: wrong shapes
+/// or lengths, bad offsets, codes or names, integer codes or offsets that are not whole
+/// numbers (``2.7``, NaN), numbers not finite in float32, keys out of time order, a curve
+/// without keys, more than ``MAX_FCURVE_KEYS`` keys or ``MAX_FCURVE_VALUES`` values, more
+/// memory than the budget (the prepared curves, the values and the copies of the input,
+/// checked before anything is copied), or a value that is not finite (where Blender's
+/// would be NaN or infinite); TypeError for complex, string or object arrays.
 #[pyfunction]
 #[pyo3(signature = (times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None))]
 #[allow(clippy::too_many_arguments)]
@@ -478,11 +528,24 @@ fn evaluate_fcurves<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate_fcurves, m)?)?;
     let py = m.py();
+    // stub:
+    // stub: INTERPOLATIONS: tuple[InterpolationName, ...]
+    // stub: """Blender's ``Keyframe.interpolation`` identifiers; a key's code is its index here."""
     m.add("INTERPOLATIONS", PyTuple::new(py, Interpolation::NAMES)?)?;
+    // stub: EASINGS: tuple[EasingName, ...]
+    // stub: """Blender's ``Keyframe.easing`` identifiers; a key's code is its index here."""
     m.add("EASINGS", PyTuple::new(py, Easing::NAMES)?)?;
+    // stub: EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
+    // stub: """Blender's ``FCurve.extrapolation`` identifiers."""
     m.add("EXTRAPOLATIONS", PyTuple::new(py, Extrapolation::NAMES)?)?;
+    // stub: CYCLE_MODES: tuple[CycleModeName, ...]
+    // stub: """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
     m.add("CYCLE_MODES", PyTuple::new(py, CycleMode::NAMES)?)?;
+    // stub: MAX_FCURVE_KEYS: int
+    // stub: """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
     m.add("MAX_FCURVE_KEYS", MAX_KEYS)?;
+    // stub: MAX_FCURVE_VALUES: int
+    // stub: """The most values (curves x times) one ``evaluate_fcurves`` call returns (2**27)."""
     m.add("MAX_FCURVE_VALUES", MAX_VALUES)?;
     Ok(())
 }

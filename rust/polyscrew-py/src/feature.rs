@@ -130,12 +130,17 @@ fn read_feature_spec<'py>(
     ))
 }
 
-/// register_points(src, dst, weights=None) -> ndarray
+// stub:
+// stub: CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
+// stub: ParametrizationName = Literal["uniform", "centripetal"]
+/// register_points(src: ArrayLike, dst: ArrayLike, weights: ArrayLike | None = None) -> FloatArray
 ///
-/// The rigid pose (4, 4) minimising sum_k w_k |pose(src_k) - dst_k|^2 by Horn's quaternion
-/// method: `src`, `dst` (K, 3) corresponding points, K >= 3, `weights` (K,) >= 0.
-/// Raises ValueError for mismatched shapes, NaN, negative weights, or collinear points
-/// (the best rotation is then not unique).
+/// The rigid pose (4, 4) minimising ``sum_k w_k |pose(src_k) - dst_k|^2`` (Horn's method).
+///
+/// ``src``, ``dst``: (K, 3) corresponding points, K >= 3; ``weights``: (K,) >= 0, default 1.
+/// The rotation is the eigenvector of the largest eigenvalue of Horn's symmetric 4x4
+/// matrix; when that eigenvalue is repeated (collinear points, or a target too distorted to
+/// have a unique best fit) ValueError is raised instead of an arbitrary rotation.
 #[pyfunction]
 #[pyo3(signature = (src, dst, weights=None))]
 fn register_points<'py>(
@@ -182,12 +187,13 @@ fn register_points<'py>(
     Ok(out.index_axis_move(Axis(0), 0).into_pyarray(py))
 }
 
-/// inertia_points(points) -> ndarray
+/// inertia_points(points: ArrayLike) -> FloatArray
 ///
-/// The six inertia points (6, 3) of a point cloud (K, 3): barycentre +- sqrt(lambda_j / 2)
-/// e_j along the principal axes of its inertia tensor. They have the cloud's barycentre and
-/// inertia tensor, so registering them is registering the cloud (for affine distortions).
-/// Raises ValueError for fewer than 3 or collinear points.
+/// The six inertia points (6, 3) of a cloud ``points`` (K, 3): barycentre
+/// ``+- sqrt(lambda_j / 2) e_j`` along the principal axes of its inertia tensor.
+///
+/// They share the cloud's barycentre and inertia tensor, so they stand in for a whole mesh
+/// as ``feature_points``. Raises ValueError for fewer than 3 or collinear points.
 #[pyfunction]
 fn inertia_points<'py>(
     py: Python<'py>,
@@ -212,13 +218,35 @@ fn inertia_points<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// feature_motion(poses, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None) -> ndarray
+/// feature_motion(
+///     poses: ArrayLike,
+///     scheme: CurveSchemeName = "variational",
+///     levels: int = 5,
+///     closed: bool = False,
+///     feature_points: ArrayLike | None = None,
+///     parametrization: ParametrizationName = "uniform",
+///     stiffness: float | ArrayLike | None = None,
+///     inserted_stiffness: float | None = None,
+/// ) -> FloatArray
 ///
-/// Feature-point motion design (Hofer-Pottmann-Ravani): the curve scheme runs on the
-/// homologous positions of the feature points of the key poses (N, 4, 4), and the rigid
-/// body is registered to the distorted points at every output pose. Returns
-/// (N * 2**levels, 4, 4) closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose i * 2**levels
-/// belongs to key i.
+/// Feature-point motion design (Hofer-Pottmann-Ravani) of the keys ``poses`` (N, 4, 4).
+///
+/// The curve ``scheme`` runs on the homologous positions of ``feature_points`` (K, 3, in
+/// the body frame; default the six unit points +-x, +-y, +-z, whose isotropic inertia makes
+/// the result independent of how the local axes are turned), then the rigid body is
+/// registered to the distorted points at every output pose. Returns (N * 2**levels, 4, 4)
+/// closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose ``i * 2**levels`` belongs to key i.
+/// Rigid (unit quaternions) and independent of the world frame.
+///
+/// ``"variational"`` is Kobbelt's variational subdivision (C2), the only scheme that takes
+/// ``parametrization`` (``"centripetal"``: spacing sqrt of the feature points' distance
+/// between keys) and ``stiffness``: the spring lambda per key, a float for all keys or an
+/// (N,) array; ``inf`` (or ``None``) hits that key exactly, a finite lambda >= 0 lets the
+/// motion pass near it (smaller = smoother; an open motion needs two keys and a closed one
+/// one key with lambda > 0). ``inserted_stiffness`` is lambda for the poses inserted at
+/// earlier levels (``None`` = ``inf``: kept once inserted). ``"four_point"`` interpolates (C1),
+/// ``"bspline"`` and ``"jarek"`` approximate (C2).
+/// Raises ValueError naming the bad pose, key or sample and the reason.
 #[pyfunction]
 #[pyo3(signature = (poses, scheme=Choice::of(CurveScheme::Variational), levels=5, closed=false,
     feature_points=None, parametrization=Choice::of(Parametrization::Uniform), stiffness=None,
@@ -291,11 +319,25 @@ fn feature_motion<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// sample_feature(poses, key_times, times, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None, period=None, timing="smooth") -> ndarray
+/// sample_feature(
+///     poses: ArrayLike,
+///     key_times: ArrayLike,
+///     times: ArrayLike,
+///     scheme: CurveSchemeName = "variational",
+///     levels: int = 5,
+///     closed: bool = False,
+///     feature_points: ArrayLike | None = None,
+///     parametrization: ParametrizationName = "uniform",
+///     stiffness: float | ArrayLike | None = None,
+///     inserted_stiffness: float | None = None,
+///     period: float | None = None,
+///     timing: TimingName = "smooth",
+/// ) -> FloatArray
 ///
-/// `feature_motion` as a function of time, evaluated at `times` (M,): (M, 4, 4). Key i
-/// sits at `key_times[i]` (strictly increasing); `period`, `timing` and the screw between
-/// dense poses as in `sample`.
+/// ``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).
+///
+/// Key i sits at ``key_times[i]`` (finite, strictly increasing); ``period`` and ``timing``
+/// as in ``sample``; between dense poses the motion is the screw joining them.
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, scheme=Choice::of(CurveScheme::Variational),
     levels=5, closed=false, feature_points=None,

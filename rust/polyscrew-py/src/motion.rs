@@ -28,7 +28,8 @@ use crate::errors::{check_budget, invalid, shape_err, to_py_err};
 /// How to ask a sampling call for less memory.
 const SAMPLE_HINT: &str = polyscrew::motion::sample::SAMPLE_HINT;
 
-/// The screw between two poses (Rossignac-Kim): axis, point on the axis, angle, slide.
+/// The screw between two poses (Rossignac-Kim): ``b = M a`` with ``M`` a rotation by
+/// ``angle`` about the line through ``point`` along ``axis``, plus ``slide`` along it.
 #[pyclass(frozen, module = "polyscrew", name = "Screw")]
 pub struct PyScrew {
     inner: Screw,
@@ -36,21 +37,29 @@ pub struct PyScrew {
 
 #[pymethods]
 impl PyScrew {
-    /// Unit direction of the screw axis, shape (3,).
+    /// axis -> FloatArray
+    ///
+    /// Unit direction of the axis, shape (3,). Along the translation for a pure translation.
     #[getter]
     fn axis<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {
         self.inner.axis().to_array().to_vec().into_pyarray(py)
     }
+    /// point -> FloatArray
+    ///
     /// The point of the axis nearest to the first pose's origin, shape (3,).
     #[getter]
     fn point<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray1<f64>> {
         self.inner.point().to_array().to_vec().into_pyarray(py)
     }
-    /// Rotation angle about the axis, radians in [0, pi].
+    /// angle -> float
+    ///
+    /// Rotation angle, radians in [0, pi].
     #[getter]
     fn angle(&self) -> f64 {
         self.inner.angle()
     }
+    /// slide -> float
+    ///
     /// Translation along the axis.
     #[getter]
     fn slide(&self) -> f64 {
@@ -94,13 +103,13 @@ fn one_pose(function: &str, what: &str, view: &ArrayViewD<'_, f64>) -> PyResult<
 /// How to ask `screw` or `interpolate` for less memory.
 const POSE_HINT: &str = "pass (4, 4) float64 poses and fewer t at once";
 
-/// screw(a, b) -> Screw
+/// screw(a: ArrayLike, b: ArrayLike) -> Screw
 ///
-/// The minimal screw carrying pose `a` to pose `b` (Rossignac-Kim): `b = M a` with `M` a
-/// rotation by `angle` in [0, pi] about the line through `point` along unit `axis`, plus
-/// `slide` along it. A pure translation has angle 0 and its axis along the translation.
-/// `a`, `b`: (4, 4) rigid matrices, translation in the last column.
-/// Raises ValueError for a non-rigid matrix, NaN or a wrong shape.
+/// The minimal screw carrying pose ``a`` (4, 4) to pose ``b`` (4, 4).
+///
+/// A relative rotation within round-off of the identity (``|q.xyz| <= 16 eps``, a turn
+/// below 7e-15 rad) is a pure translation: axis along it, slide its length, angle 0.
+/// Errors name the pose: ``"screw: b: not rigid: ..."``.
 #[pyfunction]
 fn screw(py: Python<'_>, a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult<PyScrew> {
     const F: &str = "screw";
@@ -142,11 +151,14 @@ enum TArg<'py> {
     Array(FloatArg<'py>),
 }
 
-/// interpolate(a, b, t) -> ndarray
+/// interpolate(a: ArrayLike, b: ArrayLike, t: float) -> FloatArray
+/// interpolate(a: ArrayLike, b: ArrayLike, t: ArrayLike) -> FloatArray
 ///
-/// `s(a, t, b)`: the pose a fraction `t` along the screw from `a` to `b` (t = 0 gives a,
-/// t = 1 gives b; any real t extrapolates). Returns (4, 4) for a float `t`, (len(t), 4, 4)
-/// for an array. Raises ValueError for bad poses or non-finite t.
+/// ``s(a, t, b)``: the pose a fraction ``t`` along the screw from ``a`` to ``b``.
+///
+/// ``t = 0`` gives ``a``, ``t = 1`` gives ``b``, other values move along or past the screw,
+/// within +-1e12 (beyond, ``t**2`` times a coordinate could overflow).
+/// Returns (4, 4) for a float ``t``, (len(t), 4, 4) for an array.
 #[pyfunction]
 fn interpolate<'py>(
     py: Python<'py>,
@@ -229,13 +241,15 @@ fn keys_footprint(n: usize) -> Footprint {
     Footprint::of::<Pose>(n)
 }
 
-/// subdivide(poses, scheme="jarek", levels=4, closed=False) -> ndarray
+/// subdivide(
+///     poses: ArrayLike, scheme: SchemeName = "jarek", levels: int = 4, closed: bool = False
+/// ) -> FloatArray
 ///
-/// Split&Tweak subdivision of the polyscrew through `poses` (N, 4, 4) with scheme
-/// "four_point" (interpolating, C1), "bspline" (C2) or "jarek" (C2), `levels` in 0..=12.
-/// Returns (N * 2**levels, 4, 4) for a closed cycle, ((N - 1) * 2**levels + 1, 4, 4) for an
-/// open sequence, whose first and last poses are kept exactly.
-/// Raises ValueError naming the bad pose index and the reason.
+/// Split&Tweak subdivision of the polyscrew through ``poses`` (N, 4, 4).
+///
+/// Returns (N * 2**levels, 4, 4) closed, ((N - 1) * 2**levels + 1, 4, 4) open; an open
+/// sequence keeps its first and last pose exactly; "four_point" keeps every key.
+/// ``levels`` must be in 0..=12; at least 2 poses are needed.
 #[pyfunction]
 #[pyo3(signature = (poses, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false))]
 #[pyo3(text_signature = "(poses, scheme='jarek', levels=4, closed=False)")]
@@ -312,14 +326,24 @@ impl<'py> TimedInput<'py> {
     }
 }
 
-/// sample(poses, key_times, times, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> ndarray
+/// sample(
+///     poses: ArrayLike,
+///     key_times: ArrayLike,
+///     times: ArrayLike,
+///     scheme: SchemeName = "jarek",
+///     levels: int = 4,
+///     closed: bool = False,
+///     period: float | None = None,
+///     timing: TimingName = "smooth",
+/// ) -> FloatArray
 ///
-/// The subdivided motion of `poses` (N, 4, 4), keyed at `key_times` (N,) strictly
-/// increasing, evaluated at `times` (M,) (frames, subframes): (M, 4, 4). `closed` makes the
-/// keys a cycle of length `period` (default: closed after the mean key spacing);
-/// `timing="smooth"` maps time to the motion by a monotone C1 cubic through the keys,
-/// `"linear"` maps each key span linearly. Open motions hold their end poses outside the
-/// keys' range. Between dense poses the motion is the screw joining them.
+/// The subdivided motion of ``poses`` keyed at ``key_times``, at ``times``: (len(times), 4, 4).
+///
+/// ``key_times`` must be strictly increasing, within +-1e300 and at least 1e-300 apart;
+/// ``times`` within +-1e300. ``closed`` makes a cycle of length
+/// ``period`` (default: closed after the mean key spacing). ``timing="smooth"`` is the
+/// monotone C1 map from time to the motion parameter, ``"linear"`` maps each key span
+/// linearly. Open motions hold their end poses outside the keys' range.
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
 #[pyo3(
@@ -368,11 +392,22 @@ fn sample<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// sample_channels(poses, key_times, times, mode, previous=None, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> (ndarray, ndarray)
+/// sample_channels(
+///     poses: ArrayLike,
+///     key_times: ArrayLike,
+///     times: ArrayLike,
+///     mode: RotationModeName,
+///     previous: ArrayLike | None = None,
+///     scheme: SchemeName = "jarek",
+///     levels: int = 4,
+///     closed: bool = False,
+///     period: float | None = None,
+///     timing: TimingName = "smooth",
+/// ) -> tuple[FloatArray, FloatArray]
 ///
-/// `sample` as Blender's channels: the locations (M, 3) and the rotation channels of
-/// `rotation_channels(sample(...), mode, previous)`, without building and re-checking the
-/// (M, 4, 4) matrices in between. What a bake writes.
+/// ``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
+/// ``rotation_channels(sample(...), mode, previous)``, without the (len(times), 4, 4)
+/// matrices in between (what a bake writes).
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, mode, previous=None, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
 #[pyo3(
@@ -450,10 +485,11 @@ fn sample_channels<'py>(
     Ok((locations.into_pyarray(py), rotations.into_pyarray(py)))
 }
 
-/// subdivide_vectors(values, scheme="jarek", levels=4, closed=False) -> ndarray
+/// subdivide_vectors(
+///     values: ArrayLike, scheme: SchemeName = "jarek", levels: int = 4, closed: bool = False
+/// ) -> FloatArray
 ///
-/// The same schemes applied to plain vectors `values` (N, 3) (the linear masks of
-/// ScrewBender section 2); the output count is as in `subdivide`.
+/// The same schemes on plain vectors ``values`` (N, 3) (the linear masks).
 #[pyfunction]
 #[pyo3(signature = (values, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false))]
 #[pyo3(text_signature = "(values, scheme='jarek', levels=4, closed=False)")]
@@ -493,10 +529,18 @@ fn subdivide_vectors<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// sample_vectors(values, key_times, times, scheme="jarek", levels=4, closed=False, period=None, timing="smooth") -> ndarray
+/// sample_vectors(
+///     values: ArrayLike,
+///     key_times: ArrayLike,
+///     times: ArrayLike,
+///     scheme: SchemeName = "jarek",
+///     levels: int = 4,
+///     closed: bool = False,
+///     period: float | None = None,
+///     timing: TimingName = "smooth",
+/// ) -> FloatArray
 ///
-/// `sample` for plain vectors `values` (N, 3): linear subdivision, the same timing,
-/// straight lines between dense values. Used for log-scale smoothing. Returns (M, 3).
+/// ``sample`` for plain vectors ``values`` (N, 3) (for example log-scale): (len(times), 3).
 #[pyfunction]
 #[pyo3(signature = (values, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
 #[pyo3(
@@ -585,15 +629,17 @@ fn read_rotations(function: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Vec<D
     }
 }
 
-/// rotation_channels(rotations, mode, previous=None) -> ndarray
+/// rotation_channels(
+///     rotations: ArrayLike, mode: RotationModeName, previous: ArrayLike | None = None
+/// ) -> FloatArray
 ///
-/// Blender rotation channels of `rotations` ((N, 3, 3) or (N, 4, 4), rigid), continuous
-/// frame to frame. `mode`: "QUATERNION" -> (N, 4) w, x, y, z without sign flips;
-/// "AXIS_ANGLE" -> (N, 4) angle, x, y, z, unwrapped; "XYZ", "XZY", "YXZ", "YZX", "ZXY",
-/// "ZYX" -> (N, 3) Euler angles (radians, per axis x, y, z) each compatible with the
-/// previous frame as `Euler.make_compatible` does. `previous`: the channel values just
-/// before the first frame, to continue from (its angles within +-`MAX_PREVIOUS_ANGLE`).
-/// At most `MAX_ROTATIONS` rotations per call.
+/// Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), continuous.
+///
+/// "QUATERNION": (N, 4) w, x, y, z without sign flips; "AXIS_ANGLE": (N, 4) angle, x, y, z
+/// unwrapped; Euler orders: (N, 3) angles per axis (x, y, z), each frame compatible with the
+/// previous one (no jump above 180 degrees). ``previous`` continues from earlier values;
+/// its angles (Euler, the axis-angle angle) within ``+-MAX_PREVIOUS_ANGLE`` (1e9), else
+/// ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
 #[pyfunction]
 #[pyo3(signature = (rotations, mode, previous=None))]
 fn rotation_channels<'py>(
@@ -642,17 +688,18 @@ fn rotation_channels<'py>(
 /// memory_budget() -> int
 ///
 /// The memory budget in bytes: the most one call may hold at its peak (output, working
-/// memory, the copies it makes of its input). A call that would need more raises
-/// ValueError up front, saying how much it asked for and how to ask for less.
+/// memory, copies of the input). A call that would need more raises ``ValueError`` up
+/// front, naming the bytes asked for and how to ask for less.
 #[pyfunction]
 fn memory_budget() -> usize {
     polyscrew::memory_budget()
 }
 
-/// set_memory_budget(bytes) -> int
+/// set_memory_budget(bytes: int) -> int
 ///
-/// Sets the memory budget (bytes, >= 0) for every later call in the process and returns the
-/// previous one. `DEFAULT_MEMORY_BUDGET` restores the default.
+/// Sets the memory budget (bytes, >= 0) for every later call in the process; returns
+/// the previous one. ``set_memory_budget(DEFAULT_MEMORY_BUDGET)`` restores the default.
+/// Raise it on a machine that has the memory; lower it to keep a host application safe.
 #[pyfunction]
 fn set_memory_budget(bytes: &Bound<'_, PyAny>) -> PyResult<usize> {
     let bytes = args::int_in("set_memory_budget", "bytes", bytes, 0, i64::MAX)?;
@@ -672,11 +719,36 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add_function(wrap_pyfunction!(memory_budget, m)?)?;
     m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
+    // stub:
+    // stub: MAX_LEVELS: int
+    // stub: """The largest accepted number of subdivision levels (12)."""
     m.add("MAX_LEVELS", MAX_LEVELS)?;
+    // stub:
+    // stub: DEFAULT_MEMORY_BUDGET: int
+    // stub: """The default memory budget per call, 1 GiB (1073741824 bytes): about 5 times the largest
+    // stub: legitimate use (the 10,000 keys x 8 levels subdivision benchmark in Rust, 215 MB by the
+    // stub: estimate; through Python a 100,000-triangle sweep over 64 screws in 8 steps, 154 MB
+    // stub: estimated, 118 MB measured)."""
     m.add("DEFAULT_MEMORY_BUDGET", polyscrew::DEFAULT_MEMORY_BUDGET)?;
+    // stub:
+    // stub: MAX_COORDINATE: float
+    // stub: """The working range of coordinates: ``|x| <= 1e150`` (see the module documentation)."""
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
+    // stub:
+    // stub: MAX_TIME: float
+    // stub: """The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
+    // stub:
+    // stub: MAX_PREVIOUS_ANGLE: float
+    // stub: """The largest ``previous`` angle (radians, either sign) the rotation channels continue
+    // stub: from: 1e9 (see the module documentation); beyond it ``ValueError``."""
     m.add("MAX_PREVIOUS_ANGLE", polyscrew::MAX_PREVIOUS_ANGLE)?;
+    // stub:
+    // stub: MAX_ROTATIONS: int
+    // stub: """The most rotations one ``rotation_channels`` call converts: 2**24 (16,777,216), the most
+    // stub: the default memory budget accepts in quaternion and axis-angle modes. It bounds the call's
+    // stub: time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
+    // stub: is read."""
     m.add("MAX_ROTATIONS", polyscrew::MAX_ROTATIONS)?;
     Ok(())
 }
