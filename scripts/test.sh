@@ -23,6 +23,7 @@ stage "bootstrap"
 scripts/bootstrap.sh
 py="$root/.venv/bin/python"
 scripts/test_blender.sh --check  # fails now, not after 10 minutes, when a version cannot run
+"$py" scripts/generate_stub.py --check  # the committed .pyi is what the binding's Rust doc comments generate
 
 stage "cargo test (workspace)"
 cargo test --workspace --quiet
