@@ -100,8 +100,8 @@ fn one_pose(function: &str, what: &str, view: &ArrayViewD<'_, f64>) -> PyResult<
     Ok(read_poses(function, what, view)?[0])
 }
 
-/// How to ask `screw` or `interpolate` for less memory.
-const POSE_HINT: &str = "pass (4, 4) float64 poses and fewer t at once";
+/// How to ask `interpolate` for less memory (`screw` holds two poses whatever it is given).
+const POSE_HINT: &str = "pass fewer t at once";
 
 /// screw(a: ArrayLike, b: ArrayLike) -> Screw
 ///
