@@ -210,3 +210,12 @@ def test_the_exception_family():
     assert isinstance(over.value, ValueError) and isinstance(over.value, MemoryError)
     assert "budget" in str(over.value)
     print(f"\nover the budget: {over.value}")
+
+
+def test_a_fit_that_fails_is_a_fit_failed_with_its_best_result():
+    keys = [[1.0, 0.0, 0.0, 0.0]] * 2  # identity at both ends, a target of 10 rad in 1 s
+    with pytest.raises(polyscrew.FitFailed, match="infeasible") as info:
+        polyscrew.fit_angular_velocity(keys, [0.0, 1.0], [0.0, 1.0], [[0.0, 0.0, 10.0]] * 2, max_frames=2)
+    assert isinstance(info.value, ValueError) and not isinstance(info.value, polyscrew.InvalidArgument)
+    assert isinstance(info.value.result, polyscrew.AngularVelocityFit)
+    assert info.value.result.status == "above_delta"
