@@ -396,17 +396,18 @@ fn denoise(
         order,
         kinks,
     };
-    // The one pass over the poses keeps the held ones' matrices as read: nothing is read
-    // from the caller's arrays twice, and everything after the mask runs without the GIL.
+    // The one pass over the poses, with the GIL held: a held pose comes back as it was read,
+    // and once the GIL is released another Python thread may write the caller's arrays
+    // (nothing is read from them again). The work after it runs without the GIL.
+    let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
+    let times = read_vector(F, "times", &times)?;
+    if times.len() != n {
+        return Err(crate::errors::invalid(format!(
+            "{F}: times: expected {n} entries, got {}",
+            times.len()
+        )));
+    }
     let (results, matrices) = py.detach(|| -> PyResult<(Vec<Denoised>, Vec<f64>)> {
-        let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
-        let times = read_vector(F, "times", &times)?;
-        if times.len() != n {
-            return Err(crate::errors::invalid(format!(
-                "{F}: times: expected {n} entries, got {}",
-                times.len()
-            )));
-        }
         let results = denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads)
             .map_err(|e| to_py_err(F, e))?;
         drop(poses);
