@@ -35,18 +35,8 @@ pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> Py
         let mut m = [0.0; 16];
         values(&mut m);
         let row = |r: usize| [m[4 * r], m[4 * r + 1], m[4 * r + 2], m[4 * r + 3]];
-        let pose = Pose::from_rows(&[row(0), row(1), row(2), row(3)], i).map_err(|e| {
-            if single {
-                match e {
-                    Error::BadPose { defect, .. } => {
-                        invalid(format!("{function}: {what}: {defect}"))
-                    }
-                    other => to_py_err(function, other),
-                }
-            } else {
-                invalid(format!("{function}: {what}: {e}"))
-            }
-        })?;
+        let pose = Pose::from_rows(&[row(0), row(1), row(2), row(3)], i)
+            .map_err(|e| pose_err(function, what, single, e))?;
         poses.push(pose);
         Ok(())
     };
@@ -58,6 +48,26 @@ pub fn read_poses(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> Py
         push(&mut |m| fill(m, array.iter()), 0)?;
     }
     Ok(poses)
+}
+
+/// The error of a pose that is not rigid: `"{function}: {what}: pose 2: ..."`, or
+/// `"{function}: {what}: ..."` for a `single` matrix.
+fn pose_err(function: &str, what: &str, single: bool, e: Error) -> PyErr {
+    match e {
+        Error::BadPose { defect, .. } if single => invalid(format!("{function}: {what}: {defect}")),
+        other if single => to_py_err(function, other),
+        other => invalid(format!("{function}: {what}: {other}")),
+    }
+}
+
+/// Reads the one pose of a `(4, 4)` array (its shape checked by the caller), without
+/// allocating: what `read_poses` makes of a single matrix (no GIL needed).
+pub fn read_one_pose(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyResult<Pose> {
+    let mut m = [[0.0; 4]; 4];
+    for (slot, v) in m.iter_mut().flatten().zip(array.iter()) {
+        *slot = *v;
+    }
+    Pose::from_rows(&m, 0).map_err(|e| pose_err(function, what, true, e))
 }
 
 /// `m` filled from `values` (as many as it holds).

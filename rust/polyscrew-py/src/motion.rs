@@ -20,8 +20,8 @@ use crate::args::{
     SampleChannels, SampleVectors, Subdivide, SubdivideVectors,
 };
 use crate::arrays::{
-    fill, key_count, pose_count, poses_to_array, read_keys, read_poses, read_spec, read_vec3s,
-    read_vector, rows3_len, vec3s_to_array, vector_len,
+    fill, key_count, pose_count, poses_to_array, read_keys, read_one_pose, read_poses, read_spec,
+    read_vec3s, read_vector, rows3_len, vec3s_to_array, vector_len,
 };
 use crate::errors::{check_budget, invalid, shape_err, to_py_err};
 
@@ -95,11 +95,6 @@ fn one_pose_arg<'py>(
     Ok(array)
 }
 
-/// Reads the one pose of a [`one_pose_arg`] (no GIL needed).
-fn one_pose(function: &str, what: &str, view: &ArrayViewD<'_, f64>) -> PyResult<Pose> {
-    Ok(read_poses(function, what, view)?[0])
-}
-
 /// How to ask `interpolate` for less memory (`screw` holds two poses whatever it is given).
 const POSE_HINT: &str = "pass fewer t at once";
 
@@ -123,7 +118,7 @@ fn screw(py: Python<'_>, a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult
     let (a, b) = (a.read()?, b.read()?);
     let (a, b) = (a.as_array(), b.as_array());
     let inner = py.detach(|| -> PyResult<Screw> {
-        let (a, b) = (one_pose(F, "a", &a)?, one_pose(F, "b", &b)?);
+        let (a, b) = (read_one_pose(F, "a", &a)?, read_one_pose(F, "b", &b)?);
         Ok(Screw::between(&a, &b))
     })?;
     Ok(PyScrew { inner })
@@ -204,7 +199,7 @@ fn interpolate<'py>(
         ts.as_ref().map(|t| t.as_array()),
     );
     let out = py.detach(|| -> PyResult<Array3<f64>> {
-        let (a, b) = (one_pose(F, "a", &a)?, one_pose(F, "b", &b)?);
+        let (a, b) = (read_one_pose(F, "a", &a)?, read_one_pose(F, "b", &b)?);
         let sc = Screw::between(&a, &b);
         let many = match &ts {
             Some(ts) if !single => Some(read_vector(F, "t", ts)?),
