@@ -23,6 +23,7 @@ use crate::arrays::{
     fill, key_count, pose_count, poses_to_array, read_keys, read_one_pose, read_poses, read_spec,
     read_vec3s, read_vector, rows3_len, vec3s_to_array, vector_len,
 };
+use crate::detach_unless_small;
 use crate::errors::{check_budget, invalid, shape_err, to_py_err};
 
 /// How to ask a sampling call for less memory.
@@ -117,7 +118,8 @@ fn screw(py: Python<'_>, a: &Bound<'_, PyAny>, b: &Bound<'_, PyAny>) -> PyResult
     )?;
     let (a, b) = (a.read()?, b.read()?);
     let (a, b) = (a.as_array(), b.as_array());
-    let inner = py.detach(|| -> PyResult<Screw> {
+    // two poses: constant work, done without leaving the GIL (`detach_unless_small`)
+    let inner = detach_unless_small(py, true, || -> PyResult<Screw> {
         let (a, b) = (read_one_pose(F, "a", &a)?, read_one_pose(F, "b", &b)?);
         Ok(Screw::between(&a, &b))
     })?;
@@ -198,7 +200,7 @@ fn interpolate<'py>(
         b.as_array(),
         ts.as_ref().map(|t| t.as_array()),
     );
-    let out = py.detach(|| -> PyResult<Array3<f64>> {
+    let out = detach_unless_small(py, single, || -> PyResult<Array3<f64>> {
         let (a, b) = (read_one_pose(F, "a", &a)?, read_one_pose(F, "b", &b)?);
         let sc = Screw::between(&a, &b);
         let many = match &ts {
