@@ -25,6 +25,7 @@ stage "bootstrap"
 scripts/bootstrap.sh
 py="$root/.venv/bin/python"
 scripts/test_blender.sh --check  # fails now, not after 10 minutes, when a version cannot run
+"$py" scripts/generate_stub.py --check  # the committed .pyi is what the binding's Rust doc comments generate
 
 # Lint gates: each failure fails the run with one line naming the gate and the fix.
 gate() { # gate NAME FIX COMMAND...: runs COMMAND; on failure prints what failed and how to fix it

@@ -44,7 +44,10 @@ def report(call):
     try:
         out = call()
     except (ValueError, TypeError, MemoryError) as e:
-        print(json.dumps({{"error": type(e).__name__, "message": str(e)}}), flush=True)
+        # the builtin kind (ValueError, TypeError, MemoryError): polyscrew's own classes
+        # (polyscrew.InvalidArgument, ...) derive from it
+        kind = next(c.__name__ for c in type(e).__mro__ if c.__module__ == "builtins")
+        print(json.dumps({{"error": kind, "message": str(e)}}), flush=True)
         return None
     print(json.dumps({{"finite": finite(out)}}), flush=True)
     return out

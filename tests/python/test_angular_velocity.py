@@ -219,28 +219,3 @@ def test_default_arguments_are_the_papers():
     assert angle_between_rotations(mid, wxyz(Rotation.from_rotvec([[0, 0, np.pi / 2]])))[0] < 1e-4
     assert np.allclose(fit.sample_times, [0.0, 1.0])
     assert "AngularVelocityFit" in repr(fit)
-
-
-def test_stub_matches_the_module():
-    """The AngularVelocityFit / fit_angular_velocity part of __init__.pyi is in step with the code."""
-    import ast
-    import inspect
-    from pathlib import Path
-
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    classes = {n.name: n for n in stub.body if isinstance(n, ast.ClassDef)}
-    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
-    members = {n.name for n in classes["AngularVelocityFit"].body if isinstance(n, ast.FunctionDef)}
-    public = {name for name in dir(polyscrew.AngularVelocityFit) if not name.startswith("_")}
-    assert members == public, (members ^ public)
-    stub_fn = functions["fit_angular_velocity"]
-    stub_params = [a.arg for a in stub_fn.args.args + stub_fn.args.kwonlyargs]
-    stub_defaults = [ast.literal_eval(d) for d in stub_fn.args.defaults] + [
-        ast.literal_eval(d) for d in stub_fn.args.kw_defaults
-    ]
-    sig = inspect.signature(polyscrew.fit_angular_velocity)
-    assert list(sig.parameters) == stub_params
-    real_defaults = [p.default for p in sig.parameters.values() if p.default is not inspect.Parameter.empty]
-    assert real_defaults == stub_defaults
-    kinds = {n: p.kind for n, p in sig.parameters.items()}
-    assert all(kinds[a.arg] == inspect.Parameter.KEYWORD_ONLY for a in stub_fn.args.kwonlyargs)

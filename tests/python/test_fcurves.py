@@ -7,11 +7,8 @@ the Cycles modifier; shapes, names and errors. Agreement with Blender itself is
 
 from __future__ import annotations
 
-import ast
-import inspect
 import threading
 import time
-from pathlib import Path
 
 import numpy as np
 import polyscrew
@@ -286,19 +283,3 @@ def test_gil_is_released():
     during = [t for t in ticks if start < t < end]
     assert alone > 0.01, "the evaluation must be long enough to observe"
     assert len(during) >= 3, f"the other thread ran {len(during)} times in {end - start:.3f} s"
-
-
-def test_stub_matches_the_module():
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    fn = next(n for n in stub.body if isinstance(n, ast.FunctionDef) and n.name == "evaluate_fcurves")
-    sig = inspect.signature(polyscrew.evaluate_fcurves)
-    names = [a.arg for a in fn.args.args] + [a.arg for a in fn.args.kwonlyargs]
-    assert names == list(sig.parameters)
-    kinds = [p.kind for p in sig.parameters.values()]
-    assert kinds.count(inspect.Parameter.KEYWORD_ONLY) == len(fn.args.kwonlyargs)
-    required = "required"
-    stub_defaults = [required if d is None else ast.literal_eval(d) for d in fn.args.kw_defaults]
-    real = [required if p.default is inspect.Parameter.empty else p.default for p in sig.parameters.values()][1:]
-    assert stub_defaults == real
-    for const in ("INTERPOLATIONS", "EASINGS", "EXTRAPOLATIONS", "CYCLE_MODES", "MAX_FCURVE_KEYS", "MAX_FCURVE_VALUES"):
-        assert any(isinstance(n, ast.AnnAssign) and n.target.id == const for n in stub.body), const

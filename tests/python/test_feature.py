@@ -334,21 +334,3 @@ def test_errors(rng):
         polyscrew.sample_feature(keys, [0.0, 1.0, 2.0], [0.5])
     with pytest.raises(ValueError, match=r"key time 2 is not finite or not greater"):
         polyscrew.sample_feature(keys, [0.0, 1.0, 1.0, 2.0], [0.5])
-
-
-def test_stub_matches_the_module():
-    """The feature-point part of __init__.pyi is in step with the code (names, defaults)."""
-    import ast
-    import inspect
-    from pathlib import Path
-
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
-    for name in ("register_points", "inertia_points", "feature_motion", "sample_feature"):
-        stub_fn = functions[name]
-        params = [a.arg for a in stub_fn.args.args]
-        defaults = [ast.literal_eval(d) for d in stub_fn.args.defaults]
-        sig = inspect.signature(getattr(polyscrew, name))
-        assert list(sig.parameters) == params, name
-        real = [p.default for p in sig.parameters.values() if p.default is not inspect.Parameter.empty]
-        assert real == defaults, name

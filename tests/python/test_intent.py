@@ -8,10 +8,6 @@ own playback in ``tests/blender/test_intent.py``.
 
 from __future__ import annotations
 
-import ast
-import inspect
-from pathlib import Path
-
 import numpy as np
 import polyscrew
 import pytest
@@ -424,22 +420,3 @@ def test_constants():
     assert polyscrew.WIND_LIMIT == np.radians(150.0) and polyscrew.WIND_STEP == np.radians(45.0)
     assert (polyscrew.SPAN_SAMPLES, polyscrew.MAX_SPAN_SAMPLES, polyscrew.PACE_SAMPLES) == (8, 4096, 16)
     assert polyscrew.HOLD_TOLERANCE == 1e-6
-
-
-def test_stub_matches_the_module():
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
-    classes = {n.name: n for n in stub.body if isinstance(n, ast.ClassDef)}
-    for name in ("analyse_spans", "keys_parameters", "pace_parameters", "rotation_matrices"):
-        fn = functions[name]
-        sig = inspect.signature(getattr(polyscrew, name))
-        assert [a.arg for a in fn.args.args + fn.args.kwonlyargs] == list(sig.parameters), name
-        defaults = [ast.literal_eval(d) for d in fn.args.defaults] + [ast.literal_eval(d) for d in fn.args.kw_defaults if d is not None]
-        real = [p.default for p in sig.parameters.values() if p.default is not inspect.Parameter.empty]
-        assert defaults == real, name
-    init = next(n for n in classes["Playback"].body if isinstance(n, ast.FunctionDef) and n.name == "__init__")
-    stub_names = [a.arg for a in init.args.kwonlyargs]
-    assert stub_names[:4] == ["channels", "unkeyed", "mode", "located"]
-    assert stub_names[4:] == list(inspect.signature(polyscrew.evaluate_fcurves).parameters)[1:]
-    for const in ("WIND_LIMIT", "WIND_STEP", "SPAN_SAMPLES", "MAX_SPAN_SAMPLES", "HOLD_TOLERANCE", "PACE_SAMPLES"):
-        assert any(isinstance(n, ast.AnnAssign) and n.target.id == const for n in stub.body), const

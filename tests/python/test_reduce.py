@@ -11,10 +11,6 @@ CONSTANT spans. The error of a played pose on a body of radius r is measured as
 contract names (1/4, 1/2, 3/4), and are reported at 1/8 steps too.
 """
 
-import ast
-import inspect
-from pathlib import Path
-
 import numpy as np
 import polyscrew
 import pytest
@@ -669,18 +665,3 @@ def test_budget_is_checked_before_work():
         polyscrew.set_memory_budget(old)
     with pytest.raises(ValueError, match="exceed the limits"):
         polyscrew.reduce_keys(np.broadcast_to(np.eye(4), (30, 1_000_000, 4, 4)), np.arange(1e6), "XYZ", 1.0, MM, DEG)
-
-
-def test_stub_is_in_step():
-    """The reduce_keys part of __init__.pyi matches the function's signature and defaults."""
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
-    fn = functions["reduce_keys"]
-    params = [a.arg for a in fn.args.args] + [a.arg for a in fn.args.kwonlyargs]
-    sig = inspect.signature(polyscrew.reduce_keys)
-    assert list(sig.parameters) == params
-    kw_defaults = [ast.literal_eval(d) for d in fn.args.kw_defaults]
-    real = [p.default for p in sig.parameters.values() if p.kind == p.KEYWORD_ONLY]
-    assert real == kw_defaults
-    names = {t.id for n in stub.body if isinstance(n, ast.AnnAssign) for t in [n.target]}
-    assert "HANDLE_TYPES" in names

@@ -252,18 +252,3 @@ def test_bad_steps():
     for steps in [0, -1, polyscrew.MAX_STEPS + 1]:
         with pytest.raises(ValueError, match="steps"):
             polyscrew.sweep(v, t, poses, steps=steps)
-
-
-def test_stub_matches_the_module():
-    """The sweep part of __init__.pyi is in step with the code (names and defaults)."""
-    import ast
-    import inspect
-    from pathlib import Path
-
-    stub = ast.parse((Path(polyscrew.__file__).parent / "__init__.pyi").read_text())
-    fn = next(n for n in stub.body if isinstance(n, ast.FunctionDef) and n.name == "sweep")
-    sig = inspect.signature(polyscrew.sweep)
-    assert [a.arg for a in fn.args.args] == list(sig.parameters)
-    real = [p.default for p in sig.parameters.values() if p.default is not inspect.Parameter.empty]
-    assert [ast.literal_eval(d) for d in fn.args.defaults] == real
-    assert polyscrew.MAX_STEPS == 4096

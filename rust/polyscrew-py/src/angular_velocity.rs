@@ -4,7 +4,6 @@
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArray2};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 // The defaults are written as literals so that Python's signature shows them; they are
@@ -21,9 +20,9 @@ use polyscrew::{
 };
 
 use crate::args::{self, FitAngularVelocity, Function, Most};
-use crate::{
-    check_budget, copy_of, float_array, read_rows3, read_vector, shape_err, to_py_err, vector_len,
-};
+use crate::args::{copy_of, float_array};
+use crate::arrays::{read_rows3, read_vector, vector_len};
+use crate::errors::{check_budget, shape_err, to_py_err};
 use polyscrew::angular_velocity::{fit_footprint, FIT_HINT};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::Error;
@@ -59,7 +58,7 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
     if let Some((shape, mask)) = args::bool_array(F, "constrained", c, most_indices)? {
         if !mask.is_empty() {
             if shape.len() != 1 || mask.len() != n {
-                return Err(PyValueError::new_err(format!(
+                return Err(crate::errors::invalid(format!(
                     "{F}: constrained: boolean mask has {} entries for {n} keys",
                     mask.len()
                 )));
@@ -73,7 +72,7 @@ fn read_constrained(constrained: Option<&Bound<'_, PyAny>>, n: usize) -> PyResul
     for i in indices {
         let j = if i < 0 { i + n as i64 } else { i };
         if j < 0 || j >= n as i64 {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: constrained: index {i} out of range for {n} keys"
             )));
         }
@@ -111,7 +110,13 @@ fn angular_velocities(fit: &AngularVelocityFit, times: &[f64]) -> Result<Vec<DVe
     Ok(w)
 }
 
-/// The result of `fit_angular_velocity`: the fitted rotation and how well it fits.
+// stub:
+// stub: FitStatusName = Literal["converged", "iteration_limit", "above_delta"]
+/// The rotation fitted by ``fit_angular_velocity`` and how well it fits.
+///
+/// The rotation is the normalised Hermite quaternion spline ``q(t) / |q(t)|`` through the
+/// keys and the variable frames, so every orientation is exactly unit. Quaternions are
+/// (..., 4) arrays in w, x, y, z order; angular velocities are world-frame, rad per unit time.
 #[pyclass(frozen, module = "polyscrew", name = "AngularVelocityFit")]
 pub struct PyAngularVelocityFit {
     inner: AngularVelocityFit,
@@ -122,73 +127,101 @@ pub struct PyAngularVelocityFit {
 
 #[pymethods]
 impl PyAngularVelocityFit {
-    /// Fitted orientations at `sample_times`, (S, 4) w, x, y, z, unit and sign-continuous.
+    /// quaternions -> FloatArray
+    ///
+    /// Fitted orientations at ``sample_times``, (S, 4) w, x, y, z: unit, sign-continuous,
+    /// with the first key's sign; equal (up to sign) to the constrained keys at their times.
     #[getter]
     fn quaternions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         quaternions_to_array(&self.quaternions).into_pyarray(py)
     }
 
-    /// The times the orientations were sampled at, (S,).
+    /// sample_times -> FloatArray
+    ///
+    /// The times of ``quaternions`` and ``omega``, (S,) (the key times by default).
     #[getter]
     fn sample_times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from(self.sample_times.clone()).into_pyarray(py)
     }
 
-    /// Fitted world-frame angular velocity `vec(2 q' q^-1)` at `sample_times`, (S, 3).
+    /// omega -> FloatArray
+    ///
+    /// Fitted angular velocity ``vec(2 q' q^-1)`` at ``sample_times``, (S, 3).
     #[getter]
     fn omega<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         vectors_to_array(&self.omega).into_pyarray(py)
     }
 
-    /// Fitted orientation at each key time, (N, 4) w, x, y, z.
+    /// key_quaternions -> FloatArray
+    ///
+    /// Fitted orientation at each key time, (N, 4): the free keys moved, the others kept.
     #[getter]
     fn key_quaternions<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         quaternions_to_array(&self.inner.keys).into_pyarray(py)
     }
 
-    /// Times of the variable frames inserted, (F,).
+    /// frame_times -> FloatArray
+    ///
+    /// Times of the variable frames inserted (at most ``max_frames``), (F,) increasing.
     #[getter]
     fn frame_times<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from(self.inner.frame_times.clone()).into_pyarray(py)
     }
 
-    /// The largest per-fragment error `max F_n` (Xie et al. eq. 2).
+    /// fit_error -> float
+    ///
+    /// The largest fragment error ``max_n F_n``, ``F_n = ∫ |2 q' q^-1 - omega_s|^2 dt``
+    /// over each fragment (the paper's eq. 2); the fit succeeded when it is <= ``delta``.
     #[getter]
     fn fit_error(&self) -> f64 {
         self.inner.fit_error
     }
 
-    /// Every fragment error `F_n`, in time order.
+    /// fragment_errors -> FloatArray
+    ///
+    /// Every fragment error ``F_n``, in time order.
     #[getter]
     fn fragment_errors<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from(self.inner.fragment_errors.clone()).into_pyarray(py)
     }
 
+    /// fragment_duration -> float
+    ///
     /// The fragment length used.
     #[getter]
     fn fragment_duration(&self) -> f64 {
         self.inner.fragment_duration
     }
 
-    /// Levenberg-Marquardt steps over all rounds.
+    /// iterations -> int
+    ///
+    /// Levenberg-Marquardt steps taken over all rounds.
     #[getter]
     fn iterations(&self) -> usize {
         self.inner.iterations
     }
 
-    /// Optimisation rounds.
+    /// rounds -> int
+    ///
+    /// Optimisation rounds (variable frames are inserted between rounds).
     #[getter]
     fn rounds(&self) -> usize {
         self.inner.rounds
     }
 
-    /// Whether the optimiser converged with every fragment error at most `delta`.
+    /// converged -> bool
+    ///
+    /// True when the optimiser converged and ``fit_error <= delta``.
     #[getter]
     fn converged(&self) -> bool {
         self.inner.converged()
     }
 
-    /// "converged", "iteration_limit" or "above_delta".
+    /// status -> FitStatusName
+    ///
+    /// How the fit ended: "converged", "iteration_limit" (the optimiser ran out of
+    /// ``max_iterations``) or "above_delta" (converged, but the error stays above ``delta``
+    /// with the variable frames allowed: the target is infeasible for these keys).
     #[getter]
     fn status(&self) -> &'static str {
         match self.inner.status {
@@ -198,31 +231,41 @@ impl PyAngularVelocityFit {
         }
     }
 
-    /// The energy `alpha W_T + W_A`.
+    /// energy -> float
+    ///
+    /// The minimised energy ``alpha * W_T + W_A``.
     #[getter]
     fn energy(&self) -> f64 {
         self.inner.energy
     }
 
-    /// The tangential acceleration term `W_T`.
+    /// tangential -> float
+    ///
+    /// ``W_T``: the integrated squared tangential acceleration.
     #[getter]
     fn tangential(&self) -> f64 {
         self.inner.tangential
     }
 
-    /// The deviation term `W_A`.
+    /// deviation -> float
+    ///
+    /// ``W_A``: the integrated squared deviation from the target angular velocity.
     #[getter]
     fn deviation(&self) -> f64 {
         self.inner.deviation
     }
 
-    /// The `delta` the fit was held to.
+    /// delta -> float
+    ///
+    /// The threshold the fit was held to.
     #[getter]
     fn delta(&self) -> f64 {
         self.inner.delta
     }
 
-    /// Fitted orientations at `times` (T,) within the key range: (T, 4) w, x, y, z.
+    /// sample(times: ArrayLike) -> FloatArray
+    ///
+    /// Fitted orientations at ``times`` (T,) inside the key range: (T, 4) w, x, y, z.
     fn sample<'py>(
         &self,
         py: Python<'py>,
@@ -248,7 +291,9 @@ impl PyAngularVelocityFit {
         Ok(out.into_pyarray(py))
     }
 
-    /// Fitted world-frame angular velocity at `times` (T,) within the key range: (T, 3).
+    /// angular_velocity(times: ArrayLike) -> FloatArray
+    ///
+    /// Fitted angular velocity at ``times`` (T,) inside the key range: (T, 3).
     fn angular_velocity<'py>(
         &self,
         py: Python<'py>,
@@ -291,11 +336,61 @@ impl PyAngularVelocityFit {
     }
 }
 
-/// fit_angular_velocity(key_quaternions, key_times, target_times, target_omega, constrained=None, alpha=0.002, delta=0.1, max_iterations=200, max_frames=10, sample_times=None, *, target_speed=None, fragment_duration=None) -> AngularVelocityFit
+/// fit_angular_velocity(
+///     key_quaternions: ArrayLike,
+///     key_times: ArrayLike,
+///     target_times: ArrayLike,
+///     target_omega: ArrayLike,
+///     constrained: ArrayLike | None = None,
+///     alpha: float = 0.002,
+///     delta: float = 0.1,
+///     max_iterations: int = 200,
+///     max_frames: int = 10,
+///     sample_times: ArrayLike | None = None,
+///     *,
+///     target_speed: ArrayLike | None = None,
+///     fragment_duration: float | None = None,
+/// ) -> AngularVelocityFit
 ///
-/// Fits the rotation between keys to a target angular velocity (Xie et al. 2011). See the
-/// stub for the full contract. Raises ValueError for bad input, and for a fit that does not
-/// converge or stays above `delta`, with the best result as the exception's `result`.
+/// Fit the rotation between keys to a target angular velocity, keeping chosen keys
+/// (Xie, Xu, Yu, Weng 2011, "Sketch-based rotation editing").
+///
+/// Minimises ``alpha * W_T + W_A`` over a Hermite quaternion spline through the keys, with
+/// ``W_T = ∫ |q''|^2 - (q . q'')^2 / |q|^2 dt`` (tangential acceleration) and
+/// ``W_A = ∫ |2 q' q^-1 - omega_s|^2 dt`` (deviation from the target), the constrained keys
+/// held exactly and unit norm exact; inserts variable frames at the midpoints of fragments
+/// whose error exceeds ``delta`` and fits again, up to ``max_frames`` in all.
+///
+/// Args:
+///     key_quaternions: (N, 4) key orientations, w, x, y, z; N >= 2. Normalised (zero or
+///         NaN rejected); their signs are chosen to follow the target between keys.
+///     key_times: (N,) strictly increasing key times. Use seconds (and rad/s below) for the
+///         default ``alpha`` and ``delta`` to mean what they mean in the paper.
+///     target_times: (M,) strictly increasing times of the target samples, M >= 2, covering
+///         ``[key_times[0], key_times[-1]]``; the target is linear between samples.
+///     target_omega: (M, 3) world-frame target angular velocity. With ``target_speed`` these
+///         are directions instead (the sketch on the unit sphere): normalised, not
+///         required to be unit, zero length rejected.
+///     constrained: the keys held exactly: None (all), a boolean mask (N,) or key indices
+///         (integers, at most max(4 N, 64) of them; TypeError for anything else).
+///         The other keys are free: the fit moves them.
+///     alpha: weight of ``W_T`` (paper: 0.002; 0.001-0.005 works well), >= 0.
+///     delta: threshold on every fragment error (paper: 0.1), > 0.
+///     max_iterations: Levenberg-Marquardt steps allowed per round, >= 1.
+///     max_frames: variable frames allowed in total (paper: at most 10 were needed).
+///     sample_times: times for ``quaternions``/``omega`` within the key range (default:
+///         the key times).
+///     target_speed: (M,) magnitudes; when given, ``target_omega`` holds directions.
+///     fragment_duration: fragment length for the error test (default: two fragments per
+///         key span, at least 8 in all).
+///
+/// Raises:
+///     ValueError: bad input (shapes, NaN, times not increasing, zero-length range, no or
+///         one key, zero directions, target not covering the keys, options out of range),
+///         with the argument and index named; or a fit that did not converge
+///         ("did not converge") or stayed above ``delta`` ("target infeasible"). In the
+///         latter two cases the exception's ``result`` attribute holds the best
+///         ``AngularVelocityFit`` found.
 #[pyfunction]
 #[pyo3(signature = (
     key_quaternions, key_times, target_times, target_omega, constrained=None,
@@ -381,7 +476,7 @@ fn fit_angular_velocity(
         let (kq, kt, tt, to, ts, st) = &views;
         let keys = read_quaternions("key_quaternions", kq)?;
         if keys.len() < 2 {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: key_quaternions: {} keys given, at least 2 needed",
                 keys.len()
             )));
@@ -425,9 +520,10 @@ fn fit_angular_velocity(
         Err(failure) => failure.to_string(),
         Ok(_) => String::from("fit failed"),
     };
-    let err = PyValueError::new_err(format!(
-        "{F}: {message}; the best result is the exception's `result` attribute"
-    ));
+    let err = crate::errors::raise(
+        crate::errors::Kind::FitFailed,
+        format!("{F}: {message}; the best result is the exception's `result` attribute"),
+    );
     err.value(py).setattr("result", Py::new(py, result)?)?;
     Err(err)
 }

@@ -12,7 +12,9 @@ use numpy::{
     Element, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArray,
     PyUntypedArrayMethods,
 };
-use pyo3::exceptions::{PyException, PyMemoryError, PyOverflowError, PyTypeError, PyValueError};
+use pyo3::exceptions::PyOverflowError;
+
+use crate::errors::named;
 use pyo3::prelude::*;
 use pyo3::types::{PyFloat, PyString};
 
@@ -77,7 +79,7 @@ impl<'py, T: Element> Arg<'py, T> {
     fn check_copy(&self, what: &'static str, hint: &'static str) -> PyResult<()> {
         self.copy
             .check(what, hint)
-            .map_err(|e| crate::arg_err(self.function, self.what, e))
+            .map_err(|e| crate::errors::arg_err(self.function, self.what, e))
     }
 
     /// `err` named after the function and the argument.
@@ -138,7 +140,7 @@ impl<'py> Arg<'py, i64> {
                 .indexed_iter()
                 .find(|(_, v)| !(v.fract() == 0.0 && v.abs() < 9.2e18))
             {
-                return Err(PyValueError::new_err(format!(
+                return Err(crate::errors::invalid(format!(
                     "{}: {}: entry {:?} is {value}, not an integer",
                     self.function,
                     self.what,
@@ -198,6 +200,12 @@ functions!(
     Sweep = "sweep",
     FitAngularVelocity = "fit_angular_velocity",
     KeysParameters = "keys_parameters",
+    RotationChannels = "rotation_channels",
+    RotationMatrices = "rotation_matrices",
+    PlaybackNew = "Playback",
+    AnalyseSpans = "analyse_spans",
+    AnalyseTurns = "analyse_turns",
+    ReduceKeys = "reduce_keys",
 );
 
 /// The name of `obj`'s type, for messages.
@@ -205,31 +213,6 @@ fn type_name(obj: &Bound<'_, PyAny>) -> String {
     obj.get_type()
         .name()
         .map_or_else(|_| "?".to_owned(), |n| n.to_string())
-}
-
-/// `err` with `"{function}: {what}: "` before its message, as a `MemoryError` (numpy's own
-/// allocation failure included), a `TypeError`, or a `ValueError` for any other exception
-/// (numpy's exception classes cannot all be rebuilt from one message); the original is its
-/// `__cause__`. A `BaseException` that is not an `Exception` (`KeyboardInterrupt`) passes
-/// as it is.
-pub fn named(py: Python<'_>, function: &str, what: &str, err: PyErr) -> PyErr {
-    let message = err.value(py).to_string();
-    let prefix = format!("{function}: {what}: ");
-    if message.starts_with(&prefix) {
-        return err;
-    }
-    let text = format!("{prefix}{message}");
-    let renamed = if err.is_instance_of::<PyMemoryError>(py) {
-        PyMemoryError::new_err(text)
-    } else if err.is_instance_of::<PyTypeError>(py) {
-        PyTypeError::new_err(text)
-    } else if err.is_instance_of::<PyException>(py) {
-        PyValueError::new_err(text)
-    } else {
-        return err;
-    };
-    renamed.set_cause(py, Some(err));
-    renamed
 }
 
 /// Takes a float array-like for reading ([`Arg::read`]): float64 arrays as they are, other
@@ -244,7 +227,7 @@ pub fn float_array<'py>(
     let array = untyped(function, what, obj)?;
     let native = array.cast::<PyArrayDyn<f64>>().ok().cloned();
     if native.is_none() && !matches!(array.dtype().kind(), b'b' | b'i' | b'u' | b'f') {
-        return Err(PyTypeError::new_err(format!(
+        return Err(crate::errors::wrong_type(format!(
             "{function}: {what}: expected real numbers, got {}",
             dtype_name(array.as_any())
         )));
@@ -281,12 +264,12 @@ pub fn int_array<'py>(
             // the int64 copy, checked before the entries are even scanned
             Footprint::of::<i64>(n)
                 .check("the integer conversion", "pass fewer entries")
-                .map_err(|e| crate::arg_err(function, what, e))?;
+                .map_err(|e| crate::errors::arg_err(function, what, e))?;
             let floats = array.cast::<PyArrayDyn<f64>>().is_ok();
             Footprint::of::<i64>(n).and::<f64>(if floats { 0 } else { n })
         }
         _ => {
-            return Err(PyTypeError::new_err(format!(
+            return Err(crate::errors::wrong_type(format!(
                 "{function}: {what}: expected integers, got {}",
                 dtype_name(array.as_any())
             )))
@@ -346,7 +329,7 @@ fn too_long(function: &str, what: &str, max: Most, len: String) -> PyErr {
         Most::Exactly(n) => n.to_string(),
         Most::AtMost(n) => format!("at most {n}"),
     };
-    PyValueError::new_err(format!(
+    crate::errors::invalid(format!(
         "{function}: {what}: expected {expected} entries, got {len}"
     ))
 }
@@ -362,7 +345,7 @@ pub fn sequence<'py>(
     expected: &str,
 ) -> PyResult<Vec<Bound<'py, PyAny>>> {
     let not_a_sequence = || {
-        PyTypeError::new_err(format!(
+        crate::errors::wrong_type(format!(
             "{function}: {what}: expected {expected}, got {}",
             type_name(obj)
         ))
@@ -375,7 +358,8 @@ pub fn sequence<'py>(
         .map_err(|_| not_a_sequence())?;
     check_len(function, what, obj, max)?;
     let n = seq.len().map_err(|e| named(obj.py(), function, what, e))?;
-    let mut out = try_vec(n, "input sequence").map_err(|e| crate::to_py_err(function, e))?;
+    let mut out =
+        try_vec(n, "input sequence").map_err(|e| crate::errors::to_py_err(function, e))?;
     for i in 0..n {
         out.push(
             seq.get_item(i)
@@ -407,9 +391,10 @@ pub fn bool_array(
     let total = array.len();
     Footprint::of::<bool>(total)
         .check("the boolean mask", "pass a smaller mask")
-        .map_err(|e| crate::to_py_err(function, e))?;
+        .map_err(|e| crate::errors::to_py_err(function, e))?;
     let readonly = array.readonly();
-    let mut out = try_vec(total, "boolean mask").map_err(|e| crate::to_py_err(function, e))?;
+    let mut out =
+        try_vec(total, "boolean mask").map_err(|e| crate::errors::to_py_err(function, e))?;
     out.extend(readonly.as_array().iter().copied());
     Ok(Some((shape, out)))
 }
@@ -425,7 +410,12 @@ pub fn int_list(
     check_len(function, what, obj, max_len)?;
     let array = int_array(function, what, obj)?;
     if array.ndim() != 1 {
-        return Err(crate::shape_err(function, what, "(N,)", array.shape()));
+        return Err(crate::errors::shape_err(
+            function,
+            what,
+            "(N,)",
+            array.shape(),
+        ));
     }
     if array.len() > max_len.count() {
         return Err(too_long(function, what, max_len, array.len().to_string()));
@@ -433,7 +423,7 @@ pub fn int_list(
     let array = array.read()?;
     let view = array.as_array();
     let mut out =
-        try_vec(view.len(), "input integers").map_err(|e| crate::to_py_err(function, e))?;
+        try_vec(view.len(), "input integers").map_err(|e| crate::errors::to_py_err(function, e))?;
     out.extend(view.iter().copied());
     Ok(out)
 }
@@ -465,12 +455,12 @@ fn dtype_name(array: &Bound<'_, PyAny>) -> String {
 pub fn float_scalar(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<f64> {
     obj.extract::<f64>().map_err(|e| {
         if e.is_instance_of::<PyOverflowError>(obj.py()) {
-            PyValueError::new_err(format!(
+            crate::errors::invalid(format!(
                 "{function}: {what}: {} is too large for a float",
                 obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string())
             ))
         } else {
-            PyTypeError::new_err(format!(
+            crate::errors::wrong_type(format!(
                 "{function}: {what}: expected a real number, got {}",
                 type_name(obj)
             ))
@@ -500,12 +490,12 @@ pub fn int_in(
     hi: i64,
 ) -> PyResult<i64> {
     let out_of_range = |shown: String| {
-        PyValueError::new_err(format!(
+        crate::errors::invalid(format!(
             "{function}: {what} {shown} out of range {lo}..={hi}"
         ))
     };
     if obj.is_instance_of::<PyFloat>() {
-        return Err(PyTypeError::new_err(format!(
+        return Err(crate::errors::wrong_type(format!(
             "{function}: {what}: expected an int, got float {}",
             obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string())
         )));
@@ -516,7 +506,7 @@ pub fn int_in(
         Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => Err(out_of_range(
             obj.str().map_or_else(|_| "?".to_owned(), |s| s.to_string()),
         )),
-        Err(_) => Err(PyTypeError::new_err(format!(
+        Err(_) => Err(crate::errors::wrong_type(format!(
             "{function}: {what}: expected an int, got {}",
             type_name(obj)
         ))),
@@ -558,7 +548,7 @@ pub fn delta<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<f64> {
 /// A bool argument.
 pub fn bool_arg(function: &str, what: &str, obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     obj.extract::<bool>().map_err(|_| {
-        PyTypeError::new_err(format!(
+        crate::errors::wrong_type(format!(
             "{function}: {what}: expected a bool, got {}",
             type_name(obj)
         ))
@@ -579,7 +569,7 @@ pub fn caps<F: Function>(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
 pub fn str_arg<'a>(function: &str, what: &str, obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
     obj.cast::<PyString>()
         .map_err(|_| {
-            PyTypeError::new_err(format!(
+            crate::errors::wrong_type(format!(
                 "{function}: {what}: expected a str, got {}",
                 type_name(obj)
             ))
@@ -587,17 +577,58 @@ pub fn str_arg<'a>(function: &str, what: &str, obj: &'a Bound<'_, PyAny>) -> PyR
         .to_str()
 }
 
-/// `scheme`, a str.
-pub fn scheme<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "scheme", obj)
+/// A core enumeration that a Python argument names by a str ([`Choice`]).
+pub trait Named: Sized + Copy {
+    /// The argument's name in messages (`"scheme"`).
+    const ARG: &'static str;
+    /// The value called `name` (the core's parser and its error).
+    fn from_name(name: &str) -> Result<Self, polyscrew::Error>;
 }
 
-/// `timing`, a str.
-pub fn timing<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "timing", obj)
+macro_rules! named {
+    ($($ty:ty = $arg:literal),* $(,)?) => {
+        $(
+            impl Named for $ty {
+                const ARG: &'static str = $arg;
+                fn from_name(name: &str) -> Result<Self, polyscrew::Error> {
+                    <$ty>::from_name(name)
+                }
+            }
+        )*
+    };
 }
 
-/// `parametrization`, a str.
-pub fn parametrization<'a, F: Function>(obj: &'a Bound<'_, PyAny>) -> PyResult<&'a str> {
-    str_arg(F::NAME, "parametrization", obj)
+named!(
+    polyscrew::Scheme = "scheme",
+    polyscrew::Timing = "timing",
+    polyscrew::RotationMode = "mode",
+    polyscrew::CurveScheme = "scheme",
+    polyscrew::Parametrization = "parametrization",
+    polyscrew::intent::Turns = "turns",
+    polyscrew::reduce::Between = "between",
+);
+
+/// An enumeration argument of function `F`, parsed when pyo3 extracts it: a str naming one
+/// of the core's values (`"jarek"`), or an `ArgumentTypeError` (`"{function}: {arg}:
+/// expected a str, got int"`) / `InvalidArgument` (`"{function}: {arg}: \"x\" is not one
+/// of ..."`, the core's message) naming the function and the argument. One implementation
+/// for every enumeration, so every one fails the same way.
+pub struct Choice<F: Function, T: Named>(pub T, std::marker::PhantomData<F>);
+
+impl<F: Function, T: Named> Choice<F, T> {
+    /// The choice `value` (a default in a `#[pyo3(signature)]`).
+    pub const fn of(value: T) -> Self {
+        Self(value, std::marker::PhantomData)
+    }
+}
+
+impl<'a, 'py, F: Function, T: Named> FromPyObject<'a, 'py> for Choice<F, T> {
+    type Error = PyErr;
+
+    fn extract(obj: Borrowed<'a, 'py, PyAny>) -> PyResult<Self> {
+        let name = str_arg(F::NAME, T::ARG, &obj)?;
+        T::from_name(name)
+            .map(Self::of)
+            .map_err(|e| crate::errors::to_py_err(F::NAME, e))
+    }
 }

@@ -3,16 +3,19 @@
 
 use numpy::ndarray::{Array1, Array2, Array4, ArrayViewD};
 use numpy::{IntoPyArray, PyArray1, PyArrayDyn};
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
 
-use polyscrew::denoise::{MAX_DENOISE_BATCH, MAX_DENOISE_POSES, MIN_DENOISE_POSES};
+use polyscrew::denoise::{
+    denoise_footprint, denoised_rows, DENOISE_HINT, MAX_DENOISE_BATCH, MAX_DENOISE_POSES,
+    MIN_DENOISE_POSES,
+};
 use polyscrew::memory::try_vec;
 use polyscrew::{denoise_batch, DenoiseOptions, Denoised, Pose, Strength};
 
 use crate::args::Most;
-use crate::{read_vector, shape_err, to_py_err};
+use crate::arrays::read_vector;
+use crate::errors::{check_budget, shape_err, to_py_err};
 
 const F: &str = "denoise";
 
@@ -29,12 +32,12 @@ fn clip_shape(array: &ArrayViewD<'_, f64>) -> PyResult<(usize, usize, bool)> {
         _ => return Err(shape_err(F, "poses", "(N, 4, 4) or (B, N, 4, 4)", &shape)),
     };
     if n > MAX_DENOISE_POSES || bodies.saturating_mul(n) > MAX_DENOISE_BATCH {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {bodies} x {n} poses exceed the limits ({MAX_DENOISE_POSES} per clip, {MAX_DENOISE_BATCH} in all)"
         )));
     }
     if n < MIN_DENOISE_POSES {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {n} poses given, at least {MIN_DENOISE_POSES} needed"
         )));
     }
@@ -62,7 +65,7 @@ fn read_clips(
         let (b, i) = (g / n, g % n);
         poses.push(Pose::from_rows(&m, i).map_err(|e| {
             if batch {
-                PyValueError::new_err(format!("{F}: body {b}: {e}"))
+                crate::errors::invalid(format!("{F}: body {b}: {e}"))
             } else {
                 to_py_err(F, e)
             }
@@ -86,7 +89,7 @@ fn read_strength(strength: Option<&Bound<'_, PyAny>>) -> PyResult<Strength> {
         });
     }
     let pair: (f64, f64) = s.extract().map_err(|_| {
-        PyValueError::new_err(format!(
+        crate::errors::invalid(format!(
             "{F}: strength: expected None, a time or (rotation, translation) times"
         ))
     })?;
@@ -107,7 +110,7 @@ fn read_held(
         return Ok(None);
     };
     let err = || {
-        PyValueError::new_err(format!(
+        crate::errors::invalid(format!(
             "{F}: held: expected a boolean mask of shape ({n},) or ({bodies}, {n})"
         ))
     };
@@ -128,7 +131,10 @@ fn read_held(
     }
 }
 
-/// The result of `denoise`: the smooth poses and what was chosen.
+/// The result of ``denoise``: the smooth poses and what was chosen on the way.
+///
+/// For one clip the strengths, noises and iterations are floats (ints) and the pivot is
+/// (3,); for a batch of B clips they are (B,) arrays, the pivot (B, 3), the kinks a list.
 #[pyclass(frozen, module = "polyscrew", name = "Denoised")]
 pub struct PyDenoised {
     results: Vec<Denoised>,
@@ -156,7 +162,10 @@ impl PyDenoised {
 
 #[pymethods]
 impl PyDenoised {
-    /// The smooth poses, shape of the input ((N, 4, 4) or (B, N, 4, 4)); held ones exact.
+    /// poses -> FloatArray
+    ///
+    /// The smooth poses, in the input's shape ((N, 4, 4) or (B, N, 4, 4)), rigid;
+    /// held poses exactly as given.
     #[getter]
     fn poses<'py>(&self, py: Python<'py>) -> Bound<'py, PyArrayDyn<f64>> {
         let out = self.matrices.clone().into_dyn();
@@ -168,31 +177,41 @@ impl PyDenoised {
         }
     }
 
-    /// The rotation's strength tau (a time, in the units of `times`): float, or (B,).
+    /// rotation_strength -> float | FloatArray
+    ///
+    /// The rotation's strength tau, a time in the units of ``times`` (chosen or given).
     #[getter]
     fn rotation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.rotation_strength)
     }
 
-    /// The translation's strength tau: float, or (B,).
+    /// translation_strength -> float | FloatArray
+    ///
+    /// The translation's strength tau.
     #[getter]
     fn translation_strength<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.translation_strength)
     }
 
-    /// Estimated rotation noise of the input, radians per axis: float, or (B,).
+    /// rotation_noise -> float | FloatArray
+    ///
+    /// Estimated rotation noise of the input: standard deviation per axis, radians.
     #[getter]
     fn rotation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.rotation_noise)
     }
 
-    /// Estimated position noise of the pivot, per axis, units of the poses: float, or (B,).
+    /// translation_noise -> float | FloatArray
+    ///
+    /// Estimated position noise of the pivot, per axis, in the units of the poses.
     #[getter]
     fn translation_noise<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.scalar(py, |r| r.translation_noise)
     }
 
-    /// The pivot (body coordinates) whose world path was smoothed: (3,), or (B, 3).
+    /// pivot -> FloatArray
+    ///
+    /// The body point (body coordinates) whose world path was smoothed: (3,) or (B, 3).
     #[getter]
     fn pivot<'py>(&self, py: Python<'py>) -> Bound<'py, PyAny> {
         let mut out = Array2::<f64>::zeros((self.results.len(), 3));
@@ -208,26 +227,35 @@ impl PyDenoised {
         }
     }
 
-    /// Samples where a kink in the rotation was let through: int array, or a list of them.
+    /// rotation_kinks -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the poses where an abrupt turn of the rotation was let through.
     #[getter]
     fn rotation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.rotation_kinks)
     }
 
-    /// Samples where a kink in the translation was let through.
+    /// translation_kinks -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the poses where an abrupt turn of the path was let through.
     #[getter]
     fn translation_kinks<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.translation_kinks)
     }
 
-    /// Pops the clip was cut at (the first pose after each jump; the pieces between are
-    /// smoothed apart): int array, or a list of them.
+    /// pops -> npt.NDArray[np.int64] | list[npt.NDArray[np.int64]]
+    ///
+    /// Indices of the first pose after each pop (a jump far faster than the motion
+    /// around it) the clip was cut at; the pieces between are smoothed apart, each with its
+    /// own strengths (those reported are the longest piece's), and the jump is kept.
     #[getter]
     fn pops<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         self.kinks(py, |r| &r.pops)
     }
 
-    /// Gauss-Newton iterations of the rotation solve: int, or (B,).
+    /// iterations -> int | npt.NDArray[np.int64]
+    ///
+    /// Gauss-Newton iterations of the rotation solve.
     #[getter]
     fn iterations<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         if self.batch {
@@ -238,7 +266,9 @@ impl PyDenoised {
         }
     }
 
-    /// Whether every rotation solve converged.
+    /// converged -> bool
+    ///
+    /// Whether every rotation solve converged (last step below 1e-9 rad).
     #[getter]
     fn converged(&self) -> bool {
         self.results.iter().all(|r| r.converged)
@@ -277,9 +307,45 @@ impl PyDenoised {
     }
 }
 
-/// denoise(poses, times, strength=None, held=None, order=3, kinks=True, threads=0) -> Denoised
+/// denoise(
+///     poses: ArrayLike,
+///     times: ArrayLike,
+///     strength: float | tuple[float, float] | None = None,
+///     held: ArrayLike | None = None,
+///     order: int = 3,
+///     kinks: bool = True,
+///     threads: int = 0,
+/// ) -> Denoised
 ///
-/// Removes noise from dense captured poses (see the stub for the full contract).
+/// Remove noise from a captured rigid motion (camera solve, motion capture, baked
+/// simulation): the smooth motion nearest to ``poses`` (N, 4, 4) at ``times`` (N,), or to
+/// each of B clips (B, N, 4, 4) at the same times, in one call.
+///
+/// Coordinate-free: ``denoise(G @ poses @ H)`` is ``G @ denoise(poses) @ H`` for rigid G, H,
+/// with the automatic strengths too; a screw motion (and any motion turning at constant
+/// angular velocity while one body point moves at constant velocity) comes back unchanged.
+/// The rotation is smoothed on the rotation group and the path of one body point (the
+/// ``pivot``, the point of least jitter) in space, each by a smoothing spline of ``order``
+/// 3 (quintic: constant acceleration is free; 2: cubic) on the given, possibly uneven, times.
+///
+/// ``strength``: None chooses the strengths from the data (generalised cross-validation,
+/// rotation and translation apart, reported back); a time tau (in the units of ``times``)
+/// or (rotation, translation) times: motion faster than about ``2 pi tau`` per cycle is
+/// removed, 0 leaves that part as is; any finite tau >= 0 is served, one above 100 median
+/// spacings of ``times`` acts as 100 spacings (the strength reported). The work is done in
+/// a normalised time: scaling ``times`` changes nothing but the strengths' unit. ``held``:
+/// boolean mask (N,) or (B, N); held poses are kept exactly (their matrices as given, read
+/// once) and the motion passes through them. ``kinks``: let abrupt turns (a prop stopping
+/// against a wall) through instead of rounding them, and cut the clip at pops (see
+/// ``Denoised.pops``). ``threads``: clips of a batch
+/// are spread over this many threads (0: all the machine has). A batch of no clips
+/// (0, N, 4, 4) is checked like any other and gives an empty result.
+///
+/// Raises ValueError for a wrong shape, fewer than 4 poses, more than 1,000,000 poses per
+/// clip or 20,000,000 in all, a non-rigid or non-finite pose (naming the index, and the
+/// body of a batch), times that are not finite and increasing, a held mask of the wrong
+/// shape, an order other than 2 or 3, a negative or non-finite strength, and values so
+/// large that the computation overflows.
 #[pyfunction]
 #[pyo3(signature = (poses, times, strength=None, held=None, order=None, kinks=None, threads=None))]
 #[pyo3(text_signature = "(poses, times, strength=None, held=None, order=3, kinks=True, threads=0)")]
@@ -299,9 +365,9 @@ fn denoise(
         _ => 3,
     };
     let kinks = match kinks {
-        Some(k) if !k.is_none() => k.extract::<bool>().map_err(|_| {
-            pyo3::exceptions::PyTypeError::new_err(format!("{F}: kinks: expected a bool"))
-        })?,
+        Some(k) if !k.is_none() => k
+            .extract::<bool>()
+            .map_err(|_| crate::errors::wrong_type(format!("{F}: kinks: expected a bool")))?,
         _ => true,
     };
     let threads = match threads {
@@ -310,62 +376,57 @@ fn denoise(
     };
     let poses = crate::args::float_array(F, "poses", poses)?;
     let times = crate::args::float_array(F, "times", times)?;
-    // Before anything is copied: the conversions of the arguments, the input copy and the
-    // output (16 values each per pose), and the scratch of the solves (measured: 1,500 bytes
-    // per pose at the peak of a 400,000-pose clip with the strengths chosen automatically;
-    // 1,536 counted), against the memory budget.
-    const BYTES_PER_POSE: usize = 16 * 8 * 2 + 1536;
+    // Before anything is copied: the conversions of the arguments and what the call holds
+    // at its peak (the core's estimate per pose), against the memory budget.
     let count: usize = poses.shape().iter().rev().skip(2).product();
-    let footprint = poses.copy()
-        + times.copy()
-        + polyscrew::Footprint::bytes(count.saturating_mul(BYTES_PER_POSE));
-    const HINT: &str = "denoise fewer frames or fewer bodies in one call";
-    crate::check_budget(F, footprint, "the noise removal", HINT)?;
+    check_budget(
+        F,
+        poses.copy() + times.copy() + denoise_footprint(count),
+        "the noise removal",
+        DENOISE_HINT,
+    )?;
     let (poses, times) = (poses.read()?, times.read()?);
-    let input = poses.as_array();
+    let (input, times) = (poses.as_array(), times.as_array());
     let shape = clip_shape(&input)?;
     let (bodies, n, batch) = shape;
-    // The mask first, so that the one pass over the poses keeps the held ones' matrices
-    // (at most 128 bytes per pose, within the measured margin of BYTES_PER_POSE): the
-    // caller's arrays are not read again once the work leaves the GIL.
     let held = read_held(held, bodies, n)?;
-    let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
-    let times = read_vector(F, "times", &times.as_array())?;
-    if times.len() != n {
-        return Err(PyValueError::new_err(format!(
-            "{F}: times: expected {n} entries, got {}",
-            times.len()
-        )));
-    }
     let strength = read_strength(strength)?;
     let options = DenoiseOptions {
         strength,
         order,
         kinks,
     };
-    let results = py
-        .detach(|| denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads))
-        .map_err(|e| to_py_err(F, e))?;
-    drop(poses);
-    let mut out = Vec::with_capacity(bodies);
-    for (b, r) in results.into_iter().enumerate() {
-        match r {
-            Ok(d) => out.push(d),
-            Err(e) if batch => {
-                return Err(PyValueError::new_err(format!("{F}: body {b}: {e}")));
+    // The one pass over the poses, with the GIL held: a held pose comes back as it was read,
+    // and once the GIL is released another Python thread may write the caller's arrays
+    // (nothing is read from them again). The work after it runs without the GIL.
+    let (poses, held_rows) = read_clips(input.view(), shape, held.as_deref())?;
+    let times = read_vector(F, "times", &times)?;
+    if times.len() != n {
+        return Err(crate::errors::invalid(format!(
+            "{F}: times: expected {n} entries, got {}",
+            times.len()
+        )));
+    }
+    let (results, matrices) = py.detach(|| -> PyResult<(Vec<Denoised>, Vec<f64>)> {
+        let results = denoise_batch(&poses, bodies, &times, held.as_deref(), &options, threads)
+            .map_err(|e| to_py_err(F, e))?;
+        drop(poses);
+        let mut out = try_vec(bodies, "denoised bodies").map_err(|e| to_py_err(F, e))?;
+        for (b, r) in results.into_iter().enumerate() {
+            match r {
+                Ok(d) => out.push(d),
+                Err(e) if batch => return Err(to_py_err(&format!("{F}: body {b}"), e)),
+                Err(e) => return Err(to_py_err(F, e)),
             }
-            Err(e) => return Err(to_py_err(F, e)),
         }
-    }
-    let mut matrices = Array4::<f64>::zeros((bodies, n, 4, 4));
-    let flat = matrices.as_slice_mut().expect("a new array is contiguous");
-    let mut used = 0;
-    for (b, (r, dst)) in out.iter().zip(flat.chunks_exact_mut(16 * n)).enumerate() {
-        let h = held.as_ref().map(|h| &h[b * n..(b + 1) * n]);
-        used += r.write_rows(h, &held_rows[used..], dst);
-    }
+        let matrices =
+            denoised_rows(&out, n, held.as_deref(), &held_rows).map_err(|e| to_py_err(F, e))?;
+        Ok((out, matrices))
+    })?;
+    let matrices = Array4::from_shape_vec((bodies, n, 4, 4), matrices)
+        .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
     Ok(PyDenoised {
-        results: out,
+        results,
         matrices,
         n,
         batch,

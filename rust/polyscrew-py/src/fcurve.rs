@@ -7,7 +7,6 @@
 
 use numpy::ndarray::{Array2, ArrayViewD};
 use numpy::{IntoPyArray, PyArray2};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyString, PyTuple};
 
@@ -18,8 +17,9 @@ use polyscrew::fcurve::{
 };
 use polyscrew::memory::{try_vec, Footprint};
 
-use crate::args::{self, copy_of, float_array, int_array, FloatArg, Most};
-use crate::{read_vector, shape_err, to_py_err, vector_len};
+use crate::args::{self, copy_of, float_array, int_array, FloatArg, FloatArray, IntArray, Most};
+use crate::arrays::{read_vector, vector_len};
+use crate::errors::{shape_err, to_py_err};
 
 const F: &str = "evaluate_fcurves";
 
@@ -51,20 +51,6 @@ fn filled<T: Clone>(f: &str, value: T, n: usize, what: &'static str) -> PyResult
     Ok(out)
 }
 
-/// A per-key float array, or `k` copies of `default` when it is not given.
-fn read_per_key(
-    f: &str,
-    what: &str,
-    array: Option<&FloatArg<'_>>,
-    k: usize,
-    default: f32,
-) -> PyResult<Vec<f64>> {
-    match array {
-        Some(a) => read_vector(f, what, &a.read()?.as_array()),
-        None => filled(f, default as f64, k, "per-key values"),
-    }
-}
-
 /// An optional float array-like (`None` stays `None`).
 fn optional_floats<'py>(
     f: &'static str,
@@ -88,7 +74,7 @@ fn read_extrapolation(f: &str, arg: &Bound<'_, PyAny>, c: usize) -> PyResult<Vec
     let mut out = try_vec(items.len(), "extrapolations").map_err(|e| to_py_err(f, e))?;
     for item in &items {
         let name = item.cast::<PyString>().map_err(|_| {
-            PyTypeError::new_err(format!("{f}: extrapolation: expected {expected}"))
+            crate::errors::wrong_type(format!("{f}: extrapolation: expected {expected}"))
         })?;
         out.push(parse(name.to_str()?)?);
     }
@@ -113,10 +99,10 @@ const CYCLES_KEYS: [&str; 11] = [
 /// Reads one Cycles settings dict (named as Blender's RNA properties; missing entries take
 /// the defaults of a new modifier).
 fn read_cycles(f: &str, c: usize, dict: &Bound<'_, PyDict>) -> PyResult<Cycles> {
-    let err = |reason: String| PyValueError::new_err(format!("{f}: cycles[{c}]: {reason}"));
+    let err = |reason: String| crate::errors::invalid(format!("{f}: cycles[{c}]: {reason}"));
     for key in dict.keys() {
         let key: String = key.extract().map_err(|_| {
-            PyTypeError::new_err(format!(
+            crate::errors::wrong_type(format!(
                 "{f}: cycles[{c}]: setting names must be str, got {}",
                 key.get_type()
                     .name()
@@ -198,7 +184,7 @@ fn read_cycles_list(
         "a sequence of dicts or None, one per curve",
     )?;
     if items.len() != c {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{f}: cycles: expected {c} entries (one per curve), got {}",
             items.len()
         )));
@@ -211,16 +197,52 @@ fn read_cycles_list(
                 return Ok(None);
             }
             let dict = item.cast::<PyDict>().map_err(|_| {
-                PyTypeError::new_err(format!("{f}: cycles[{i}]: expected a dict or None"))
+                crate::errors::wrong_type(format!("{f}: cycles[{i}]: expected a dict or None"))
             })?;
             read_cycles(f, i, dict).map(Some)
         })
         .collect()
 }
 
-/// The packed curves' arguments of `evaluate_fcurves`, read and owned: shared with the
-/// functions that take the same curves (`Playback`).
-pub(crate) struct CurveArgs {
+/// The packed curves' arguments of `evaluate_fcurves`, checked against the budget and read
+/// (numpy's conversions done, nothing copied yet): shared with the functions that take the
+/// same curves (`Playback`). [`CurveInput::views`] and [`CurveViews::to_args`] copy them
+/// with the GIL released.
+pub(crate) struct CurveInput<'py> {
+    function: &'static str,
+    k: usize,
+    offsets: IntArray<'py>,
+    co: FloatArray<'py>,
+    handle_left: FloatArray<'py>,
+    handle_right: FloatArray<'py>,
+    interpolation: IntArray<'py>,
+    easing: IntArray<'py>,
+    back: Option<FloatArray<'py>>,
+    amplitude: Option<FloatArray<'py>>,
+    period: Option<FloatArray<'py>>,
+    extrapolation: Vec<Extrapolation>,
+    cycles: Vec<Option<Cycles>>,
+}
+
+/// Views of a [`CurveInput`]'s arrays: what the copies read, without the GIL.
+pub(crate) struct CurveViews<'a> {
+    function: &'static str,
+    k: usize,
+    offsets: ArrayViewD<'a, i64>,
+    co: ArrayViewD<'a, f64>,
+    handle_left: ArrayViewD<'a, f64>,
+    handle_right: ArrayViewD<'a, f64>,
+    interpolation: ArrayViewD<'a, i64>,
+    easing: ArrayViewD<'a, i64>,
+    back: Option<ArrayViewD<'a, f64>>,
+    amplitude: Option<ArrayViewD<'a, f64>>,
+    period: Option<ArrayViewD<'a, f64>>,
+    extrapolation: &'a [Extrapolation],
+    cycles: &'a [Option<Cycles>],
+}
+
+/// The packed curves' arguments, copied: what [`CurveArgs::packed`] lends the core.
+pub(crate) struct CurveArgs<'a> {
     offsets: Vec<i64>,
     co: Vec<f64>,
     handle_left: Vec<f64>,
@@ -230,18 +252,18 @@ pub(crate) struct CurveArgs {
     back: Vec<f64>,
     amplitude: Vec<f64>,
     period: Vec<f64>,
-    extrapolation: Vec<Extrapolation>,
-    cycles: Vec<Option<Cycles>>,
+    extrapolation: &'a [Extrapolation],
+    cycles: &'a [Option<Cycles>],
 }
 
-impl CurveArgs {
+impl<'py> CurveInput<'py> {
     /// Reads the arguments (errors name `function` and the argument): every array through
     /// the module's readers ([`float_array`], [`int_array`]: no silent casts), then the
     /// batch's sizes and everything the call will hold (the core's [`check_batch_with`]:
-    /// the copies made here, `extra` bytes more the caller holds and the evaluation at
-    /// `times` times) checked before anything is copied.
+    /// the copies [`CurveViews::to_args`] makes, `extra` bytes more the caller holds and the
+    /// evaluation at `times` times) checked before anything is converted or copied.
     #[allow(clippy::too_many_arguments)]
-    pub(crate) fn read<'py>(
+    pub(crate) fn read(
         function: &'static str,
         times: usize,
         extra: Footprint,
@@ -310,15 +332,17 @@ impl CurveArgs {
         check_batch_with(c, k, times, copies + extra).map_err(|e| to_py_err(f, e))?;
 
         Ok(Self {
-            offsets: read_ints(f, "offsets", offsets.read()?.as_array())?,
-            co: read_pairs(f, "co", co.read()?.as_array())?,
-            handle_left: read_pairs(f, "handle_left", handle_left.read()?.as_array())?,
-            handle_right: read_pairs(f, "handle_right", handle_right.read()?.as_array())?,
-            interpolation: read_ints(f, "interpolation", interpolation.read()?.as_array())?,
-            easing: read_ints(f, "easing", easing.read()?.as_array())?,
-            back: read_per_key(f, "back", back.as_ref(), k, DEFAULT_BACK)?,
-            amplitude: read_per_key(f, "amplitude", amplitude.as_ref(), k, DEFAULT_AMPLITUDE)?,
-            period: read_per_key(f, "period", period.as_ref(), k, DEFAULT_PERIOD)?,
+            function,
+            k,
+            offsets: offsets.read()?,
+            co: co.read()?,
+            handle_left: handle_left.read()?,
+            handle_right: handle_right.read()?,
+            interpolation: interpolation.read()?,
+            easing: easing.read()?,
+            back: back.as_ref().map(|a| a.read()).transpose()?,
+            amplitude: amplitude.as_ref().map(|a| a.read()).transpose()?,
+            period: period.as_ref().map(|a| a.read()).transpose()?,
             extrapolation: match extrapolation.filter(|e| !e.is_none()) {
                 Some(e) => read_extrapolation(f, e, c)?,
                 None => filled(f, Extrapolation::Constant, c, "extrapolations")?,
@@ -327,6 +351,52 @@ impl CurveArgs {
         })
     }
 
+    /// Views of the arrays, to copy without the GIL.
+    pub(crate) fn views(&self) -> CurveViews<'_> {
+        CurveViews {
+            function: self.function,
+            k: self.k,
+            offsets: self.offsets.as_array(),
+            co: self.co.as_array(),
+            handle_left: self.handle_left.as_array(),
+            handle_right: self.handle_right.as_array(),
+            interpolation: self.interpolation.as_array(),
+            easing: self.easing.as_array(),
+            back: self.back.as_ref().map(|a| a.as_array()),
+            amplitude: self.amplitude.as_ref().map(|a| a.as_array()),
+            period: self.period.as_ref().map(|a| a.as_array()),
+            extrapolation: &self.extrapolation,
+            cycles: &self.cycles,
+        }
+    }
+}
+
+impl<'a> CurveViews<'a> {
+    /// The arrays copied (allocated fallibly, no GIL needed: the budget was checked by
+    /// [`CurveInput::read`]); the per-key arrays not given are Blender's defaults.
+    pub(crate) fn to_args(&self) -> PyResult<CurveArgs<'a>> {
+        let (f, k) = (self.function, self.k);
+        let per_key = |what, a: &Option<ArrayViewD<'_, f64>>, default: f32| match a {
+            Some(a) => read_vector(f, what, a),
+            None => filled(f, default as f64, k, "per-key values"),
+        };
+        Ok(CurveArgs {
+            offsets: read_ints(f, "offsets", self.offsets.view())?,
+            co: read_pairs(f, "co", self.co.view())?,
+            handle_left: read_pairs(f, "handle_left", self.handle_left.view())?,
+            handle_right: read_pairs(f, "handle_right", self.handle_right.view())?,
+            interpolation: read_ints(f, "interpolation", self.interpolation.view())?,
+            easing: read_ints(f, "easing", self.easing.view())?,
+            back: per_key("back", &self.back, DEFAULT_BACK)?,
+            amplitude: per_key("amplitude", &self.amplitude, DEFAULT_AMPLITUDE)?,
+            period: per_key("period", &self.period, DEFAULT_PERIOD)?,
+            extrapolation: self.extrapolation,
+            cycles: self.cycles,
+        })
+    }
+}
+
+impl CurveArgs<'_> {
     /// The arguments as the core's packed curves.
     pub(crate) fn packed(&self) -> PackedCurves<'_> {
         PackedCurves {
@@ -339,22 +409,69 @@ impl CurveArgs {
             back: &self.back,
             amplitude: &self.amplitude,
             period: &self.period,
-            extrapolation: &self.extrapolation,
-            cycles: &self.cycles,
+            extrapolation: self.extrapolation,
+            cycles: self.cycles,
         }
     }
 }
 
-/// evaluate_fcurves(times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation="CONSTANT", back=None, amplitude=None, period=None, cycles=None) -> ndarray
+// stub:
+// stub: InterpolationName = Literal[
+// stub:     "CONSTANT", "LINEAR", "BEZIER", "SINE", "QUAD", "CUBIC", "QUART", "QUINT", "EXPO", "CIRC",
+// stub:     "BACK", "BOUNCE", "ELASTIC",
+// stub: ]
+// stub: EasingName = Literal["AUTO", "EASE_IN", "EASE_OUT", "EASE_IN_OUT"]
+// stub: ExtrapolationName = Literal["CONSTANT", "LINEAR"]
+// stub: CycleModeName = Literal["NONE", "REPEAT", "REPEAT_OFFSET", "MIRROR"]
+/// evaluate_fcurves(
+///     times: ArrayLike,
+///     *,
+///     offsets: ArrayLike,
+///     co: ArrayLike,
+///     handle_left: ArrayLike,
+///     handle_right: ArrayLike,
+///     interpolation: ArrayLike,
+///     easing: ArrayLike,
+///     extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+///     back: ArrayLike | None = None,
+///     amplitude: ArrayLike | None = None,
+///     period: ArrayLike | None = None,
+///     cycles: Sequence[Mapping[str, Any] | None] | None = None,
+/// ) -> FloatArray
 ///
-/// Blender's F-curve evaluation of C curves at T times in one call: `(C, T)` float64, each
-/// value exactly Blender's `FCurve.evaluate(time)` (float32 arithmetic mirrored). Curve `c`
-/// owns keys `offsets[c]:offsets[c + 1]` of the packed per-key arrays (`co`, `handle_left`,
-/// `handle_right` (K, 2); `interpolation`, `easing` (K,) integer codes indexing
-/// `INTERPOLATIONS` and `EASINGS`; `back`, `amplitude`, `period` (K,), default Blender's
-/// defaults). `extrapolation`: one of `EXTRAPOLATIONS` for all curves or one per curve.
-/// `cycles`: None, or one entry per curve, None or a dict of the Cycles modifier's RNA
-/// properties. GIL released. Raises ValueError naming the argument, curve and key.
+/// C keyframed F-curves at T ``times`` as Blender evaluates them: (C, T) float64.
+///
+/// Each value is exactly Blender's ``FCurve.evaluate(time)`` (4.2 and later): every step
+/// is done in float32 (and float64 where Blender uses double) in Blender's order, so the
+/// result is Blender's float32 value, widened. Times may be in any order and are rounded to
+/// float32, as Blender's frame is.
+///
+/// Keys are packed one curve after the other (K keys in all); curve ``c`` owns keys
+/// ``offsets[c]:offsets[c + 1]`` (``offsets`` (C + 1,), from 0 to K, non-decreasing; every
+/// curve needs a key):
+///
+/// - ``co``, ``handle_left``, ``handle_right``: (K, 2) ``(frame, value)``; frames of a
+///   curve's keys must not decrease;
+/// - ``interpolation``: (K,) integer codes, indices into ``INTERPOLATIONS`` (the segment
+///   from each key to the next); ``easing``: (K,) indices into ``EASINGS`` (AUTO is
+///   ease-out for BACK, BOUNCE, ELASTIC and ease-in for the others, as in Blender);
+/// - ``back``, ``amplitude``, ``period``: (K,), default Blender's 1.70158, 0.8, 4.1.
+///
+/// ``extrapolation``: one name of ``EXTRAPOLATIONS`` for every curve or one per curve
+/// (default ``"CONSTANT"``). ``cycles``: None, or C entries, each None (no modifier) or a
+/// dict of the Cycles modifier's RNA properties: ``mode_before``, ``mode_after`` (names
+/// of ``CYCLE_MODES``, default ``"REPEAT"``), ``cycles_before``, ``cycles_after`` (0:
+/// unlimited), ``use_restricted_range`` with ``frame_start``, ``frame_end``, ``blend_in``,
+/// ``blend_out``, ``use_influence`` with ``influence``. Other modifiers, drivers and muted
+/// curves are not evaluated (the add-on's ``curves.py`` refuses them).
+///
+/// The GIL is released. Raises ValueError naming the argument, curve and key: wrong shapes
+/// or lengths, bad offsets, codes or names, integer codes or offsets that are not whole
+/// numbers (``2.7``, NaN), numbers not finite in float32, keys out of time order, a curve
+/// without keys, more than ``MAX_FCURVE_KEYS`` keys or ``MAX_FCURVE_VALUES`` values, more
+/// memory than the budget (the prepared curves, the values and the copies of the input,
+/// checked before anything is copied), or a value that is not finite (where Blender's
+/// would be NaN or infinite); TypeError for complex, string or object arrays.
 #[pyfunction]
 #[pyo3(signature = (times, *, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None))]
 #[allow(clippy::too_many_arguments)]
@@ -375,7 +492,7 @@ fn evaluate_fcurves<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let times = float_array(F, "times", times)?;
     let n = vector_len(F, "times", &times)?;
-    let args = CurveArgs::read(
+    let input = CurveInput::read(
         F,
         n,
         times.copy() + Footprint::of::<f64>(n), // the times' conversion and copy
@@ -391,14 +508,16 @@ fn evaluate_fcurves<'py>(
         period,
         cycles,
     )?;
-    let times = read_vector(F, "times", &times.read()?.as_array())?;
-    let packed = args.packed();
-    let c = packed.len();
-    let values = py
-        .detach(|| evaluate_packed(&packed, &times))
-        .map_err(|e| to_py_err(F, e))?;
-    let out = Array2::from_shape_vec((c, n), values)
-        .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+    let times = times.read()?;
+    let (times, curves) = (times.as_array(), input.views());
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let times = read_vector(F, "times", &times)?;
+        let args = curves.to_args()?;
+        let packed = args.packed();
+        let values = evaluate_packed(&packed, &times).map_err(|e| to_py_err(F, e))?;
+        Array2::from_shape_vec((packed.len(), n), values)
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))
+    })?;
     Ok(out.into_pyarray(py))
 }
 
@@ -406,11 +525,24 @@ fn evaluate_fcurves<'py>(
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(evaluate_fcurves, m)?)?;
     let py = m.py();
+    // stub:
+    // stub: INTERPOLATIONS: tuple[InterpolationName, ...]
+    // stub: """Blender's ``Keyframe.interpolation`` identifiers; a key's code is its index here."""
     m.add("INTERPOLATIONS", PyTuple::new(py, Interpolation::NAMES)?)?;
+    // stub: EASINGS: tuple[EasingName, ...]
+    // stub: """Blender's ``Keyframe.easing`` identifiers; a key's code is its index here."""
     m.add("EASINGS", PyTuple::new(py, Easing::NAMES)?)?;
+    // stub: EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
+    // stub: """Blender's ``FCurve.extrapolation`` identifiers."""
     m.add("EXTRAPOLATIONS", PyTuple::new(py, Extrapolation::NAMES)?)?;
+    // stub: CYCLE_MODES: tuple[CycleModeName, ...]
+    // stub: """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
     m.add("CYCLE_MODES", PyTuple::new(py, CycleMode::NAMES)?)?;
+    // stub: MAX_FCURVE_KEYS: int
+    // stub: """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
     m.add("MAX_FCURVE_KEYS", MAX_KEYS)?;
+    // stub: MAX_FCURVE_VALUES: int
+    // stub: """The most values (curves x times) one ``evaluate_fcurves`` call returns (2**27)."""
     m.add("MAX_FCURVE_VALUES", MAX_VALUES)?;
     Ok(())
 }

@@ -14,11 +14,12 @@ use polyscrew::{
     InertiaFrame, Parametrization, Pose, Stiffness, Timing,
 };
 
-use crate::args::{self, FeatureMotion, Function, SampleFeature};
-use crate::{
-    check_budget, copy_of, float_array, key_count, poses_to_array, read_keys, read_rows3,
-    read_vector, to_py_err, vec3s_to_array, vector_len,
+use crate::args::{self, Choice, FeatureMotion, Function, SampleFeature};
+use crate::args::{copy_of, float_array};
+use crate::arrays::{
+    key_count, poses_to_array, read_keys, read_rows3, read_vector, vec3s_to_array, vector_len,
 };
+use crate::errors::{check_budget, to_py_err};
 
 /// Reads `(K, 3)` points; finiteness and range are checked by the core, which names the
 /// point (no GIL needed).
@@ -27,7 +28,7 @@ fn read_points(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyRes
 }
 
 /// The feature points' count of an optional `(K, 3)` argument.
-fn points_len(points: Option<&crate::FloatArg<'_>>) -> usize {
+fn points_len(points: Option<&crate::args::FloatArg<'_>>) -> usize {
     points.map_or(6, |p| p.shape().first().copied().unwrap_or(0))
 }
 
@@ -39,7 +40,7 @@ enum StiffnessArg<'py> {
     /// One value for every key.
     Scalar(f64),
     /// One value per key (its length is checked by the core).
-    PerKey(crate::FloatArg<'py>),
+    PerKey(crate::args::FloatArg<'py>),
 }
 
 impl StiffnessArg<'_> {
@@ -79,16 +80,13 @@ impl StiffnessArg<'_> {
 #[allow(clippy::too_many_arguments)]
 fn read_feature_spec<'py>(
     function: &'static str,
-    scheme: &str,
+    scheme: CurveScheme,
     levels: u32,
     closed: bool,
-    parametrization: &str,
+    parametrization: Parametrization,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(FeatureSpec, StiffnessArg<'py>)> {
-    let scheme = CurveScheme::from_name(scheme).map_err(|e| to_py_err(function, e))?;
-    let parametrization =
-        Parametrization::from_name(parametrization).map_err(|e| to_py_err(function, e))?;
     let keys = match stiffness.filter(|s| !s.is_none()) {
         None => StiffnessArg::Absent,
         Some(s) => {
@@ -103,7 +101,12 @@ fn read_feature_spec<'py>(
                     StiffnessArg::Scalar(value.unwrap_or(f64::NAN))
                 } else {
                     if a.ndim() != 1 {
-                        return Err(crate::shape_err(function, "stiffness", "(N,)", a.shape()));
+                        return Err(crate::errors::shape_err(
+                            function,
+                            "stiffness",
+                            "(N,)",
+                            a.shape(),
+                        ));
                     }
                     StiffnessArg::PerKey(a)
                 }
@@ -127,12 +130,17 @@ fn read_feature_spec<'py>(
     ))
 }
 
-/// register_points(src, dst, weights=None) -> ndarray
+// stub:
+// stub: CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
+// stub: ParametrizationName = Literal["uniform", "centripetal"]
+/// register_points(src: ArrayLike, dst: ArrayLike, weights: ArrayLike | None = None) -> FloatArray
 ///
-/// The rigid pose (4, 4) minimising sum_k w_k |pose(src_k) - dst_k|^2 by Horn's quaternion
-/// method: `src`, `dst` (K, 3) corresponding points, K >= 3, `weights` (K,) >= 0.
-/// Raises ValueError for mismatched shapes, NaN, negative weights, or collinear points
-/// (the best rotation is then not unique).
+/// The rigid pose (4, 4) minimising ``sum_k w_k |pose(src_k) - dst_k|^2`` (Horn's method).
+///
+/// ``src``, ``dst``: (K, 3) corresponding points, K >= 3; ``weights``: (K,) >= 0, default 1.
+/// The rotation is the eigenvector of the largest eigenvalue of Horn's symmetric 4x4
+/// matrix; when that eigenvalue is repeated (collinear points, or a target too distorted to
+/// have a unique best fit) ValueError is raised instead of an arbitrary rotation.
 #[pyfunction]
 #[pyo3(signature = (src, dst, weights=None))]
 fn register_points<'py>(
@@ -179,12 +187,13 @@ fn register_points<'py>(
     Ok(out.index_axis_move(Axis(0), 0).into_pyarray(py))
 }
 
-/// inertia_points(points) -> ndarray
+/// inertia_points(points: ArrayLike) -> FloatArray
 ///
-/// The six inertia points (6, 3) of a point cloud (K, 3): barycentre +- sqrt(lambda_j / 2)
-/// e_j along the principal axes of its inertia tensor. They have the cloud's barycentre and
-/// inertia tensor, so registering them is registering the cloud (for affine distortions).
-/// Raises ValueError for fewer than 3 or collinear points.
+/// The six inertia points (6, 3) of a cloud ``points`` (K, 3): barycentre
+/// ``+- sqrt(lambda_j / 2) e_j`` along the principal axes of its inertia tensor.
+///
+/// They share the cloud's barycentre and inertia tensor, so they stand in for a whole mesh
+/// as ``feature_points``. Raises ValueError for fewer than 3 or collinear points.
 #[pyfunction]
 fn inertia_points<'py>(
     py: Python<'py>,
@@ -209,25 +218,51 @@ fn inertia_points<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// feature_motion(poses, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None) -> ndarray
+/// feature_motion(
+///     poses: ArrayLike,
+///     scheme: CurveSchemeName = "variational",
+///     levels: int = 5,
+///     closed: bool = False,
+///     feature_points: ArrayLike | None = None,
+///     parametrization: ParametrizationName = "uniform",
+///     stiffness: float | ArrayLike | None = None,
+///     inserted_stiffness: float | None = None,
+/// ) -> FloatArray
 ///
-/// Feature-point motion design (Hofer-Pottmann-Ravani): the curve scheme runs on the
-/// homologous positions of the feature points of the key poses (N, 4, 4), and the rigid
-/// body is registered to the distorted points at every output pose. Returns
-/// (N * 2**levels, 4, 4) closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose i * 2**levels
-/// belongs to key i.
+/// Feature-point motion design (Hofer-Pottmann-Ravani) of the keys ``poses`` (N, 4, 4).
+///
+/// The curve ``scheme`` runs on the homologous positions of ``feature_points`` (K, 3, in
+/// the body frame; default the six unit points +-x, +-y, +-z, whose isotropic inertia makes
+/// the result independent of how the local axes are turned), then the rigid body is
+/// registered to the distorted points at every output pose. Returns (N * 2**levels, 4, 4)
+/// closed, ((N - 1) * 2**levels + 1, 4, 4) open; pose ``i * 2**levels`` belongs to key i.
+/// Rigid (unit quaternions) and independent of the world frame.
+///
+/// ``"variational"`` is Kobbelt's variational subdivision (C2), the only scheme that takes
+/// ``parametrization`` (``"centripetal"``: spacing sqrt of the feature points' distance
+/// between keys) and ``stiffness``: the spring lambda per key, a float for all keys or an
+/// (N,) array; ``inf`` (or ``None``) hits that key exactly, a finite lambda >= 0 lets the
+/// motion pass near it (smaller = smoother; an open motion needs two keys and a closed one
+/// one key with lambda > 0). ``inserted_stiffness`` is lambda for the poses inserted at
+/// earlier levels (``None`` = ``inf``: kept once inserted). ``"four_point"`` interpolates (C1),
+/// ``"bspline"`` and ``"jarek"`` approximate (C2).
+/// Raises ValueError naming the bad pose, key or sample and the reason.
 #[pyfunction]
-#[pyo3(signature = (poses, scheme="variational", levels=5, closed=false, feature_points=None,
-    parametrization="uniform", stiffness=None, inserted_stiffness=None))]
+#[pyo3(signature = (poses, scheme=Choice::of(CurveScheme::Variational), levels=5, closed=false,
+    feature_points=None, parametrization=Choice::of(Parametrization::Uniform), stiffness=None,
+    inserted_stiffness=None))]
+#[pyo3(
+    text_signature = "(poses, scheme='variational', levels=5, closed=False, feature_points=None, parametrization='uniform', stiffness=None, inserted_stiffness=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn feature_motion<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<FeatureMotion>)] scheme: &str,
+    scheme: Choice<FeatureMotion, CurveScheme>,
     #[pyo3(from_py_with = args::levels::<FeatureMotion>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<FeatureMotion>)] closed: bool,
     feature_points: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::parametrization::<FeatureMotion>)] parametrization: &str,
+    parametrization: Choice<FeatureMotion, Parametrization>,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
@@ -236,10 +271,10 @@ fn feature_motion<'py>(
     let n = key_count(F, &poses)?;
     let (mut spec, stiffness) = read_feature_spec(
         F,
-        scheme,
+        scheme.0,
         levels,
         closed,
-        parametrization,
+        parametrization.0,
         stiffness,
         inserted_stiffness,
     )?;
@@ -284,45 +319,63 @@ fn feature_motion<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// sample_feature(poses, key_times, times, scheme="variational", levels=5, closed=False, feature_points=None, parametrization="uniform", stiffness=None, inserted_stiffness=None, period=None, timing="smooth") -> ndarray
+/// sample_feature(
+///     poses: ArrayLike,
+///     key_times: ArrayLike,
+///     times: ArrayLike,
+///     scheme: CurveSchemeName = "variational",
+///     levels: int = 5,
+///     closed: bool = False,
+///     feature_points: ArrayLike | None = None,
+///     parametrization: ParametrizationName = "uniform",
+///     stiffness: float | ArrayLike | None = None,
+///     inserted_stiffness: float | None = None,
+///     period: float | None = None,
+///     timing: TimingName = "smooth",
+/// ) -> FloatArray
 ///
-/// `feature_motion` as a function of time, evaluated at `times` (M,): (M, 4, 4). Key i
-/// sits at `key_times[i]` (strictly increasing); `period`, `timing` and the screw between
-/// dense poses as in `sample`.
+/// ``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).
+///
+/// Key i sits at ``key_times[i]`` (finite, strictly increasing); ``period`` and ``timing``
+/// as in ``sample``; between dense poses the motion is the screw joining them.
 #[pyfunction]
-#[pyo3(signature = (poses, key_times, times, scheme="variational", levels=5, closed=false,
-    feature_points=None, parametrization="uniform", stiffness=None,
-    inserted_stiffness=None, period=None, timing="smooth"))]
+#[pyo3(signature = (poses, key_times, times, scheme=Choice::of(CurveScheme::Variational),
+    levels=5, closed=false, feature_points=None,
+    parametrization=Choice::of(Parametrization::Uniform), stiffness=None,
+    inserted_stiffness=None, period=None, timing=Choice::of(Timing::Smooth)))]
+#[pyo3(
+    text_signature = "(poses, key_times, times, scheme='variational', levels=5, closed=False, feature_points=None, parametrization='uniform', stiffness=None, inserted_stiffness=None, period=None, timing='smooth')"
+)]
 #[allow(clippy::too_many_arguments)]
 fn sample_feature<'py>(
     py: Python<'py>,
     poses: &Bound<'py, PyAny>,
     key_times: &Bound<'py, PyAny>,
     times: &Bound<'py, PyAny>,
-    #[pyo3(from_py_with = args::scheme::<SampleFeature>)] scheme: &str,
+    scheme: Choice<SampleFeature, CurveScheme>,
     #[pyo3(from_py_with = args::levels::<SampleFeature>)] levels: u32,
     #[pyo3(from_py_with = args::closed::<SampleFeature>)] closed: bool,
     feature_points: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::parametrization::<SampleFeature>)] parametrization: &str,
+    parametrization: Choice<SampleFeature, Parametrization>,
     stiffness: Option<&Bound<'py, PyAny>>,
     inserted_stiffness: Option<&Bound<'py, PyAny>>,
     period: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::timing::<SampleFeature>)] timing: &str,
+    timing: Choice<SampleFeature, Timing>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
     const F: &str = SampleFeature::NAME;
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let (mut spec, stiffness) = read_feature_spec(
         F,
-        scheme,
+        scheme.0,
         levels,
         closed,
-        parametrization,
+        parametrization.0,
         stiffness,
         inserted_stiffness,
     )?;
     let period = args::optional_float(F, "period", period)?;
-    let timing = Timing::from_name(timing).map_err(|e| to_py_err(F, e))?;
+    let timing = timing.0;
     let key_times = float_array(F, "key_times", key_times)?;
     let times = float_array(F, "times", times)?;
     let n_key_times = vector_len(F, "key_times", &key_times)?;

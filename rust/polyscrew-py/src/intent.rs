@@ -6,7 +6,6 @@
 
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 use polyscrew::intent::{
@@ -17,14 +16,15 @@ use polyscrew::intent::{
     RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
-use polyscrew::{Error, Pose, RotationMode};
+use polyscrew::{Error, Pose, RotationMode, Scheme};
 
-use crate::args::{self, float_array, Function, KeysParameters, Most};
-use crate::fcurve::CurveArgs;
-use crate::{
-    check_budget, key_count, pose_count, read_keys, read_poses, read_vector, shape_err, to_py_err,
-    vector_len,
+use crate::args::{
+    self, float_array, AnalyseSpans, AnalyseTurns, Choice, Function, KeysParameters, Most,
+    PlaybackNew, RotationMatrices,
 };
+use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
+use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::fcurve::CurveInput;
 
 /// How to ask these functions for less memory.
 const HINT: &str = "pass fewer frames or keys in one call";
@@ -42,7 +42,7 @@ fn playback_arg<'a, 'py>(
     obj: &'a Bound<'py, PyAny>,
 ) -> PyResult<&'a Bound<'py, PyPlayback>> {
     obj.cast::<PyPlayback>().map_err(|_| {
-        PyTypeError::new_err(format!("{function}: {what}: expected a polyscrew.Playback"))
+        crate::errors::wrong_type(format!("{function}: {what}: expected a polyscrew.Playback"))
     })
 }
 
@@ -51,14 +51,19 @@ fn located(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     args::bool_arg("Playback", "located", obj)
 }
 
-/// Playback(*, channels, unkeyed, mode, located=True, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None)
+/// An owner's transform channels as Blender plays them.
 ///
-/// An owner's transform channels as Blender plays them: C keyframed curves (packed as
-/// `evaluate_fcurves` takes them), curve `c` driving channel `channels[c]`, a
-/// `(property, index)` pair (`"location"`, `"scale"` or the rotation property of `mode`);
-/// `unkeyed`: the owner's own values of every channel, location (3), rotation (3 Euler
-/// angles, 4 for quaternion or axis-angle) and scale (3), used where no curve drives one;
-/// `located=False`: location is ignored (a connected bone).
+/// C keyframed curves, packed as ``evaluate_fcurves`` takes them (the same keyword
+/// arguments, evaluated exactly as it does), curve ``c`` driving ``channels[c]``, a
+/// ``(property, index)`` pair: ``"location"``, ``"scale"`` or the rotation property of
+/// ``mode`` (``"rotation_euler"``, ``"rotation_quaternion"``, ``"rotation_axis_angle"``).
+/// ``unkeyed``: the owner's own values of all channels, location (3), rotation (3 Euler
+/// angles, or 4: quaternion w, x, y, z / axis-angle angle, x, y, z) and scale (3), used where
+/// no curve drives a channel. ``located=False``: location is ignored (0), as Blender does
+/// for a bone connected to its parent. Raises ValueError for bad curves (as
+/// ``evaluate_fcurves``), an unknown property or mode, an index out of range, more channels
+/// than the owner has (``6 + width``), two curves on one channel, or ``unkeyed`` of the
+/// wrong length or not finite.
 #[pyclass(frozen, module = "polyscrew", name = "Playback")]
 pub struct PyPlayback {
     inner: Playback,
@@ -66,6 +71,24 @@ pub struct PyPlayback {
 
 #[pymethods]
 impl PyPlayback {
+    /// __init__(
+    ///     *,
+    ///     channels: Sequence[tuple[str, int]],
+    ///     unkeyed: ArrayLike,
+    ///     mode: RotationModeName,
+    ///     located: bool = True,
+    ///     offsets: ArrayLike,
+    ///     co: ArrayLike,
+    ///     handle_left: ArrayLike,
+    ///     handle_right: ArrayLike,
+    ///     interpolation: ArrayLike,
+    ///     easing: ArrayLike,
+    ///     extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+    ///     back: ArrayLike | None = None,
+    ///     amplitude: ArrayLike | None = None,
+    ///     period: ArrayLike | None = None,
+    ///     cycles: Sequence[Mapping[str, Any] | None] | None = None,
+    /// ) -> None
     #[new]
     #[pyo3(signature = (*, channels, unkeyed, mode, located=true, offsets, co, handle_left, handle_right, interpolation, easing, extrapolation=None, back=None, amplitude=None, period=None, cycles=None))]
     #[allow(clippy::too_many_arguments)]
@@ -73,7 +96,7 @@ impl PyPlayback {
         py: Python<'py>,
         channels: &Bound<'py, PyAny>,
         unkeyed: &Bound<'py, PyAny>,
-        mode: &Bound<'py, PyAny>,
+        mode: Choice<PlaybackNew, RotationMode>,
         #[pyo3(from_py_with = located)] located: bool,
         offsets: &Bound<'py, PyAny>,
         co: &Bound<'py, PyAny>,
@@ -88,8 +111,7 @@ impl PyPlayback {
         cycles: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Self> {
         const F: &str = "Playback";
-        let mode = RotationMode::from_name(args::str_arg(F, "mode", mode)?)
-            .map_err(|e| to_py_err(F, e))?;
+        let mode = mode.0;
         // One curve per channel of the row at most (more drive a channel twice).
         let expected = "a sequence of (property, index) pairs";
         let items = args::sequence(
@@ -103,7 +125,7 @@ impl PyPlayback {
             .iter()
             .map(|item| {
                 item.extract::<(String, i64)>().map_err(|_| {
-                    PyTypeError::new_err(format!("{F}: channels: expected {expected}"))
+                    crate::errors::wrong_type(format!("{F}: channels: expected {expected}"))
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
@@ -112,20 +134,20 @@ impl PyPlayback {
             .enumerate()
             .map(|(c, (property, index))| {
                 let index = usize::try_from(*index).map_err(|_| {
-                    PyValueError::new_err(format!("{F}: channels[{c}]: index {index} is negative"))
+                    crate::errors::invalid(format!("{F}: channels[{c}]: index {index} is negative"))
                 })?;
                 Channel::from_property(property, index, mode).map_err(|e| {
                     let reason = match e {
                         Error::Invalid { reason, .. } => reason,
                         e => e.to_string(),
                     };
-                    PyValueError::new_err(format!("{F}: channels[{c}]: {reason}"))
+                    crate::errors::invalid(format!("{F}: channels[{c}]: {reason}"))
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
         let unkeyed = float_array(F, "unkeyed", unkeyed)?;
         let width = vector_len(F, "unkeyed", &unkeyed)?;
-        let args = CurveArgs::read(
+        let input = CurveInput::read(
             F,
             0,
             unkeyed.copy() + Footprint::of::<f64>(width), // the owner's values and their copy
@@ -141,22 +163,22 @@ impl PyPlayback {
             period,
             cycles,
         )?;
-        let unkeyed = read_vector(F, "unkeyed", &unkeyed.read()?.as_array())?;
-        let packed = args.packed();
-        let inner = py
-            .detach(|| {
-                let curves = packed.to_curves()?;
-                Playback::new(curves, &channels, unkeyed, mode, located)
-            })
-            .map_err(|e| to_py_err(F, e))?;
+        let unkeyed = unkeyed.read()?;
+        let (unkeyed, curves) = (unkeyed.as_array(), input.views());
+        let inner = py.detach(|| -> PyResult<Playback> {
+            let unkeyed = read_vector(F, "unkeyed", &unkeyed)?;
+            let args = curves.to_args()?;
+            let curves = args.packed().to_curves().map_err(|e| to_py_err(F, e))?;
+            Playback::new(curves, &channels, unkeyed, mode, located).map_err(|e| to_py_err(F, e))
+        })?;
         Ok(Self { inner })
     }
 
-    /// channels(frames) -> (location, rotation, scale)
+    /// channels(frames: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]
     ///
-    /// The channels at `frames` (T,) (any order, subframes allowed) as Blender plays them:
-    /// location (T, 3), rotation (T, 3 or 4) in the owner's mode, scale (T, 3); keyed
-    /// channels are Blender's float32 values exactly. GIL released.
+    /// Location (T, 3), rotation (T, 3 or 4) and scale (T, 3) at ``frames`` (T,), any
+    /// order, subframes allowed: keyed channels exactly Blender's float32 values, the
+    /// others ``unkeyed``. GIL released.
     #[allow(clippy::type_complexity)]
     fn channels<'py>(
         &self,
@@ -207,17 +229,22 @@ impl PyPlayback {
         ))
     }
 
+    /// __len__() -> int
+    ///
     /// The number of curves.
     fn __len__(&self) -> usize {
         self.inner.curves().len()
     }
 
-    /// departure(frames, location, rotation) -> (distance, angle)
+    /// departure(
+    ///     frames: ArrayLike, location: ArrayLike, rotation: ArrayLike
+    /// ) -> tuple[FloatArray, FloatArray]
     ///
-    /// How far a result's channels, `location` (T, 3) and `rotation` (T, 3 or 4, in the
-    /// owner's mode) at `frames` (T,), are from this playback: per frame the distance between
-    /// the locations (0 when `located` is false) and the angle (radians, in [0, pi]) between
-    /// the rotations, both (T,). GIL released.
+    /// How far a result's ``location`` (T, 3) and ``rotation`` (T, 3 or 4, in the owner's
+    /// mode) at ``frames`` (T,) are from this playback: per frame the distance between the
+    /// locations (0 when ``located`` is false) and the angle (radians, in [0, pi]) between
+    /// the rotations, both (T,). GIL released. Raises ValueError for shapes that do not
+    /// match or values that are not finite.
     #[allow(clippy::type_complexity)]
     fn departure<'py>(
         &self,
@@ -275,10 +302,9 @@ fn spans_of(
     function: &'static str,
     playback: &Bound<'_, PyAny>,
     frames: &Bound<'_, PyAny>,
-    turns: &str,
+    turns: Turns,
 ) -> PyResult<Spans> {
     let playback = playback_arg(function, "playback", playback)?;
-    let turns = Turns::from_name(turns).map_err(|e| to_py_err(function, e))?;
     let frames = float_array(function, "frames", frames)?;
     let k = vector_len(function, "frames", &frames)?;
     let inner = &playback.get().inner;
@@ -302,29 +328,43 @@ fn spans_of(
     })
 }
 
-/// analyse_spans(playback, frames, turns="AUTO") -> (held, pops, turn, inserted)
+/// analyse_spans(
+///     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
+/// ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]
 ///
-/// Per key span of `frames` (K,) (strictly increasing, K >= 2): `held` (K - 1,) bool, every
-/// channel still over the span; `pops` (K - 1,) bool, held and jumping at its end; `turn`
-/// (K - 1,) radians the rotation turns through over the span (along Blender's playback);
-/// `inserted` (M,) the frames (ascending) where poses of the playback must be added so that
-/// no screw span of a spin `turns` follows turns more than `WIND_STEP` (`analyse_turns`).
-/// GIL released.
+/// What each key span of ``frames`` (K,) (strictly increasing, K >= 2) does along the
+/// playback: ``(held, pops, turn, inserted)``.
+///
+/// Each span is sampled at ``SPAN_SAMPLES`` frames from its start (included) to its end
+/// (excluded), more where the rotation channels change a lot between its keys (one per 10
+/// degrees, at most ``MAX_SPAN_SAMPLES``). ``held`` (K - 1,): no channel of any sample moves
+/// from the span's start by more than ``HOLD_TOLERANCE`` (relative to the value + 1);
+/// ``pops`` (K - 1,): held, and a channel differs between its keys; ``turn`` (K - 1,):
+/// radians the rotation turns through, the sum of the angles between consecutive samples
+/// and the span's end. ``inserted`` (M,), ascending: the frames where poses of the playback
+/// must be added: a span that ``turns`` follows (``analyse_turns``; by default Euler and
+/// axis-angle spans that are not Euler wraps) turning more than ``WIND_LIMIT`` (not held),
+/// and the runs of its followed neighbours turning more than ``WIND_STEP``, get
+/// ``ceil(turn / WIND_STEP) - 1`` frames where the accumulated turn
+/// reaches equal fractions of the span's (linear between samples). GIL released. Raises
+/// ValueError for fewer than two frames, frames that do not increase, or spans that would
+/// take more than ``MAX_ANALYSIS_SAMPLES`` samples in all (refused before any is taken).
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns="AUTO"))]
+#[pyo3(signature = (playback, frames, turns=Choice::of(Turns::Auto)))]
+#[pyo3(text_signature = "(playback, frames, turns='AUTO')")]
 #[allow(clippy::type_complexity)]
 fn analyse_spans<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: &str,
+    turns: Choice<AnalyseSpans, Turns>,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 )> {
-    let spans = spans_of(py, "analyse_spans", playback, frames, turns)?;
+    let spans = spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
@@ -333,22 +373,30 @@ fn analyse_spans<'py>(
     ))
 }
 
-/// analyse_turns(playback, frames, turns="AUTO") -> (held, pops, turn, inserted, flips)
+/// analyse_turns(
+///     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
+/// ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray, npt.NDArray[np.bool_]]
 ///
-/// `analyse_spans` and, per span, `flips` (K - 1,) bool: not held, and its key values are an
-/// Euler wrap (both keys inside -pi..pi and an equivalent triple, 2 pi added or the twin
-/// triple, at least `WRAP_MARGIN` closer to the first) or a quaternion sign flip (q0 . q1 <
-/// 0). `turns`: "AUTO" follows Blender's playback for typed Euler and axis-angle spins and
-/// takes flips (and quaternions) the short way; "BLENDER" follows every span as Blender
-/// plays it; "SHORTEST" follows none (nothing inserted). GIL released.
+/// ``analyse_spans`` and, per span, ``flips`` (K - 1,): not held, and its key values are
+/// an Euler wrap (every value of both keys inside -pi..pi, and an equivalent triple of the
+/// second key, 2 pi added or the twin triple, at least ``WRAP_MARGIN`` closer to the first,
+/// sum of absolute differences) or a quaternion sign flip (q0 . q1 < 0): what Blender plays
+/// the long way round although the animator did not type a spin.
+///
+/// ``turns`` picks the spans whose playback is followed (poses added, the rule of
+/// ``analyse_spans``): "AUTO", Euler and axis-angle spans that are not flips (typed spins
+/// turn as Blender plays them; flips and quaternion keys take the short screw); "BLENDER",
+/// every span (flips and quaternion sign flips too, as Blender plays them); "SHORTEST",
+/// none (the short screw between every two key poses; nothing inserted).
 #[pyfunction]
-#[pyo3(signature = (playback, frames, turns="AUTO"))]
+#[pyo3(signature = (playback, frames, turns=Choice::of(Turns::Auto)))]
+#[pyo3(text_signature = "(playback, frames, turns='AUTO')")]
 #[allow(clippy::type_complexity)]
 fn analyse_turns<'py>(
     py: Python<'py>,
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    turns: &str,
+    turns: Choice<AnalyseTurns, Turns>,
 ) -> PyResult<(
     Bound<'py, PyArray1<bool>>,
     Bound<'py, PyArray1<bool>>,
@@ -356,7 +404,7 @@ fn analyse_turns<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
 )> {
-    let spans = spans_of(py, "analyse_turns", playback, frames, turns)?;
+    let spans = spans_of(py, AnalyseTurns::NAME, playback, frames, turns.0)?;
     Ok((
         spans.held.into_pyarray(py),
         spans.pops.into_pyarray(py),
@@ -374,16 +422,43 @@ enum Smoothed {
     Given(Vec<Pose>),
 }
 
-/// keys_parameters(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme="four_point", levels=4, smooth=None) -> ndarray
+/// keys_parameters(
+///     key_frames: ArrayLike,
+///     frames: ArrayLike,
+///     *,
+///     size: float,
+///     closed: bool = False,
+///     period: float | None = None,
+///     playback: Playback | None = None,
+///     poses: ArrayLike | None = None,
+///     scheme: SchemeName = "four_point",
+///     levels: int = 4,
+///     smooth: ArrayLike | None = None,
+/// ) -> FloatArray
 ///
-/// Timing "Keys": the motion parameter (key i at i) of each of `frames` (T,): within each
-/// span, where the smoothed motion has travelled the same fraction of the span as Blender's
-/// `playback` has at that frame (the fraction of time without playback). Travel:
-/// `sqrt(|dt|^2 + size^2 / 3 |dR|_F^2)`. The smoothed motion is the screw motion of the key
-/// `poses` (K, 4, 4) by `scheme` and `levels`, or `smooth`, its poses at
-/// `pace_parameters(spans)`. `closed`: the keys are a cycle of `period` frames. GIL released.
+/// Timing "Keys": the motion parameter (key i at i) of each of ``frames`` (T,).
+///
+/// Within span s (keys s, s + 1; for a ``closed`` cycle of ``period`` frames the last span
+/// returns to the first key), a frame at the fraction ``tau`` of the span's time gets the
+/// parameter at which the smoothed motion has travelled the same fraction of the span as
+/// the ``playback`` has at that frame (the fraction of time without ``playback``, or where
+/// it does not move). Travel is ``sqrt(|dt|^2 + size^2 / 3 |dR|_F^2)`` (the root mean square
+/// displacement of six points at +-``size``), summed over ``PACE_SAMPLES`` steps per span
+/// and the output frames inside it; the smoothed motion's travel is measured at
+/// ``pace_parameters(spans)`` and inverted linearly. Frames at keys and outside the spans
+/// keep ``s + tau``.
+///
+/// The smoothed motion: the screw motion of the key ``poses`` (K, 4, 4) by ``scheme`` and
+/// ``levels`` (keys at parameters 0..K-1, linear timing), or ``smooth``, its poses at
+/// ``pace_parameters(spans)`` computed by the caller (feature points). GIL released.
+/// Raises ValueError naming the argument: key frames that do not increase, a period not
+/// beyond the keys, a size that is not positive, frames not finite, neither or both of
+/// ``poses`` and ``smooth``, or ``smooth`` of the wrong length.
 #[pyfunction]
-#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme="four_point", levels=4, smooth=None))]
+#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme=Choice::of(Scheme::FourPoint), levels=4, smooth=None))]
+#[pyo3(
+    text_signature = "(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme='four_point', levels=4, smooth=None)"
+)]
 #[allow(clippy::too_many_arguments)]
 fn keys_parameters<'py>(
     py: Python<'py>,
@@ -394,7 +469,7 @@ fn keys_parameters<'py>(
     period: Option<&Bound<'py, PyAny>>,
     playback: Option<&Bound<'py, PyAny>>,
     poses: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = args::scheme::<KeysParameters>)] scheme: &str,
+    scheme: Choice<KeysParameters, Scheme>,
     #[pyo3(from_py_with = args::levels::<KeysParameters>)] levels: u32,
     smooth: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
@@ -404,13 +479,13 @@ fn keys_parameters<'py>(
     let period = match (closed, period) {
         (true, Some(p)) => Some(p),
         (true, None) => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: period: a closed motion needs its period"
             )))
         }
         (false, _) => None,
     };
-    let scheme = polyscrew::Scheme::from_name(scheme).map_err(|e| to_py_err(F, e))?;
+    let scheme = scheme.0;
     let playback = playback
         .filter(|p| !p.is_none())
         .map(|p| playback_arg(F, "playback", p))
@@ -427,7 +502,7 @@ fn keys_parameters<'py>(
         (Some(p), None) => (float_array(F, "poses", p)?, true),
         (None, Some(s)) => (float_array(F, "smooth", s)?, false),
         _ => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: give either poses (the key poses) or smooth (the smoothed motion's poses)"
             )))
         }
@@ -482,10 +557,10 @@ fn keys_parameters<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// pace_parameters(spans) -> ndarray
+/// pace_parameters(spans: int) -> FloatArray
 ///
-/// The motion parameters `s + j / PACE_SAMPLES` (j = 0..PACE_SAMPLES) of each span s, span
-/// after span: where `keys_parameters` wants the smoothed motion (`smooth`).
+/// ``s + j / PACE_SAMPLES`` for j in 0..PACE_SAMPLES of each span s in 0..spans, span
+/// after span: where ``keys_parameters`` measures the smoothed motion.
 #[pyfunction]
 fn pace_parameters<'py>(
     py: Python<'py>,
@@ -494,25 +569,27 @@ fn pace_parameters<'py>(
     const F: &str = "pace_parameters";
     let spans = args::int_in(F, "spans", spans, 0, i64::MAX)?;
     let spans = usize::try_from(spans).unwrap_or(usize::MAX);
-    let out = core_pace_parameters(spans).map_err(|e| to_py_err(F, e))?;
+    let out = py
+        .detach(|| core_pace_parameters(spans))
+        .map_err(|e| to_py_err(F, e))?;
     Ok(out.into_pyarray(py))
 }
 
-/// rotation_matrices(values, mode) -> ndarray
+/// rotation_matrices(values: ArrayLike, mode: RotationModeName) -> FloatArray
 ///
-/// (N, 3, 3) rotation matrices of (N, k) rotation channel values in Blender's `mode`:
-/// quaternions (w, x, y, z) normalised (zero: identity), axis-angle (angle, x, y, z) about
-/// the normalised axis (zero axis: identity), Euler (x, y, z) radians with "XYZ" meaning X
-/// applied first (R = Rz Ry Rx). GIL released.
+/// (N, 3, 3) rotation matrices of (N, k) rotation channel values in Blender's ``mode``:
+/// quaternions (w, x, y, z) normalised (zero: identity); axis-angle (angle, x, y, z) about
+/// the normalised axis (zero axis: identity); Euler (x, y, z) radians, ``"XYZ"`` meaning X
+/// applied first (``R = Rz Ry Rx``). GIL released. Raises ValueError for a wrong shape or a
+/// row that is not finite.
 #[pyfunction]
 fn rotation_matrices<'py>(
     py: Python<'py>,
     values: &Bound<'py, PyAny>,
-    mode: &Bound<'py, PyAny>,
+    mode: Choice<RotationMatrices, RotationMode>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    const F: &str = "rotation_matrices";
-    let mode =
-        RotationMode::from_name(args::str_arg(F, "mode", mode)?).map_err(|e| to_py_err(F, e))?;
+    const F: &str = RotationMatrices::NAME;
+    let mode = mode.0;
     let values = float_array(F, "values", values)?;
     let width = mode.width();
     let shape = values.shape();
@@ -556,14 +633,37 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(keys_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(pace_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_matrices, m)?)?;
+    // stub:
+    // stub: WIND_LIMIT: float
+    // stub: """A span whose rotation channels turn further than this (radians, 150 degrees) is a spin."""
     m.add("WIND_LIMIT", WIND_LIMIT)?;
+    // stub: WIND_STEP: float
+    // stub: """The most a screw span of a spin turns once poses are added (radians, 45 degrees); the
+    // stub: neighbouring spans of a spin turning more than this are cut too."""
     m.add("WIND_STEP", WIND_STEP)?;
+    // stub: SPAN_SAMPLES: int
+    // stub: """Samples of the playback per key span in ``analyse_spans`` (8; more for spinning spans)."""
     m.add("SPAN_SAMPLES", SPAN_SAMPLES)?;
+    // stub: MAX_SPAN_SAMPLES: int
+    // stub: """At most this many samples per span in ``analyse_spans`` (4096; one per 10 degrees)."""
     m.add("MAX_SPAN_SAMPLES", MAX_SPAN_SAMPLES)?;
+    // stub: MAX_ANALYSIS_SAMPLES: int
+    // stub: """At most this many samples in one ``analyse_spans`` call, all spans together (2,097,152):
+    // stub: its work is not bounded by memory, this bounds its time (about 2 s of one core at the
+    // stub: limit: 512 spans of 4,096 samples, each a spin)."""
     m.add("MAX_ANALYSIS_SAMPLES", MAX_ANALYSIS_SAMPLES)?;
+    // stub: HOLD_TOLERANCE: float
+    // stub: """A channel moving less than this times (its size + 1) over a span is still (1e-6)."""
     m.add("HOLD_TOLERANCE", HOLD_TOLERANCE)?;
+    // stub: PACE_SAMPLES: int
+    // stub: """Steps per span along which ``keys_parameters`` measures travel (16)."""
     m.add("PACE_SAMPLES", PACE_SAMPLES)?;
+    // stub: WRAP_MARGIN: float
+    // stub: """An Euler span is a wrap when an equivalent triple of its second key is at least this much
+    // stub: closer (radians, 45 degrees, sum over the three angles) to its first key (``analyse_turns``)."""
     m.add("WRAP_MARGIN", WRAP_MARGIN)?;
+    // stub: RANGE_TOLERANCE: float
+    // stub: """How far beyond -pi..pi an Euler key may lie and still be inside the range (1e-6 radians)."""
     m.add("RANGE_TOLERANCE", RANGE_TOLERANCE)?;
     Ok(())
 }

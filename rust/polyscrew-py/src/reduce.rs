@@ -5,7 +5,6 @@
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2, ArrayViewD};
 use numpy::IntoPyArray;
-use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString, PyTuple};
 
@@ -16,10 +15,13 @@ use polyscrew::reduce::{
 };
 use polyscrew::{reduce_keys as core_reduce_keys, Pose, RotationMode};
 
-use crate::args::{bool_array, float_array, float_scalar, int_in, int_list, sequence, Most};
-use crate::{shape_err, to_py_err};
+use crate::args::{
+    bool_array, float_array, float_scalar, int_in, int_list, sequence, Choice, Function, Most,
+    ReduceKeys,
+};
+use crate::errors::{shape_err, to_py_err};
 
-const F: &str = "reduce_keys";
+const F: &str = ReduceKeys::NAME;
 
 /// Reads `(B, N, 4, 4)` poses (no GIL needed), errors naming the owner and the frame.
 fn read_poses(view: &ArrayViewD<'_, f64>, b: usize, n: usize) -> PyResult<Vec<Pose>> {
@@ -32,10 +34,10 @@ fn read_poses(view: &ArrayViewD<'_, f64>, b: usize, n: usize) -> PyResult<Vec<Po
                 *v = *it.next().expect("16 values per pose");
             }
         }
-        poses.push(
-            Pose::from_rows(&m, g % n)
-                .map_err(|e| PyValueError::new_err(format!("{F}: poses: owner {}: {e}", g / n)))?,
-        );
+        poses
+            .push(Pose::from_rows(&m, g % n).map_err(|e| {
+                crate::errors::invalid(format!("{F}: poses: owner {}: {e}", g / n))
+            })?);
     }
     Ok(poses)
 }
@@ -45,7 +47,7 @@ fn read_modes(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<RotationMode>> {
     let parse = |o: Option<usize>, s: &str| {
         RotationMode::from_name(s).map_err(|e| {
             let at = o.map_or_else(String::new, |o| format!("owner {o}: "));
-            PyValueError::new_err(format!("{F}: modes: {at}{e}"))
+            crate::errors::invalid(format!("{F}: modes: {at}{e}"))
         })
     };
     if let Ok(s) = obj.cast::<PyString>() {
@@ -60,7 +62,7 @@ fn read_modes(obj: &Bound<'_, PyAny>, b: usize) -> PyResult<Vec<RotationMode>> {
         "a mode name or a sequence of them",
     )?;
     if items.len() != b {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: modes: expected one name or {b} of them, got {}",
             items.len()
         )));
@@ -100,7 +102,7 @@ fn read_mask(
     };
     let expected = format!("{shape:?}").replace('[', "(").replace(']', ")");
     let Some((got, mask)) = bool_array(F, what, obj, Most::Exactly(shape[0]))? else {
-        return Err(PyTypeError::new_err(format!(
+        return Err(crate::errors::wrong_type(format!(
             "{F}: {what}: expected a boolean array of shape {expected}"
         )));
     };
@@ -130,10 +132,108 @@ fn read_floats(
     Ok(Some(out))
 }
 
-/// reduce_keys(poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=False, per_channel=False, start=None, threads=0, between="screw") -> dict
+// stub:
+// stub: HandleTypeName = Literal["FREE", "ALIGNED", "VECTOR", "AUTO", "AUTO_CLAMPED"]
+/// reduce_keys(
+///     poses: ArrayLike,
+///     frames: ArrayLike,
+///     modes: RotationModeName | Sequence[RotationModeName],
+///     radius: float | ArrayLike,
+///     distance: float,
+///     angle: float,
+///     *,
+///     scales: ArrayLike | None = None,
+///     channels: ArrayLike | None = None,
+///     parents: ArrayLike | None = None,
+///     offsets: ArrayLike | None = None,
+///     constant: ArrayLike | None = None,
+///     cyclic: bool = False,
+///     per_channel: bool = False,
+///     start: ArrayLike | None = None,
+///     threads: int = 0,
+///     between: Literal["screw", "cubic", "linear"] = "screw",
+/// ) -> dict[str, Any]
 ///
-/// The fewest Bezier keys whose playback by Blender stays within a world-space tolerance of
-/// dense rigid motions (see the stub for the full contract).
+/// The fewest Bezier keys whose playback by Blender stays within a world-space tolerance
+/// of B owners' dense rigid motions.
+///
+/// ``poses`` (B, N, 4, 4): each owner's rigid pose at each of the N >= 2 ``frames`` (strictly
+/// increasing, shared, subframes allowed), in the space its channels key (an object's parent
+/// space, a bone's ``matrix_basis``), scale separated. ``modes``: one Blender rotation mode
+/// for all owners or B of them ("QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX",
+/// "ZXY", "ZYX"). ``radius``: float or (B,), the body's radius (>= 0). ``distance`` (> 0):
+/// no point of the body within ``radius`` of its origin moves further than this from the
+/// dense motion; ``angle`` (> 0, radians): no rotation differs more. The measure of a played
+/// pose against the dense one is ``|dt| + 2 radius sin(theta / 2)`` (+ ``radius |ds|`` with
+/// scale) and ``theta``.
+///
+/// The dense motion is the poses at ``frames`` and the screw between two consecutive ones
+/// (across a ``constant`` span: the first pose until the next frame). The tolerance is
+/// checked at every frame and 3 subframes between two (1/4, 1/2, 3/4) through Blender's own
+/// F-curve evaluation of the float32 keys (``evaluate_fcurves``, bit-identical), quaternions
+/// normalised as Blender plays them.
+///
+/// - ``scales``: None, or (B, N, 3) positive scales to reduce too (linear between frames).
+/// - ``channels``: None (location and rotation, and scale when ``scales`` is given) or (B, 3)
+///   bool: which of location / rotation / scale each owner keys; unkeyed groups get no
+///   curves and count as exact.
+/// - ``parents``: None, or (B,) int: each owner's parent's batch index (-1: none). The
+///   tolerance then holds in world space, ``world_i = world_parent @ offsets[i] @ poses[i]``
+///   (roots: ``offsets[i] @ poses[i]``): parents are reduced first and each child keys
+///   ``(world_parent_reduced @ offset)^-1 @ world_child_dense``, compensating its parents'
+///   errors. Scale is not propagated to children.
+/// - ``offsets``: None (identity) or (B, 4, 4) rigid constant offsets.
+/// - ``constant``: None, or (B, N-1) bool: span i -> i+1 is a step or hold (CONSTANT in the
+///   source); it stays a CONSTANT key, its end keyed.
+/// - ``cyclic``: the frames are one period of a cycle (first pose == last pose): the first
+///   and last keys sit at the first and last frame, with equal values on every channel that
+///   returns to its first value (a cycle that turns a whole turn keeps its offset).
+/// - ``per_channel``: each channel gets its own key frames (each reduced within a share of
+///   the tolerance, halved until the whole holds); default: an owner's channels share them.
+/// - ``start``: None or (B, 4): each owner's channel values at the first frame as the source
+///   had them (Euler: the first 3; axis-angle: angle, axis; quaternion: w, x, y, z for its
+///   sign); the first key takes the equivalent values nearest to them (a spin from 360 to 720
+///   degrees stays there). None: those nearest zero.
+/// - ``threads``: owners of one depth of the hierarchy spread over this many threads (0: all).
+/// - ``between``: the dense motion at the subframes. "screw" (default): the screw between
+///   two frames, what a source keyed on every frame with LINEAR keys plays (to first order).
+///   "cubic": the cubic through the two poses each side (fewer at the clip's ends and
+///   around CONSTANT spans) by Aitken-Neville's scheme with screws for straight lines,
+///   what a source keyed on every frame with Bezier keys plays (smooth: an ``nla.bake``, an
+///   imported capture); a smooth reduction can follow it much more closely than the
+///   screw's corners at every frame, so it needs fewer keys at tight tolerances. Both
+///   reproduce screw motions exactly and are coordinate-free. "linear": the owner's channels
+///   interpolated linearly between two frames, exactly what a source keyed on every frame
+///   with LINEAR keys plays (a Smooth Motion bake); not coordinate-free (Euler channels are
+///   not).
+///
+/// Keys sit on the dense values (first and last frame always keyed); rotation channels are
+/// unwrapped along the dense samples (quaternion signs continuous, Euler triples compatible,
+/// axis-angle unwrapped), so spins keep turning and no key wraps. Each span between keys is
+/// a Bezier with its handles at 1/3 and 2/3 of the span in time (a cubic in time), the two
+/// inner handle values fitted by least squares; handles are FREE (C0 at keys: editing a
+/// key keeps its neighbours' segments as they are). Where even a one-frame span cannot meet
+/// the tolerance, keys go at the subframes. Where float32 storage alone cannot (a tolerance
+/// below float32's resolution at the motion's scale), the errors reported say so.
+///
+/// Returns a dict of the curves packed as ``evaluate_fcurves`` takes them, so
+/// ``evaluate_fcurves(times, offsets=r["offsets"], co=r["co"], handle_left=r["handle_left"],
+/// handle_right=r["handle_right"], interpolation=r["interpolation"], easing=r["easing"])``
+/// plays them: ``"owner"`` (C,) int64, ``"path"`` list of C str ("location",
+/// "rotation_quaternion", "rotation_euler", "rotation_axis_angle", "scale"), ``"index"``
+/// (C,) int64, ``"offsets"`` (C+1,) int64, ``"co"``, ``"handle_left"``, ``"handle_right"``
+/// (K, 2) float64 (frame, value), ``"interpolation"``, ``"easing"``, ``"handle_type"`` (K,)
+/// int64 codes into ``INTERPOLATIONS``, ``EASINGS``, ``HANDLE_TYPES`` (BEZIER or CONSTANT,
+/// AUTO, FREE); ``"keys"`` (B,) int64 distinct key frames per owner; ``"distance_error"``,
+/// ``"angle_error"`` (B,) float64, the largest errors measured at the checked samples
+/// (world space with ``parents``).
+///
+/// The GIL is released. Raises ValueError / TypeError naming ``reduce_keys``, the argument
+/// and the owner: wrong shapes, non-rigid or non-finite poses or offsets, frames not finite
+/// and strictly increasing, fewer than 2 frames, tolerances not positive and finite, unknown
+/// modes, negative radii, non-positive scales, scale keyed without ``scales``, parents out
+/// of range or forming a cycle, more than 1,000,000 frames or 20,000,000 poses, more memory
+/// than the budget (checked before anything is copied).
 #[pyfunction]
 #[pyo3(signature = (poses, frames, modes, radius, distance, angle, *, scales=None, channels=None, parents=None, offsets=None, constant=None, cyclic=None, per_channel=None, start=None, threads=None, between=None))]
 #[pyo3(
@@ -157,17 +257,13 @@ fn reduce_keys<'py>(
     per_channel: Option<&Bound<'py, PyAny>>,
     start: Option<&Bound<'py, PyAny>>,
     threads: Option<&Bound<'py, PyAny>>,
-    between: Option<&Bound<'py, PyAny>>,
+    between: Option<Choice<ReduceKeys, Between>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let between = match between.filter(|b| !b.is_none()) {
-        Some(b) => Between::from_name(crate::args::str_arg(F, "between", b)?)
-            .map_err(|e| to_py_err(F, e))?,
-        None => Between::Screw,
-    };
+    let between = between.map_or(Between::Screw, |b| b.0);
     let flag = |what: &str, o: Option<&Bound<'py, PyAny>>| match o {
         Some(o) if !o.is_none() => o
             .extract::<bool>()
-            .map_err(|_| PyTypeError::new_err(format!("{F}: {what}: expected a bool"))),
+            .map_err(|_| crate::errors::wrong_type(format!("{F}: {what}: expected a bool"))),
         _ => Ok(false),
     };
     let cyclic = flag("cyclic", cyclic)?;
@@ -193,7 +289,7 @@ fn reduce_keys<'py>(
         ));
     }
     if n > MAX_REDUCE_FRAMES || b.saturating_mul(n) > MAX_REDUCE_POSES {
-        return Err(PyValueError::new_err(format!(
+        return Err(crate::errors::invalid(format!(
             "{F}: poses: {b} owners x {n} frames exceed the limits ({MAX_REDUCE_FRAMES} frames per owner, {MAX_REDUCE_POSES} poses in all)"
         )));
     }
@@ -201,7 +297,7 @@ fn reduce_keys<'py>(
     // Before anything input-sized is copied: the copies of the input, the core's peak and
     // the output arrays (every channel keyed at every frame at most).
     let keys_bound = b.saturating_mul(n).saturating_mul(10);
-    crate::check_budget(
+    crate::errors::check_budget(
         F,
         poses.copy()
             + frames.copy()
@@ -232,7 +328,7 @@ fn reduce_keys<'py>(
                     -1 => None,
                     q if q >= 0 => Some(q as usize),
                     q => {
-                        return Err(PyValueError::new_err(format!(
+                        return Err(crate::errors::invalid(format!(
                             "{F}: parents: owner {o}: {q} is neither -1 nor an owner index"
                         )))
                     }
@@ -241,36 +337,35 @@ fn reduce_keys<'py>(
             Some(out)
         }
     };
-    let offsets =
-        match offsets.filter(|o| !o.is_none()) {
-            None => None,
-            Some(o) => {
-                let array = float_array(F, "offsets", o)?.read()?;
-                let view = array.as_array();
-                if view.shape() != [b, 4, 4] {
-                    return Err(shape_err(
-                        F,
-                        "offsets",
-                        &format!("({b}, 4, 4)"),
-                        view.shape(),
-                    ));
-                }
-                let mut out = Vec::with_capacity(b);
-                let mut it = view.iter();
-                for o in 0..b {
-                    let mut m = [[0.0; 4]; 4];
-                    for row in m.iter_mut() {
-                        for v in row.iter_mut() {
-                            *v = *it.next().expect("16 values per offset");
-                        }
-                    }
-                    out.push(Pose::from_rows(&m, o).map_err(|e| {
-                        PyValueError::new_err(format!("{F}: offsets: owner {o}: {e}"))
-                    })?);
-                }
-                Some(out)
+    let offsets = match offsets.filter(|o| !o.is_none()) {
+        None => None,
+        Some(o) => {
+            let array = float_array(F, "offsets", o)?.read()?;
+            let view = array.as_array();
+            if view.shape() != [b, 4, 4] {
+                return Err(shape_err(
+                    F,
+                    "offsets",
+                    &format!("({b}, 4, 4)"),
+                    view.shape(),
+                ));
             }
-        };
+            let mut out = Vec::with_capacity(b);
+            let mut it = view.iter();
+            for o in 0..b {
+                let mut m = [[0.0; 4]; 4];
+                for row in m.iter_mut() {
+                    for v in row.iter_mut() {
+                        *v = *it.next().expect("16 values per offset");
+                    }
+                }
+                out.push(Pose::from_rows(&m, o).map_err(|e| {
+                    crate::errors::invalid(format!("{F}: offsets: owner {o}: {e}"))
+                })?);
+            }
+            Some(out)
+        }
+    };
     let (poses, frames) = (poses.read()?, frames.read()?);
     let (pv, fv) = (poses.as_array(), frames.as_array());
     let reduced = py.detach(|| -> PyResult<polyscrew::Reduced> {
@@ -374,6 +469,10 @@ fn wrap<'py>(
 /// Adds `reduce_keys` and `HANDLE_TYPES` to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(reduce_keys, m)?)?;
+    // stub:
+    // stub: HANDLE_TYPES: tuple[HandleTypeName, ...]
+    // stub: """Blender's ``Keyframe.handle_left_type`` / ``handle_right_type`` identifiers; a key's code
+    // stub: in ``reduce_keys``' ``"handle_type"`` is its index here."""
     m.add("HANDLE_TYPES", PyTuple::new(m.py(), HandleType::NAMES)?)?;
     Ok(())
 }

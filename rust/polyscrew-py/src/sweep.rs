@@ -2,7 +2,6 @@
 
 use numpy::ndarray::{Array2, ArrayViewD};
 use numpy::IntoPyArray;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyTuple};
 
@@ -14,8 +13,10 @@ use polyscrew::sweep::{
 };
 use polyscrew::{Error, Pose};
 
+use crate::args::float_array;
 use crate::args::{self, Function, Sweep};
-use crate::{check_budget, float_array, pose_count, read_poses, read_rows3, shape_err, to_py_err};
+use crate::arrays::{pose_count, read_poses, read_rows3};
+use crate::errors::{check_budget, shape_err, to_py_err};
 
 /// Reads `(T, 3)` integer triangles (no GIL needed).
 fn read_triangles(
@@ -34,27 +35,64 @@ fn read_triangles(
     Ok(out)
 }
 
-/// sweep(vertices, triangles, poses, steps=1, caps=True, tolerance=None, info=False) -> (ndarray, ndarray) | (ndarray, ndarray, dict)
+// stub:
+// stub: IntArray = npt.NDArray[np.int64]
+// stub:
+// stub: class SweepInfo(TypedDict):
+// stub:     tolerance: float
+// stub:     error_bound: float
+// stub:     max_steps: int
+// stub:     generator_segments: int
+/// sweep(
+///     vertices: ArrayLike,
+///     triangles: ArrayLike,
+///     poses: ArrayLike,
+///     steps: int = 1,
+///     caps: bool = True,
+///     tolerance: float | None = None,
+///     info: Literal[False] = False,
+/// ) -> tuple[FloatArray, IntArray]
+/// sweep(
+///     vertices: ArrayLike,
+///     triangles: ArrayLike,
+///     poses: ArrayLike,
+///     steps: int = 1,
+///     caps: bool = True,
+///     tolerance: float | None = None,
+///     *,
+///     info: Literal[True],
+/// ) -> tuple[FloatArray, IntArray, SweepInfo]
 ///
-/// The region swept by the triangle mesh `vertices` (V, 3), `triangles` (T, 3) (the body in
-/// its local frame) moving through `poses` (N >= 2, 4, 4), one screw per span
-/// (Rossignac-Kim, "Swept volumes"): each screw's generator (silhouette edge segments and
-/// characteristic segments, in the body frame) swept in quads, the body at the first and last
-/// pose as caps when `caps`, and at interior poses the faces where the motion turns back. Its
-/// depth image from outside equals that of the union of the body's instances.
+/// The region swept by a triangle mesh moving through ``poses``, as one triangle mesh.
 ///
-/// Accuracy: each screw takes the fewest steps (at least `steps`) that keep every swept
-/// triangle within `tolerance` (a length in the body's units) of the exact surface its
-/// generator sweeps (chord sagitta `rho (1 - cos(theta / 2k))` plus the quads' twist).
-/// `tolerance=None`: 0.2 % of the body's bounding radius (half its bounding box's
-/// diagonal); `tolerance=0`: no tolerance, exactly `steps` per screw.
-/// Returns `(vertices (V', 3) float64, triangles (T', 3) int64)`, world frame, triangles
-/// counter-clockwise seen from outside; with `info=True` also a dict: `tolerance` (the one
-/// asked for, 0 without), `error_bound` (the bound met, at most `tolerance` unless
-/// `MAX_STEPS` capped a screw), `max_steps` (most steps of one screw), `generator_segments`.
-/// Raises ValueError for an empty mesh, a NaN vertex, a bad or zero-area triangle (with its
-/// index), fewer than 2 poses, a non-rigid pose, `steps` outside 1..=4096, or a negative or
-/// non-finite `tolerance`.
+/// ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame; ``poses``
+/// (N >= 2, 4, 4) its world poses, one screw per span (Rossignac-Kim, "Swept volumes").
+/// Each screw's generator (silhouette edge segments and characteristic segments inside
+/// faces, computed in the body frame) is swept in quads; ``caps`` adds the body at the first
+/// and the last pose; at interior poses the faces where the motion turns back are added. The
+/// result is a superset of the swept region's boundary whose excess lies inside the region:
+/// its depth image from outside equals that of the union of the body's instances.
+///
+/// Accuracy: each screw takes the fewest steps (at least ``steps``) that keep every swept
+/// triangle within ``tolerance`` (a length, the body's units) of the exact surface its
+/// generator sweeps: the chord sagitta ``rho (1 - cos(theta / 2k))`` (``rho`` the farthest
+/// generator point from the screw's axis, ``theta`` its angle, ``k`` steps) and the quads'
+/// twist ``sin(theta / 2k) l / (2 n)`` (a segment of length ``l`` across the axis cut into
+/// ``n`` pieces), each held to half the tolerance. ``tolerance=None``: ``DEFAULT_SWEEP_TOLERANCE``
+/// (0.2 %) of the body's bounding radius (half its bounding box's diagonal);
+/// ``tolerance=0``: no tolerance, exactly ``steps`` per screw.
+///
+/// Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
+/// triangles counter-clockwise seen from outside, none degenerate; with ``info=True`` also a
+/// dict: ``tolerance`` (asked for; 0 without), ``error_bound`` (the bound met: at most
+/// ``tolerance`` unless ``MAX_STEPS`` capped a screw), ``max_steps``, ``generator_segments``.
+///
+/// Raises ``ValueError`` for an empty mesh, a NaN or infinite vertex or one beyond +-1e75, a
+/// triangle with an index out of range or zero area (naming the triangle), a fractional
+/// index (``2.7``: float arrays are accepted only with whole numbers), fewer than 2 poses, a
+/// non-rigid pose (naming it), ``steps`` outside ``1..=MAX_STEPS``, a negative or non-finite
+/// ``tolerance``, or a swept mesh over the memory budget (checked before each screw's quads
+/// are added: 48 bytes per vertex, 36 per triangle).
 #[pyfunction]
 #[pyo3(signature = (vertices, triangles, poses, steps = 1, caps = true, tolerance = None, info = false))]
 #[allow(clippy::too_many_arguments)]
@@ -74,7 +112,7 @@ fn sweep<'py>(
         Some(0.0) => Accuracy::Steps,
         Some(t) if t.is_finite() && t > 0.0 => Accuracy::Tolerance(t),
         Some(t) => {
-            return Err(PyValueError::new_err(format!(
+            return Err(crate::errors::invalid(format!(
                 "{F}: tolerance: {t} is not a positive length (0: exactly `steps` per screw)"
             )))
         }
@@ -120,12 +158,12 @@ fn sweep<'py>(
             try_vec(out.vertices.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
         flat.extend(out.vertices.iter().flat_map(|q| q.to_array()));
         let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat)
-            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
         let mut flat =
             try_vec(out.triangles.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
         flat.extend(out.triangles.iter().flat_map(|t| t.map(i64::from)));
         let to = Array2::from_shape_vec((out.triangles.len(), 3), flat)
-            .map_err(|e| PyValueError::new_err(format!("{F}: {e}")))?;
+            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
         Ok((
             vo,
             to,
@@ -153,7 +191,13 @@ fn info_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
 /// Adds `sweep` to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
+    // stub:
+    // stub: MAX_STEPS: int
+    // stub: """The largest accepted number of sweep steps per screw (4096)."""
     m.add("MAX_STEPS", MAX_STEPS)?;
+    // stub:
+    // stub: DEFAULT_SWEEP_TOLERANCE: float
+    // stub: """The default tolerance of ``sweep``, as a fraction of the body's bounding radius (0.002)."""
     m.add("DEFAULT_SWEEP_TOLERANCE", DEFAULT_TOLERANCE_REL)?;
     Ok(())
 }
