@@ -157,7 +157,7 @@ def class_lines(item: Item, items: list[object]) -> list[str]:
         if not isinstance(other, Item):
             continue
         if not other.line.startswith(" "):  # a top-level item: a #[pymethods] block of the class?
-            inside = bool(re.match(r"^impl(<[^>]*>)?\s+%s\b" % rust, other.line)) and other.has("#[pymethods]")
+            inside = bool(re.match(rf"^impl(<[^>]*>)?\s+{rust}\b", other.line)) and other.has("#[pymethods]")
             continue
         if not inside or not re.match(r"^    (pub )?fn ", other.line):
             continue

@@ -17,9 +17,8 @@ import inspect
 from pathlib import Path
 
 import numpy as np
-import pytest
-
 import polyscrew
+import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 STUB_PATH = Path(polyscrew.__file__).parent / "__init__.pyi"
