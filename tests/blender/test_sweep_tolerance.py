@@ -23,6 +23,7 @@ from scipy.spatial.transform import Rotation
 
 import bake_helpers as h
 from conftest import addon_module
+from screws import screw_matrix
 
 CUBE_V = [(x, y, z) for z in (-0.5, 0.5) for y in (-0.5, 0.5) for x in (-0.5, 0.5)]
 CUBE_F = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
@@ -42,15 +43,6 @@ def key(obj, frame, matrix):
     obj.keyframe_insert("location", frame=frame)
     obj.keyframe_insert("rotation_euler", frame=frame)
 
-
-def screw_matrix(axis, point, angle, slide):
-    """Rotation by `angle` about the line through `point` along `axis`, then `slide` along it."""
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    r = Rotation.from_rotvec(angle * axis).as_matrix()
-    m = np.eye(4)
-    m[:3, :3] = r
-    m[:3, 3] = np.asarray(point) - r @ np.asarray(point) + slide * axis
-    return m
 
 
 def played_poses(obj, frames):

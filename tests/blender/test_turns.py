@@ -242,14 +242,8 @@ def quaternion_keys(name: str, values) -> bpy.types.Object:
 def departure_from_blender(obj, frames) -> tuple[float, float]:
     """Largest angle (degrees) and distance between the object's playback now and its
     source's playback at `frames` (Blender's own evaluation of both actions)."""
-    result = obj.animation_data.action
-    ours = h.evaluated_basis(obj, frames)
-    obj.animation_data.action = result["screwbender_source"]
-    theirs = h.evaluated_basis(obj, frames)
-    obj.animation_data.action = result
-    r = np.einsum("nji,njk->nik", theirs[:, :3, :3], ours[:, :3, :3])
-    angle = np.degrees(np.arccos(np.clip((np.trace(r, axis1=1, axis2=2) - 1) / 2, -1, 1)))
-    return float(angle.max()), float(np.linalg.norm(ours[:, :3, 3] - theirs[:, :3, 3], axis=1).max())
+    angle, distance = per_frame_departure(obj, frames)
+    return float(angle.max()), float(distance.max())
 
 
 def per_frame_departure(obj, frames) -> tuple[np.ndarray, np.ndarray]:

@@ -48,6 +48,22 @@ GROUPS = [
 ]
 
 
+def pose_matrix(q, t=(0.0, 0.0, 0.0)):
+    """The 4x4 pose of the unit quaternion `q` (w, x, y, z) and the translation `t` (numpy is
+    imported by the workers, under their address-space cap)."""
+    import numpy as np
+
+    w, x, y, z = q
+    m = np.eye(4)
+    m[:3, :3] = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
+    m[:3, 3] = t
+    return m
+
+
 def worker(group: int, seed: int, examples: int) -> None:
     resource.setrlimit(resource.RLIMIT_AS, (CAP, CAP))
     import numpy as np
@@ -118,14 +134,7 @@ def worker(group: int, seed: int, examples: int) -> None:
     def rigid(draw, scale=None):
         q = np.array(draw(st.lists(st.floats(-1, 1), min_size=4, max_size=4)))
         n = np.linalg.norm(q)
-        q = np.array([1.0, 0, 0, 0]) if n < 1e-3 else q / n
-        w, x, y, z = q
-        m = np.eye(4)
-        m[:3, :3] = [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
+        m = pose_matrix(np.array([1.0, 0, 0, 0]) if n < 1e-3 else q / n)
         m[:3, 3] = [draw(real if scale is None else scale) for _ in range(3)]
         if draw(st.integers(0, 29)) == 0:  # a corrupted entry
             m[draw(st.integers(0, 3)), draw(st.integers(0, 3))] = draw(real)
@@ -497,16 +506,7 @@ def worker(group: int, seed: int, examples: int) -> None:
         angle = {1: np.pi, 2: 1e-9, 3: np.pi - 1e-9}.get(kind, draw(st.floats(-np.pi, np.pi)))
         return np.r_[np.cos(angle / 2), np.sin(angle / 2) * axis]
 
-    def matrix(q, t=(0.0, 0.0, 0.0)):
-        w, x, y, z = q
-        m = np.eye(4)
-        m[:3, :3] = [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
-        ]
-        m[:3, 3] = t
-        return m
+    matrix = pose_matrix
 
     @st.composite
     def valid_pose(draw, coord=coordinate):

@@ -24,18 +24,12 @@ from scipy.spatial.transform import Rotation
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "addon" / "screwbender"))
 import sweep_report  # noqa: E402  (pure: no bpy)
 
+from screws import screw_matrix  # noqa: E402  (tests/fixtures)
+
 CUBE_V = np.array([(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
 CUBE_T = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7],
                    [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
 
-
-def screw_matrix(axis, point, angle, slide):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    r = Rotation.from_rotvec(angle * axis).as_matrix()
-    m = np.eye(4)
-    m[:3, :3] = r
-    m[:3, 3] = np.asarray(point) - r @ np.asarray(point) + slide * axis
-    return m
 
 
 LONG = np.array([np.eye(4), screw_matrix((0.3, 0.2, 1.0), (0.5, -1.0, 0.0), 2 * math.pi / 3, 1.0)])

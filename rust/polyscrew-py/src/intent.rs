@@ -364,13 +364,36 @@ fn analyse_spans<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
 )> {
-    let spans = spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?;
-    Ok((
-        spans.held.into_pyarray(py),
-        spans.pops.into_pyarray(py),
-        spans.turn.into_pyarray(py),
-        spans.inserted.into_pyarray(py),
-    ))
+    Ok(span_arrays(
+        py,
+        spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?,
+    )
+    .0)
+}
+
+/// The arrays of ``analyse_spans`` (held, pops, turn, inserted), and the flips.
+#[allow(clippy::type_complexity)]
+fn span_arrays(
+    py: Python<'_>,
+    spans: Spans,
+) -> (
+    (
+        Bound<'_, PyArray1<bool>>,
+        Bound<'_, PyArray1<bool>>,
+        Bound<'_, PyArray1<f64>>,
+        Bound<'_, PyArray1<f64>>,
+    ),
+    Bound<'_, PyArray1<bool>>,
+) {
+    (
+        (
+            spans.held.into_pyarray(py),
+            spans.pops.into_pyarray(py),
+            spans.turn.into_pyarray(py),
+            spans.inserted.into_pyarray(py),
+        ),
+        spans.flips.into_pyarray(py),
+    )
 }
 
 /// analyse_turns(
@@ -404,14 +427,11 @@ fn analyse_turns<'py>(
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<bool>>,
 )> {
-    let spans = spans_of(py, AnalyseTurns::NAME, playback, frames, turns.0)?;
-    Ok((
-        spans.held.into_pyarray(py),
-        spans.pops.into_pyarray(py),
-        spans.turn.into_pyarray(py),
-        spans.inserted.into_pyarray(py),
-        spans.flips.into_pyarray(py),
-    ))
+    let ((held, pops, turn, inserted), flips) = span_arrays(
+        py,
+        spans_of(py, AnalyseTurns::NAME, playback, frames, turns.0)?,
+    );
+    Ok((held, pops, turn, inserted, flips))
 }
 
 /// Where `keys_parameters` gets the smoothed motion from.

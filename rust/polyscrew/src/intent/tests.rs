@@ -15,7 +15,7 @@ use crate::{
 const XYZ: RotationMode = RotationMode::Euler(EulerOrder::Xyz);
 
 /// A curve through `(frame, value)` keys, every key with `interpolation`.
-fn curve(points: &[(f32, f32)], interpolation: Interpolation) -> FCurve {
+pub(super) fn curve(points: &[(f32, f32)], interpolation: Interpolation) -> FCurve {
     let keys = points
         .iter()
         .map(|&(x, y)| Key::new(x, y).with_interpolation(interpolation))
@@ -24,7 +24,7 @@ fn curve(points: &[(f32, f32)], interpolation: Interpolation) -> FCurve {
 }
 
 /// A playback of location/rotation/scale curves, everything else at rest (unit scale).
-fn playback(curves: Vec<(Channel, FCurve)>, mode: RotationMode) -> Playback {
+pub(super) fn playback(curves: Vec<(Channel, FCurve)>, mode: RotationMode) -> Playback {
     let mut statics = vec![0.0; 6 + mode.width()];
     statics[3 + mode.width()..].fill(1.0);
     if mode == RotationMode::Quaternion {

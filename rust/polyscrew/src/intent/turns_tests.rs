@@ -5,27 +5,15 @@ use std::f64::consts::{PI, TAU};
 
 use glam::DVec3;
 
+use super::tests::playback;
 use super::*;
-use crate::{EulerOrder, Extrapolation, FCurve, Interpolation, Key, RotationMode};
+use crate::{EulerOrder, FCurve, Interpolation, RotationMode};
 
 const XYZ: RotationMode = RotationMode::Euler(EulerOrder::Xyz);
 
+/// A curve through `(frame, value)` keys, every key LINEAR.
 fn curve(points: &[(f32, f32)]) -> FCurve {
-    let keys = points
-        .iter()
-        .map(|&(x, y)| Key::new(x, y).with_interpolation(Interpolation::Linear))
-        .collect();
-    FCurve::new(keys, Extrapolation::Constant, None).unwrap()
-}
-
-fn playback(curves: Vec<(Channel, FCurve)>, mode: RotationMode) -> Playback {
-    let mut statics = vec![0.0; 6 + mode.width()];
-    statics[3 + mode.width()..].fill(1.0);
-    if mode == RotationMode::Quaternion {
-        statics[3] = 1.0;
-    }
-    let (channels, curves): (Vec<_>, Vec<_>) = curves.into_iter().unzip();
-    Playback::new(curves, &channels, statics, mode, true).unwrap()
+    super::tests::curve(points, Interpolation::Linear)
 }
 
 fn deg(x: f64, y: f64, z: f64) -> DVec3 {

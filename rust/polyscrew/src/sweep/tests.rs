@@ -100,7 +100,7 @@ fn distance_to_surface(body: &Body, p: DVec3) -> f64 {
 }
 
 /// Ericson, Real-Time Collision Detection 5.1.5: closest point on triangle.
-fn point_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+pub(crate) fn point_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     let ab = b - a;
     let ac = c - a;
     let ap = p - a;

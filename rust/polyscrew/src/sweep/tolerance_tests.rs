@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 use glam::{DQuat, DVec3};
 
-use super::tests::{cuboid, torus};
+use super::tests::{cuboid, point_triangle, torus};
 use super::*;
 use crate::motion::subdivision::{subdivide, Scheme};
 
@@ -21,39 +21,6 @@ fn sd_box(p: DVec3, size: DVec3) -> f64 {
     let c = 0.5 * size;
     let q = (p - c).abs() - c;
     q.max(DVec3::ZERO).length() + q.x.max(q.y).max(q.z).min(0.0)
-}
-
-/// Ericson 5.1.5: the distance from `p` to the triangle `abc`.
-fn point_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return p.distance(a);
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return p.distance(b);
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return p.distance(a + ab * (d1 / (d1 - d3)));
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return p.distance(c);
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return p.distance(a + ac * (d2 / (d2 - d6)));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return p.distance(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    p.distance(a + ab * (vb * denom) + ac * (vc * denom))
 }
 
 /// The minimum of `f(pose)` over the motion through `poses` (the exact screws between them):
