@@ -39,10 +39,10 @@ demo_common.blender_with_addon()
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-preview = importlib.import_module("bl_ext.user_default.screwbender.preview")
-keys = importlib.import_module("bl_ext.user_default.screwbender.keys")
-bake = importlib.import_module("bl_ext.user_default.screwbender.bake")
-channels = importlib.import_module("bl_ext.user_default.screwbender.channels")
+preview = importlib.import_module("bl_ext.user_default.screwbender.blender.preview")
+keys = importlib.import_module("bl_ext.user_default.screwbender.blender.keys")
+bake = importlib.import_module("bl_ext.user_default.screwbender.blender.bake")
+channels = importlib.import_module("bl_ext.user_default.screwbender.blender.channels")
 
 KEYS = 50
 LEVELS = 5

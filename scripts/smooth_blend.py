@@ -79,7 +79,7 @@ def load_addon():
             return importlib.import_module(f"{name}.bake")
     sys.path.insert(0, str(ROOT / "addon"))
     try:
-        return importlib.import_module("screwbender.bake")
+        return importlib.import_module("screwbender.blender.bake")
     except ImportError as err:
         raise Failure(
             f"cannot import the add-on ({err}); install the ScrewBender extension or put the polyscrew wheel on PYTHONPATH"

@@ -45,7 +45,7 @@ def transform_curves(action, owner_prefix: str = "") -> list[tuple[str, str, int
 
 
 def addon_channels():
-    return addon_module("channels")
+    return addon_module("blender.channels")
 
 
 def assert_read_once(reads, curves) -> None:
@@ -134,7 +134,7 @@ def test_revert_of_many_objects_scans_the_scene_once(count):
     removes the smoothed copies in one batch (before: a scan of every object and of the file
     per reverted action, quadratic: 0.27 of the smoothing's CPU at 300 objects, 0.4 at 500).
     Counted, not timed (the times are printed; speed is measured in scripts/bench_floor.py)."""
-    bake = addon_module("bake")
+    bake = addon_module("blender.bake")
     objects = many(count)
     sources = [o.animation_data.action for o in objects]
     h.select_only(*objects)
@@ -172,8 +172,8 @@ def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
     frames: the largest departure and the frames over the thresholds agree with measuring
     every frame (a screw between two keys against Blender's independent channel curves)."""
-    intent = addon_module("intent")
-    bake = addon_module("bake")
+    intent = addon_module("pure.intent")
+    bake = addon_module("blender.bake")
     obj = h.new_object("Long")
     for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
         obj.location = (x, 0.3 * x, 0.0)

@@ -224,7 +224,7 @@ def test_sweeps_the_smoothed_motion_at_its_baked_keys():
     assert bpy.ops.screwbender.smooth(step=0.5) == {"FINISHED"}
     from conftest import addon_module
 
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     frames = swept.motion_frames(body, scene)
     np.testing.assert_allclose(frames, np.arange(1, 30.25, 0.5))
     assert bpy.ops.screwbender.sweep(steps=2) == {"FINISHED"}

@@ -17,8 +17,9 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
 
-from . import bake, bake_ops, channels, insert_key, owners, preview, preview_draw, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, insert_key, owners, preview, transaction
+from ..blender.keys import SmoothError
+from . import bake_ops, preview_draw
 
 STYLES = (
     ("WIRE", "Wireframe", "Each instance drawn as the wireframe of its mesh"),

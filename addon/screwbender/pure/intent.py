@@ -56,7 +56,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import polyscrew
 
-from . import curves
+from ..blender import curves
 
 #: A span whose channels turn further than this (radians, 150 degrees) along Blender's
 #: playback gets poses from that playback added inside it: the screw between its keys alone,

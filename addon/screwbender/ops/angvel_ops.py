@@ -7,9 +7,9 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty
 
-from . import transaction
-from .angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
-from .keys import SmoothError
+from ..blender import transaction
+from ..blender.angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
+from ..blender.keys import SmoothError
 
 
 class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):

@@ -9,8 +9,9 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
-from . import bake, bake_ops, channels, owners, reduce, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, owners, reduce, transaction
+from ..blender.keys import SmoothError
+from . import bake_ops
 
 
 def distance_property(name: str = "Distance") -> FloatProperty:

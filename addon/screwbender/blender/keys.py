@@ -20,7 +20,8 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bulk, channels, curves, intent, modifiers, owners
+from ..pure import intent
+from . import bulk, channels, curves, modifiers, owners
 
 #: Rotation modes and the property holding the rotation in each.
 ROTATION_PATHS = {

@@ -31,7 +31,8 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, bulk, channels, denoise_data, feature, keys, owners, transaction
+from ..pure import denoise_data
+from . import bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import polyscrew
 
-from . import feature, keys
+from ..blender import feature, keys
 
 #: Steps per key span along which the travel of Blender's playback and of the smoothed motion
 #: is measured (timing "keys"; the output frames inside a span are measured too): the core's

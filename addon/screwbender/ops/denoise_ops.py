@@ -7,8 +7,9 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
-from . import bake, bake_ops, channels, denoise, owners, reduce, reduce_ops, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, denoise, owners, reduce, transaction
+from ..blender.keys import SmoothError
+from . import bake_ops, reduce_ops
 
 
 class SCREWBENDER_OT_denoise(bpy.types.Operator):

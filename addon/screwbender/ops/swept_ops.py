@@ -8,7 +8,8 @@ import time
 import bpy
 from bpy.props import BoolProperty, FloatProperty, IntProperty
 
-from . import sweep_report, swept, transaction
+from ..blender import swept, transaction
+from ..pure import sweep_report
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):

@@ -6,8 +6,10 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, channels, feature, intent, owners, reduce, reduce_ops, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, feature, owners, reduce, transaction
+from ..blender.keys import SmoothError
+from ..pure import intent
+from . import reduce_ops
 
 
 def report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str) -> None:

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import bpy
 import numpy as np
 
-from . import bulk, channels, feature, intent, keys, modifiers, owners, range_join, sampling, transaction
+from ..pure import intent, sampling
+from . import bulk, channels, feature, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
