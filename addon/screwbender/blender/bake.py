@@ -236,7 +236,7 @@ def sample_poses(
     (:mod:`sampling`: pieces between holds, timing "keys").
     """
     owner = owners.as_owner(owner) if owner is not None else None
-    sampled = sampling.sample(motion, frames, options, owner)
+    sampled = sampling.sample(motion, frames, options, feature.sampler(owner, options))
     return sampled.poses, sampled.scales
 
 
@@ -355,7 +355,7 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        sampled = sampling.sample(motion, frames, options, owner, channels=True, previous=previous)
+        sampled = sampling.sample(motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous)
         location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
         values = {"location": location, keys.rotation_path(mode): rotation}
         if not motion.located:

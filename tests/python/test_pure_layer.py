@@ -1,0 +1,193 @@
+"""The add-on's pure layer (`addon/screwbender/pure`, issue 25 item 1): numpy and polyscrew
+only, never bpy, and tested here without Blender.
+
+- Every module of the folder imports in a fresh interpreter in which importing `bpy` (or
+  `bmesh`, `mathutils`, `gpu`, ...) raises; the same check run on a copy of the folder with one
+  module that reaches for Blender fails, so the check can fail.
+- Its parts against independent references: Blender's rotation conventions (`keyed`) against
+  scipy, `compose` against the product T R S, the pieces and holds of `sampling.segments`,
+  `sampling.sample` reproducing a screw motion (scipy's matrix exponential of its twist),
+  `feature_points.nearest_rows` against a brute-force search.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+import scipy.linalg
+from scipy.spatial.transform import Rotation
+
+import pure_layer
+from screws import screw_matrix
+
+BLOCKED = ("bpy", "bmesh", "mathutils", "gpu", "gpu_extras", "bpy_extras", "bl_ui", "addon_utils")
+
+#: Run in a fresh interpreter: block Blender's modules, import every module of a pure folder.
+CHECK = textwrap.dedent(
+    """
+    import importlib, importlib.abc, importlib.util, sys
+    from pathlib import Path
+
+    BLOCKED = {blocked!r}
+
+    class Blocker(importlib.abc.MetaPathFinder):
+        def find_spec(self, name, path=None, target=None):
+            if name.split(".")[0] in BLOCKED:
+                raise ImportError(f"the pure layer imported {{name}}")
+            return None
+
+    sys.meta_path.insert(0, Blocker())
+    folder = Path({folder!r})
+    spec = importlib.util.spec_from_file_location("pure_check", folder / "__init__.py",
+                                                  submodule_search_locations=[str(folder)])
+    package = importlib.util.module_from_spec(spec)
+    sys.modules["pure_check"] = package
+    spec.loader.exec_module(package)
+    failed = []
+    for path in sorted(folder.glob("*.py")):
+        if path.stem == "__init__":
+            continue
+        try:
+            importlib.import_module("pure_check." + path.stem)
+            print("ok", path.stem)
+        except Exception as err:
+            failed.append(path.stem)
+            print("FAILED", path.stem, type(err).__name__, err)
+    loaded = sorted(m for m in sys.modules if m.split(".")[0] in BLOCKED)
+    print("blender modules loaded:", loaded)
+    sys.exit(1 if failed or loaded else 0)
+    """
+)
+
+
+def check_folder(folder: Path) -> subprocess.CompletedProcess:
+    script = CHECK.format(blocked=BLOCKED, folder=str(folder))
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+
+
+def test_every_pure_module_imports_without_blender():
+    names = pure_layer.names()
+    # the folder holds the layer's modules (a rename or an empty folder would pass vacuously)
+    assert {"intent", "sampling", "keyed", "packed", "feature_points", "denoise_data", "sweep_report"} <= set(names)
+    done = check_folder(pure_layer.FOLDER)
+    print(done.stdout)
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert done.stdout.count("ok ") == len(names)
+
+
+def test_the_check_fails_on_a_module_that_reaches_for_blender(tmp_path):
+    copy = tmp_path / "pure"
+    shutil.copytree(pure_layer.FOLDER, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    (copy / "reaches.py").write_text("from . import keyed\nimport mathutils\n")
+    done = check_folder(copy)
+    assert done.returncode != 0, done.stdout
+    assert "FAILED reaches ImportError the pure layer imported mathutils" in done.stdout, done.stdout
+    (copy / "reaches.py").write_text("from ..blender import keys\n")  # the Blender layer: not there
+    done = check_folder(copy)
+    assert done.returncode != 0 and "FAILED reaches" in done.stdout, done.stdout
+
+
+keyed = pure_layer.module("keyed")
+sampling = pure_layer.module("sampling")
+feature_points = pure_layer.module("feature_points")
+
+
+@pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
+def test_euler_rotation_matrices_follow_blender_against_scipy(order, rng):
+    angles = rng.uniform(-4.0, 4.0, (20, 3))  # beyond +-pi too
+    got = keyed.rotation_matrices(angles, order)
+    # Blender's "XYZ": X applied first about the fixed axes (R = Rz Ry Rx): scipy's extrinsic "xyz"
+    # with the angles in the order's letters.
+    index = ["XYZ".index(c) for c in order]
+    want = Rotation.from_euler(order.lower(), angles[:, index]).as_matrix()
+    np.testing.assert_allclose(got, want, atol=1e-12)
+
+
+def test_quaternion_and_axis_angle_matrices_against_scipy(rng):
+    q = rng.normal(size=(20, 4)) * rng.uniform(0.2, 3.0, (20, 1))  # not unit: Blender normalises
+    got = keyed.rotation_matrices(q, "QUATERNION")
+    want = Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
+    np.testing.assert_allclose(got, want, atol=1e-12)
+    axis_angle = np.column_stack([rng.uniform(-6, 6, 20), rng.normal(size=(20, 3))])
+    got = keyed.rotation_matrices(axis_angle, "AXIS_ANGLE")
+    axes = axis_angle[:, 1:] / np.linalg.norm(axis_angle[:, 1:], axis=1, keepdims=True)
+    want = Rotation.from_rotvec(axes * axis_angle[:, :1]).as_matrix()
+    np.testing.assert_allclose(got, want, atol=1e-12)
+    with pytest.raises(keyed.SmoothError, match="unknown rotation mode"):
+        keyed.rotation_matrices(q, "QUATERNIONS")
+
+
+def test_compose_is_t_r_s(rng):
+    loc, scale = rng.normal(size=(5, 3)), rng.uniform(0.5, 2.0, (5, 3))
+    rot = Rotation.random(5, random_state=7).as_matrix()
+    got = keyed.compose(loc, rot, scale)
+    for i in range(5):
+        t, r, s = np.eye(4), np.eye(4), np.diag([*scale[i], 1.0])
+        t[:3, 3], r[:3, :3] = loc[i], rot[i]
+        np.testing.assert_allclose(got[i], t @ r @ s, atol=1e-14)
+    assert keyed.baked_channels("XYZ", True, np.array([False, True, False])) == [
+        ("location", 0), ("location", 1), ("location", 2),
+        ("rotation_euler", 0), ("rotation_euler", 1), ("rotation_euler", 2), ("scale", 1),
+    ]
+    assert [c for c, _ in keyed.baked_channels("QUATERNION", False, np.zeros(3, bool))] == ["rotation_quaternion"] * 4
+
+
+def motion(frames, poses, held=None):
+    k = len(frames)
+    return keyed.KeyedMotion(
+        frames=np.asarray(frames, float), poses=np.asarray(poses), scales=np.ones((k, 3)),
+        scale_axes=np.zeros(3, bool), rotation_mode="XYZ", first_rotation=np.zeros(3), closed=False,
+        period=None, cyclic=False, held=None if held is None else np.asarray(held, bool),
+    )
+
+
+def test_segments_cut_at_holds():
+    m = motion([0, 10, 20, 30, 40], [np.eye(4)] * 5, held=[False, True, False, False])
+    frames = np.arange(-2.0, 43.0)
+    segments = sampling.segments(m, frames)
+    assert [(s.lo, s.hi, s.held) for s in segments] == [(0, 1, False), (1, 1, True), (2, 4, False)]
+    rows = np.concatenate([s.rows for s in segments])
+    np.testing.assert_array_equal(rows, np.arange(len(frames)))  # every frame once, in order
+    held = segments[1]
+    # the held span 10..20 (from the key at 10 up to, not including, 20)
+    np.testing.assert_array_equal(frames[held.rows], np.arange(10.0, 20.0))
+    print("segments:", [(s.lo, s.hi, len(s.rows)) for s in segments])
+
+
+@pytest.mark.parametrize("scheme", ["four_point", "bspline", "jarek"])
+def test_sample_reproduces_a_screw_motion(scheme):
+    """Key poses on one screw (a helix): the smoothed motion at any frame is that screw, as the
+    matrix exponential of its twist (scipy) gives it, with every scheme and linear timing."""
+    start = screw_matrix((0.2, 0.4, 1.0), (1.0, -0.5, 0.3), 0.0, 0.0) @ np.diag([1.0, 1.0, 1.0, 1.0])
+    step = screw_matrix((0.2, 0.4, 1.0), (1.0, -0.5, 0.3), math.radians(35.0), 0.4)
+    twist = scipy.linalg.logm(step).real
+    frames = np.array([1.0, 11.0, 21.0, 31.0, 41.0])
+    poses = [np.linalg.matrix_power(step, i) @ start for i in range(len(frames))]
+    options = SimpleNamespace(scheme=scheme, levels=5, timing="linear", method="SCREW")
+    at = np.linspace(1.0, 41.0, 97)
+    got = sampling.sample(motion(frames, poses), at, options).poses
+    want = np.array([scipy.linalg.expm(twist * (f - 1.0) / 10.0) @ start for f in at])
+    err = np.abs(got - want).max()
+    print(f"{scheme}: largest entry error against expm {err:.2e}")
+    assert err < 1e-9
+
+
+def test_nearest_rows_against_brute_force(rng):
+    frames = np.sort(rng.choice(np.arange(0.0, 200.0, 0.5), 40, replace=False))
+    at = np.concatenate([frames + rng.uniform(-5e-5, 5e-5, 40), rng.uniform(-10, 210, 60)])
+    index, same = feature_points.nearest_rows(frames, at)
+    brute = np.abs(frames[None, :] - at[:, None]).argmin(axis=1)
+    np.testing.assert_allclose(np.abs(frames[index] - at), np.abs(frames[brute] - at))
+    np.testing.assert_array_equal(same, np.abs(frames[brute] - at) < keyed.FRAME_TOLERANCE)
+    assert same[:40].all()
+    stiff = feature_points.key_stiffness(motion(frames[:4], [np.eye(4)] * 4), np.array([1, 1, 0, 1], bool), True, 0.5)
+    np.testing.assert_array_equal(stiff, [np.inf, 0.5, np.inf, np.inf])  # ends of an open motion are hit
+    assert feature_points.key_stiffness(motion(frames[:4], [np.eye(4)] * 4), np.ones(4, bool), False, 0.5) is None
