@@ -10,6 +10,7 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty
 
 from ..blender import swept, transaction
 from ..pure import sweep_report
+from . import pipeline
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):
@@ -78,7 +79,8 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
         start = time.perf_counter()
-        try:
+
+        def work(progress: pipeline.Progress) -> tuple[list, list, list]:
             tolerance = self.tolerance if self.tolerance > 0.0 else None
             read: dict = {}  # each key curve read once, also when meshes share an action or a rig
             computed = [swept.compute(o, context, self.steps, self.caps, tolerance, read) for o in objects]
@@ -98,24 +100,25 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                 for obj in created:
                     obj.select_set(True)
                 context.view_layer.objects.active = created[-1]
-        except swept.SweepError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Build Swept Region")
-        seconds = time.perf_counter() - start
-        tris = sum(swept.triangle_count(o.data) for o in created)
-        sweep_ms = 1e3 * sum(s.seconds for s in computed)
-        volumes = [m.volume for m in found]
-        self.report(
-            {"INFO"},
-            sweep_report.summary(
-                len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
-                max(s.error_bound for s in computed), sum(m.area for m in found),
-                None if any(v is None for v in volumes) else sum(volumes),
-            ),
-        )
-        return {"FINISHED"}
+            return computed, created, found
+
+        def report(done: tuple[list, list, list]) -> set[str]:
+            computed, created, found = done
+            seconds = time.perf_counter() - start
+            tris = sum(swept.triangle_count(o.data) for o in created)
+            sweep_ms = 1e3 * sum(s.seconds for s in computed)
+            volumes = [m.volume for m in found]
+            self.report(
+                {"INFO"},
+                sweep_report.summary(
+                    len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
+                    max(s.error_bound for s in computed), sum(m.area for m in found),
+                    None if any(v is None for v in volumes) else sum(volumes),
+                ),
+            )
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Build Swept Region", work, report, refusals=(swept.SweepError,))
 
 
 class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
