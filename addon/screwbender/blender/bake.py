@@ -18,7 +18,6 @@ leaves the scene as it was.
 
 from __future__ import annotations
 
-import contextlib
 import hashlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
@@ -27,7 +26,7 @@ import bpy
 import numpy as np
 
 from ..pure import intent, sampling
-from . import bulk, channels, feature, keys, modifiers, owners, range_join, transaction
+from . import action_groups, bulk, channels, feature, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
@@ -581,6 +580,22 @@ def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Actio
     return None
 
 
+def source_action(
+    current: bpy.types.Action, identifier: str, made_by: str, again: bool, keep_edits: bool = True
+) -> tuple[bpy.types.Action, str, bool]:
+    """The action (and slot) a run of the operator `made_by` reads for owners animated by
+    `current`: `current` itself, or, when `current` is that operator's result and `again` (run on
+    the result) is off, the original it was made from, read again with the new options; with
+    `keep_edits`, a result the animator edited since is read as it is (never thrown away). The
+    third value says whether that happened (for the report)."""
+    found = original_of(current, made_by)
+    if found is None or again:
+        return current, identifier, False
+    if keep_edits and was_edited(current, identifier):
+        return current, identifier, True
+    return found[0], found[1], False
+
+
 def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
     """Gives the objects of `bake` a copy of their current action whose transform curves of
     the smoothed owners are the baked ones (every other curve as it was); see
@@ -696,21 +711,15 @@ class _Group:
 def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
     """The owners grouped by the action and slot that animates them (linked duplicates share
     one), in the order given; owners without an action are refused here."""
+    found, skipped = action_groups.by_action(selection)
     groups: dict[tuple, _Group] = {}
-    skipped = []
-    for item in selection:
-        owner = owners.as_owner(item)
-        adt = owner.obj.animation_data
-        if adt is None or adt.action is None:
-            skipped.append((owner, keys.no_action(owner.name, adt)))
-            continue
-        group = groups.setdefault(
-            (adt.action.as_pointer(), channels.slot_identifier(owner.obj)), _Group([], [])
-        )
-        if owner.obj not in group.objects:
-            group.objects.append(owner.obj)
-        if owner.bone not in group.bones:
-            group.bones.append(owner.bone)
+    for by_action in found:
+        group = groups[by_action.action.as_pointer(), by_action.identifier] = _Group([], [])
+        for owner in by_action.members:
+            if owner.obj not in group.objects:
+                group.objects.append(owner.obj)
+            if owner.bone not in group.bones:
+                group.bones.append(owner.bone)
     # Every object the action animates through that slot keeps sharing it, selected or not
     # (one pass over the scene's objects for all the actions).
     users = users_by_slot({pointer for pointer, _ in groups})
@@ -749,20 +758,14 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     first = group.objects[0]
     current = first.animation_data.action
     identifier = channels.slot_identifier(first)
-    source, source_slot = current, identifier
-    found = original_of(current, "smooth")
+    source, source_slot, edited = source_action(current, identifier, "smooth", options.smooth_result)
     notes = []
-    if found is not None and not options.smooth_result:
-        if was_edited(current, identifier):
-            # The animator changed the result: the edit is the new source, never thrown away.
-            notes.append(
-                f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
-                "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
-                "them, a second Revert to the original)"
-            )
-        else:
-            # A result of Smooth Motion: smooth the original keys again with the new options.
-            source, source_slot = found
+    if edited:
+        notes.append(
+            f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
+            "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
+            "them, a second Revert to the original)"
+        )
     read_from = None if source is current else source
     # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
@@ -950,14 +953,7 @@ def smooth(
         from . import reduce
 
         notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
-    with contextlib.ExitStack() as stack:
-        if t is None:
-            t = stack.enter_context(transaction.atomic())
-        actions = []
-        for i, bake in enumerate(bakes):
-            actions.append(write(bake, t))
-            if progress is not None:
-                progress(len(groups) + i + 1, total)
+    actions = action_groups.write_all(bakes, write, t, progress, len(groups), total)
     return Smoothed(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],

@@ -39,7 +39,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, bulk, channels, keys, modifiers, owners, range_join, transaction
+from . import action_groups, bake, bulk, channels, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
 
 #: The default tolerance: 1 mm (at the scene's unit scale, :func:`default_distance`) and half
@@ -757,28 +757,17 @@ def reduce_keys(
     """Reduces the keys of the owners in `selection` (objects or :class:`owners.Owner`s);
     owners animated by one action get one new action. Everything is read and reduced (one
     `polyscrew.reduce_keys` call) before anything is written; the writing is all or nothing."""
-    selection = [owners.as_owner(item) for item in selection]
-    groups: dict[tuple, list[owners.Owner]] = {}
-    skipped = []
-    for owner in selection:
-        adt = owner.obj.animation_data
-        if adt is None or adt.action is None:
-            skipped.append(f"{owner.name}: no animation (no active action): skipped")
-            continue
-        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
+    groups, refused = action_groups.by_action(selection)
+    skipped = [message for _, message in refused]
     pairs, plans, notes, rerun, edited = [], [], [], [], []
-    for members in groups.values():
+    for group in groups:
+        members = group.members
         first = members[0].obj
-        current = first.animation_data.action
-        identifier = channels.slot_identifier(first)
-        source, slot = current, identifier
-        found = bake.original_of(current, "reduce")
-        if found is not None and not options.reduce_result:
-            if bake.was_edited(current, identifier):
-                # the animator changed the result: the edit is the new source, never thrown away
-                edited.append(f"'{current.name}'")
-            else:
-                source, slot = found
+        current, identifier = group.action, group.identifier
+        source, slot, was_edited = bake.source_action(current, identifier, "reduce", options.reduce_result)
+        if was_edited:
+            # the animator changed the result: the edit is the new source, never thrown away
+            edited.append(f"'{current.name}'")
         by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
         done = []
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
@@ -811,22 +800,20 @@ def reduce_keys(
     }
     if progress is not None:
         progress(2, 3)
-    actions = []
-    with contextlib.ExitStack() as stack:
-        if t is None:
-            t = stack.enter_context(transaction.atomic())
-        for objects, source, current, identifier, done in plans:
-            parts = [reduced[(o.obj.as_pointer(), o.bone)] for o in done]
 
-            digests: dict = {}
+    def write(plan, t: transaction.Transaction) -> bpy.types.Action:
+        objects, source, current, identifier, done = plan
+        parts = [reduced[(o.obj.as_pointer(), o.bone)] for o in done]
 
-            def edit(bag, parts=parts, digests=digests) -> None:
-                for part in parts:
-                    write_reduced(bag, part, digests=digests)
+        digests: dict = {}
 
-            actions.append(
-                bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce", digests=digests)
-            )
+        def edit(bag, parts=parts, digests=digests) -> None:
+            for part in parts:
+                write_reduced(bag, part, digests=digests)
+
+        return bake.new_result(objects, source, current, identifier, t, edit, made_by="reduce", digests=digests)
+
+    actions = action_groups.write_all(plans, write, t)
     parts = list(reduced.values())
     return Result(
         actions=actions,

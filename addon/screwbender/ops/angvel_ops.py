@@ -32,16 +32,16 @@ class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
-        try:
+
+        def work(progress: pipeline.Progress) -> bpy.types.Object:
             with transaction.atomic() as t:
-                sphere = add_sketch(context, obj, t)
-        except (SmoothError, ValueError) as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Add Angular Velocity Sketch")
-        self.report({"INFO"}, f"{obj.name}: edit the blue curve on {sphere.name} and its '{SPEED_PROP}' curve")
-        return {"FINISHED"}
+                return add_sketch(context, obj, t)
+
+        def report(sphere: bpy.types.Object) -> set[str]:
+            self.report({"INFO"}, f"{obj.name}: edit the blue curve on {sphere.name} and its '{SPEED_PROP}' curve")
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Add Angular Velocity Sketch", work, report, refusals=(SmoothError, ValueError))
 
 
 class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):

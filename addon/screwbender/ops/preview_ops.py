@@ -19,7 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 
 from ..blender import bake, channels, insert_key, owners, preview, transaction
 from ..blender.keys import SmoothError
-from . import bake_ops, preview_draw
+from . import bake_ops, pipeline, preview_draw
 
 STYLES = (
     ("WIRE", "Wireframe", "Each instance drawn as the wireframe of its mesh"),
@@ -113,20 +113,21 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
                 "the keys do not: key it (or undo the move) before applying",
             )
             return {"CANCELLED"}
-        try:
-            with transaction.atomic() as t:
-                selection = preview_draw.previewed_owners(context.scene, objects)
-                result = bake.smooth(selection, preview_draw.smooth_options(context.scene), t=t)
-                for obj in result.objects:
-                    t.set(obj, preview_draw.OBJECT_PROP, False)
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Apply Preview")
-        finally:
-            preview_draw.sync()
-        return bake_ops.report_smoothed(self, result, "Applied the preview of")
+
+        def work(progress: pipeline.Progress) -> bake.Smoothed:
+            try:
+                with transaction.atomic() as t:
+                    selection = preview_draw.previewed_owners(context.scene, objects)
+                    result = bake.smooth(selection, preview_draw.smooth_options(context.scene), t=t)
+                    for obj in result.objects:
+                        t.set(obj, preview_draw.OBJECT_PROP, False)
+            finally:
+                preview_draw.sync()
+            return result
+
+        return pipeline.run(
+            self, "Apply Preview", work, lambda result: bake_ops.report_smoothed(self, result, "Applied the preview of")
+        )
 
 
 class SCREWBENDER_OT_insert_key(bpy.types.Operator):
@@ -162,16 +163,19 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         selection = _key_owners(context)
         results = []
         errors = []
-        try:
-            with transaction.atomic() as t:
+
+        def work(progress: pipeline.Progress) -> None:
+            with transaction.atomic() as t:  # a failure takes back every key inserted so far
                 for owner in selection:  # an owner that cannot be smoothed is skipped unchanged
                     try:
                         with transaction.atomic(t) as one:
                             results.append((owner, insert_key.insert_key(owner, frame, options, one)))
                     except SmoothError as err:
                         errors.append(str(err))
-        except Exception as err:  # every key inserted so far is taken back
-            return transaction.report_failure(self, err, "Insert Key on Motion")
+
+        return pipeline.run(self, "Insert Key on Motion", work, lambda _: self.report_inserted(scene, frame, results, errors))
+
+    def report_inserted(self, scene: bpy.types.Scene, frame: float, results: list, errors: list[str]) -> set[str]:
         for message in errors:
             self.report({"WARNING" if results else "ERROR"}, message)
         if not results:

@@ -143,12 +143,9 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
         region = context.active_object
         others = sorted((o for o in context.selected_objects if o is not region and o.type == "MESH"), key=lambda o: o.name)
         depsgraph = context.evaluated_depsgraph_get()
-        try:
+
+        def work(progress: pipeline.Progress) -> dict:
             results = {o.name: swept.clearance(region, o, depsgraph) for o in others}
-        except swept.SweepError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        try:
             with transaction.atomic() as t:
                 for o in [region, *others]:
                     t.keep_face_selection(o.data)
@@ -157,14 +154,17 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
                     swept.select_faces(o, results[o.name].faces_b)
                 t.set_item(region, "screwbender_clearance", {name: r.distance for name, r in results.items()})
                 t.set_item(region, "screwbender_intersects", [name for name, r in results.items() if r.intersects])
-        except Exception as err:
-            return transaction.report_failure(self, err, "Check Clearance")
-        for name, r in results.items():
-            if r.intersects:
-                self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")
-            else:
-                self.report({"INFO"}, f"{region.name} clears {name} by {r.distance:.6g}")
-        return {"FINISHED"}
+            return results
+
+        def report(results: dict) -> set[str]:
+            for name, r in results.items():
+                if r.intersects:
+                    self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")
+                else:
+                    self.report({"INFO"}, f"{region.name} clears {name} by {r.distance:.6g}")
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Check Clearance", work, report, refusals=(swept.SweepError,))
 
 
 class VIEW3D_PT_screwbender_sweep(bpy.types.Panel):
