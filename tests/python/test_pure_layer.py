@@ -98,6 +98,8 @@ def test_the_check_fails_on_a_module_that_reaches_for_blender(tmp_path):
 keyed = pure_layer.module("keyed")
 sampling = pure_layer.module("sampling")
 feature_points = pure_layer.module("feature_points")
+grids = pure_layer.module("grids")
+reports = pure_layer.module("reports")
 
 
 @pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
@@ -191,3 +193,56 @@ def test_nearest_rows_against_brute_force(rng):
     stiff = feature_points.key_stiffness(motion(frames[:4], [np.eye(4)] * 4), np.array([1, 1, 0, 1], bool), True, 0.5)
     np.testing.assert_array_equal(stiff, [np.inf, 0.5, np.inf, np.inf])  # ends of an open motion are hit
     assert feature_points.key_stiffness(motion(frames[:4], [np.eye(4)] * 4), np.ones(4, bool), False, 0.5) is None
+
+
+def closed_keys(frames, poses, is_closed=True):
+    """`keyed.key_motion` of key values alone (no playback), as `keys.read` calls it."""
+    k = len(frames)
+    poses = np.asarray(poses)
+    rotation = np.zeros((k, 3))
+    return keyed.key_motion(
+        "Body", "XYZ", np.asarray(frames, float), poses, poses[:, :3, 3], rotation, np.ones((k, 3)),
+        np.zeros(3, bool), None, {}, False, False, is_closed, [], None, True, "AUTO", True, None, 1.0, {}, frozenset(),
+    )
+
+
+def test_key_motion_turns_a_closing_key_into_the_period():
+    turn = [screw_matrix((0, 0, 1), (0, 0, 0), a, 0.0) for a in (0.0, 2.0, 4.0)]
+    m = closed_keys([0, 10, 20, 30], [*turn, turn[0]])  # the last key repeats the first pose
+    assert m.closed and m.period == 30.0
+    np.testing.assert_array_equal(m.frames, [0, 10, 20])
+    assert m.frame_range == (0.0, 30.0) and m.is_key.tolist() == [True] * 3
+    m = closed_keys([0, 10, 20], turn)  # no closing key: back to the first after the mean spacing
+    assert m.closed and m.period == pytest.approx(30.0) and len(m.frames) == 3
+    m = closed_keys([0, 10, 20], turn, is_closed=False)
+    assert not m.closed and m.period is None and m.frame_range == (0.0, 20.0)
+    with pytest.raises(keyed.SmoothError, match="Body: a cycle needs two distinct key poses"):
+        closed_keys([0, 10], [turn[0], turn[0]])
+
+
+@pytest.mark.parametrize(("start", "end", "step"), [(1.0, 30.0, 1.0), (1.5, 20.6, 1.0), (1.0, 30.0, 0.1), (0.0, 10.0, 0.3)])
+def test_bake_frames_ends_exact_and_the_step_grid_between(start, end, step):
+    frames = grids.bake_frames(start, end, step)
+    assert frames[0] == start and frames[-1] == end
+    inner = frames[1:-1]
+    # every multiple of the step strictly inside (not within the tolerance of an end), exactly k / n for 1 / n steps
+    k = np.arange(math.ceil(start / step) - 1, math.floor(end / step) + 2)
+    want = k * step if abs(1 / step - round(1 / step)) > 1e-9 else k / round(1 / step)
+    want = want[(want > start + keyed.FRAME_TOLERANCE) & (want < end - keyed.FRAME_TOLERANCE)]
+    np.testing.assert_array_equal(inner, want)
+    print(f"{start:g}..{end:g} step {step:g}: {len(frames)} frames")
+
+
+def test_with_key_frames_adds_every_key_and_refuses_bad_ranges():
+    grid = grids.bake_frames(1.0, 10.0, 1.0)
+    keys_ = np.array([0.0, 2.5, 4.00002, 7.0, 12.0])  # outside, a subframe, a hair off a grid frame, on one
+    frames = grids.with_key_frames(grid, keys_)
+    np.testing.assert_array_equal(frames, [1, 2, 2.5, 3, 4.00002, 5, 6, 7, 8, 9, 10])
+    assert grids.with_key_frames(grid, np.array([3.0, 5.0])) is grid  # every key on the grid: unchanged
+    with pytest.raises(keyed.SmoothError, match="step must be positive"):
+        grids.bake_frames(1.0, 10.0, 0.0)
+    with pytest.raises(keyed.SmoothError, match="frame range 10 to 1 is empty"):
+        grids.bake_frames(10.0, 1.0, 1.0)
+    with pytest.raises(keyed.SmoothError, match="raise Step or shorten the Frame Range"):
+        grids.bake_frames(0.0, 1e9, 1.0)
+    assert reports.summary(["C", "A", "B", "D", "E"]) == "A, B, C and 2 more"

@@ -42,7 +42,6 @@ PARAMETRIZATIONS = (
 )
 
 
-
 def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per frame of `at`: the index of the nearest frame of `frames` (sorted, not empty), and
     whether it is the same frame (within :data:`FRAME_TOLERANCE`). Both neighbours are
@@ -59,13 +58,11 @@ def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.nda
 BONE_BOX_WIDTH = 0.1
 
 
-
 def bone_points(length: float) -> np.ndarray:
     """The eight corners of a box around a bone of `length` in its own space (head at the
     origin, the bone along +Y): the bone's body for the Feature Points method."""
     w = BONE_BOX_WIDTH * length
     return np.array([(x, y, z) for x in (-w, w) for y in (0.0, length) for z in (-w, w)])
-
 
 
 def key_stiffness(motion: KeyedMotion, selected: np.ndarray, approximate: bool, stiffness: float):

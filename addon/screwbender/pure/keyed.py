@@ -159,3 +159,192 @@ def _union(frames: list[np.ndarray]) -> np.ndarray:
     merged = np.unique(np.concatenate(frames))
     keep = np.concatenate(([True], np.diff(merged) > FRAME_TOLERANCE))
     return merged[keep]
+
+
+def key_motion(
+    name: str,
+    mode: str,
+    frames: np.ndarray,
+    poses: np.ndarray,
+    location: np.ndarray,
+    rotation: np.ndarray,
+    scale: np.ndarray,
+    scale_axes: np.ndarray,
+    source: intent.Source | None,
+    modes: dict,
+    cyclic: bool,
+    extended: bool,
+    is_closed: bool,
+    kept: list[str],
+    extend_to: tuple[float, float] | None,
+    analyse: bool,
+    turns: str,
+    located: bool,
+    owner: object,
+    size: float,
+    stacked: dict,
+    keyed: frozenset,
+) -> KeyedMotion:
+    """The key motion of the owner `name` from what the Blender layer read (`keys.read`): the
+    channels and rigid `poses` at the key `frames`, its curves as Blender plays them (`source`,
+    None for key values alone), the Cycles modifier modes per curve (`modes`; `extended`: one
+    that plays the keys on beyond their range), and the options (`extend_to`, `analyse`,
+    `turns`; `is_closed` decided from them).
+
+    An extended cycle becomes an open motion over neighbouring cycles; with `analyse`, spans
+    are told apart (holds, pops, spins followed with poses from Blender's playback inserted,
+    Euler wraps and quaternion sign flips taken the short way, as `turns` says) and reported in
+    `kept`/`removed`/`causes`; a closed motion's closing key becomes its period, and a cycle with
+    holds is tiled over neighbouring periods as an open motion. Raises :class:`SmoothError`.
+    `owner`, `size`, `stacked` (the modifiers kept per curve) and `keyed` are carried into the
+    result as they are.
+    """
+    paths = transform_paths(mode)
+    bake_range = None
+    if extended:
+        # Blender plays the keys on, shifted (offset) or mirrored, beyond their range: take
+        # that playback over neighbouring cycles as keys of an open motion.
+        first, last = float(frames[0]), float(frames[-1])
+        cycle = last - first
+        before, after = intent.EXTRA_CYCLES, intent.EXTRA_CYCLES
+        if extend_to is not None:
+            before += max(0, int(np.ceil((first - extend_to[0]) / cycle)))
+            after += max(0, int(np.ceil((extend_to[1] - last) / cycle)))
+        if before + after > intent.MAX_CYCLES:
+            raise SmoothError(
+                f"{name}: the frame range spans {before + after} cycles of its Cycles modifier; "
+                f"at most {intent.MAX_CYCLES} are baked: shorten the Frame Range: skipped"
+            )
+        frames = np.concatenate(
+            [frames[:-1] + c * cycle for c in range(-before, after + 1)] + [frames[-1:] + after * cycle]
+        )
+        played = source.channels(frames)
+        location, rotation, scale = played["location"], played[paths[1]], played["scale"]
+        poses = compose(location, rotation_matrices(rotation, mode))
+        bake_range = (first, last)
+        kept.append(f"the Cycles modifier's {_cycle_words(modes)} (the motion goes on beyond the keys)")
+
+    held = pops = None
+    is_key = np.ones(len(frames), dtype=bool)
+    removed, causes = [], []
+    if mode == "QUATERNION" and np.abs(np.linalg.norm(rotation, axis=1) - 1.0).max() > 1e-3:
+        causes.append("non-normalised quaternion keys: Blender's playback interpolates their components")
+    if source is not None and analyse:
+        held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
+        followed = ~held & ((~flips & (mode != "QUATERNION")) if turns == "AUTO" else (turns == "BLENDER"))
+        # Shortest: typed turns whose short screw turns less far than Blender's playback
+        shortened = np.zeros(len(held), dtype=bool)
+        if turns == "SHORTEST":
+            relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
+            short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+            longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
+            shortened = ~held & longer & ~flips
+        spans = np.stack([frames[:-1], frames[1:]], axis=1)
+        if bake_range is not None:  # an extended cycle: report the keys' own period once
+            once = (spans[:, 0] >= bake_range[0]) & (spans[:, 0] < bake_range[1])
+            flips, shortened = flips & once, shortened & once
+        elif extend_to is not None and not is_closed:
+            # a Frame Range narrower than the keys smooths the spans it reaches; the source keys
+            # outside it are kept as they are (range_join), their flips too: not reported
+            inside = (spans[:, 1] > extend_to[0] + FRAME_TOLERANCE) & (spans[:, 0] < extend_to[1] - FRAME_TOLERANCE)
+            flips, shortened = flips & inside, shortened & inside
+        if flips.any():
+            where = intent.frame_runs(spans[flips])
+            if turns == "BLENDER":
+                kept.append(f"{int(flips.sum())} flip(s) as Blender plays them (Turns: As Blender Plays) at frames {where}")
+            else:
+                what = "Euler wrap(s)" if mode != "QUATERNION" else "quaternion sign flip(s)"
+                removed.append(f"{int(flips.sum())} flip(s) ({what} taken the short way) at frames {where}")
+                causes.append("flips removed")
+        if shortened.any():
+            removed.append(f"{int(shortened.sum())} spin(s) taken the short way (Turns: Shortest) at frames "
+                           f"{intent.frame_runs(spans[shortened])}")
+            causes.append("spins taken the short way")
+        if len(inserted):
+            spins = int(np.sum((turn > intent.WIND_LIMIT) & followed))
+            played = source.channels(inserted)
+            order = np.argsort(np.concatenate([frames, inserted]), kind="stable")
+            parent = np.clip(np.searchsorted(frames, np.concatenate([frames, inserted])[order][:-1], side="right") - 1, 0, len(frames) - 2)
+            frames = np.concatenate([frames, inserted])[order]
+            location = np.concatenate([location, played["location"]])[order]
+            rotation = np.concatenate([rotation, played[paths[1]]])[order]
+            scale = np.concatenate([scale, played["scale"]])[order]
+            is_key = np.concatenate([is_key, np.zeros(len(inserted), dtype=bool)])[order]
+            poses = compose(location, rotation_matrices(rotation, mode))
+            held, pops = held[parent], pops[parent]
+            kept.append(f"{spins} spin(s) over half a turn or more ({len(inserted)} poses from Blender's playback added)")
+        if held.any():
+            popping = int(pops.sum())
+            kept.append(f"{int(held.sum())} hold(s)" + (f", {popping} with a pop" if popping else ""))
+        if scale_axes.any():
+            bad = np.argwhere((scale <= 0.0) & scale_axes)
+            if len(bad):
+                raise SmoothError(f"{name}: keyed scale reaches {scale[tuple(bad[0])]:g} between keys: skipped")
+
+    period = None
+    if is_closed:
+        size = 1.0 + float(np.max(np.abs(location)))
+        repeats = np.allclose(poses[-1], poses[0], atol=REPEAT_TOLERANCE * size) and np.allclose(
+            np.log(scale[-1, scale_axes]), np.log(scale[0, scale_axes]), atol=REPEAT_TOLERANCE
+        )  # (keyed scale is positive; an unkeyed axis is the same at every key, maybe 0)
+        if repeats:
+            if len(frames) < 3:
+                raise SmoothError(f"{name}: a cycle needs two distinct key poses: skipped")
+            period = float(frames[-1] - frames[0])
+            frames, poses, scale, rotation, is_key = frames[:-1], poses[:-1], scale[:-1], rotation[:-1], is_key[:-1]
+        else:
+            # no closing key: the last key returns to the first after the mean key spacing
+            user_keys = int(is_key.sum())
+            period = float(frames[-1] - frames[0]) * user_keys / (user_keys - 1)
+            if held is not None:  # the span from the last key back to the first moves
+                held, pops = np.append(held, False), np.append(pops, False)
+        if held is not None and held.any():
+            # A cycle with holds: cut at them, as an open motion over neighbouring periods.
+            first = float(frames[0])
+            reps = intent.EXTRA_CYCLES
+            shifts = [c * period for c in range(-reps, reps + 1)]
+            count = len(frames)
+            frames = np.concatenate([frames + d for d in shifts] + [frames[:1] + (reps + 1) * period])
+            poses = np.concatenate([poses] * len(shifts) + [poses[:1]])
+            scale = np.concatenate([scale] * len(shifts) + [scale[:1]])
+            is_key = np.concatenate([is_key] * len(shifts) + [is_key[:1]])
+            held, pops = np.tile(held, len(shifts)), np.tile(pops, len(shifts))
+            rotation = rotation[np.arange(len(frames)) % count]
+            bake_range = (first, first + period)
+            # every curve the bake writes repeats, keyed or not (an unkeyed location axis
+            # moves along the screw path too), as every column of a cycle without holds does
+            modes = {key: ("REPEAT", "REPEAT") for key in baked_channels(mode, located, scale_axes)} if cyclic else {}
+            is_closed, period = False, None
+    start_index = 0
+    if bake_range is not None:
+        start_index = int(np.argmin(np.abs(frames - bake_range[0])))
+    return KeyedMotion(
+        frames=frames,
+        poses=poses,
+        scales=scale,
+        scale_axes=scale_axes,
+        rotation_mode=mode,
+        first_rotation=rotation[start_index].copy(),
+        closed=is_closed,
+        period=period,
+        cyclic=cyclic,
+        owner=owner,
+        located=located,
+        source=source,
+        held=held,
+        pops=pops,
+        is_key=is_key,
+        bake_range=bake_range,
+        cycle_modes=modes if bake_range is not None else None,
+        size=size,
+        kept=kept,
+        removed=removed,
+        causes=causes,
+        modifiers=stacked,
+        keyed=keyed,
+    )
+
+
+def _cycle_words(modes: dict) -> str:
+    names = sorted({m for pair in modes.values() for m in pair if m in intent.EXTENDED_CYCLES})
+    return " and ".join(n.replace("_", " ").title().replace("Offset", "with Offset") for n in names)

@@ -53,7 +53,6 @@ class Packed:
         }
 
 
-
 def evaluate_packed(packed: Packed, frames: np.ndarray) -> np.ndarray:
     """The packed curves at `frames` (any order, subframes allowed): (C, len(frames))."""
     times = np.ascontiguousarray(frames, dtype=np.float64).reshape(-1)
