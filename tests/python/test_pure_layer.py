@@ -100,6 +100,8 @@ sampling = pure_layer.module("sampling")
 feature_points = pure_layer.module("feature_points")
 grids = pure_layer.module("grids")
 reports = pure_layer.module("reports")
+reduce_plan = pure_layer.module("reduce_plan")
+preview_geometry = pure_layer.module("preview_geometry")
 
 
 @pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
@@ -246,3 +248,54 @@ def test_with_key_frames_adds_every_key_and_refuses_bad_ranges():
     with pytest.raises(keyed.SmoothError, match="raise Step or shorten the Frame Range"):
         grids.bake_frames(0.0, 1e9, 1.0)
     assert reports.summary(["C", "A", "B", "D", "E"]) == "A, B, C and 2 more"
+
+
+def test_reduce_measures_against_scipy(rng):
+    """`reduce_plan`: the rigid part of a float32 matrix is scipy's polar factor; the body error
+    between two poses is |dt| + 2 r sin(theta / 2) with theta scipy's rotation angle."""
+    m = np.eye(4)
+    m[:3, :3] = Rotation.random(random_state=3).as_matrix() @ (np.eye(3) + 1e-4 * rng.normal(size=(3, 3)))
+    m[:3, 3] = rng.normal(size=3)
+    rigid = reduce_plan._rigid(m.astype(np.float32))
+    u, _ = scipy.linalg.polar(m[:3, :3].astype(np.float32).astype(np.float64))
+    np.testing.assert_allclose(rigid[:3, :3], u, atol=1e-12)
+    np.testing.assert_allclose(reduce_plan._mul(rigid, reduce_plan._rigid_inverse(rigid)), np.eye(4), atol=1e-12)
+    a = np.array([screw_matrix(rng.normal(size=3), rng.normal(size=3), rng.uniform(0, 3), 0.3) for _ in range(6)])
+    b = np.array([screw_matrix(rng.normal(size=3), rng.normal(size=3), rng.uniform(0, 3), -0.2) for _ in range(6)])
+    bound, theta = reduce_plan._body_error(a, b, 0.7)
+    want = Rotation.from_matrix(np.einsum("nji,njk->nik", a[:, :3, :3], b[:, :3, :3])).magnitude()
+    np.testing.assert_allclose(theta, want, atol=1e-7)
+    np.testing.assert_allclose(bound, np.linalg.norm(a[:, :3, 3] - b[:, :3, 3], axis=1) + 1.4 * np.sin(want / 2), atol=1e-7)
+    frames = reduce_plan.dense_frames([np.array([1.5, 4.0]), np.array([2.0, 3.25, 5.00001])])
+    np.testing.assert_array_equal(frames, [1.5, 2.0, 3.0, 3.25, 4.0, 5.0])
+    assert reduce_plan._chain_order(np.array([2, -1, 1]), 3) == [1, 2, 0]  # parents first
+
+
+def test_preview_space_from_probes_of_a_known_transform(rng):
+    """`preview_geometry.space_from_probes` recovers `f(M) = [A M3 D | L t + l]` from the probes
+    Blender's bone transform gives, and maps matrices as f does."""
+    a = Rotation.random(random_state=5).as_matrix()
+    d = np.array([1.0, 2.0, 0.5])
+    big_l, small_l = rng.normal(size=(3, 3)), rng.normal(size=3)
+
+    def f(m):
+        out = np.eye(4)
+        out[:3, :3] = a @ m[:3, :3] @ np.diag(d)
+        out[:3, 3] = big_l @ m[:3, 3] + small_l
+        return out
+
+    moved = []
+    for i in range(3):
+        t = np.eye(4)
+        t[i, 3] = 1.0
+        moved.append(f(t))
+    world = screw_matrix((1, 0, 0), (0, 1, 0), 0.4, 0.2)
+    space = preview_geometry.space_from_probes(world, f(np.eye(4)), np.array(moved), f(preview_geometry.CYCLE))
+    poses = np.array([screw_matrix(rng.normal(size=3), rng.normal(size=3), rng.uniform(0, 3), 0.1) for _ in range(4)])
+    got = space.apply(poses)
+    for g, p in zip(got, poses):
+        w = world @ f(p)
+        np.testing.assert_allclose(g, w, atol=1e-9)
+    assert space.matrix is None  # location and rotation go through different matrices
+    vertices = preview_geometry.instance_vertices(np.eye(3), poses)
+    np.testing.assert_allclose(vertices[3:6], (poses[1][:3, :3] @ np.eye(3)).T + poses[1][:3, 3], atol=1e-5)
