@@ -102,6 +102,8 @@ grids = pure_layer.module("grids")
 reports = pure_layer.module("reports")
 reduce_plan = pure_layer.module("reduce_plan")
 preview_geometry = pure_layer.module("preview_geometry")
+bezier = pure_layer.module("bezier")
+smooth_options = pure_layer.module("smooth_options")
 
 
 @pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
@@ -299,3 +301,27 @@ def test_preview_space_from_probes_of_a_known_transform(rng):
     assert space.matrix is None  # location and rotation go through different matrices
     vertices = preview_geometry.instance_vertices(np.eye(3), poses)
     np.testing.assert_allclose(vertices[3:6], (poses[1][:3, :3] @ np.eye(3)).T + poses[1][:3, 3], atol=1e-5)
+
+
+def cubic(p0, p1, p2, p3, t):
+    s = 1.0 - t
+    return s**3 * p0 + 3 * s * s * t * p1 + 3 * s * t * t * p2 + t**3 * p3
+
+
+def test_split_bezier_cuts_the_segment_blender_plays():
+    """The two halves of `bezier.split_bezier` trace the segment (handles within its time span,
+    so Blender plays them uncorrected), and the cut point is at the frame asked for."""
+    p = [np.array(v, float) for v in ((1.0, 0.0), (3.0, 2.0), (6.0, -1.0), (9.0, 1.0))]
+    a1, a2, point, b1, b2 = bezier.split_bezier(*p, 4.0)
+    assert point[0] == pytest.approx(4.0, abs=1e-12)
+    ts = np.linspace(0.0, 1.0, 11)[:, None]
+    whole = cubic(*p, np.linspace(0.0, 1.0, 2001)[:, None])
+    for half in (cubic(p[0], a1, a2, point, ts), cubic(point, b1, b2, p[3], ts)):
+        # every point of a half lies on the whole segment (nearest of a dense sampling)
+        gap = np.min(np.linalg.norm(whole[None] - half[:, None], axis=2), axis=1)
+        assert gap.max() < 5e-3, gap
+    # handles longer than the segment in time are shortened as Blender does: the cut still lands on the frame
+    long = [p[0], np.array([8.0, 3.0]), np.array([2.0, -2.0]), p[3]]
+    assert bezier.split_bezier(*long, 7.5)[2][0] == pytest.approx(7.5, abs=1e-12)
+    assert smooth_options.Options().scheme == "four_point" and smooth_options.Options().timing == "keys"
+    assert [s[0] for s in smooth_options.SCHEMES] == ["four_point", "bspline", "jarek"]
