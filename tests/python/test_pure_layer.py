@@ -76,7 +76,10 @@ def check_folder(folder: Path) -> subprocess.CompletedProcess:
 def test_every_pure_module_imports_without_blender():
     names = pure_layer.names()
     # the folder holds the layer's modules (a rename or an empty folder would pass vacuously)
-    assert {"intent", "sampling", "keyed", "packed", "feature_points", "denoise_data", "sweep_report"} <= set(names)
+    assert {
+        "intent", "sampling", "keyed", "packed", "feature_points", "denoise_data", "sweep_report", "grids", "reports",
+        "smooth_options", "bezier", "preview_geometry", "reduce_plan",
+    } <= set(names)
     done = check_folder(pure_layer.FOLDER)
     print(done.stdout)
     assert done.returncode == 0, done.stdout + done.stderr

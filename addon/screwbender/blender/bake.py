@@ -20,14 +20,14 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
 
 from ..pure import intent, sampling
 from ..pure.grids import MAX_KEYS, bake_frames, with_key_frames  # noqa: F401  (re-exported: bake.bake_frames)
-from ..pure.reports import _names, summary  # noqa: F401  (re-exported: bake.summary)
+from ..pure.reports import Outcome, _names, summary  # noqa: F401  (re-exported: bake.summary)
 from ..pure.smooth_options import CLOSED_MODES, RANGE_MODES, SCHEMES, TIMINGS, Options  # noqa: F401  (re-exported: bake.Options)
 from . import action_groups, bulk, channels, feature, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
@@ -725,22 +725,14 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
 
 
 @dataclass
-class Smoothed:
-    """What Smooth Motion did."""
+class Smoothed(Outcome):
+    """What Smooth Motion did: every object given a new action is among `owners`, selected or
+    not (a linked duplicate sharing the action changes too)."""
 
-    #: The new actions.
-    actions: list[bpy.types.Action]
     #: The objects given a new action.
-    objects: list[bpy.types.Object]
-    #: The owners whose motion changed (objects and bones), by name: every object given a new
-    #: action, selected or not (a linked duplicate sharing the action changes too).
-    owners: list[str]
-    #: How many of them are bones.
-    bones: int
-    #: Messages of what was skipped (nothing changed there).
-    skipped: list[str]
-    #: Other things worth telling (shared actions split, results re-smoothed).
-    notes: list[str]
+    objects: list[bpy.types.Object] = field(default_factory=list)
+    #: How many of the owners are bones.
+    bones: int = 0
 
 
 def _in_order(selection: list, skipped: list) -> list[str]:

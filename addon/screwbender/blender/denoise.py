@@ -31,6 +31,7 @@ import numpy as np
 import polyscrew
 
 from ..pure import denoise_data
+from ..pure.reports import Outcome
 from . import action_groups, bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
@@ -91,13 +92,9 @@ class Cleaned:
 
 
 @dataclass
-class Denoised:
+class Denoised(Outcome):
     """What Remove Noise did."""
 
-    actions: list[bpy.types.Action]
-    owners: list[str]
-    skipped: list[str]
-    notes: list[str] = field(default_factory=list)
     #: The strengths used (frames), per owner: (rotation, translation).
     strengths: list[tuple[float, float]] = field(default_factory=list)
 

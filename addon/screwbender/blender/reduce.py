@@ -33,7 +33,7 @@ from __future__ import annotations
 import contextlib
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import bpy
 import numpy as np
@@ -61,6 +61,7 @@ from ..pure.reduce_plan import (  # noqa: F401  (re-exported: reduce.Options, re
     _rigid_inverse,
     dense_frames,
 )
+from ..pure.reports import Outcome
 from . import action_groups, bake, bulk, channels, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
 
@@ -544,13 +545,9 @@ def write_joined(bag, part) -> None:
 
 
 @dataclass
-class Result:
+class Result(Outcome):
     """What Reduce Keys did."""
 
-    actions: list[bpy.types.Action]
-    owners: list[str]
-    skipped: list[str]
-    notes: list[str] = field(default_factory=list)
     keys_before: int = 0
     keys_after: int = 0
     frames: int = 0
