@@ -5,7 +5,8 @@ Three layers, one folder each (an arrow is "may import"), after glTF-Blender-IO'
 ``blender/``:
 
 - :mod:`.ops` (operators, settings, panels, menus, the preview's drawing) -> :mod:`.blender`
-  and :mod:`.pure`: collect options, run the Blender layer, report.
+  and :mod:`.pure`: collect options, run the Blender layer, report; every writing operator
+  through :func:`.ops.pipeline.run` (one way of running and reporting).
 - :mod:`.blender` (bpy: every ``foreach_get``/``foreach_set`` through :mod:`.blender.bulk`, the
   action APIs in :mod:`.blender.channels`, :mod:`.blender.owners`, the all-or-nothing
   :mod:`.blender.transaction`, per feature the reading and writing) -> :mod:`.pure`.

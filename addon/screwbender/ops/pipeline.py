@@ -4,9 +4,10 @@
 Every writing operator's `execute` is: collect options -> :func:`run` its work -> report.
 The work is the Blender layer's pipeline for that feature (group owners -> read each curve
 once -> compute in the pure layer, one `polyscrew` call per operator where the data allows ->
-write once, inside one :func:`transaction.atomic`): `bake.smooth`, `bake.revert`,
-`denoise.remove_noise`, `reduce.reduce_keys`, `angvel.fit`, `swept.compute` +
-`swept.create_object`. :func:`run` gives it the progress bar, and turns what it raises into
+write once, inside one :func:`transaction.atomic`; `blender/action_groups.py` holds the two
+ends Smooth Motion, Remove Noise and Reduce Keys share): `bake.smooth`, `bake.revert`,
+`denoise.remove_noise`, `reduce.reduce_keys`, `insert_key.insert_key`, `angvel.add_sketch`,
+`angvel.fit`, `swept.compute` + `swept.create_object`, `swept.clearance`. :func:`run` gives it the progress bar, and turns what it raises into
 the one kind of report: a refusal (:class:`SmoothError`, or the feature's own refusal) is the
 animator's message and `{'CANCELLED'}`; anything else is reported by
 :func:`transaction.report_failure` (the journal has undone every change; the traceback goes
