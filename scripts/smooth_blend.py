@@ -76,7 +76,7 @@ def load_addon():
     """The add-on's bake module: the installed extension when enabled, else this checkout's."""
     for name in list(sys.modules):
         if name.startswith("bl_ext.") and name.endswith(".screwbender"):
-            return importlib.import_module(f"{name}.bake")
+            return importlib.import_module(f"{name}.blender.bake")
     sys.path.insert(0, str(ROOT / "addon"))
     try:
         return importlib.import_module("screwbender.blender.bake")
