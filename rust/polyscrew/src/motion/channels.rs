@@ -185,6 +185,10 @@ fn reflected_middle(a: f64, s: f64) -> f64 {
 /// `x` plus the multiple of `2 pi` that brings it within `pi` of `reference`.
 #[inline]
 fn wrap_towards(x: f64, reference: f64) -> f64 {
+    // Within 3 of the reference the multiple is 0 (the common case, continuous motion).
+    if (x - reference).abs() < 3.0 {
+        return x;
+    }
     x - round_half_away((x - reference) / TAU) * TAU
 }
 

@@ -519,29 +519,59 @@ impl Sums {
         }
     }
 
-    /// Adds the samples `self.last + 1 ..= last` of columns `cols`.
+    /// Adds the samples `self.last + 1 ..= last` of columns `cols` (of every column when
+    /// `cols` has more than one).
     #[inline]
     fn extend(&mut self, fitter: &Fitter<'_>, last: usize, cols: &[usize]) {
+        if last <= self.last {
+            return;
+        }
         let t0 = fitter.times[self.key];
-        for j in self.last + 1..=last {
-            let tau = fitter.times[j] - t0;
+        let range = self.last + 1..last + 1;
+        let samples = fitter.times[range.clone()].iter().zip(&fitter.v[range]);
+        // The sums in locals while they are added to (kept in registers, stored once).
+        let mut powers = self.powers;
+        let mut values = self.values;
+        // The keyed groups' columns at fixed places: a group holds all its columns or none
+        // (one column alone: per-channel keys). The fourth rotation column of an Euler
+        // owner is zero; a sum that is not read may take any value.
+        let group = |first: usize| cols.contains(&first);
+        let (loc, rot, scale) = match cols {
+            [_] => (false, false, false),
+            _ => (group(0), group(ROT), group(SCALE)),
+        };
+        for (t, v) in samples {
+            let tau = t - t0;
             let t2 = tau * tau;
             let t3 = t2 * tau;
-            self.powers[1] += tau;
-            self.powers[2] += t2;
-            self.powers[3] += t3;
-            self.powers[4] += t2 * t2;
-            self.powers[5] += t2 * t3;
-            self.powers[6] += t3 * t3;
-            let v = &fitter.v[j];
-            for &c in cols {
-                let sum = &mut self.values[c];
+            powers[1] += tau;
+            powers[2] += t2;
+            powers[3] += t3;
+            powers[4] += t2 * t2;
+            powers[5] += t2 * t3;
+            powers[6] += t3 * t3;
+            let mut add = |c: usize| {
+                let sum = &mut values[c];
                 sum[0] += tau * v[c];
                 sum[1] += t2 * v[c];
                 sum[2] += t3 * v[c];
+            };
+            if let [c] = cols {
+                add(*c);
+            }
+            if loc {
+                (0..3).for_each(&mut add);
+            }
+            if rot {
+                (ROT..ROT + 4).for_each(&mut add);
+            }
+            if scale {
+                (SCALE..SCALE + 3).for_each(&mut add);
             }
         }
-        self.last = self.last.max(last);
+        self.powers = powers;
+        self.values = values;
+        self.last = last;
     }
 }
 
