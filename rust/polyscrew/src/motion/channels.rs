@@ -197,7 +197,7 @@ fn wrap_towards(x: f64, reference: f64) -> f64 {
 /// and the sign is `v`'s (`-0.2` rounds to `-0`); beyond `2^51` std.
 #[inline(always)]
 fn round_half_away(v: f64) -> f64 {
-    if !(v.abs() < 2_251_799_813_685_248.0) {
+    if v.is_nan() || v.abs() >= 2_251_799_813_685_248.0 {
         return v.round();
     }
     let r = (v + fastmath::ROUNDING_SHIFT) - fastmath::ROUNDING_SHIFT;
@@ -208,10 +208,14 @@ fn round_half_away(v: f64) -> f64 {
     }
 }
 
-// fdlibm's `atan(0.5)` and `atan(1)` in two parts (`s_atan.c`, `atanhi`, `atanlo`).
+// fdlibm's `atan(0.5)` and `atan(1)` in two parts (`s_atan.c`, `atanhi`, `atanlo`; its
+// `atanhi[1]` is `FRAC_PI_4`), digit for digit.
+#[allow(clippy::excessive_precision)]
 const ATAN_HALF_HI: f64 = 4.636_476_090_008_060_935_15e-1;
+#[allow(clippy::excessive_precision)]
 const ATAN_HALF_LO: f64 = 2.269_877_745_296_168_709_24e-17;
-const ATAN_ONE_HI: f64 = 7.853_981_633_974_482_789_99e-1;
+const ATAN_ONE_HI: f64 = std::f64::consts::FRAC_PI_4;
+#[allow(clippy::excessive_precision)]
 const ATAN_ONE_LO: f64 = 3.061_616_997_868_383_017_93e-17;
 // The parts of pi / 2 and pi below their nearest doubles.
 const FRAC_PI_2_LO: f64 = 6.123_233_995_736_766e-17;

@@ -230,7 +230,7 @@ fn matrix_column(q: DQuat, a: usize) -> DVec3 {
 #[inline(always)]
 fn even_half_turns(angle: f64) -> bool {
     let x = angle / std::f64::consts::PI;
-    if !(x.abs() < 2_251_799_813_685_248.0) {
+    if x.is_nan() || x.abs() >= 2_251_799_813_685_248.0 {
         return (x + 0.5).floor().rem_euclid(2.0) == 0.0;
     }
     let n = (x + fastmath::ROUNDING_SHIFT) - fastmath::ROUNDING_SHIFT;
