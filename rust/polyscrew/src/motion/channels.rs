@@ -9,12 +9,13 @@
 //! two Euler triples of a matrix, each wrapped by multiples of 2 pi towards the previous
 //! frame, the one nearer to it (sum of absolute differences) is kept.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use glam::{DMat3, DQuat, DVec3};
 
 use crate::error::{Error, Result};
 use crate::memory::{try_vec, Footprint};
+use crate::numeric::fastmath;
 
 /// Below this `cos(middle angle)` an Euler triple is in gimbal lock: the first and last axes
 /// coincide and the last angle is set to 0 (as Blender does, with its f32 threshold scaled).
@@ -75,34 +76,52 @@ impl EulerOrder {
 
     /// Both Euler triples of a rotation matrix (equal in gimbal lock).
     fn two_triples(self, m: &DMat3) -> (DVec3, DVec3) {
-        let ([i, j, k], odd) = self.axes();
-        // Blender's mat[a][b] is column a, row b.
-        let at = |a: usize, b: usize| m.col(a)[b];
-        let cy = at(i, i).hypot(at(i, j));
-        let mut e1 = [0.0; 3];
-        let mut e2 = [0.0; 3];
-        if cy > GIMBAL_LOCK_COS {
-            e1[i] = at(j, k).atan2(at(k, k));
-            e1[j] = (-at(i, k)).atan2(cy);
-            e1[k] = at(i, j).atan2(at(i, i));
-            // The second triple, atan2(-y, -x) and atan2(-s, -cy) in Blender, from the first:
-            // three atan2 instead of six (Euler extraction is most of a bake's per-frame cost).
-            e2[i] = half_turn_opposite(e1[i], at(j, k));
-            e2[j] = reflected_middle(e1[j], -at(i, k));
-            e2[k] = half_turn_opposite(e1[k], at(i, j));
-        } else {
-            e1[i] = (-at(k, j)).atan2(at(j, j));
-            e1[j] = (-at(i, k)).atan2(cy);
-            e1[k] = 0.0;
-            e2 = e1;
+        let m = m.to_cols_array();
+        match self {
+            Self::Xyz => two_triples_of::<0, 1, 2, false>(&m),
+            Self::Xzy => two_triples_of::<0, 2, 1, true>(&m),
+            Self::Yxz => two_triples_of::<1, 0, 2, true>(&m),
+            Self::Yzx => two_triples_of::<1, 2, 0, false>(&m),
+            Self::Zxy => two_triples_of::<2, 0, 1, false>(&m),
+            Self::Zyx => two_triples_of::<2, 1, 0, true>(&m),
         }
-        let (mut a, mut b) = (DVec3::from_array(e1), DVec3::from_array(e2));
-        if odd {
-            a = -a;
-            b = -b;
-        }
-        (a, b)
     }
+}
+
+/// [`EulerOrder::two_triples`] of the column-major matrix `m` for the order whose axes are
+/// applied `I, J, K` (`ODD`: an odd permutation), the indices known at compile time so that
+/// a caller that builds `m` from a quaternion computes only the five entries read.
+#[inline(always)]
+fn two_triples_of<const I: usize, const J: usize, const K: usize, const ODD: bool>(
+    m: &[f64; 9],
+) -> (DVec3, DVec3) {
+    // Blender's mat[a][b] is column a, row b.
+    let at = |a: usize, b: usize| m[3 * a + b];
+    // hypot without the library call: the entries of a rotation are at most 1.
+    let cy = (at(I, I) * at(I, I) + at(I, J) * at(I, J)).sqrt();
+    let mut e1 = [0.0; 3];
+    let mut e2 = [0.0; 3];
+    if cy > GIMBAL_LOCK_COS {
+        e1[I] = atan2(at(J, K), at(K, K));
+        e1[J] = atan2(-at(I, K), cy);
+        e1[K] = atan2(at(I, J), at(I, I));
+        // The second triple, atan2(-y, -x) and atan2(-s, -cy) in Blender, from the first:
+        // three atan2 instead of six (Euler extraction is most of a bake's per-frame cost).
+        e2[I] = half_turn_opposite(e1[I], at(J, K));
+        e2[J] = reflected_middle(e1[J], -at(I, K));
+        e2[K] = half_turn_opposite(e1[K], at(I, J));
+    } else {
+        e1[I] = atan2(-at(K, J), at(J, J));
+        e1[J] = atan2(-at(I, K), cy);
+        e1[K] = 0.0;
+        e2 = e1;
+    }
+    let (mut a, mut b) = (DVec3::from_array(e1), DVec3::from_array(e2));
+    if ODD {
+        a = -a;
+        b = -b;
+    }
+    (a, b)
 }
 
 impl RotationMode {
@@ -166,13 +185,79 @@ fn reflected_middle(a: f64, s: f64) -> f64 {
 /// `x` plus the multiple of `2 pi` that brings it within `pi` of `reference`.
 #[inline]
 fn wrap_towards(x: f64, reference: f64) -> f64 {
-    x - ((x - reference) / TAU).round() * TAU
+    // Within 3 of the reference the multiple is 0 (the common case, continuous motion).
+    if (x - reference).abs() < 3.0 {
+        return x;
+    }
+    x - round_half_away((x - reference) / TAU) * TAU
 }
 
-/// Euler angles of `m` in `order`, compatible with `previous` when given (Blender's
-/// `mat3_normalized_to_compatible_eulO`), else the triple with the smaller absolute sum.
-pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -> DVec3 {
-    let (e1, e2) = order.two_triples(m);
+/// `v.round()` (half away from zero) without the library call baseline x86-64 makes of it:
+/// adding and subtracting `1.5 * 2^52` rounds half to even, a tie is moved away from zero
+/// and the sign is `v`'s (`-0.2` rounds to `-0`); beyond `2^51` std.
+#[inline(always)]
+fn round_half_away(v: f64) -> f64 {
+    if v.is_nan() || v.abs() >= 2_251_799_813_685_248.0 {
+        return v.round();
+    }
+    let r = (v + fastmath::ROUNDING_SHIFT) - fastmath::ROUNDING_SHIFT;
+    if (r - v).abs() == 0.5 {
+        v + 0.5f64.copysign(v)
+    } else {
+        r.copysign(v)
+    }
+}
+
+// fdlibm's `atan(0.5)` and `atan(1)` in two parts (`s_atan.c`, `atanhi`, `atanlo`; its
+// `atanhi[1]` is `FRAC_PI_4`), digit for digit.
+#[allow(clippy::excessive_precision)]
+const ATAN_HALF_HI: f64 = 4.636_476_090_008_060_935_15e-1;
+#[allow(clippy::excessive_precision)]
+const ATAN_HALF_LO: f64 = 2.269_877_745_296_168_709_24e-17;
+const ATAN_ONE_HI: f64 = std::f64::consts::FRAC_PI_4;
+#[allow(clippy::excessive_precision)]
+const ATAN_ONE_LO: f64 = 3.061_616_997_868_383_017_93e-17;
+// The parts of pi / 2 and pi below their nearest doubles.
+const FRAC_PI_2_LO: f64 = 6.123_233_995_736_766e-17;
+const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
+
+/// `atan2(y, x)` within about one ulp of std's, without its library call: the ratio of the
+/// smaller to the larger of `|x|`, `|y|` in `[0, 1]`, fdlibm's `atan` on it (`s_atan.c`: the
+/// polynomial below `7/16`, `atan(1/2) + atan((2t - 1) / (2 + t))` below `11/16`,
+/// `atan(1) + atan((t - 1) / (t + 1))` above), then the octant (`pi / 2 - a`, `pi - a` with
+/// the low parts of `pi`) and the sign of `y` (signed zeros as std). Both zero, infinities
+/// and NaN go to std.
+#[inline(always)]
+fn atan2(y: f64, x: f64) -> f64 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (small, large) = if ay > ax { (ax, ay) } else { (ay, ax) };
+    if !(large > 0.0 && large < f64::INFINITY) {
+        return y.atan2(x);
+    }
+    let t = small / large;
+    let mut a = if t < 7.0 / 16.0 {
+        t - fastmath::atan_poly(t)
+    } else if t < 11.0 / 16.0 {
+        let u = (2.0 * t - 1.0) / (2.0 + t);
+        ATAN_HALF_HI - ((fastmath::atan_poly(u) - ATAN_HALF_LO) - u)
+    } else {
+        let u = (t - 1.0) / (t + 1.0);
+        ATAN_ONE_HI - ((fastmath::atan_poly(u) - ATAN_ONE_LO) - u)
+    };
+    if ay > ax {
+        a = (FRAC_PI_2 - a) + FRAC_PI_2_LO;
+    }
+    if x < 0.0 {
+        a = (PI - a) + PI_LO;
+    }
+    a.copysign(y)
+}
+
+/// Of the two Euler triples `e1`, `e2` of one rotation: each wrapped towards `previous` and
+/// the nearer kept (sum of absolute differences; `e1` on a tie); without `previous` the one
+/// of smaller absolute sum.
+#[inline(always)]
+fn nearer_triple(e1: DVec3, e2: DVec3, previous: Option<DVec3>) -> DVec3 {
     match previous {
         None => {
             if e1.abs().element_sum() > e2.abs().element_sum() {
@@ -196,6 +281,28 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
                 c1
             }
         }
+    }
+}
+
+/// Euler angles of `m` in `order`, compatible with `previous` when given (Blender's
+/// `mat3_normalized_to_compatible_eulO`), else the triple with the smaller absolute sum.
+pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -> DVec3 {
+    let (e1, e2) = order.two_triples(m);
+    nearer_triple(e1, e2, previous)
+}
+
+/// [`euler_compatible`] of every rotation in turn, each compatible with the one before,
+/// appended to `out` (3 values a row), the order's axes fixed at compile time.
+fn euler_rows<const I: usize, const J: usize, const K: usize, const ODD: bool>(
+    rotations: &[DQuat],
+    mut previous: Option<DVec3>,
+    out: &mut Vec<f64>,
+) {
+    for q in rotations {
+        let (e1, e2) = two_triples_of::<I, J, K, ODD>(&DMat3::from_quat(*q).to_cols_array());
+        let e = nearer_triple(e1, e2, previous);
+        out.extend_from_slice(&e.to_array());
+        previous = Some(e);
     }
 }
 
@@ -343,11 +450,15 @@ pub fn rotation_channels(
             }
         }
         RotationMode::Euler(order) => {
-            let mut prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
-            for q in rotations {
-                let e = euler_compatible(&DMat3::from_quat(*q), order, prev);
-                out.extend_from_slice(&e.to_array());
-                prev = Some(e);
+            let prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
+            let out = &mut out;
+            match order {
+                EulerOrder::Xyz => euler_rows::<0, 1, 2, false>(rotations, prev, out),
+                EulerOrder::Xzy => euler_rows::<0, 2, 1, true>(rotations, prev, out),
+                EulerOrder::Yxz => euler_rows::<1, 0, 2, true>(rotations, prev, out),
+                EulerOrder::Yzx => euler_rows::<1, 2, 0, false>(rotations, prev, out),
+                EulerOrder::Zxy => euler_rows::<2, 0, 1, false>(rotations, prev, out),
+                EulerOrder::Zyx => euler_rows::<2, 1, 0, true>(rotations, prev, out),
             }
         }
     }
@@ -378,6 +489,90 @@ mod tests {
         EulerOrder::Zxy,
         EulerOrder::Zyx,
     ];
+
+    #[test]
+    fn atan2_matches_std() {
+        // Every octant, ratios across fdlibm's ranges and their edges, tiny and huge values,
+        // signed zeros and non-finite values.
+        let mut worst: f64 = 0.0;
+        let mut check = |y: f64, x: f64| {
+            let (got, want) = (atan2(y, x), y.atan2(x));
+            if want.is_nan() {
+                assert!(got.is_nan(), "atan2({y}, {x}) = {got}, std NaN");
+                return;
+            }
+            assert_eq!(
+                got.is_sign_negative(),
+                want.is_sign_negative(),
+                "atan2({y}, {x}): {got} vs {want}"
+            );
+            let ulp = f64::EPSILON * want.abs().max(f64::MIN_POSITIVE);
+            worst = worst.max((got - want).abs() / ulp);
+        };
+        for i in 0..=100_000 {
+            let a = i as f64 / 100_000.0 * TAU - PI;
+            let (s, c) = a.sin_cos();
+            for r in [1.0, 1e-200, 3.7e150] {
+                check(s * r, c * r);
+            }
+        }
+        for t in [
+            7.0 / 16.0,
+            11.0 / 16.0,
+            1.0,
+            0.4375f64.next_down(),
+            0.6875f64.next_up(),
+        ] {
+            for (y, x) in [(t, 1.0), (1.0, t), (-t, 1.0), (t, -1.0), (-1.0, -t)] {
+                check(y, x);
+            }
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (1.0, -0.0),
+            (-1.0, -0.0),
+            (0.0, 0.0),
+            (-0.0, -0.0),
+            (0.0, -0.0),
+            (1e-320, 1.0),
+            (1.0, 1e-320),
+            (f64::INFINITY, 1.0),
+            (1.0, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::INFINITY),
+            (f64::NAN, 1.0),
+            (1.0, f64::NAN),
+        ] {
+            check(y, x);
+        }
+        assert!(worst <= 2.0, "worst {worst} ulps");
+    }
+
+    #[test]
+    fn round_half_away_is_round() {
+        for v in [
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            2.4999999999999996,
+            0.49999999999999994,
+            3.0,
+            -0.0,
+            7e15,
+            1e300,
+            -4.5e9 + 0.5,
+        ] {
+            let (got, want) = (round_half_away(v), v.round());
+            assert!(
+                got == want && got.is_sign_negative() == want.is_sign_negative(),
+                "{v}: {got} vs {want}"
+            );
+        }
+    }
 
     #[test]
     fn euler_round_trip_every_order() {

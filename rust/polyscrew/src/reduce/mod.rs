@@ -24,7 +24,10 @@
 //!   source's own first values when given;
 //! - rigs: owners are reduced parents first; a child's target is
 //!   `(world_parent_reduced @ offset)^-1 @ world_child_dense`, so it compensates its parent's
-//!   error and the tolerance holds in world space at every owner.
+//!   error and the tolerance holds in world space at every owner. It is formed from the
+//!   parent's error transform `E = world_reduced^-1 @ world_dense` as
+//!   `offset^-1 @ E_parent @ offset @ local_dense`, and the child's own `E` is
+//!   `played^-1 @ target`: no world pose is formed.
 //!
 //! Owners are independent within a depth of the hierarchy and are spread over threads.
 //! Every size that input drives is checked against the memory budget ([`reduce_footprint`])
@@ -248,9 +251,10 @@ pub fn sample_count(n: usize) -> usize {
 }
 
 /// The most bytes [`reduce_keys`] holds for `bodies` owners of `n` frames on `threads`
-/// workers (0: the machine's), `with_parents` when world poses are kept for children: the
-/// sample times, one working set per worker (targets, channels, reduced poses), the world
-/// poses, and the curves when each of the 10 channels keeps up to one key per frame.
+/// workers (0: the machine's), `with_parents` when error transforms are kept for children: the
+/// sample times, one working set per worker (targets, channels, reduced poses), one error
+/// transform per sample of every owner, and the curves when each of the 10 channels keeps up
+/// to one key per frame.
 pub fn reduce_footprint(bodies: usize, n: usize, threads: usize, with_parents: bool) -> Footprint {
     let m = sample_count(n);
     let workers = effective_threads(threads, bodies).max(1);
@@ -260,7 +264,7 @@ pub fn reduce_footprint(bodies: usize, n: usize, threads: usize, with_parents: b
         .and::<[f64; compose::STRIDE]>(m.saturating_mul(2))
         .and::<usize>(m);
     let worlds = if with_parents {
-        Footprint::of::<Pose>(m.saturating_mul(2)).times(bodies)
+        Footprint::of::<Pose>(m).times(bodies)
     } else {
         Footprint::ZERO
     };
@@ -518,7 +522,9 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
                 .map(|&o| {
                     let parent = input.parents.and_then(|p| p[o]).map(|q| {
                         let r = results[q].as_ref().expect("parents first");
-                        r.world.as_ref().expect("a parent keeps its world poses")
+                        r.world
+                            .as_ref()
+                            .expect("a parent keeps its error transforms")
                     });
                     (o, ctx.reduce_owner(ws, o, parent, has_children[o]))
                 })
@@ -547,8 +553,8 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
                 e => e,
             })?);
         }
-        // The owners one level up have no children left to reduce: their world poses go
-        // (their memory is reused by the next level's).
+        // The owners one level up have no children left to reduce: their error transforms
+        // go (their memory is reused by the next level's).
         if let Some(up) = level.checked_sub(1) {
             for o in (0..b).filter(|o| depth[*o] == up) {
                 if let Some(r) = results[o].as_mut() {
