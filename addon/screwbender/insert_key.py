@@ -37,9 +37,9 @@ import polyscrew
 
 from . import bake, bulk, channels, curves, keys, owners, transaction
 from .keys import SmoothError
-
-#: What one curve's packed keys hold per key (`curves.Packed`), spliced after an insertion.
-_PER_KEY = ("co", "handle_left", "handle_right", "interpolation", "easing", "back", "amplitude", "period")
+from .packed_parts import PER_KEY as _PER_KEY
+from .packed_parts import joined as _joined
+from .packed_parts import one as _one
 
 
 @dataclass
@@ -100,30 +100,6 @@ def _transform_curves(owner: owners.Owner, listed: list) -> list:
         if prop in paths and not fc.mute and len(fc.keyframe_points) > 0 and (located or prop != "location"):
             found[prop, fc.array_index] = fc
     return list(found.values())
-
-
-def _one(packed: curves.Packed, c: int) -> curves.Packed:
-    """Curve `c` of `packed` alone (views of its arrays)."""
-    lo, hi = int(packed.offsets[c]), int(packed.offsets[c + 1])
-    return curves.Packed(
-        offsets=np.array([0, hi - lo], dtype=np.int64),
-        extrapolation=[packed.extrapolation[c]],
-        cycles=[packed.cycles[c]] if packed.cycles else [None],
-        **{name: getattr(packed, name)[lo:hi] for name in _PER_KEY},
-    )
-
-
-def _joined(parts: list[curves.Packed]) -> curves.Packed:
-    """One packed set of the curves of `parts`, in order."""
-    counts = [int(p.offsets[-1]) for p in parts]
-    offsets = np.zeros(len(parts) + 1, dtype=np.int64)
-    np.cumsum(counts, out=offsets[1:])
-    return curves.Packed(
-        offsets=offsets,
-        extrapolation=[e for p in parts for e in p.extrapolation],
-        cycles=[c for p in parts for c in (p.cycles or [None])],
-        **{name: np.concatenate([getattr(p, name) for p in parts]) for name in _PER_KEY},
-    )
 
 
 def _key_codes(point) -> tuple[int, int]:

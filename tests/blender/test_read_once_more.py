@@ -181,3 +181,52 @@ def test_insert_key_on_a_rig_does_the_same_work_per_bone_at_any_size():
         assert keyed == 6 * bones, (bones, keyed)
     print(f"curves listed per bone (10, 40 bones): {per_bone}")
     assert per_bone[1] <= per_bone[0] * 1.01, per_bone
+
+
+def test_the_preview_refresh_reads_every_objects_curves_in_one_pass():
+    """Twelve previewed objects and a rig of three previewed bones: a refresh reads all their
+    curves in one `curves.read` call (on 6a217ff: one per owner), and the key hashes and
+    previews equal those of owners read one by one."""
+    pd, curves = addon_module("preview_draw"), addon_module("curves")
+    scene = bpy.context.scene
+    objects = [keyed_object(f"Body{i:02d}", 0.3 * i) for i in range(12)]
+    rig = armature(bones=(("Upper", None, False), ("Fore", "Upper", False), ("Hand", "Fore", False)), holder=False)
+    for i, bone in enumerate(("Upper", "Fore", "Hand")):
+        key_bone(rig, bone, [1, 11, 30], random_poses(3, 30 + i, reach=0.4))
+    calls = []
+    original = curves.read
+
+    def counting(fcurves, keys_only=False, original=original):
+        calls.append(len(fcurves))
+        return original(fcurves, keys_only)
+
+    previewed = [*objects, rig]
+    try:
+        for ob in previewed:
+            ob.screwbender_preview = True
+        pd.CACHE.forget()
+        curves.read = counting
+        try:
+            pd.refresh(scene)
+        finally:
+            curves.read = original
+        together = {k: (e.digest, e.batches) for k, e in pd.CACHE.entries.items()}
+        print(f"curves.read calls in one refresh of {len(previewed)} objects: {calls}")
+        assert calls == [12 * 9 + 3 * 6], calls  # every owner's curves, once, in one call
+        assert len(together) == 15 and all(b is not None for _, b in together.values())
+        pd.CACHE.forget()
+        preview = addon_module("preview")
+        alone = preview.read_together
+        preview.read_together = lambda pairs, memo: None  # each owner reads its own curves
+        try:
+            pd.refresh(scene)
+        finally:
+            preview.read_together = alone
+        for key, entry in pd.CACHE.entries.items():
+            digest, batches = together[key]
+            assert entry.digest == digest, key
+            np.testing.assert_array_equal(entry.batches.instances, batches.instances)
+            np.testing.assert_array_equal(entry.batches.trajectory, batches.trajectory)
+    finally:
+        for ob in previewed:
+            ob.screwbender_preview = False
