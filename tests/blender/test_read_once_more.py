@@ -189,8 +189,9 @@ def test_the_preview_refresh_reads_every_objects_curves_in_one_pass():
     previews equal those of owners read one by one."""
     pd, curves = addon_module("preview_draw"), addon_module("curves")
     scene = bpy.context.scene
-    objects = [keyed_object(f"Body{i:02d}", 0.3 * i) for i in range(12)]
-    rig = armature(bones=(("Upper", None, False), ("Fore", "Upper", False), ("Hand", "Fore", False)), holder=False)
+    objects = [keyed_object(f"Previewed{i:02d}", 0.3 * i) for i in range(12)]
+    rig = armature("Previewed rig", bones=(("Upper", None, False), ("Fore", "Upper", False), ("Hand", "Fore", False)),
+                   holder=False)  # (names of their own: preview_draw.CACHE counts recomputes by name)
     for i, bone in enumerate(("Upper", "Fore", "Hand")):
         key_bone(rig, bone, [1, 11, 30], random_poses(3, 30 + i, reach=0.4))
     calls = []

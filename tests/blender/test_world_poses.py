@@ -50,6 +50,18 @@ def played(obj, frames, deform=None) -> np.ndarray:
     return np.array(out)
 
 
+def posed_counting_frame_sets(items) -> tuple[list, list]:
+    """`swept.world_poses_all(items)` and the frames Blender was set to meanwhile."""
+    sets = []
+    handler = lambda scene, *args: sets.append(scene.frame_current)  # noqa: E731
+    bpy.app.handlers.frame_change_post.append(handler)
+    try:
+        posed = addon_module("swept").world_poses_all(items, bpy.context.scene)
+    finally:
+        bpy.app.handlers.frame_change_post.remove(handler)
+    return posed, sets
+
+
 def scene_with_every_chain():
     """An object; a child (with a parent inverse) of an animated parent; a rig parented to an
     animated empty, in Pose Mode, with a mesh parented to a bone (below a connected one) and a
@@ -91,13 +103,7 @@ def test_world_poses_from_the_curves_equal_blenders_matrix_world_at_every_frame(
     plan = swept._plan([(obj, driver) for obj, _, driver in items], scene, None, True)
     assert all(chain is not None for chain in plan.chains), "every chain read from its curves"
     assert items[3][2] is not None and items[3][2].deformed and items[2][2] is not None
-    sets = []
-    handler = lambda scene, *args: sets.append(scene.frame_current)  # noqa: E731
-    bpy.app.handlers.frame_change_post.append(handler)
-    try:
-        posed = swept.world_poses_all(items, scene)
-    finally:
-        bpy.app.handlers.frame_change_post.remove(handler)
+    posed, sets = posed_counting_frame_sets(items)
     assert sets == [], "no frame_set on the fast path"
     for (name, _), (poses, scale) in zip(cases.items(), posed):
         got = poses.copy()
@@ -130,13 +136,7 @@ def test_an_object_with_a_constraint_is_played_once_per_frame_for_all():
     plan = swept._plan([(o, None) for o, _, _ in items], scene, None, True)
     assert plan.chains[0] is not None and plan.chains[1] is None and plan.chains[2] is None
     expected = [played(o, frames) for o in followers]
-    sets = []
-    handler = lambda scene, *args: sets.append(scene.frame_current)  # noqa: E731
-    bpy.app.handlers.frame_change_post.append(handler)
-    try:
-        posed = swept.world_poses_all(items, scene)
-    finally:
-        bpy.app.handlers.frame_change_post.remove(handler)
+    posed, sets = posed_counting_frame_sets(items)
     print(f"frame_set calls for 2 constrained objects x {len(frames)} frames: {len(sets)}")
     assert len(sets) == len(frames) + 1  # each frame once, then the current frame back
     for (poses, scale), want in zip(posed[1:], expected):
