@@ -6,16 +6,16 @@
 #     CPU time), and the other issues' benches (angular velocity, ...);
 #   - callgrind instruction counts of s (ours one by one and through s_many, vs nalgebra) and
 #     of one subdivision;
-#   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
-#   - scripts/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
-#   - scripts/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
-#   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
-#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench-requirements.txt
+#   - scripts/bench/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
+#   - scripts/bench/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
+#   - scripts/bench/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
+#   - scripts/bench/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
+#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench/requirements.txt
 #     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv;
-#   - scripts/bench_floor.py (every writing operator against its floor, the Blender calls it
+#   - scripts/bench/bench_floor.py (every writing operator against its floor, the Blender calls it
 #     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
 #     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
-#   - scripts/bench_denoise.py, scripts/bench_denoise_rig.py (Remove Noise vs Blender's filters).
+#   - scripts/bench/bench_denoise.py, scripts/bench/bench_denoise_rig.py (Remove Noise vs Blender's filters).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
 # and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
 # a refresh's: log-<parts>.txt).
@@ -70,8 +70,8 @@ py="$root/.venv/bin/python"
 bpy_dir=${BPY:-$root/.venv/bpy/5.0}
 peers_ok=1
 if want sweep; then
-  "$py" -m pip --disable-pip-version-check install -q -r scripts/bench-requirements.txt \
-    || { peers_ok=0; echo "bench: scripts/bench-requirements.txt did not install; the sweep comparison will be missing"; }
+  "$py" -m pip --disable-pip-version-check install -q -r scripts/bench/requirements.txt \
+    || { peers_ok=0; echo "bench: scripts/bench/requirements.txt did not install; the sweep comparison will be missing"; }
 fi
 
 pylib="$run/pylib"
@@ -148,11 +148,11 @@ fi
 if want python; then
 pyargs=(); [ "$quick" = 1 ] && pyargs=(--n 2000 --repeat 3)
 stage "Python: batch vs loops (pytransform3d)"
-PYTHONPATH="$pylib" "$py" scripts/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
+PYTHONPATH="$pylib" "$py" scripts/bench/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
   || echo "bench: bench_python.py failed"
 stage "Python inside Blender: batch vs mathutils.Matrix.lerp"
 if [ -d "$bpy_dir" ]; then
-  PYTHONPATH="$pylib:$bpy_dir" "$py" scripts/bench_python.py --blender --out "$run/blender.json" "${pyargs[@]}" \
+  PYTHONPATH="$pylib:$bpy_dir" "$py" scripts/bench/bench_python.py --blender --out "$run/blender.json" "${pyargs[@]}" \
     || echo "bench: bench_python.py --blender failed"
 else
   echo "not available: no Blender module at $bpy_dir"
@@ -161,19 +161,19 @@ fi
 
 if want bake; then
 stage "bake: ScrewBender vs nla.bake vs a keyframe_insert loop"
-if [ ! -f scripts/bench_bake.py ]; then
-  echo "scripts/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
+if [ ! -f scripts/bench/bench_bake.py ]; then
+  echo "scripts/bench/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
 elif [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
   echo "the wheel or the Blender module is missing" | tee "$run/bake.missing"
 elif ! SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1; then
   echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/bake.missing"
 else
   bake_args=(--out "$run/bake.json"); [ "$quick" = 1 ] && bake_args+=(--quick)
-  if PYTHONPATH="$bpy_dir" "$py" scripts/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
+  if PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
     grep -v -e '^Warning' -e '^Read blend' "$run/bake.out" > "$run/bake.txt"; cat "$run/bake.txt"
   else
     tail -5 "$run/bake.out"
-    echo "scripts/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
+    echo "scripts/bench/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
   fi
 fi
 fi
@@ -183,13 +183,13 @@ stage "sweep: ours vs stroboscopic instancing, gpytoolbox, Warp"
 if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
   echo "polyscrew.sweep is not in this build" | tee "$run/sweep.missing"
 elif [ "$peers_ok" != 1 ]; then
-  echo "scripts/bench-requirements.txt (gpytoolbox, warp-lang) did not install" | tee "$run/sweep.missing"
+  echo "scripts/bench/requirements.txt (gpytoolbox, warp-lang) did not install" | tee "$run/sweep.missing"
 else
   sweep_args=(--out "$run/sweep.json"); [ "$quick" = 1 ] && sweep_args+=(--quick)
   # (Warp's start-up banner filtered out: no CUDA here, the CPU device is used.)
-  PYTHONPATH="$pylib" "$py" scripts/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
+  PYTHONPATH="$pylib" "$py" scripts/bench/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
     | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
-  [ -f "$run/sweep.json" ] || echo "scripts/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
+  [ -f "$run/sweep.json" ] || echo "scripts/bench/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
 fi
 fi
 
@@ -202,9 +202,9 @@ elif ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasatt
 else
   [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
   reduce_args=(--json "$run/reduce.json"); [ "$quick" = 1 ] && reduce_args+=(--quick)
-  PYTHONPATH="$bpy_dir" "$py" scripts/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
     || true
-  [ -f "$run/reduce.json" ] || echo "scripts/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
+  [ -f "$run/reduce.json" ] || echo "scripts/bench/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
 fi
 fi
 
@@ -216,9 +216,9 @@ elif ! { [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build
   echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/floor.missing"
 else
   floor_args=(--out "$run/floor.json"); [ "$quick" = 1 ] && floor_args+=(--quick)
-  PYTHONPATH="$bpy_dir" "$py" scripts/bench_floor.py "${floor_args[@]}" 2>&1 \
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_floor.py "${floor_args[@]}" 2>&1 \
     | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' -e '^ScrewBender: ' || true
-  [ -f "$run/floor.json" ] || echo "scripts/bench_floor.py failed (see target/bench/log.txt)" | tee "$run/floor.missing"
+  [ -f "$run/floor.json" ] || echo "scripts/bench/bench_floor.py failed (see target/bench/log.txt)" | tee "$run/floor.missing"
 fi
 fi
 
@@ -228,10 +228,10 @@ fi
 if want denoise; then
 stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
 [ -z "$wheel" ] || [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise.py --json "$run/denoise.json" --benchmarks "$run/denoise.md" \
-  || echo "scripts/bench_denoise.py failed"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise.py --json "$run/denoise.json" --benchmarks "$run/denoise.md" \
+  || echo "scripts/bench/bench_denoise.py failed"
 stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench_denoise_rig.py failed"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench/bench_denoise_rig.py failed"
 fi
 
 stage "write BENCHMARKS.md"
@@ -258,6 +258,6 @@ if os.path.exists(bpy_json):
     env["bpy"] = json.load(open(bpy_json))["env"].get("bpy", "?")
 json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), indent=1)
 PY
-"$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
+"$py" scripts/bench/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
   --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md ${only:+--only "$only"}
 stage "done"

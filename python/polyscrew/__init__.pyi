@@ -53,7 +53,7 @@ key count, the same result to the bit); ``subdivide`` 212 per output pose;
 ``rotation_channels`` 56 per rotation (Euler); ``sweep`` 48 per output vertex and 36 per
 output triangle (checked before each screw's quads are added) plus 320 per body triangle;
 ``feature_motion`` 640 per output pose; ``denoise`` 1,792 per pose (its scratch measured at
-1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/memory_footprints.py`` prints the
+1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/bench/memory_footprints.py`` prints the
 estimates beside the peaks measured for the largest uses (all below 160 MB).
 
 The module releases the GIL while it reads its input, computes and builds its output.

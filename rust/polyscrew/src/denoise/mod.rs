@@ -50,7 +50,7 @@
 //!   close as `1e-300` apart are served like keys one frame apart. A given strength above
 //!   [`MAX_STRENGTH_SPACINGS`] spacings acts as that many (the one the result reports).
 //!
-//! What was measured to choose this (`scripts/bench_denoise.py`, the tables in
+//! What was measured to choose this (`scripts/bench/bench_denoise.py`, the tables in
 //! BENCHMARKS.md, the alternatives in `docs/denoise.md`): the SE(3) spline on logarithms
 //! relative to each pose (screw motions as the straight lines) smooths a spinning object that
 //! travels along a curve badly, because in its geometry the translation of a spinning body

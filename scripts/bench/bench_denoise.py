@@ -25,7 +25,7 @@ Writes JSON (--json), the Markdown section "Denoise" of BENCHMARKS.md (replaced 
 markers, or appended) and the figure docs/denoise_error.png (error over time, ours against
 the three filters at their defaults; drawn by this script run again with plain Python and
 matplotlib, since Blender's numpy is older). Run:
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_denoise.py
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_denoise.py
 """
 
 from __future__ import annotations
@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FPS = 24
 N = 240
 LEVELS = {"low": (0.005, 0.125), "high": (0.02, 0.5)}  # metres, degrees per axis
@@ -519,7 +519,7 @@ def verdict(ok):
 def markdown(results, meta):
     lines = [BEGIN, "## Denoise (issue 19)", ""]
     lines.append(
-        f"Written by `scripts/bench_denoise.py` ({meta['seconds']:.0f} s) on {meta['date']}: "
+        f"Written by `scripts/bench/bench_denoise.py` ({meta['seconds']:.0f} s) on {meta['date']}: "
         f"Blender {meta['blender']}, {meta['cpu']}, load average {meta['load']}. "
         "Noise per axis: low 5 mm and 0.125 degrees, high 20 mm and 0.5 degrees (the issue's camera track). "
         "Errors are to the known truth, measured on the keys each side writes back (float32). "
