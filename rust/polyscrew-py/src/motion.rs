@@ -135,7 +135,7 @@ fn check_t(index: usize, t: f64) -> Result<(), Error> {
             what: "t",
             index,
             value: t,
-            range: "+-1e12",
+            limit: MAX_T,
         })
     } else {
         Err(Error::NotFinite { what: "t", index })
