@@ -15,7 +15,16 @@
 #   - scripts/bench/bench_floor.py (every writing operator against its floor, the Blender calls it
 #     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
 #     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
-#   - scripts/bench/bench_denoise.py, scripts/bench/bench_denoise_rig.py (Remove Noise vs Blender's filters).
+#   - scripts/bench/bench_denoise.py, scripts/bench/bench_denoise_rig.py (Remove Noise vs Blender's filters);
+#   - the measurements the docs quote (part "measure"): what Smooth Motion keeps of the
+#     animator's intent (measure_intent.py), how far each scheme strays from the keys
+#     (measure_schemes.py), where a bake's time goes (profile_bake.py), the live preview's
+#     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
+#     (bench_sweep_blender.py), key fractions of reduce_keys (measure_reduce.py), memory
+#     estimates beside measured peaks (memory_footprints.py), and the paper's smoothness
+#     figures (plot_smoothness.py, into docs/): each one's printout in BENCHMARKS.md.
+# Every script bench.sh runs is in scripts/bench/; bench_report.py is the one writer of
+# BENCHMARKS.md (the others write JSON or text into the run folder).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
 # and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
 # a refresh's: log-<parts>.txt).
@@ -23,7 +32,7 @@
 #      BENCHMARKS.md it writes says so); BPY=.venv/bpy/5.0 selects the Blender module.
 #      BENCH_ONLY=<part>[,<part>] runs only those parts and rewrites only their sections of
 #      BENCHMARKS.md, keeping the others as they are (each refreshed section says so). Parts:
-#      criterion, callgrind, python, bake, reduce, floor, denoise, sweep. E.g.
+#      criterion, callgrind, python, bake, reduce, floor, denoise, sweep, measure. E.g.
 #      BENCH_ONLY=floor scripts/bench.sh (the floor part; the reduce part alone takes ~22 minutes).
 #      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
 #      other parts' results in target/bench; a section that shows a refreshed part and another
@@ -35,7 +44,7 @@ export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$root/target}
 run="$CARGO_TARGET_DIR/bench"
 only=${BENCH_ONLY:-}
-parts="criterion callgrind python bake reduce floor denoise sweep"
+parts="criterion callgrind python bake reduce floor denoise sweep measure"
 for p in ${only//,/ }; do
   case " $parts " in *" $p "*) ;; *) echo "bench: unknown part '$p' in BENCH_ONLY (the parts: $parts)"; exit 2 ;; esac
 done
@@ -52,6 +61,7 @@ else  # a refresh: only the named parts' results are removed, the others kept fo
   want floor && rm -f "$run"/floor.*
   want denoise && rm -f "$run"/denoise.* "$run"/denoise_rig.json
   want sweep && rm -f "$run"/sweep.*
+  want measure && rm -f "$run"/measure-*
   rm -rf "$run/wheel" "$run/pylib" "$run/extension.txt"
 fi
 mkdir -p "$run"
@@ -77,7 +87,7 @@ fi
 pylib="$run/pylib"
 wheel=""
 needs_wheel=0  # every part but criterion and callgrind runs the Python module
-for p in python bake reduce floor denoise sweep; do want "$p" && needs_wheel=1; done
+for p in python bake reduce floor denoise sweep measure; do want "$p" && needs_wheel=1; done
 if [ "$needs_wheel" = 1 ]; then
   stage "build the polyscrew wheel (release, once)"
   if "$root/.venv/bin/maturin" build --release --quiet -o "$run/wheel" 2>&1 | grep -v '^ *Compiling'; then :; fi
@@ -228,10 +238,42 @@ fi
 if want denoise; then
 stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
 [ -z "$wheel" ] || [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
-PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise.py --json "$run/denoise.json" --benchmarks "$run/denoise.md" \
+PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise.py --json "$run/denoise.json" --section "$run/denoise.md" \
   || echo "scripts/bench/bench_denoise.py failed"
 stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
 PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench/bench_denoise_rig.py failed"
+fi
+
+# The measurements the docs quote: each script's printout (target/bench/measure-<name>.txt),
+# put into BENCHMARKS.md by bench_report.py; a script that fails leaves measure-<name>.missing.
+if want measure; then
+stage "measure: the figures the docs quote"
+if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
+  echo "the wheel or the Blender module is missing" | tee "$run/measure.missing"
+else
+  [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
+  profile_args=(); preview_args=()
+  [ "$quick" = 1 ] && profile_args=(--objects 30 --runs 2) && preview_args=(--quick)
+  measure() {  # name, PYTHONPATH, arguments...
+    local name=$1 path=$2; shift 2
+    echo "--- $name"
+    if PYTHONPATH="$path" "$py" "scripts/bench/$name.py" "$@" > "$run/measure-$name.out" 2>&1; then
+      grep -v -e '^Warning' -e '^Read blend' -e '^Info: ' -e '^ScrewBender: ' "$run/measure-$name.out" > "$run/measure-$name.txt"
+      cat "$run/measure-$name.txt"
+    else
+      tail -5 "$run/measure-$name.out"
+      echo "scripts/bench/$name.py failed: $(tail -1 "$run/measure-$name.out")" | tee "$run/measure-$name.missing"
+    fi
+  }
+  measure measure_intent "$pylib:$bpy_dir"
+  measure measure_schemes "$pylib:$bpy_dir"
+  measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
+  measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
+  measure bench_sweep_blender "$pylib:$bpy_dir"
+  measure measure_reduce "$pylib"
+  measure memory_footprints "$pylib"
+  measure plot_smoothness "$pylib" --bpy "$bpy_dir" --out-dir docs
+fi
 fi
 
 stage "write BENCHMARKS.md"

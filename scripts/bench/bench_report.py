@@ -758,6 +758,37 @@ class Report:
             self.w("## Denoise (issue 19)", "", "not available: scripts/bench/bench_denoise.py did not write its section "
                    "(see the bench.sh log)", "")
 
+    #: The measurement scripts of the "measure" part, in the order of their sections: (script,
+    #: what it measures).
+    MEASUREMENTS = (
+        ("measure_intent", "what Smooth Motion keeps of the animator's intent, against Blender's playback (issue 17)"),
+        ("measure_schemes", "how far each subdivision scheme strays from the key poses (the Scheme tooltips)"),
+        ("profile_bake", "where Smooth Motion's time goes on many objects, and Blender's own read and write calls"),
+        ("bench_preview", "the live preview's recompute (issue 8: 50 keys, 5 levels, 64 instances)"),
+        ("bench_sweep_blender", "Build Swept Region on a 100,000-triangle mesh against stroboscopic instancing"),
+        ("measure_reduce", "key fractions of reduce_keys on synthetic and captured-like motion (issue 26)"),
+        ("memory_footprints", "the module's memory estimates beside the peaks measured"),
+        ("plot_smoothness", "the ScrewBender paper's smoothness figures (docs/smoothness_fig10.png, docs/circle_fig11.png)"),
+    )
+
+    def measure_section(self) -> None:
+        """The printouts of the measurement scripts (target/bench/measure-<name>.txt), each as
+        it printed them: the figures README.md and docs/ quote."""
+        self.w("## Measurements the docs quote", "",
+               "Each script in `scripts/bench/`, run by `scripts/bench.sh` (part `measure`), as it printed its figures.", "")
+        if (self.run / "measure.missing").exists():
+            self.w(f"not available: {(self.run / 'measure.missing').read_text().strip()}", "")
+            return
+        for name, what in self.MEASUREMENTS:
+            self.w(f"### `scripts/bench/{name}.py`: {what}", "")
+            text, missing = self.run / f"measure-{name}.txt", self.run / f"measure-{name}.missing"
+            if text.exists() and not missing.exists():
+                self.w("```", text.read_text().rstrip(), "```", "")
+            elif missing.exists():
+                self.w(f"not available: {missing.read_text().strip()}", "")
+            else:
+                self.w(f"not available: measure-{name}.txt was not written (see the bench.sh log).", "")
+
     def floor_section(self) -> None:
         """Every writing operator against its floor and Blender's counterpart, and how each grows,
         from scripts/bench/bench_floor.py's JSON (issue 27)."""
@@ -922,7 +953,7 @@ def growth_of(cases: list[dict], name: str, family: str, axis: str):
 
 
 #: The parts of scripts/bench.sh (BENCH_ONLY=<part>[,<part>]).
-PARTS = ("criterion", "callgrind", "python", "bake", "reduce", "floor", "denoise", "sweep")
+PARTS = ("criterion", "callgrind", "python", "bake", "reduce", "floor", "denoise", "sweep", "measure")
 #: The blocks of BENCHMARKS.md in order: (name, the parts whose results it shows, its methods).
 #: Each is written between ``<!-- name:begin -->`` and ``<!-- name:end -->``; a refresh of some
 #: parts rewrites the blocks that show them and keeps the others as they are.
@@ -939,6 +970,7 @@ BLOCKS = (
     ("reduce", ("reduce",), ("reduce_section",)),
     ("papers", ("criterion",), ("papers_section",)),
     ("denoise", ("denoise",), ("denoise_section",)),
+    ("measure", ("measure",), ("measure_section",)),
 )
 #: A file written before the blocks had markers: the block of each "## " heading (prefix).
 LEGACY_HEADINGS = (
@@ -1020,6 +1052,8 @@ def parts_at_hand(run: Path, crit: dict) -> set[str]:
     for part, names in files.items():
         if any((run / n).exists() for n in names):
             have.add(part)
+    if (run / "measure.missing").exists() or any(run.glob("measure-*.txt")) or any(run.glob("measure-*.missing")):
+        have.add("measure")
     return have
 
 
