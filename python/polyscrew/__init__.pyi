@@ -26,7 +26,8 @@ Working ranges (every value Blender can store, float32 below 3.4e38, is inside t
 - times (key times, sample times, the end of a period) within ``+-MAX_TIME`` (1e300), key
   times at least 1e-300 apart: the time map only takes differences, ratios and the
   reciprocal of two spacings.
-- ``fit_angular_velocity``: times within +-1e30, key times at least 1e-30 apart, target
+- ``fit_angular_velocity``: times within +-1e30 (the tenth root of ``MAX_TIME``: the fit
+  multiplies up to about ten such factors in one product), key times at least 1e-30 apart, target
   angular velocities and speeds within +-1e30, ``alpha`` in 0..=1e30, at most 1,000,000
   fragments, ``max_iterations`` in 1..=1,000,000, ``max_frames`` in 0..=1,000,000
   (``q''`` of a Hermite segment grows like ``1 / h^2`` and ``omega / h``: in these ranges
@@ -235,7 +236,8 @@ MAX_COORDINATE: float
 """The working range of coordinates: ``|x| <= 1e150`` (see the module documentation)."""
 
 MAX_TIME: float
-"""The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
+"""The one working range of times: ``|t| <= 1e300`` (``fit_angular_velocity``, which
+multiplies times, works within its tenth root, ``|t| <= 1e30``)."""
 
 MAX_PREVIOUS_ANGLE: float
 """The largest ``previous`` angle (radians, either sign) the rotation channels continue

@@ -4,24 +4,15 @@ the "measure" part of bench_report.py, and bench_report.py is BENCHMARKS.md's on
 
 from __future__ import annotations
 
-import importlib.util
 import re
 from pathlib import Path
 
 import pytest
 
+from test_bench_tools import load, report
+
 ROOT = Path(__file__).resolve().parents[2]
 BENCH = ROOT / "scripts" / "bench"
-
-
-def load(name: str):
-    spec = importlib.util.spec_from_file_location(name, BENCH / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-report = load("bench_report")
 
 
 def test_every_bench_script_is_run_by_bench_sh_or_a_helper_of_one():

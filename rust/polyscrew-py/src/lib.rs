@@ -78,7 +78,8 @@ where
 /// - times (key times, sample times, the end of a period) within ``+-MAX_TIME`` (1e300), key
 ///   times at least 1e-300 apart: the time map only takes differences, ratios and the
 ///   reciprocal of two spacings.
-/// - ``fit_angular_velocity``: times within +-1e30, key times at least 1e-30 apart, target
+/// - ``fit_angular_velocity``: times within +-1e30 (the tenth root of ``MAX_TIME``: the fit
+///   multiplies up to about ten such factors in one product), key times at least 1e-30 apart, target
 ///   angular velocities and speeds within +-1e30, ``alpha`` in 0..=1e30, at most 1,000,000
 ///   fragments, ``max_iterations`` in 1..=1,000,000, ``max_frames`` in 0..=1,000,000
 ///   (``q''`` of a Hermite segment grows like ``1 / h^2`` and ``omega / h``: in these ranges

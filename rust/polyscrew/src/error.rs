@@ -200,8 +200,10 @@ pub enum Error {
     /// More work than one call may do (a cap that bounds time, not memory; see
     /// [`Error::Memory`] for the memory budget).
     Limit {
-        /// What is counted.
+        /// The argument that asks for the work.
         what: &'static str,
+        /// What is counted (for example `"keys"`).
+        counted: &'static str,
         /// How many the call asks for (saturated at `usize::MAX`).
         count: usize,
         /// The most one call accepts.
@@ -344,6 +346,16 @@ pub enum Expected {
     Normalisable(f64),
     /// Finite (the field of the argument named).
     Finite(&'static str),
+    /// At least `min`, so that the call makes at most `limit` of `counted` (a length that
+    /// cuts a range into pieces).
+    AtLeast {
+        /// The smallest value accepted.
+        min: f64,
+        /// The most pieces a call makes.
+        limit: usize,
+        /// What the pieces are.
+        counted: &'static str,
+    },
     /// Finite once rounded to `float32`, as Blender stores it (the field named).
     FiniteInF32(&'static str),
 }
@@ -388,6 +400,11 @@ impl fmt::Display for Expected {
                 write!(f, "of length at least {} (to be normalised)", number(*min))
             }
             Self::Finite(field) => write!(f, "finite ({field})"),
+            Self::AtLeast {
+                min,
+                limit,
+                counted,
+            } => write!(f, "at least {} (at most {limit} {counted})", number(*min)),
             Self::FiniteInF32(field) => write!(f, "finite in float32 ({field})"),
         }
     }
@@ -536,6 +553,9 @@ impl fmt::Display for Error {
                 value,
                 expected,
             } => match (at, expected) {
+                (None, Expected::AtLeast { .. }) if *value > 0.0 => {
+                    write!(f, "{what}: {} is not {expected}", number(*value))
+                }
                 (Some(at), Expected::NonNegative(_)) if *value < 0.0 => {
                     write!(f, "{what}: {at} is negative ({value})")
                 }
@@ -556,8 +576,8 @@ impl fmt::Display for Error {
                     "{what}: {at} has length {value:e}, shorter than {min:e}: it cannot be \
                      normalised"
                 ),
-                (Some(at), _) => write!(f, "{what}: {at} is {value}, not {expected}"),
-                (None, _) => write!(f, "{what}: {value} is not {expected}"),
+                (Some(at), _) => write!(f, "{what}: {at} has {what} {value}, not {expected}"),
+                (None, _) => write!(f, "{what}: {} is not {expected}", number(*value)),
             },
             Self::Index {
                 what,
@@ -596,11 +616,15 @@ impl fmt::Display for Error {
             }
             Self::Limit {
                 what,
+                counted,
                 count,
                 limit,
                 hint,
             } => {
-                write!(f, "{what}: {count} exceed the limit of {limit} in one call")?;
+                write!(
+                    f,
+                    "{what}: {count} {counted} exceed the limit of {limit} in one call"
+                )?;
                 if hint.is_empty() {
                     Ok(())
                 } else {

@@ -988,11 +988,15 @@ pub fn fit_angular_velocity(
         Some(d) => {
             let count = (span / d).round();
             if !(count <= MAX_FRAGMENTS as f64) {
-                return Err(Error::Limit {
-                    what: "fragments of the key range (its length over fragment_duration)",
-                    count: count as usize,
-                    limit: MAX_FRAGMENTS,
-                    hint: "use a longer fragment_duration",
+                return Err(Error::Value {
+                    what: "fragment_duration",
+                    at: None,
+                    value: d,
+                    expected: Expected::AtLeast {
+                        min: span / MAX_FRAGMENTS as f64,
+                        limit: MAX_FRAGMENTS,
+                        counted: "fragments of the key range",
+                    },
                 });
             }
             (count as usize).max(1)

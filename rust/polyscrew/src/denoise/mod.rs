@@ -281,7 +281,8 @@ pub fn denoise_batch(
     let n = times.len();
     if n > MAX_DENOISE_POSES {
         return Err(Error::Limit {
-            what: "poses per clip",
+            what: "poses",
+            counted: "poses per clip",
             count: n,
             limit: MAX_DENOISE_POSES,
             hint: "",
@@ -291,7 +292,8 @@ pub fn denoise_batch(
         .checked_mul(n)
         .filter(|t| *t <= MAX_DENOISE_BATCH)
         .ok_or(Error::Limit {
-            what: "poses of all bodies",
+            what: "poses",
+            counted: "poses of all bodies",
             count: bodies.saturating_mul(n),
             limit: MAX_DENOISE_BATCH,
             hint: "",
@@ -360,6 +362,7 @@ fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
     if n > MAX_DENOISE_POSES {
         return Err(Error::Limit {
             what: "poses",
+            counted: "poses",
             count: n,
             limit: MAX_DENOISE_POSES,
             hint: "",

@@ -64,8 +64,8 @@ impl PackedCurves<'_> {
         let c = self.len();
         if self.offsets[0] != 0 {
             return Err(Error::Value {
-                what: "offsets",
-                at: Some(At::new("offset", 0)),
+                what: "first offset",
+                at: None,
                 value: self.offsets[0] as f64,
                 expected: Expected::OneOf(&[0.0]),
             });
@@ -81,8 +81,8 @@ impl PackedCurves<'_> {
             }
         }
         let k = usize::try_from(self.offsets[c]).map_err(|_| Error::Value {
-            what: "offsets",
-            at: Some(At::new("offset", c)),
+            what: "last offset",
+            at: None,
             value: self.offsets[c] as f64,
             expected: Expected::NonNegative("offset"),
         })?;

@@ -60,6 +60,7 @@ pub fn check_batch_with(curves: usize, keys: usize, times: usize, extra: Footpri
     if keys > MAX_KEYS {
         return Err(Error::Limit {
             what: "keys",
+            counted: "keys",
             count: keys,
             limit: MAX_KEYS,
             hint: "",
@@ -72,7 +73,8 @@ pub fn check_batch_with(curves: usize, keys: usize, times: usize, extra: Footpri
                 "evaluate fewer curves or times in one call",
             ),
         _ => Err(Error::Limit {
-            what: "values (curves x times)",
+            what: "times",
+            counted: "values (curves x times)",
             count: curves.saturating_mul(times),
             limit: MAX_VALUES,
             hint: "evaluate fewer curves or times in one call",

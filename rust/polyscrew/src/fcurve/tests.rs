@@ -622,7 +622,7 @@ fn bad_input_is_an_error_naming_curve_and_key() {
     assert!(
         matches!(
             err(&p),
-            Error::Value { what: "offsets", at: Some(At { index: 0, .. }), value, .. } if value == 1.0
+            Error::Value { what: "first offset", at: None, value, .. } if value == 1.0
         ),
         "{:?}",
         err(&p)
@@ -689,7 +689,7 @@ fn sizes_are_checked_before_allocating() {
     assert!(
         matches!(
             e,
-            Error::Limit { what: "values (curves x times)", count, limit: MAX_VALUES, .. }
+            Error::Limit { counted: "values (curves x times)", count, limit: MAX_VALUES, .. }
                 if count == MAX_VALUES + 2
         ),
         "{e:?}"

@@ -185,7 +185,8 @@ pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Resul
     let total = counts.iter().fold(0usize, |a, &c| a.saturating_add(c));
     if total > MAX_ANALYSIS_SAMPLES {
         return Err(Error::Limit {
-            what: "samples of the playback the key spans would take",
+            what: "frames",
+            counted: "samples of the playback (for the key spans)",
             count: total,
             limit: MAX_ANALYSIS_SAMPLES,
             hint: "analyse fewer key frames at once (a span takes one sample per few degrees \

@@ -228,6 +228,7 @@ pub fn check_rotation_count(count: usize) -> Result<()> {
     if count > MAX_ROTATIONS {
         return Err(Error::Limit {
             what: "rotations",
+            counted: "rotations",
             count,
             limit: MAX_ROTATIONS,
             hint: CHANNELS_HINT,
@@ -525,6 +526,7 @@ mod tests {
             err,
             Error::Limit {
                 what: "rotations",
+                counted: "rotations",
                 count: MAX_ROTATIONS + 1,
                 limit: MAX_ROTATIONS,
                 hint: CHANNELS_HINT,
@@ -532,7 +534,7 @@ mod tests {
         );
         assert_eq!(
             err.to_string(),
-            "rotations: 16777217 exceed the limit of 16777216 in one call: convert fewer rotations at once"
+            "rotations: 16777217 rotations exceed the limit of 16777216 in one call: convert fewer rotations at once"
         );
     }
 }

@@ -287,7 +287,8 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
     }
     if n > MAX_REDUCE_FRAMES {
         return Err(Error::Limit {
-            what: "frames per owner",
+            what: "frames",
+            counted: "frames per owner",
             count: n,
             limit: MAX_REDUCE_FRAMES,
             hint: "",
@@ -295,7 +296,8 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
     }
     if b.saturating_mul(n) > MAX_REDUCE_POSES {
         return Err(Error::Limit {
-            what: "poses (owners x frames)",
+            what: "poses",
+            counted: "poses (owners x frames)",
             count: b.saturating_mul(n),
             limit: MAX_REDUCE_POSES,
             hint: "reduce fewer owners at once",

@@ -126,7 +126,8 @@ impl Body {
         }
         if vertices.len() > (u32::MAX - 1) as usize || triangles.len() > (u32::MAX - 1) as usize {
             return Err(Error::Limit {
-                what: "vertices or triangles",
+                what: "vertices",
+                counted: "vertices or triangles",
                 count: vertices.len().max(triangles.len()),
                 limit: (u32::MAX - 1) as usize,
                 hint: "",

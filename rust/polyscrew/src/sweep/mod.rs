@@ -351,7 +351,8 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         let total = out.vertices.len() as u64 + (k as u64 + 1) * g as u64;
         if total > u32::MAX as u64 {
             return Err(Error::Limit {
-                what: "vertices of the swept mesh",
+                what: "steps",
+                counted: "vertices of the swept mesh",
                 count: usize::try_from(total).unwrap_or(usize::MAX),
                 limit: u32::MAX as usize,
                 hint: "use fewer steps or a larger tolerance",
