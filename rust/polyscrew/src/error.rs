@@ -701,3 +701,205 @@ impl std::error::Error for Error {}
 
 /// The crate's result type.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bad_name_lists_the_names_as_they_are_written() {
+        let blender = Error::Choice {
+            what: "turns",
+            got: "LONGEST".into(),
+            expected: &["AUTO", "BLENDER", "SHORTEST"],
+        };
+        assert_eq!(
+            blender.to_string(),
+            "turns: \"LONGEST\" is not one of AUTO, BLENDER, SHORTEST"
+        );
+        let option = Error::Choice {
+            what: "timing",
+            got: "cubic".into(),
+            expected: &["smooth", "linear"],
+        };
+        assert_eq!(
+            option.to_string(),
+            "timing: \"cubic\" is not one of \"smooth\", \"linear\""
+        );
+        assert_eq!(option.what(), Some("timing"));
+    }
+
+    #[test]
+    fn a_value_says_what_it_is_and_what_it_must_be() {
+        let cases = [
+            (
+                None,
+                -1.0,
+                Expected::NonNegative("time"),
+                "strength: -1 is not a finite time >= 0",
+            ),
+            (
+                None,
+                0.0,
+                Expected::Positive("length"),
+                "strength: 0 is not a positive length",
+            ),
+            (
+                None,
+                -1.0,
+                Expected::PositiveUpTo(1e150),
+                "strength: -1 is not in the working range (0, 1e150]",
+            ),
+            (
+                None,
+                4.0,
+                Expected::OneOf(&[2.0, 3.0]),
+                "strength: 4 is not 2 or 3",
+            ),
+            (
+                None,
+                1e-15,
+                Expected::AtLeast {
+                    min: 1e-6,
+                    limit: 1_000_000,
+                    counted: "fragments",
+                },
+                "strength: 1e-15 is not at least 1e-6 (at most 1000000 fragments)",
+            ),
+            (
+                Some(At::new("key", 1)),
+                -1.0,
+                Expected::NonNegative("weight"),
+                "strength: key 1 is negative (-1)",
+            ),
+            (
+                Some(At::new("key", 1)),
+                -1.0,
+                Expected::WithinOrInfinite {
+                    low: 0.0,
+                    high: 1e100,
+                },
+                "strength: key 1 has strength -1, not in 0..=1e100 or inf",
+            ),
+            (
+                Some(At::new("time", 0)),
+                2.0,
+                Expected::KeyRange {
+                    low: 0.0,
+                    high: 1.0,
+                },
+                "strength: time 0 (2) is outside the key range [0, 1]",
+            ),
+            (
+                Some(At::new("key", 0)),
+                0.0,
+                Expected::Normalisable(1e-9),
+                "strength: key 0 has length 0e0, shorter than 1e-9: it cannot be normalised",
+            ),
+            (
+                Some(At::new("key", 2)),
+                f64::INFINITY,
+                Expected::FiniteInF32("back"),
+                "strength: key 2: back is not finite in float32 (inf)",
+            ),
+            (
+                None,
+                f64::NAN,
+                Expected::Finite("influence"),
+                "strength: influence is not finite (NaN)",
+            ),
+        ];
+        for (at, value, expected, message) in cases {
+            let e = Error::Value {
+                what: "strength",
+                at,
+                value,
+                expected,
+            };
+            assert_eq!(e.to_string(), message, "{e:?}");
+        }
+    }
+
+    #[test]
+    fn spacing_tells_order_from_closeness() {
+        let at = At::new("key time", 3);
+        let e = |gap, min| {
+            Error::Spacing {
+                what: "key times",
+                at,
+                gap,
+                min,
+            }
+            .to_string()
+        };
+        assert_eq!(
+            e(-2.0, f64::MIN_POSITIVE),
+            "key times: key time 3 is less than the one before (by 2): they must increase strictly"
+        );
+        assert_eq!(
+            e(-2.0, 0.0),
+            "key times: key time 3 is less than the one before (by 2): they must be in increasing order"
+        );
+        assert_eq!(
+            e(0.0, f64::MIN_POSITIVE),
+            "key times: key time 3 equals the one before: they must increase strictly"
+        );
+        assert_eq!(
+            e(1e-301, 1e-300),
+            "key times: key time 3 is 1e-301 after the one before, closer than 1e-300"
+        );
+    }
+
+    #[test]
+    fn an_entry_of_a_batch_wraps_the_error_and_keeps_its_kind() {
+        let inner = Error::Memory {
+            what: "the keys",
+            bytes: 1 << 30,
+            budget: Some(1 << 20),
+            hint: "use fewer keys",
+        };
+        let e = inner
+            .clone()
+            .within("key", 4)
+            .within_argument("poses", "owner", 2);
+        assert_eq!(e.innermost(), &inner);
+        assert_eq!(e.what(), Some("poses"));
+        assert!(
+            e.to_string()
+                .starts_with("poses: owner 2: key 4: the keys would need 1.07 GB"),
+            "{e}"
+        );
+        let limit = Error::Limit {
+            what: "keys",
+            counted: "keys",
+            count: 5,
+            limit: 4,
+            hint: "",
+        };
+        assert_eq!(
+            limit.to_string(),
+            "keys: 5 keys exceed the limit of 4 in one call"
+        );
+        let index = Error::Index {
+            what: "triangles",
+            at: Some(At::new("triangle", 12)),
+            item: "vertex",
+            index: 9,
+            len: 8,
+        };
+        assert_eq!(
+            index.within("curve", 0).to_string(),
+            "curve 0: triangles: triangle 12: vertex 9 is outside 0..8"
+        );
+        assert_eq!(
+            Error::OutOfRange {
+                what: "key time",
+                index: 2,
+                value: 2e300,
+                limit: 1e300
+            }
+            .to_string(),
+            "key time 2 (2e300) is outside the working range +-1e300"
+        );
+    }
+}
