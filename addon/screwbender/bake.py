@@ -30,7 +30,7 @@ from . import bulk, channels, feature, intent, keys, modifiers, owners, range_jo
 from .keys import SmoothError
 
 #: Subdivision schemes: (identifier, label, description).
-#: (The strays are measured by scripts/measure_schemes.py: the demo scene and 20 random keyed
+#: (The strays are measured by scripts/bench/measure_schemes.py: the demo scene and 20 random keyed
 #: motions spanning about 6 units, at 4 levels.)
 SCHEMES = (
     ("four_point", "4-Point", "Interpolating (the default): the motion passes through every key pose exactly (C1)"),

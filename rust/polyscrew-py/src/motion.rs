@@ -135,7 +135,7 @@ fn check_t(index: usize, t: f64) -> Result<(), Error> {
             what: "t",
             index,
             value: t,
-            range: "+-1e12",
+            limit: MAX_T,
         })
     } else {
         Err(Error::NotFinite { what: "t", index })
@@ -733,7 +733,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
     // stub:
     // stub: MAX_TIME: float
-    // stub: """The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
+    // stub: """The one working range of times: ``|t| <= 1e300`` (``fit_angular_velocity``, which
+    // stub: multiplies times, works within its tenth root, ``|t| <= 1e30``)."""
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
     // stub:
     // stub: MAX_PREVIOUS_ANGLE: float

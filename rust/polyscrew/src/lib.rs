@@ -56,11 +56,11 @@ pub mod reduce;
 pub mod sweep;
 
 pub use angular_velocity::{
-    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
-    FitStatus, QuatJet, QuatSpline,
+    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitOptions, FitStatus,
+    QuatJet, QuatSpline,
 };
 pub use denoise::{denoise, denoise_batch, DenoiseOptions, Denoised, Strength};
-pub use error::{Error, PoseDefect, Result};
+pub use error::{At, Error, Expected, PoseDefect, Result};
 pub use fcurve::{
     evaluate_fcurves, CycleMode, Cycles, Easing, Extrapolation, FCurve, Interpolation, Key,
     PackedCurves,

@@ -129,7 +129,7 @@ impl RotationMode {
     /// `"XZY"`, `"YXZ"`, `"YZX"`, `"ZXY"`, `"ZYX"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for anything else.
+    /// [`Error::Choice`] for anything else.
     pub fn from_name(name: &str) -> Result<Self> {
         Ok(match name {
             "QUATERNION" => Self::Quaternion,
@@ -141,11 +141,19 @@ impl RotationMode {
             "ZXY" => Self::Euler(EulerOrder::Zxy),
             "ZYX" => Self::Euler(EulerOrder::Zyx),
             _ => {
-                return Err(Error::Invalid {
+                return Err(Error::Choice {
                     what: "rotation mode",
-                    reason: format!(
-                    "{name:?} is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
-                ),
+                    got: name.to_owned(),
+                    expected: &[
+                        "QUATERNION",
+                        "AXIS_ANGLE",
+                        "XYZ",
+                        "XZY",
+                        "YXZ",
+                        "YZX",
+                        "ZXY",
+                        "ZYX",
+                    ],
                 })
             }
         })
@@ -322,14 +330,15 @@ pub const MAX_ROTATIONS: usize = 1 << 24;
 /// Refuses more than [`MAX_ROTATIONS`] rotations in one call.
 ///
 /// # Errors
-/// [`Error::Invalid`] (`rotations`) naming the count and the limit.
+/// [`Error::Limit`] (`rotations`) naming the count and the limit.
 pub fn check_rotation_count(count: usize) -> Result<()> {
     if count > MAX_ROTATIONS {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "rotations",
-            reason: format!(
-                "{count} rotations, more than {MAX_ROTATIONS} in one call: {CHANNELS_HINT}"
-            ),
+            counted: "rotations",
+            count,
+            limit: MAX_ROTATIONS,
+            hint: CHANNELS_HINT,
         });
     }
     Ok(())
@@ -348,7 +357,7 @@ pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
 /// it holds NaN or infinity, [`Error::OutOfRange`] when one of its angles (Euler, or the
-/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Invalid`] for more than
+/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Limit`] for more than
 /// [`MAX_ROTATIONS`] rotations, [`Error::Memory`] when the channels exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
@@ -383,7 +392,7 @@ pub fn rotation_channels(
                 what: "previous value",
                 index,
                 value: p[index],
-                range: "+-1e9",
+                limit: MAX_PREVIOUS_ANGLE,
             });
         }
     }
@@ -709,8 +718,18 @@ mod tests {
         assert!(check_rotation_count(MAX_ROTATIONS).is_ok());
         let err = check_rotation_count(MAX_ROTATIONS + 1).unwrap_err();
         assert_eq!(
+            err,
+            Error::Limit {
+                what: "rotations",
+                counted: "rotations",
+                count: MAX_ROTATIONS + 1,
+                limit: MAX_ROTATIONS,
+                hint: CHANNELS_HINT,
+            }
+        );
+        assert_eq!(
             err.to_string(),
-            "rotations: 16777217 rotations, more than 16777216 in one call: convert fewer rotations at once"
+            "rotations: 16777217 rotations exceed the limit of 16777216 in one call: convert fewer rotations at once"
         );
     }
 }

@@ -10,7 +10,7 @@ use super::{
     interpolation, Between, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
     SEARCH_MARGIN, SUBSAMPLES,
 };
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fcurve::bezier::BezierSegment;
 use crate::fcurve::curve::KEY_THRESHOLD;
 use crate::fcurve::{Extrapolation, FCurve, Interpolation, Key};
@@ -1177,13 +1177,7 @@ impl Fitter<'_> {
         for (j, slot) in out.iter_mut().enumerate() {
             let mut y = self.v[j];
             for (&c, curve) in cols.iter().zip(&fcurves) {
-                y[c] = curve.evaluate(self.times[j]).map_err(|e| match e {
-                    Error::Invalid { reason, .. } => Error::Invalid {
-                        what: "keys",
-                        reason,
-                    },
-                    e => e,
-                })?;
+                y[c] = curve.evaluate(self.times[j])?;
             }
             let (d, turn, q, t) = self.error(j, &y);
             let a = turn.angle();

@@ -24,7 +24,7 @@ waiting for a core on a shared machine (polyscrew runs on the calling thread).
 
 Run with the bpy wheel after scripts/build_extension.sh (the add-on is installed from the
 built .zip into a temporary Blender user directory):
-    PYTHONPATH=<polyscrew target>:.venv/bpy/5.0 .venv/bin/python scripts/bench_preview.py [--quick]
+    PYTHONPATH=<polyscrew target>:.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_preview.py [--quick]
 """
 
 from __future__ import annotations
@@ -38,7 +38,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
