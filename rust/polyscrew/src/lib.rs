@@ -80,8 +80,9 @@ pub use intent::{
 };
 pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{
-    rotation_channels, EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
+    channels_near, rotation_channels, EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
 };
+pub use motion::moves::{partial_moves, turn_vectors, MoveBounds};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};
 pub use motion::screw::{midpoint, s, s_many, Screw};

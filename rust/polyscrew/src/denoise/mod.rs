@@ -66,7 +66,7 @@ pub(crate) mod pops;
 pub(crate) mod rotation;
 mod rows;
 pub(crate) mod smoother;
-mod so3;
+pub(crate) mod so3;
 pub(crate) mod stencil;
 
 pub use rows::{denoise_footprint, denoised_rows, DENOISE_BYTES_PER_POSE, DENOISE_HINT};
