@@ -775,6 +775,9 @@ fn turn_vectors<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// The poses of [`partial_moves`] and which were cut short.
+type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
+
 /// partial_moves(
 ///     source: ArrayLike, target: ArrayLike, pivot: ArrayLike, max_angle: float,
 ///     max_distance: float
@@ -795,7 +798,7 @@ fn partial_moves<'py>(
     pivot: &Bound<'py, PyAny>,
     max_angle: &Bound<'py, PyAny>,
     max_distance: &Bound<'py, PyAny>,
-) -> PyResult<(Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>)> {
+) -> PyResult<MovedPoses<'py>> {
     const F: &str = PartialMoves::NAME;
     let bounds = MoveBounds {
         angle: args::float_scalar(F, "max_angle", max_angle)?,

@@ -821,7 +821,7 @@ impl Problem {
             match trial {
                 Some((t, x, new_cost)) if new_cost < cost => {
                     // Predicted decrease of the linear model: -(2 g.x + x^T H x).
-                    let hx = sym_band_mul(&h, &x);
+                    let hx = h.mul(&x);
                     let predicted: f64 = -x
                         .iter()
                         .zip(&g)
@@ -857,21 +857,6 @@ impl Problem {
         }
         (steps, false)
     }
-}
-
-/// `H x` for a symmetric band matrix stored by its lower band.
-fn sym_band_mul(h: &SymBand, x: &[f64]) -> Vec<f64> {
-    let n = h.len();
-    let mut y = vec![0.0; n];
-    for i in 0..n {
-        y[i] += h.get(i, i) * x[i];
-        for j in i.saturating_sub(h.bandwidth())..i {
-            let v = h.get(i, j);
-            y[i] += v * x[j];
-            y[j] += v * x[i];
-        }
-    }
-    y
 }
 
 /// The fragment errors `F_n = ∫ |2 q' q^-1 - omega^s|^2 dt` (eq. 2) over `count` equal

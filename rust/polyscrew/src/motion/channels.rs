@@ -680,7 +680,7 @@ mod tests {
     fn every_mode_parses_its_own_name() {
         for mode in RotationMode::ALL {
             assert_eq!(RotationMode::from_name(mode.name()).unwrap(), mode);
-            assert_eq!(mode.property().starts_with("rotation_"), true, "{mode:?}");
+            assert!(mode.property().starts_with("rotation_"), "{mode:?}");
         }
         let err = RotationMode::from_name("xyz").unwrap_err();
         assert_eq!(

@@ -130,7 +130,7 @@ pub fn partial_moves(
         ("largest angle", bounds.angle),
         ("largest distance", bounds.distance),
     ] {
-        if !(bound >= 0.0) {
+        if bound.is_nan() || bound < 0.0 {
             return Err(Error::Invalid {
                 what,
                 reason: format!("{bound} is not a number at least 0"),

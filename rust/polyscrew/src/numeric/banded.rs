@@ -29,11 +29,6 @@ impl SymBand {
         self.n
     }
 
-    /// Half-bandwidth `b`.
-    pub(crate) fn bandwidth(&self) -> usize {
-        self.b
-    }
-
     #[inline]
     fn idx(&self, i: usize, j: usize) -> usize {
         debug_assert!(j <= i && i - j <= self.b && i < self.n);
@@ -51,6 +46,21 @@ impl SymBand {
     pub(crate) fn add(&mut self, i: usize, j: usize, v: f64) {
         let k = self.idx(i, j);
         self.data[k] += v;
+    }
+
+    /// `a x`, from the lower band and its mirror image.
+    pub(crate) fn mul(&self, x: &[f64]) -> Vec<f64> {
+        debug_assert_eq!(x.len(), self.n);
+        let mut y = vec![0.0; self.n];
+        for i in 0..self.n {
+            y[i] += self.get(i, i) * x[i];
+            for j in i.saturating_sub(self.b)..i {
+                let v = self.get(i, j);
+                y[i] += v * x[j];
+                y[j] += v * x[i];
+            }
+        }
+        y
     }
 
     /// Solves `a x = rhs` by Cholesky factorisation `a = L L^T` within the band.
@@ -131,6 +141,17 @@ mod tests {
         }
         let rhs: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
         let x = a.solve(&rhs).unwrap();
+        // the product of the band and its mirror is the dense product
+        let back = a.mul(&x);
+        let dense_back = &dense * nalgebra::DVector::from_vec(x.clone());
+        for i in 0..n {
+            assert!(
+                (back[i] - dense_back[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                back[i],
+                dense_back[i]
+            );
+        }
         let expected = dense
             .cholesky()
             .unwrap()
