@@ -25,6 +25,21 @@
 //! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
 //! allocation whose size depends on input is checked against one budget before it is made.
 //!
+//! One home for each rule: the rotation modes are [`RotationMode`]'s
+//! ([`motion::channels`]: the list [`RotationMode::ALL`], Blender's names, properties and
+//! widths, channel values to matrices ([`motion::channels::rotation_matrix`]), matrices to
+//! continuous channels ([`rotation_channels`]) or to channels written like a reference
+//! ([`channels_near`]: quaternion signs, Euler twins, whole turns)); the turn between two
+//! orientations and a move cut short are [`motion::moves`]'; the Python module exposes them
+//! (`ROTATION_MODES`, `rotation_matrices`, `rotation_channels`, `rotation_channels_near`,
+//! `turn_vectors`, `partial_moves`) and the add-on calls them. Adding a rotation mode touches
+//! `motion/channels.rs` (its variant, [`RotationMode::ALL`], the name, property and width
+//! matches, the three conversions) and the binding's `lib.rs` (the `RotationModeName` literal
+//! of the generated stub). Adding a timing mode like [`Timing::Smooth`] or [`Timing::Linear`]
+//! touches `motion/timing.rs` (the variant, [`Timing::from_name`], the slopes of
+//! [`TimeMap`]), the binding's `lib.rs` (`TimingName`) and the add-on's option list
+//! (`bake_ops.py`); timing "Keys" is still its own path ([`intent::keys_parameters`]).
+//!
 //! What users reach for is re-exported here.
 //!
 //! Everything is `f64` (glam's `DVec3`, `DQuat`). Functions are pure and report bad input
