@@ -631,6 +631,9 @@ EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
 """Blender's ``FCurve.extrapolation`` identifiers."""
 CYCLE_MODES: tuple[CycleModeName, ...]
 """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
+CYCLES_PROPERTIES: tuple[str, ...]
+"""The keys a Cycles settings dict of ``evaluate_fcurves`` may hold: the RNA property names of
+Blender's ``FModifierCycles`` it reads."""
 MAX_FCURVE_KEYS: int
 """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
 MAX_FCURVE_VALUES: int

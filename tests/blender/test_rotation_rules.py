@@ -1,9 +1,10 @@
-"""One home for each rotation rule (issue 25, item 2), seen from Blender: Remove Noise writes
+"""One home for each rule (issue 25, item 2), seen from Blender: Remove Noise writes
 each smoothed key like the key the animator typed (`polyscrew.rotation_channels_near`, once the
 add-on's numpy `_like_original`): spins beyond a turn, a deliberate quaternion sign flip and
 the axis-angle angle beyond 2 pi are kept, per key. The written values are read back from the
 F-curves and turned into matrices by Blender's own mathutils; the add-on's rotation table is
-the core's (`polyscrew.ROTATION_MODES`) and Blender's."""
+the core's (`polyscrew.ROTATION_MODES`) and Blender's, and so is the list of the Cycles modifier's
+settings it reads (`polyscrew.CYCLES_PROPERTIES`)."""
 
 from __future__ import annotations
 
@@ -102,3 +103,14 @@ def test_remove_noise_writes_each_key_like_the_animators(sb, capfd, mode):
           f"(keys span {np.ptp(original, axis=0).max():.1f})")
     assert max(turn) < 2.0
     assert worst < math.radians(5.0), worst
+
+
+def test_the_cycles_properties_are_the_cores_and_blenders(sb):
+    """The one list of the Cycles modifier's settings `evaluate_fcurves` reads: the add-on passes
+    those (`curves.CYCLES_PROPERTIES`, once a copy of the binding's list), each an RNA property of
+    Blender's FModifierCycles."""
+    curves = sb.keys.curves
+    assert curves.CYCLES_PROPERTIES == polyscrew.CYCLES_PROPERTIES
+    rna = set(bpy.types.FModifierCycles.bl_rna.properties.keys())
+    assert set(polyscrew.CYCLES_PROPERTIES) <= rna, set(polyscrew.CYCLES_PROPERTIES) - rna
+    assert {"mode_before", "mode_after", "cycles_before", "cycles_after"} <= set(polyscrew.CYCLES_PROPERTIES)
