@@ -58,8 +58,6 @@
 //! 2 on every smooth clip; robust (Huber, Cauchy) reweighting of the penalty rounded a hard
 //! stop almost as much as no reweighting, releasing the rows at detected kinks did not.
 
-mod band;
-mod blockband;
 pub(crate) mod kinks;
 pub(crate) mod pivot;
 pub(crate) mod pops;

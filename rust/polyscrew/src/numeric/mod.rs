@@ -7,6 +7,7 @@
 //! [`banded`] and [`cyclic_band`] solve the banded systems of spline fits and of variational
 //! subdivision (Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, eqs. 23-27).
 
+pub(crate) mod band;
 pub(crate) mod banded;
 pub(crate) mod cyclic_band;
 pub(crate) mod eigen;
