@@ -37,7 +37,7 @@ use crate::angular_velocity::quat_spline::{
 };
 use crate::error::{Error, Result};
 use crate::memory::{try_vec, Footprint};
-use crate::numeric::banded::SymBand;
+use crate::numeric::band::Band;
 
 /// The working range of the fit's times (key, target and sample times): `|t| <= MAX_TIME`,
 /// and consecutive key times at least [`MIN_KEY_SPACING`] apart.
@@ -615,6 +615,13 @@ impl Nodes {
     }
 }
 
+/// Half-bandwidth of the normal equations: a segment couples its two nodes' parameters,
+/// at most 7 each (3 tangent parameters of a free value, 4 derivatives), so `7 + 7 - 1`.
+const HESSIAN_BANDWIDTH: usize = 13;
+
+/// The normal equations' matrix `J^T J`: symmetric, banded ([`Band`]).
+type Hessian = Band<f64, HESSIAN_BANDWIDTH>;
+
 /// The energy terms and the structure of the unknowns for one round.
 struct Problem {
     alpha: f64,
@@ -695,9 +702,10 @@ impl Problem {
     /// The Gauss-Newton normal equations `J^T J`, `J^T r` and the energy `r^T r`, with the
     /// exact Jacobian of the residuals `sqrt(w) (2 q' q^-1 - omega^s)` and
     /// `sqrt(alpha w) (q'' - (q . q'') q / |q|^2)` at every quadrature point.
-    fn normal_equations(&self, nodes: &Nodes) -> Option<(SymBand, Vec<f64>, f64)> {
+    fn normal_equations(&self, nodes: &Nodes) -> Option<(Hessian, Vec<f64>, f64)> {
         const E: [DVec4; 4] = [DVec4::X, DVec4::Y, DVec4::Z, DVec4::W];
-        let mut h = SymBand::zeros(self.params, self.bandwidth);
+        debug_assert!(self.bandwidth <= HESSIAN_BANDWIDTH);
+        let mut h = Hessian::zeros(self.params);
         let mut g = vec![0.0; self.params];
         let mut cost = 0.0;
         // Tangent directions of each free node value: d(exp(d) q)/dd_i = e_i q.
@@ -815,7 +823,7 @@ impl Problem {
             let rhs: Vec<f64> = g.iter().map(|v| -v).collect();
             steps += 1;
             let trial = damped
-                .solve(&rhs)
+                .solved(&rhs)
                 .map(|x| (self.apply(nodes, &x), x))
                 .and_then(|(t, x)| self.energy(&t).map(|e| (t, x, e.total)));
             match trial {

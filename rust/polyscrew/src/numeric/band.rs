@@ -139,6 +139,14 @@ impl<E: Entry, const W: usize> Band<E, W> {
     /// Factorises in place into `L D L^T`. Returns false when a pivot is not positive
     /// definite and finite ([`Entry::pivot`]).
     pub(crate) fn factor(&mut self) -> bool {
+        self.factor_or_pivot().is_ok()
+    }
+
+    /// [`Band::factor`], telling which pivot failed.
+    ///
+    /// # Errors
+    /// The index of the first pivot that is not positive definite and finite.
+    pub(crate) fn factor_or_pivot(&mut self) -> Result<(), usize> {
         let n = self.len();
         self.inv.clear();
         self.inv.reserve(n);
@@ -163,13 +171,13 @@ impl<E: Entry, const W: usize> Band<E, W> {
                 d = d - row[p] * ld[p].transpose();
             }
             let Some((d, inv)) = E::pivot(d) else {
-                return false;
+                return Err(i);
             };
             self.off[i] = row;
             self.diag[i] = d;
             self.inv.push(inv);
         }
-        true
+        Ok(())
     }
 
     /// Solves `a x = b` in place after [`Band::factor`].
@@ -198,14 +206,61 @@ impl<E: Entry, const W: usize> Band<E, W> {
 }
 
 impl<const W: usize> Band<f64, W> {
+    /// The zero matrix of size `n`.
+    pub(crate) fn zeros(n: usize) -> Self {
+        let mut a = Self::default();
+        a.reset(n);
+        a
+    }
+
     /// `a[i][j] += v` for `j <= i <= j + W`.
-    #[cfg(test)]
+    #[inline(always)]
     pub(crate) fn add(&mut self, i: usize, j: usize, v: f64) {
         if i == j {
             self.add_diag(i, v);
         } else {
             self.add_off(i, j, v);
         }
+    }
+
+    /// `a[i][j]` for `j <= i <= j + W` (before [`Band::factor`]).
+    #[inline(always)]
+    pub(crate) fn get(&self, i: usize, j: usize) -> f64 {
+        debug_assert!(j <= i && i - j <= W);
+        if i == j {
+            self.diag[i]
+        } else {
+            self.off[i][W - (i - j)]
+        }
+    }
+
+    /// `a x`, from the lower band and its mirror image (before [`Band::factor`]).
+    pub(crate) fn mul(&self, x: &[f64]) -> Vec<f64> {
+        let n = self.len();
+        debug_assert_eq!(x.len(), n);
+        let mut y = vec![0.0; n];
+        for i in 0..n {
+            y[i] += self.diag[i] * x[i];
+            let row = &self.off[i];
+            for p in W.saturating_sub(i)..W {
+                let j = i + p - W;
+                y[i] += row[p] * x[j];
+                y[j] += row[p] * x[i];
+            }
+        }
+        y
+    }
+
+    /// `x` with `a x = rhs`, the matrix kept (factorised on a copy); `None` when `a` is not
+    /// numerically positive definite or `x` is not finite.
+    pub(crate) fn solved(&self, rhs: &[f64]) -> Option<Vec<f64>> {
+        let mut f = self.clone();
+        if !f.factor() {
+            return None;
+        }
+        let mut x = rhs.to_vec();
+        f.solve(&mut x);
+        x.iter().all(|v| v.is_finite()).then_some(x)
     }
 
     /// `self = scale * other` (same size).
@@ -331,6 +386,39 @@ mod tests {
         check::<3>();
         check::<8>();
         check::<11>();
+    }
+
+    #[test]
+    fn multiplies_like_a_dense_matrix_and_solves_a_copy() {
+        let n = 9;
+        let (a, d) = dense_of::<3>(n, 0.71);
+        let x: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let back = a.mul(&x);
+        let want = &d * nalgebra::DVector::from_vec(x.clone());
+        for i in 0..n {
+            assert!(
+                (back[i] - want[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                back[i],
+                want[i]
+            );
+            assert_eq!(a.get(i, i), d[(i, i)]);
+        }
+        let solved = a.solved(&back).unwrap();
+        for i in 0..n {
+            assert!(
+                (solved[i] - x[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                solved[i],
+                x[i]
+            );
+        }
+        let mut bad = Band::<f64, 1>::zeros(2);
+        bad.add(0, 0, 1.0);
+        bad.add(1, 0, 2.0);
+        bad.add(1, 1, 1.0);
+        assert!(bad.solved(&[1.0, 1.0]).is_none());
+        assert_eq!(bad.factor_or_pivot(), Err(1));
     }
 
     #[test]
