@@ -20,7 +20,7 @@
 //! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
 //! | [`intent`] | what the animator meant between the keys: Blender's playback of an owner's channels, holds, pops, spins, the pace of timing "Keys" | ScrewBender issue 17 |
 //! | [`reduce`](mod@reduce) | key reduction: the fewest Bezier keys whose Blender playback stays within a world-space tolerance | ScrewBender issue 26 |
-//! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
+//! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, one banded solver (`L D L^T`, scalar or 3x3-block entries, a cyclic border on top) | |
 //!
 //! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
 //! allocation whose size depends on input is checked against one budget before it is made.

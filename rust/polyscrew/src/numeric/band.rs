@@ -413,6 +413,10 @@ mod tests {
                 x[i]
             );
         }
+    }
+
+    #[test]
+    fn refuses_to_solve_an_indefinite_matrix_and_names_its_pivot() {
         let mut bad = Band::<f64, 1>::zeros(2);
         bad.add(0, 0, 1.0);
         bad.add(1, 0, 2.0);
