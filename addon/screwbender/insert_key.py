@@ -71,14 +71,7 @@ def check_frames(before: keys.KeyedMotion, frame: float) -> np.ndarray:
 def pose_change(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per pose: origin displacement |t_b - t_a| and rotation angle of `R_a^T R_b` (radians)."""
     translation = np.linalg.norm(b[:, :3, 3] - a[:, :3, 3], axis=1)
-    relative = np.einsum("nji,njk->nik", a[:, :3, :3], b[:, :3, :3])
-    cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    # arccos loses precision near 0: use the antisymmetric part for small angles.
-    skew = np.stack(
-        [relative[:, 2, 1] - relative[:, 1, 2], relative[:, 0, 2] - relative[:, 2, 0], relative[:, 1, 0] - relative[:, 0, 1]],
-        axis=1,
-    )
-    angle = np.arctan2(np.linalg.norm(skew, axis=1) / 2.0, cos)
+    angle = np.linalg.norm(polyscrew.turn_vectors(a, b), axis=1)  # exact near 0 and pi
     return translation, angle
 
 
@@ -207,7 +200,7 @@ def insert_key(
 
     mode = owner.rotation_mode
     rotation_path = keys.rotation_path(mode)
-    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
+    size = keys.rotation_width(mode)
     by_prop = {}
     for fc in listed:
         prop = owner.prop_of(fc.data_path)

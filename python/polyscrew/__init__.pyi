@@ -211,6 +211,38 @@ def rotation_channels(
     ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
     """
 
+def rotation_channels_near(
+    rotations: ArrayLike, mode: RotationModeName, reference: ArrayLike
+) -> FloatArray:
+    """Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), each written like
+    its own row of ``reference`` ((N, 4) or (N, 3) values in ``mode``, for example the keys
+    an animator typed) rather than continued from the row before: quaternions take the
+    reference's sign; axis-angle the axis pointing the reference's way and the angle within
+    half a turn of its angle; Euler angles the one of the two triples of the rotation, each
+    wrapped by whole turns towards the reference, that is nearer to it. Spins and deliberate
+    sign flips of the reference are kept. Reference angles within ``+-MAX_PREVIOUS_ANGLE``.
+    """
+
+def turn_vectors(a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """The turn from each rotation of ``a`` to the same row of ``b`` ((N, 3, 3) or (N, 4, 4)
+    each), in the world frame: (N, 3) rotation vectors ``log(R_b R_a^T)``, axis times angle,
+    the angle (their length) in [0, pi], exact near 0 and near pi (``atan2`` of the relative
+    quaternion, not ``arccos`` of a trace). At most ``MAX_ROTATIONS`` rows.
+    """
+
+def partial_moves(
+    source: ArrayLike, target: ArrayLike, pivot: ArrayLike, max_angle: float,
+    max_distance: float
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """Each pose of ``target`` ((N, 4, 4)), or where its straight move from the same row of
+    ``source`` turns by more than ``max_angle`` (radians) or carries the point ``pivot`` (3,
+    body coordinates) further than ``max_distance``, the pose the fraction ``a`` of the way
+    there that brings both within them: ``a = min(1, max_angle / angle, max_distance /
+    distance)``, the rotation ``a`` of the turn about the same axis, the pivot ``a`` of the
+    way along its straight move (not a screw's helix). Returns the poses and which were cut
+    short. Bounds at least 0 (``inf``: no bound).
+    """
+
 def memory_budget() -> int:
     """The memory budget in bytes: the most one call may hold at its peak (output, working
     memory, copies of the input). A call that would need more raises ``ValueError`` up
@@ -248,6 +280,12 @@ MAX_ROTATIONS: int
 the default memory budget accepts in quaternion and axis-angle modes. It bounds the call's
 time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
 is read."""
+
+ROTATION_MODES: dict[str, tuple[str, int]]
+"""Blender's rotation modes, the core's: name -> (the property holding the rotation, the
+number of its channels), in Blender's order: ``"QUATERNION"`` -> ``("rotation_quaternion",
+4)``, ``"AXIS_ANGLE"`` -> ``("rotation_axis_angle", 4)``, each Euler order (``"XYZ"``, ...)
+-> ``("rotation_euler", 3)``."""
 
 FitStatusName = Literal["converged", "iteration_limit", "above_delta"]
 
@@ -595,6 +633,9 @@ EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
 """Blender's ``FCurve.extrapolation`` identifiers."""
 CYCLE_MODES: tuple[CycleModeName, ...]
 """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
+CYCLES_PROPERTIES: tuple[str, ...]
+"""The keys a Cycles settings dict of ``evaluate_fcurves`` may hold: the RNA property names of
+Blender's ``FModifierCycles`` it reads."""
 MAX_FCURVE_KEYS: int
 """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
 MAX_FCURVE_VALUES: int

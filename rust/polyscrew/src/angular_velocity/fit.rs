@@ -38,7 +38,7 @@ use crate::angular_velocity::quat_spline::{
 use crate::error::{At, Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
 use crate::motion::timing::MAX_TIME;
-use crate::numeric::banded::SymBand;
+use crate::numeric::band::Band;
 
 /// The fit's working range of times (key, target and sample times): `|t| <= FIT_MAX_TIME`,
 /// and consecutive key times at least [`MIN_KEY_SPACING`] apart. Derived from the crate's one
@@ -601,6 +601,13 @@ impl Nodes {
     }
 }
 
+/// Half-bandwidth of the normal equations: a segment couples its two nodes' parameters,
+/// at most 7 each (3 tangent parameters of a free value, 4 derivatives), so `7 + 7 - 1`.
+const HESSIAN_BANDWIDTH: usize = 13;
+
+/// The normal equations' matrix `J^T J`: symmetric, banded ([`Band`]).
+type Hessian = Band<f64, HESSIAN_BANDWIDTH>;
+
 /// The energy terms and the structure of the unknowns for one round.
 struct Problem {
     alpha: f64,
@@ -681,9 +688,10 @@ impl Problem {
     /// The Gauss-Newton normal equations `J^T J`, `J^T r` and the energy `r^T r`, with the
     /// exact Jacobian of the residuals `sqrt(w) (2 q' q^-1 - omega^s)` and
     /// `sqrt(alpha w) (q'' - (q . q'') q / |q|^2)` at every quadrature point.
-    fn normal_equations(&self, nodes: &Nodes) -> Option<(SymBand, Vec<f64>, f64)> {
+    fn normal_equations(&self, nodes: &Nodes) -> Option<(Hessian, Vec<f64>, f64)> {
         const E: [DVec4; 4] = [DVec4::X, DVec4::Y, DVec4::Z, DVec4::W];
-        let mut h = SymBand::zeros(self.params, self.bandwidth);
+        debug_assert!(self.bandwidth <= HESSIAN_BANDWIDTH);
+        let mut h = Hessian::zeros(self.params);
         let mut g = vec![0.0; self.params];
         let mut cost = 0.0;
         // Tangent directions of each free node value: d(exp(d) q)/dd_i = e_i q.
@@ -801,13 +809,13 @@ impl Problem {
             let rhs: Vec<f64> = g.iter().map(|v| -v).collect();
             steps += 1;
             let trial = damped
-                .solve(&rhs)
+                .solved(&rhs)
                 .map(|x| (self.apply(nodes, &x), x))
                 .and_then(|(t, x)| self.energy(&t).map(|e| (t, x, e.total)));
             match trial {
                 Some((t, x, new_cost)) if new_cost < cost => {
                     // Predicted decrease of the linear model: -(2 g.x + x^T H x).
-                    let hx = sym_band_mul(&h, &x);
+                    let hx = h.mul(&x);
                     let predicted: f64 = -x
                         .iter()
                         .zip(&g)
@@ -843,21 +851,6 @@ impl Problem {
         }
         (steps, false)
     }
-}
-
-/// `H x` for a symmetric band matrix stored by its lower band.
-fn sym_band_mul(h: &SymBand, x: &[f64]) -> Vec<f64> {
-    let n = h.len();
-    let mut y = vec![0.0; n];
-    for i in 0..n {
-        y[i] += h.get(i, i) * x[i];
-        for j in i.saturating_sub(h.bandwidth())..i {
-            let v = h.get(i, j);
-            y[i] += v * x[j];
-            y[j] += v * x[i];
-        }
-    }
-    y
 }
 
 /// The fragment errors `F_n = ∫ |2 q' q^-1 - omega^s|^2 dt` (eq. 2) over `count` equal

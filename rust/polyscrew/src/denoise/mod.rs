@@ -58,15 +58,13 @@
 //! 2 on every smooth clip; robust (Huber, Cauchy) reweighting of the penalty rounded a hard
 //! stop almost as much as no reweighting, releasing the rows at detected kinks did not.
 
-mod band;
-mod blockband;
 pub(crate) mod kinks;
 pub(crate) mod pivot;
 pub(crate) mod pops;
 pub(crate) mod rotation;
 mod rows;
 pub(crate) mod smoother;
-mod so3;
+pub(crate) mod so3;
 pub(crate) mod stencil;
 
 pub use rows::{denoise_footprint, denoised_rows, DENOISE_BYTES_PER_POSE, DENOISE_HINT};

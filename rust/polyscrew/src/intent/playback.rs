@@ -5,7 +5,7 @@
 //! `rotation_quaternion` `w, x, y, z` or `rotation_axis_angle` `angle, x, y, z`); scale
 //! `x, y, z`: `6 + w` numbers, `w` the mode's [`RotationMode::width`].
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::DMat3;
 
 use super::limits::{check_footprint, collected};
 use crate::memory::try_reserve;
@@ -87,61 +87,12 @@ impl Channel {
     }
 }
 
-/// Blender's rotation property of `mode`.
+/// Blender's rotation property of `mode` ([`RotationMode::property`]).
 pub fn rotation_property(mode: RotationMode) -> &'static str {
-    match mode {
-        RotationMode::Quaternion => "rotation_quaternion",
-        RotationMode::AxisAngle => "rotation_axis_angle",
-        RotationMode::Euler(_) => "rotation_euler",
-    }
+    mode.property()
 }
 
-/// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
-/// it:
-///
-/// - quaternion `(w, x, y, z)`, normalised (zero: the identity);
-/// - axis-angle `(angle, x, y, z)`, a rotation by `angle` about the normalised axis
-///   (Rodrigues, `I + sin(a) K + (1 - cos(a)) K^2`; a zero axis: the identity);
-/// - Euler `(x, y, z)` radians, order `"XYZ"` meaning X applied first: `R = Rz Ry Rx`
-///   ([`EulerOrder::to_mat3`](crate::EulerOrder::to_mat3)).
-///
-/// `values` has [`RotationMode::width`] numbers (extra ones are ignored, missing ones read
-/// as 0); they are assumed finite.
-pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
-    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
-    match mode {
-        RotationMode::Quaternion => {
-            // scaled by its largest component first: no overflow for huge values
-            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
-            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
-            if largest > 0.0 {
-                let q = q / largest;
-                DMat3::from_quat(q / q.length())
-            } else {
-                DMat3::IDENTITY
-            }
-        }
-        RotationMode::AxisAngle => {
-            let axis = DVec3::new(v(1), v(2), v(3));
-            let largest = axis.abs().max_element();
-            if largest > 0.0 {
-                let axis = axis / largest;
-                let k = axis / axis.length();
-                let (s, c) = v(0).sin_cos();
-                // K v = k x v, as columns of the skew matrix.
-                let skew = DMat3::from_cols(
-                    DVec3::new(0.0, k.z, -k.y),
-                    DVec3::new(-k.z, 0.0, k.x),
-                    DVec3::new(k.y, -k.x, 0.0),
-                );
-                DMat3::IDENTITY + skew * s + (skew * skew) * (1.0 - c)
-            } else {
-                DMat3::IDENTITY
-            }
-        }
-        RotationMode::Euler(order) => order.to_mat3(DVec3::new(v(0), v(1), v(2))),
-    }
-}
+pub use crate::motion::channels::rotation_matrix;
 
 /// [`rotation_matrix`] of every row of `values` (row-major, `N x width` numbers).
 ///

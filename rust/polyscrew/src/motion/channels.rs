@@ -131,32 +131,75 @@ impl RotationMode {
     /// # Errors
     /// [`Error::Choice`] for anything else.
     pub fn from_name(name: &str) -> Result<Self> {
-        Ok(match name {
-            "QUATERNION" => Self::Quaternion,
-            "AXIS_ANGLE" => Self::AxisAngle,
-            "XYZ" => Self::Euler(EulerOrder::Xyz),
-            "XZY" => Self::Euler(EulerOrder::Xzy),
-            "YXZ" => Self::Euler(EulerOrder::Yxz),
-            "YZX" => Self::Euler(EulerOrder::Yzx),
-            "ZXY" => Self::Euler(EulerOrder::Zxy),
-            "ZYX" => Self::Euler(EulerOrder::Zyx),
-            _ => {
-                return Err(Error::Choice {
-                    what: "rotation mode",
-                    got: name.to_owned(),
-                    expected: &[
-                        "QUATERNION",
-                        "AXIS_ANGLE",
-                        "XYZ",
-                        "XZY",
-                        "YXZ",
-                        "YZX",
-                        "ZXY",
-                        "ZYX",
-                    ],
-                })
-            }
-        })
+        Self::ALL
+            .into_iter()
+            .find(|mode| mode.name() == name)
+            .ok_or_else(|| Error::Choice {
+                what: "rotation mode",
+                got: name.to_owned(),
+                expected: &Self::NAMES,
+            })
+    }
+
+    /// Every rotation mode, in Blender's order of the `rotation_mode` enum's values that
+    /// [`RotationMode::from_name`] parses. Adding a mode: its variant, its entry here, its
+    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), and
+    /// its conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all
+    /// in this file.
+    pub const ALL: [Self; 8] = [
+        Self::Quaternion,
+        Self::AxisAngle,
+        Self::Euler(EulerOrder::Xyz),
+        Self::Euler(EulerOrder::Xzy),
+        Self::Euler(EulerOrder::Yxz),
+        Self::Euler(EulerOrder::Yzx),
+        Self::Euler(EulerOrder::Zxy),
+        Self::Euler(EulerOrder::Zyx),
+    ];
+
+    /// [`name`](Self::name) of every mode of [`ALL`](Self::ALL), in its order.
+    pub const NAMES: [&'static str; 8] = {
+        let mut names = [""; 8];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = Self::ALL[i].name();
+            i += 1;
+        }
+        names
+    };
+
+    /// Blender's name of the mode (`"QUATERNION"`, `"AXIS_ANGLE"`, `"XYZ"`, ...).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Quaternion => "QUATERNION",
+            Self::AxisAngle => "AXIS_ANGLE",
+            Self::Euler(EulerOrder::Xyz) => "XYZ",
+            Self::Euler(EulerOrder::Xzy) => "XZY",
+            Self::Euler(EulerOrder::Yxz) => "YXZ",
+            Self::Euler(EulerOrder::Yzx) => "YZX",
+            Self::Euler(EulerOrder::Zxy) => "ZXY",
+            Self::Euler(EulerOrder::Zyx) => "ZYX",
+        }
+    }
+
+    /// Blender's property holding the rotation in this mode: `"rotation_quaternion"`,
+    /// `"rotation_axis_angle"` or `"rotation_euler"`.
+    pub fn property(self) -> &'static str {
+        match self {
+            Self::Quaternion => "rotation_quaternion",
+            Self::AxisAngle => "rotation_axis_angle",
+            Self::Euler(_) => "rotation_euler",
+        }
+    }
+
+    /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
+    /// quaternions, the angle of axis-angle, the three Euler angles.
+    fn angles(self) -> usize {
+        match self {
+            Self::Quaternion => 0,
+            Self::AxisAngle => 1,
+            Self::Euler(_) => 3,
+        }
     }
 
     /// The number of channels: 4 for quaternion and axis-angle, 3 for Euler.
@@ -347,6 +390,41 @@ pub fn check_rotation_count(count: usize) -> Result<()> {
 /// How to ask [`rotation_channels`] for less memory.
 pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 
+/// Checks reference channel values (`previous`, or the rows of a reference): `expected`
+/// numbers, finite, the angles of each row of `mode` within [`MAX_PREVIOUS_ANGLE`].
+fn check_reference(
+    values: &[f64],
+    expected: usize,
+    mode: RotationMode,
+    what: &'static str,
+    value: &'static str,
+) -> Result<()> {
+    if values.len() != expected {
+        return Err(Error::LengthMismatch {
+            what,
+            expected,
+            got: values.len(),
+        });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NotFinite { what: value, index });
+    }
+    let (width, angles) = (mode.width(), mode.angles());
+    if let Some(index) = values
+        .iter()
+        .enumerate()
+        .position(|(i, v)| i % width < angles && v.abs() > MAX_PREVIOUS_ANGLE)
+    {
+        return Err(Error::OutOfRange {
+            what: value,
+            index,
+            value: values[index],
+            limit: MAX_PREVIOUS_ANGLE,
+        });
+    }
+    Ok(())
+}
+
 /// Channel values of a sequence of rotations in `mode`, continuous frame to frame.
 ///
 /// `previous` (3 values for Euler, 4 otherwise) is the value just before the first frame;
@@ -366,35 +444,7 @@ pub fn rotation_channels(
 ) -> Result<Vec<f64>> {
     let width = mode.width();
     if let Some(p) = previous {
-        if p.len() != width {
-            return Err(Error::LengthMismatch {
-                what: "previous",
-                expected: width,
-                got: p.len(),
-            });
-        }
-        if let Some(index) = p.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NotFinite {
-                what: "previous value",
-                index,
-            });
-        }
-        let angles = match mode {
-            RotationMode::Quaternion => 0,
-            RotationMode::AxisAngle => 1,
-            RotationMode::Euler(_) => 3,
-        };
-        if let Some(index) = p[..angles]
-            .iter()
-            .position(|v| v.abs() > MAX_PREVIOUS_ANGLE)
-        {
-            return Err(Error::OutOfRange {
-                what: "previous value",
-                index,
-                value: p[index],
-                limit: MAX_PREVIOUS_ANGLE,
-            });
-        }
+        check_reference(p, width, mode, "previous", "previous value")?;
     }
     let values = rotations.len().saturating_mul(width);
     Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
@@ -437,23 +487,7 @@ pub fn rotation_channels(
                     q = -q;
                 }
                 prev_q = Some(q);
-                let v = q.xyz();
-                let sin_h = v.length();
-                let mut angle = 2.0 * sin_h.atan2(q.w);
-                let mut axis = if sin_h > 0.0 {
-                    v / sin_h
-                } else {
-                    prev.map_or(first_axis, |(_, a)| a)
-                };
-                if let Some((prev_angle, prev_axis)) = prev {
-                    // (angle, axis) and (-angle, -axis) are the same rotation; so are angles
-                    // 2 pi apart: pick the representative nearest the previous frame.
-                    if axis.dot(prev_axis) < 0.0 {
-                        axis = -axis;
-                        angle = -angle;
-                    }
-                    angle = wrap_towards(angle, prev_angle);
-                }
+                let (angle, axis) = axis_angle_near(q, prev, first_axis);
                 out.extend_from_slice(&[angle, axis.x, axis.y, axis.z]);
                 prev = Some((angle, axis));
             }
@@ -472,6 +506,130 @@ pub fn rotation_channels(
         }
     }
     Ok(out)
+}
+
+/// The axis-angle `(angle, axis)` of the unit quaternion `q` nearest `reference`:
+/// `angle = 2 atan2(|v|, w)` about `v / |v|` (the reference's axis, else `fallback`, for no
+/// rotation), then `(angle, axis)` or its twin `(-angle, -axis)`, whichever axis points the
+/// reference's way, its angle wrapped by whole turns to within `pi` of the reference's.
+fn axis_angle_near(q: DQuat, reference: Option<(f64, DVec3)>, fallback: DVec3) -> (f64, DVec3) {
+    let v = q.xyz();
+    let sin_h = v.length();
+    let mut angle = 2.0 * sin_h.atan2(q.w);
+    let mut axis = if sin_h > 0.0 {
+        v / sin_h
+    } else {
+        reference.map_or(fallback, |(_, a)| a)
+    };
+    if let Some((ref_angle, ref_axis)) = reference {
+        // (angle, axis) and (-angle, -axis) are the same rotation; so are angles
+        // 2 pi apart: pick the representative nearest the reference.
+        if axis.dot(ref_axis) < 0.0 {
+            axis = -axis;
+            angle = -angle;
+        }
+        angle = wrap_towards(angle, ref_angle);
+    }
+    (angle, axis)
+}
+
+/// Channel values of each rotation in `mode` written like its own row of `reference`
+/// (`N x width` values, for example the keys an animator typed), not continued from the
+/// rotation before: the representative of rotation `i` nearest `reference[i]`. Quaternions
+/// take the reference's sign (`q . r >= 0`); axis-angle the axis that points the
+/// reference's way and the angle within half a turn of its angle; Euler angles the one of
+/// the two triples, each wrapped by whole turns towards the reference, that is nearer to
+/// it (sum of absolute differences, [`euler_compatible`]). Spins and deliberate sign flips
+/// of the reference are kept; a rotation equal to its reference's gives the reference back
+/// (to rounding).
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `reference` does not hold `N x width` values,
+/// [`Error::NotFinite`] for NaN or infinity in it, [`Error::OutOfRange`] for one of its angles
+/// beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Limit`] for more than [`MAX_ROTATIONS`]
+/// rotations, [`Error::Memory`] when the channels exceed the memory budget.
+pub fn channels_near(
+    rotations: &[DQuat],
+    mode: RotationMode,
+    reference: &[f64],
+) -> Result<Vec<f64>> {
+    let width = mode.width();
+    let values = rotations.len().saturating_mul(width);
+    check_rotation_count(rotations.len())?;
+    check_reference(reference, values, mode, "reference", "reference value")?;
+    Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    let mut out = try_vec(values, "rotation channels")?;
+    for (q, r) in rotations.iter().zip(reference.chunks_exact(width)) {
+        let q = q.normalize();
+        match mode {
+            RotationMode::Quaternion => {
+                let q = if q.dot(DQuat::from_xyzw(r[1], r[2], r[3], r[0])) < 0.0 {
+                    -q
+                } else {
+                    q
+                };
+                out.extend_from_slice(&[q.w, q.x, q.y, q.z]);
+            }
+            RotationMode::AxisAngle => {
+                let q = if q.w < 0.0 { -q } else { q };
+                let reference = (r[0], DVec3::new(r[1], r[2], r[3]));
+                let (angle, axis) = axis_angle_near(q, Some(reference), DVec3::Y);
+                out.extend_from_slice(&[angle, axis.x, axis.y, axis.z]);
+            }
+            RotationMode::Euler(order) => {
+                let e = euler_compatible(&DMat3::from_quat(q), order, Some(DVec3::from_slice(r)));
+                out.extend_from_slice(&e.to_array());
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
+/// it:
+///
+/// - quaternion `(w, x, y, z)`, normalised (zero: the identity);
+/// - axis-angle `(angle, x, y, z)`, a rotation by `angle` about the normalised axis
+///   (Rodrigues, `I + sin(a) K + (1 - cos(a)) K^2`; a zero axis: the identity);
+/// - Euler `(x, y, z)` radians, order `"XYZ"` meaning X applied first: `R = Rz Ry Rx`
+///   ([`EulerOrder::to_mat3`]).
+///
+/// `values` has [`RotationMode::width`] numbers (extra ones are ignored, missing ones read
+/// as 0); they are assumed finite.
+pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            // scaled by its largest component first: no overflow for huge values
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            if largest > 0.0 {
+                let q = q / largest;
+                DMat3::from_quat(q / q.length())
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::AxisAngle => {
+            let axis = DVec3::new(v(1), v(2), v(3));
+            let largest = axis.abs().max_element();
+            if largest > 0.0 {
+                let axis = axis / largest;
+                let k = axis / axis.length();
+                let (s, c) = v(0).sin_cos();
+                // K v = k x v, as columns of the skew matrix.
+                let skew = DMat3::from_cols(
+                    DVec3::new(0.0, k.z, -k.y),
+                    DVec3::new(-k.z, 0.0, k.x),
+                    DVec3::new(k.y, -k.x, 0.0),
+                );
+                DMat3::IDENTITY + skew * s + (skew * skew) * (1.0 - c)
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::Euler(order) => order.to_mat3(DVec3::new(v(0), v(1), v(2))),
+    }
 }
 
 /// The largest jump between consecutive rows on any channel (for tests and reports).
@@ -730,6 +888,73 @@ mod tests {
         assert_eq!(
             err.to_string(),
             "rotations: 16777217 rotations exceed the limit of 16777216 in one call: convert fewer rotations at once"
+        );
+    }
+
+    #[test]
+    fn every_mode_parses_its_own_name() {
+        for mode in RotationMode::ALL {
+            assert_eq!(RotationMode::from_name(mode.name()).unwrap(), mode);
+            assert!(mode.property().starts_with("rotation_"), "{mode:?}");
+        }
+        let err = RotationMode::from_name("xyz").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "rotation mode: \"xyz\" is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
+        );
+    }
+
+    #[test]
+    fn channels_near_keep_the_reference_spins_and_signs() {
+        let axis = DVec3::new(0.2, 0.5, 1.0).normalize();
+        let rots: Vec<DQuat> = (0..400)
+            .map(|i| DQuat::from_axis_angle(axis, i as f64 * 0.05))
+            .collect();
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let continuous = rotation_channels(&rots, mode, None).unwrap();
+            // the continuous channels are their own nearest representative
+            let near = channels_near(&rots, mode, &continuous).unwrap();
+            for (a, b) in near.iter().zip(&continuous) {
+                assert!((a - b).abs() < 1e-12, "{mode:?}: {a} vs {b}");
+            }
+            // a reference a whole turn (or a sign) away is followed, rotation unchanged
+            let shifted: Vec<f64> = continuous
+                .chunks_exact(w)
+                .flat_map(|row| {
+                    let mut row = row.to_vec();
+                    match mode {
+                        RotationMode::Quaternion => row.iter_mut().for_each(|v| *v = -*v),
+                        RotationMode::AxisAngle => row[0] += TAU,
+                        RotationMode::Euler(_) => row[1] -= 2.0 * TAU,
+                    }
+                    row
+                })
+                .collect();
+            let near = channels_near(&rots, mode, &shifted).unwrap();
+            for (row, (want, q)) in near.chunks_exact(w).zip(shifted.chunks_exact(w).zip(&rots)) {
+                for (a, b) in row.iter().zip(want) {
+                    assert!((a - b).abs() < 1e-9, "{mode:?}: {row:?} vs {want:?}");
+                }
+                let m = rotation_matrix(mode, row);
+                let err = (m - DMat3::from_quat(*q))
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f64, |a, v| a.max(v.abs()));
+                assert!(err < 1e-12, "{mode:?}: {row:?}");
+            }
+        }
+        let err = channels_near(&rots[..1], RotationMode::AxisAngle, &[1.0, 0.0, 0.0]).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::LengthMismatch {
+                    expected: 4,
+                    got: 3,
+                    ..
+                }
+            ),
+            "{err:?}"
         );
     }
 }
