@@ -6,16 +6,25 @@
 #     CPU time), and the other issues' benches (angular velocity, ...);
 #   - callgrind instruction counts of s (ours one by one and through s_many, vs nalgebra) and
 #     of one subdivision;
-#   - scripts/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
-#   - scripts/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
-#   - scripts/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
-#   - scripts/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
-#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench-requirements.txt
+#   - scripts/bench/bench_python.py: batch vs per-call loops (pytransform3d; mathutils in bpy);
+#   - scripts/bench/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
+#   - scripts/bench/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
+#   - scripts/bench/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
+#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench/requirements.txt
 #     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv;
-#   - scripts/bench_floor.py (every writing operator against its floor, the Blender calls it
+#   - scripts/bench/bench_floor.py (every writing operator against its floor, the Blender calls it
 #     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
 #     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
-#   - scripts/bench_denoise.py, scripts/bench_denoise_rig.py (Remove Noise vs Blender's filters).
+#   - scripts/bench/bench_denoise.py, scripts/bench/bench_denoise_rig.py (Remove Noise vs Blender's filters);
+#   - the measurements the docs quote (part "measure"): what Smooth Motion keeps of the
+#     animator's intent (measure_intent.py), how far each scheme strays from the keys
+#     (measure_schemes.py), where a bake's time goes (profile_bake.py), the live preview's
+#     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
+#     (bench_sweep_blender.py), key fractions of reduce_keys (measure_reduce.py), memory
+#     estimates beside measured peaks (memory_footprints.py), and the paper's smoothness
+#     figures (plot_smoothness.py, into docs/): each one's printout in BENCHMARKS.md.
+# Every script bench.sh runs is in scripts/bench/; bench_report.py is the one writer of
+# BENCHMARKS.md (the others write JSON or text into the run folder).
 # A part that is missing or fails is reported in BENCHMARKS.md as "not available: <why>"
 # and the others still run. Intermediate results go to target/bench/ (log: target/bench/log.txt;
 # a refresh's: log-<parts>.txt).
@@ -23,7 +32,7 @@
 #      BENCHMARKS.md it writes says so); BPY=.venv/bpy/5.0 selects the Blender module.
 #      BENCH_ONLY=<part>[,<part>] runs only those parts and rewrites only their sections of
 #      BENCHMARKS.md, keeping the others as they are (each refreshed section says so). Parts:
-#      criterion, callgrind, python, bake, reduce, floor, denoise, sweep. E.g.
+#      criterion, callgrind, python, bake, reduce, floor, denoise, sweep, measure. E.g.
 #      BENCH_ONLY=floor scripts/bench.sh (the floor part; the reduce part alone takes ~22 minutes).
 #      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
 #      other parts' results in target/bench; a section that shows a refreshed part and another
@@ -35,7 +44,7 @@ export CARGO_TERM_COLOR=never PYTHONDONTWRITEBYTECODE=1
 export CARGO_TARGET_DIR=${CARGO_TARGET_DIR:-$root/target}
 run="$CARGO_TARGET_DIR/bench"
 only=${BENCH_ONLY:-}
-parts="criterion callgrind python bake reduce floor denoise sweep"
+parts="criterion callgrind python bake reduce floor denoise sweep measure"
 for p in ${only//,/ }; do
   case " $parts " in *" $p "*) ;; *) echo "bench: unknown part '$p' in BENCH_ONLY (the parts: $parts)"; exit 2 ;; esac
 done
@@ -52,6 +61,7 @@ else  # a refresh: only the named parts' results are removed, the others kept fo
   want floor && rm -f "$run"/floor.*
   want denoise && rm -f "$run"/denoise.* "$run"/denoise_rig.json
   want sweep && rm -f "$run"/sweep.*
+  want measure && rm -f "$run"/measure-*
   rm -rf "$run/wheel" "$run/pylib" "$run/extension.txt"
 fi
 mkdir -p "$run"
@@ -70,14 +80,14 @@ py="$root/.venv/bin/python"
 bpy_dir=${BPY:-$root/.venv/bpy/5.0}
 peers_ok=1
 if want sweep; then
-  "$py" -m pip --disable-pip-version-check install -q -r scripts/bench-requirements.txt \
-    || { peers_ok=0; echo "bench: scripts/bench-requirements.txt did not install; the sweep comparison will be missing"; }
+  "$py" -m pip --disable-pip-version-check install -q -r scripts/bench/requirements.txt \
+    || { peers_ok=0; echo "bench: scripts/bench/requirements.txt did not install; the sweep comparison will be missing"; }
 fi
 
 pylib="$run/pylib"
 wheel=""
 needs_wheel=0  # every part but criterion and callgrind runs the Python module
-for p in python bake reduce floor denoise sweep; do want "$p" && needs_wheel=1; done
+for p in python bake reduce floor denoise sweep measure; do want "$p" && needs_wheel=1; done
 if [ "$needs_wheel" = 1 ]; then
   stage "build the polyscrew wheel (release, once)"
   if "$root/.venv/bin/maturin" build --release --quiet -o "$run/wheel" 2>&1 | grep -v '^ *Compiling'; then :; fi
@@ -148,11 +158,11 @@ fi
 if want python; then
 pyargs=(); [ "$quick" = 1 ] && pyargs=(--n 2000 --repeat 3)
 stage "Python: batch vs loops (pytransform3d)"
-PYTHONPATH="$pylib" "$py" scripts/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
+PYTHONPATH="$pylib" "$py" scripts/bench/bench_python.py --out "$run/python.json" "${pyargs[@]}" \
   || echo "bench: bench_python.py failed"
 stage "Python inside Blender: batch vs mathutils.Matrix.lerp"
 if [ -d "$bpy_dir" ]; then
-  PYTHONPATH="$pylib:$bpy_dir" "$py" scripts/bench_python.py --blender --out "$run/blender.json" "${pyargs[@]}" \
+  PYTHONPATH="$pylib:$bpy_dir" "$py" scripts/bench/bench_python.py --blender --out "$run/blender.json" "${pyargs[@]}" \
     || echo "bench: bench_python.py --blender failed"
 else
   echo "not available: no Blender module at $bpy_dir"
@@ -161,19 +171,19 @@ fi
 
 if want bake; then
 stage "bake: ScrewBender vs nla.bake vs a keyframe_insert loop"
-if [ ! -f scripts/bench_bake.py ]; then
-  echo "scripts/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
+if [ ! -f scripts/bench/bench_bake.py ]; then
+  echo "scripts/bench/bench_bake.py is not in this checkout (the add-on branch's bake benchmark has not landed)" | tee "$run/bake.missing"
 elif [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
   echo "the wheel or the Blender module is missing" | tee "$run/bake.missing"
 elif ! SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1; then
   echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/bake.missing"
 else
   bake_args=(--out "$run/bake.json"); [ "$quick" = 1 ] && bake_args+=(--quick)
-  if PYTHONPATH="$bpy_dir" "$py" scripts/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
+  if PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_bake.py "${bake_args[@]}" > "$run/bake.out" 2>&1; then
     grep -v -e '^Warning' -e '^Read blend' "$run/bake.out" > "$run/bake.txt"; cat "$run/bake.txt"
   else
     tail -5 "$run/bake.out"
-    echo "scripts/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
+    echo "scripts/bench/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
   fi
 fi
 fi
@@ -183,13 +193,13 @@ stage "sweep: ours vs stroboscopic instancing, gpytoolbox, Warp"
 if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep") else 1)' 2>/dev/null; then
   echo "polyscrew.sweep is not in this build" | tee "$run/sweep.missing"
 elif [ "$peers_ok" != 1 ]; then
-  echo "scripts/bench-requirements.txt (gpytoolbox, warp-lang) did not install" | tee "$run/sweep.missing"
+  echo "scripts/bench/requirements.txt (gpytoolbox, warp-lang) did not install" | tee "$run/sweep.missing"
 else
   sweep_args=(--out "$run/sweep.json"); [ "$quick" = 1 ] && sweep_args+=(--quick)
   # (Warp's start-up banner filtered out: no CUDA here, the CPU device is used.)
-  PYTHONPATH="$pylib" "$py" scripts/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
+  PYTHONPATH="$pylib" "$py" scripts/bench/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
     | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
-  [ -f "$run/sweep.json" ] || echo "scripts/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
+  [ -f "$run/sweep.json" ] || echo "scripts/bench/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
 fi
 fi
 
@@ -202,9 +212,9 @@ elif ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasatt
 else
   [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
   reduce_args=(--json "$run/reduce.json"); [ "$quick" = 1 ] && reduce_args+=(--quick)
-  PYTHONPATH="$bpy_dir" "$py" scripts/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_reduce.py "${reduce_args[@]}" 2>&1 | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' \
     || true
-  [ -f "$run/reduce.json" ] || echo "scripts/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
+  [ -f "$run/reduce.json" ] || echo "scripts/bench/bench_reduce.py failed (see target/bench/log.txt)" | tee "$run/reduce.missing"
 fi
 fi
 
@@ -216,9 +226,9 @@ elif ! { [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build
   echo "scripts/build_extension.sh failed (see target/bench/extension.txt)" | tee "$run/floor.missing"
 else
   floor_args=(--out "$run/floor.json"); [ "$quick" = 1 ] && floor_args+=(--quick)
-  PYTHONPATH="$bpy_dir" "$py" scripts/bench_floor.py "${floor_args[@]}" 2>&1 \
+  PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_floor.py "${floor_args[@]}" 2>&1 \
     | grep --line-buffered -v -e '^Warning' -e '^Read blend' -e '^Info: ' -e '^ScrewBender: ' || true
-  [ -f "$run/floor.json" ] || echo "scripts/bench_floor.py failed (see target/bench/log.txt)" | tee "$run/floor.missing"
+  [ -f "$run/floor.json" ] || echo "scripts/bench/bench_floor.py failed (see target/bench/log.txt)" | tee "$run/floor.missing"
 fi
 fi
 
@@ -228,10 +238,42 @@ fi
 if want denoise; then
 stage "denoise: ours vs Blender's Smooth Keys, Gaussian, Butterworth (five clips, two noise levels)"
 [ -z "$wheel" ] || [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise.py --json "$run/denoise.json" --benchmarks "$run/denoise.md" \
-  || echo "scripts/bench_denoise.py failed"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise.py --json "$run/denoise.json" --section "$run/denoise.md" \
+  || echo "scripts/bench/bench_denoise.py failed"
 stage "denoise: Remove Noise on a 100-bone rig x 1,000 frames vs graph.gaussian_smooth"
-PYTHONPATH="$bpy_dir" "$py" scripts/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench_denoise_rig.py failed"
+PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_denoise_rig.py --json "$run/denoise_rig.json" || echo "scripts/bench/bench_denoise_rig.py failed"
+fi
+
+# The measurements the docs quote: each script's printout (target/bench/measure-<name>.txt),
+# put into BENCHMARKS.md by bench_report.py; a script that fails leaves measure-<name>.missing.
+if want measure; then
+stage "measure: the figures the docs quote"
+if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
+  echo "the wheel or the Blender module is missing" | tee "$run/measure.missing"
+else
+  [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
+  profile_args=(); preview_args=()
+  [ "$quick" = 1 ] && profile_args=(--objects 30 --runs 2) && preview_args=(--quick)
+  measure() {  # name, PYTHONPATH, arguments...
+    local name=$1 path=$2; shift 2
+    echo "--- $name"
+    if PYTHONPATH="$path" "$py" "scripts/bench/$name.py" "$@" > "$run/measure-$name.out" 2>&1; then
+      grep -v -e '^Warning' -e '^Read blend' -e '^Info: ' -e '^ScrewBender: ' "$run/measure-$name.out" > "$run/measure-$name.txt"
+      cat "$run/measure-$name.txt"
+    else
+      tail -5 "$run/measure-$name.out"
+      echo "scripts/bench/$name.py failed: $(tail -1 "$run/measure-$name.out")" | tee "$run/measure-$name.missing"
+    fi
+  }
+  measure measure_intent "$pylib:$bpy_dir"
+  measure measure_schemes "$pylib:$bpy_dir"
+  measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
+  measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
+  measure bench_sweep_blender "$pylib:$bpy_dir"
+  measure measure_reduce "$pylib"
+  measure memory_footprints "$pylib"
+  measure plot_smoothness "$pylib" --bpy "$bpy_dir" --out-dir docs
+fi
 fi
 
 stage "write BENCHMARKS.md"
@@ -258,6 +300,6 @@ if os.path.exists(bpy_json):
     env["bpy"] = json.load(open(bpy_json))["env"].get("bpy", "?")
 json.dump(env, open(os.path.join(os.environ["RUN"], "machine.json"), "w"), indent=1)
 PY
-"$py" scripts/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
+"$py" scripts/bench/bench_report.py --run "$run" --criterion "$CARGO_TARGET_DIR/criterion" \
   --criterion-reuse "$CARGO_TARGET_DIR/criterion-reuse" --out BENCHMARKS.md ${only:+--only "$only"}
 stage "done"

@@ -26,7 +26,8 @@ Working ranges (every value Blender can store, float32 below 3.4e38, is inside t
 - times (key times, sample times, the end of a period) within ``+-MAX_TIME`` (1e300), key
   times at least 1e-300 apart: the time map only takes differences, ratios and the
   reciprocal of two spacings.
-- ``fit_angular_velocity``: times within +-1e30, key times at least 1e-30 apart, target
+- ``fit_angular_velocity``: times within +-1e30 (the tenth root of ``MAX_TIME``: the fit
+  multiplies up to about ten such factors in one product), key times at least 1e-30 apart, target
   angular velocities and speeds within +-1e30, ``alpha`` in 0..=1e30, at most 1,000,000
   fragments, ``max_iterations`` in 1..=1,000,000, ``max_frames`` in 0..=1,000,000
   (``q''`` of a Hermite segment grows like ``1 / h^2`` and ``omega / h``: in these ranges
@@ -53,7 +54,7 @@ key count, the same result to the bit); ``subdivide`` 212 per output pose;
 ``rotation_channels`` 56 per rotation (Euler); ``sweep`` 48 per output vertex and 36 per
 output triangle (checked before each screw's quads are added) plus 320 per body triangle;
 ``feature_motion`` 640 per output pose; ``denoise`` 1,792 per pose (its scratch measured at
-1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/memory_footprints.py`` prints the
+1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/bench/memory_footprints.py`` prints the
 estimates beside the peaks measured for the largest uses (all below 160 MB).
 
 The module releases the GIL while it reads its input, computes and builds its output.
@@ -210,6 +211,38 @@ def rotation_channels(
     ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
     """
 
+def rotation_channels_near(
+    rotations: ArrayLike, mode: RotationModeName, reference: ArrayLike
+) -> FloatArray:
+    """Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), each written like
+    its own row of ``reference`` ((N, 4) or (N, 3) values in ``mode``, for example the keys
+    an animator typed) rather than continued from the row before: quaternions take the
+    reference's sign; axis-angle the axis pointing the reference's way and the angle within
+    half a turn of its angle; Euler angles the one of the two triples of the rotation, each
+    wrapped by whole turns towards the reference, that is nearer to it. Spins and deliberate
+    sign flips of the reference are kept. Reference angles within ``+-MAX_PREVIOUS_ANGLE``.
+    """
+
+def turn_vectors(a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """The turn from each rotation of ``a`` to the same row of ``b`` ((N, 3, 3) or (N, 4, 4)
+    each), in the world frame: (N, 3) rotation vectors ``log(R_b R_a^T)``, axis times angle,
+    the angle (their length) in [0, pi], exact near 0 and near pi (``atan2`` of the relative
+    quaternion, not ``arccos`` of a trace). At most ``MAX_ROTATIONS`` rows.
+    """
+
+def partial_moves(
+    source: ArrayLike, target: ArrayLike, pivot: ArrayLike, max_angle: float,
+    max_distance: float
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """Each pose of ``target`` ((N, 4, 4)), or where its straight move from the same row of
+    ``source`` turns by more than ``max_angle`` (radians) or carries the point ``pivot`` (3,
+    body coordinates) further than ``max_distance``, the pose the fraction ``a`` of the way
+    there that brings both within them: ``a = min(1, max_angle / angle, max_distance /
+    distance)``, the rotation ``a`` of the turn about the same axis, the pivot ``a`` of the
+    way along its straight move (not a screw's helix). Returns the poses and which were cut
+    short. Bounds at least 0 (``inf``: no bound).
+    """
+
 def memory_budget() -> int:
     """The memory budget in bytes: the most one call may hold at its peak (output, working
     memory, copies of the input). A call that would need more raises ``ValueError`` up
@@ -235,7 +268,8 @@ MAX_COORDINATE: float
 """The working range of coordinates: ``|x| <= 1e150`` (see the module documentation)."""
 
 MAX_TIME: float
-"""The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
+"""The one working range of times: ``|t| <= 1e300`` (``fit_angular_velocity``, which
+multiplies times, works within its tenth root, ``|t| <= 1e30``)."""
 
 MAX_PREVIOUS_ANGLE: float
 """The largest ``previous`` angle (radians, either sign) the rotation channels continue
@@ -246,6 +280,12 @@ MAX_ROTATIONS: int
 the default memory budget accepts in quaternion and axis-angle modes. It bounds the call's
 time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
 is read."""
+
+ROTATION_MODES: dict[str, tuple[str, int]]
+"""Blender's rotation modes, the core's: name -> (the property holding the rotation, the
+number of its channels), in Blender's order: ``"QUATERNION"`` -> ``("rotation_quaternion",
+4)``, ``"AXIS_ANGLE"`` -> ``("rotation_axis_angle", 4)``, each Euler order (``"XYZ"``, ...)
+-> ``("rotation_euler", 3)``."""
 
 FitStatusName = Literal["converged", "iteration_limit", "above_delta"]
 
@@ -593,6 +633,9 @@ EXTRAPOLATIONS: tuple[ExtrapolationName, ...]
 """Blender's ``FCurve.extrapolation`` identifiers."""
 CYCLE_MODES: tuple[CycleModeName, ...]
 """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
+CYCLES_PROPERTIES: tuple[str, ...]
+"""The keys a Cycles settings dict of ``evaluate_fcurves`` may hold: the RNA property names of
+Blender's ``FModifierCycles`` it reads."""
 MAX_FCURVE_KEYS: int
 """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
 MAX_FCURVE_VALUES: int

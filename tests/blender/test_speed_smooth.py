@@ -133,7 +133,7 @@ def test_revert_of_many_objects_scans_the_scene_once(count):
     """Revert of many objects does one pass over the scene for all the smoothed actions and
     removes the smoothed copies in one batch (before: a scan of every object and of the file
     per reverted action, quadratic: 0.27 of the smoothing's CPU at 300 objects, 0.4 at 500).
-    Counted, not timed (the times are printed; speed is measured in scripts/bench_floor.py)."""
+    Counted, not timed (the times are printed; speed is measured in scripts/bench/bench_floor.py)."""
     bake = addon_module("blender.bake")
     objects = many(count)
     sources = [o.animation_data.action for o in objects]

@@ -1,4 +1,4 @@
-"""scripts/bench_report.py's refresh of some parts (BENCH_ONLY) and its floor section (issue
+"""scripts/bench/bench_report.py's refresh of some parts (BENCH_ONLY) and its floor section (issue
 27), without timing anything: a refresh rewrites only the sections of the named parts and
 keeps every other byte of BENCHMARKS.md and its target rows; the floor table's ratios, the
 growth exponents and the goals' verdicts follow from the medians given."""
@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 
 def load(name: str):
-    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(name, ROOT / "scripts" / "bench" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module

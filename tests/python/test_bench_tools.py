@@ -1,6 +1,6 @@
 """Keeps the benchmark and plotting tools honest, without timing anything: the growth
-exponent fit of scripts/bench_report.py, its readers of criterion and callgrind output,
-and the derivative and Euler helpers of scripts/plot_smoothness.py, against independent
+exponent fit of scripts/bench/bench_report.py, its readers of criterion and callgrind output,
+and the derivative and Euler helpers of scripts/bench/plot_smoothness.py, against independent
 references (analytic curves, scipy)."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-SCRIPTS = Path(__file__).resolve().parents[2] / "scripts"
+SCRIPTS = Path(__file__).resolve().parents[2] / "scripts" / "bench"
 
 
 def load(name: str):
@@ -118,7 +118,7 @@ def test_bake_ratios_are_read_from_the_best_of_lines(tmp_path):
     assert any("keyframe_insert" in line for line in rep.lines)
 
 
-# --- scripts/bench_sweep_peers.py and the report's new sections (no gpytoolbox, no warp) -----
+# --- scripts/bench/bench_sweep_peers.py and the report's new sections (no gpytoolbox, no warp) -----
 
 sweep = load("bench_sweep_peers")
 
@@ -126,7 +126,7 @@ sweep = load("bench_sweep_peers")
 def test_loading_the_sweep_bench_imports_neither_peer():
     import sys
 
-    # CI does not install scripts/bench-requirements.txt: the helpers must not need it.
+    # CI does not install scripts/bench/requirements.txt: the helpers must not need it.
     assert "gpytoolbox" not in sys.modules and "warp" not in sys.modules
 
 

@@ -309,7 +309,7 @@ def test_errors(rng):
             function(keys, stiffness=[INF, -1.0, 1.0, INF])
         with pytest.raises(ValueError, match=r"stiffness: expected 4 entries, got 3"):
             function(keys, stiffness=[1.0, 1.0, 1.0])
-        with pytest.raises(ValueError, match=r"at least 2 needed to pin"):
+        with pytest.raises(ValueError, match=r"stiffness: keys with a positive spring \(to pin the curve\): 1 given, at least 2 needed"):
             function(keys, stiffness=[0.0, 0.0, 0.0, 1.0])
         with pytest.raises(ValueError, match=r"scheme: \"spline\" is not one of"):
             function(keys, scheme="spline")
@@ -323,12 +323,12 @@ def test_errors(rng):
             function(keys, feature_points=[[0, 0, 0], [np.nan, 0, 0], [0, 1, 0]])
         with pytest.raises(ValueError, match=r"levels 13 out of range"):
             function(keys, levels=13)
-    with pytest.raises(ValueError, match=r"keys 1 and 2 coincide"):
+    with pytest.raises(ValueError, match=r"keys: key 1: coincides with the next key"):
         polyscrew.feature_motion(keys[[0, 1, 1, 2]], parametrization="centripetal")
     # Two keys half a turn apart, averaged by the closed B-spline: the distorted frame is
     # flat, so no unique rigid fit exists; the error names the sample.
     pair = np.stack([np.eye(4), rigid([0, 0, 1], np.pi, [0, 0, 0])])
-    with pytest.raises(ValueError, match=r"feature_motion: registration: sample \d+ \(after key \d\)"):
+    with pytest.raises(ValueError, match=r"feature_motion: key span \d: sample \d+: registration: the best rotation is not unique"):
         polyscrew.feature_motion(pair, scheme="bspline", levels=2, closed=True)
     with pytest.raises(ValueError, match=r"key_times: expected 4 entries, got 3|key times"):
         polyscrew.sample_feature(keys, [0.0, 1.0, 2.0], [0.5])

@@ -240,7 +240,7 @@ def test_playback_errors_name_the_argument():
     curve = [[dict(co=(1, 0)), dict(co=(2, 1))]]
     with pytest.raises(ValueError, match=r"Playback: channels\[0\]: .*rotation_quaternion"):
         playback(curve, [("rotation_quaternion", 0)], "XYZ")
-    with pytest.raises(ValueError, match=r"Playback: channels\[0\]: scale\[3\]: index out of range"):
+    with pytest.raises(ValueError, match=r"Playback: channels\[0\]: scale: index 3 is outside 0\.\.3"):
         playback(curve, [("scale", 3)])
     with pytest.raises(ValueError, match="Playback: channels: expected 1 entries"):
         playback(curve, [])

@@ -151,6 +151,6 @@ report(lambda: fit(fragment_duration=1e-6, max_frames=100_000))
 """
     )
     assert lines[0] == {"finite": True}, lines
-    assert lines[1]["error"] == "ValueError" and "more than 1000000" in lines[1]["message"], lines
+    assert lines[1]["error"] == "ValueError" and "at most 1000000 fragments" in lines[1]["message"], lines
     assert lines[2]["error"] == "ValueError" and "fit would need 8.22 GB, over the memory budget" in lines[2]["message"], lines
     assert lines[3] == {"finite": True}, lines

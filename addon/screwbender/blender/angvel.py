@@ -52,62 +52,18 @@ def frames_per_second(scene: bpy.types.Scene) -> float:
     return scene.render.fps / scene.render.fps_base
 
 
-def matrix_to_quaternion(r: np.ndarray) -> np.ndarray:
-    """(N, 3, 3) rotation matrices -> (N, 4) unit quaternions w, x, y, z (Shepperd's method)."""
-    r = np.asarray(r, dtype=np.float64)
-    n = r.shape[0]
-    q = np.empty((n, 4))
-    tr = np.trace(r, axis1=1, axis2=2)
-    diag = np.stack([r[:, 0, 0], r[:, 1, 1], r[:, 2, 2]], axis=1)
-    pick = np.argmax(np.concatenate([tr[:, None], diag], axis=1), axis=1)
-    for k in range(4):
-        m = pick == k
-        if not m.any():
-            continue
-        a = r[m]
-        if k == 0:
-            s = np.sqrt(1.0 + tr[m]) * 2
-            q[m] = np.stack([0.25 * s, (a[:, 2, 1] - a[:, 1, 2]) / s, (a[:, 0, 2] - a[:, 2, 0]) / s, (a[:, 1, 0] - a[:, 0, 1]) / s], axis=1)
-        else:
-            i = k - 1
-            j, l = (i + 1) % 3, (i + 2) % 3
-            s = np.sqrt(1.0 + a[:, i, i] - a[:, j, j] - a[:, l, l]) * 2
-            v = np.empty((m.sum(), 4))
-            v[:, 0] = (a[:, l, j] - a[:, j, l]) / s
-            v[:, 1 + i] = 0.25 * s
-            v[:, 1 + j] = (a[:, j, i] + a[:, i, j]) / s
-            v[:, 1 + l] = (a[:, l, i] + a[:, i, l]) / s
-            q[m] = v
-    return q / np.linalg.norm(q, axis=1, keepdims=True)
-
-
-def quaternion_to_matrix(q: np.ndarray) -> np.ndarray:
-    """(N, 4) quaternions w, x, y, z -> (N, 3, 3) rotation matrices."""
-    return keys.rotation_matrices(q, "QUATERNION")
-
-
-def rotation_log(r: np.ndarray) -> np.ndarray:
-    """(N, 3, 3) rotations -> (N, 3) rotation vectors (axis times angle), angles below pi."""
-    q = matrix_to_quaternion(r)
-    q *= np.where(q[:, :1] < 0.0, -1.0, 1.0)
-    v = q[:, 1:]
-    s = np.linalg.norm(v, axis=1)
-    angle = 2.0 * np.arctan2(s, q[:, 0])
-    scale = np.where(s > 1e-12, angle / np.where(s > 1e-12, s, 1.0), 2.0)
-    return v * scale[:, None]
-
-
 def current_angular_velocity(motion: keys.KeyedMotion, frames: np.ndarray, fps: float) -> np.ndarray:
     """World-frame (parent-space) angular velocity, rad/s, of the smoothed keyed motion at `frames`.
 
     The motion is `polyscrew.sample` of the key poses (the add-on's default smoothing); the
-    angular velocity is the central difference `log(R(f + h) R(f - h)^T) / 2h`.
+    angular velocity is the central difference `log(R(f + h) R(f - h)^T) / 2h`
+    (`polyscrew.turn_vectors`).
     """
     lo, hi = float(motion.frames[0]), float(motion.frames[-1])
-    plus = polyscrew.sample(motion.poses, motion.frames, np.minimum(frames + DIFF_FRAMES, hi))[:, :3, :3]
-    minus = polyscrew.sample(motion.poses, motion.frames, np.maximum(frames - DIFF_FRAMES, lo))[:, :3, :3]
+    plus = polyscrew.sample(motion.poses, motion.frames, np.minimum(frames + DIFF_FRAMES, hi))
+    minus = polyscrew.sample(motion.poses, motion.frames, np.maximum(frames - DIFF_FRAMES, lo))
     span = (np.minimum(frames + DIFF_FRAMES, hi) - np.maximum(frames - DIFF_FRAMES, lo)) / fps
-    return rotation_log(plus @ np.transpose(minus, (0, 2, 1))) / span[:, None]
+    return polyscrew.turn_vectors(minus, plus) / span[:, None]
 
 
 def _unit_rows(v: np.ndarray) -> np.ndarray:
@@ -300,7 +256,7 @@ def fit(
     frames = bake.bake_frames(start, end, 1.0)
     frames = np.union1d(frames, motion.frames)
     frames = frames[np.concatenate(([True], np.diff(frames) > keys.FRAME_TOLERANCE))]
-    quats = matrix_to_quaternion(motion.poses[:, :3, :3])
+    quats = polyscrew.rotation_channels(motion.poses, "QUATERNION")
     constrained = selected_keys(obj, motion)
     try:
         result = polyscrew.fit_angular_velocity(
@@ -317,7 +273,8 @@ def fit(
         )
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
-        rotation = polyscrew.rotation_channels(quaternion_to_matrix(result.quaternions), mode, previous=previous)
+        matrices = polyscrew.rotation_matrices(result.quaternions, "QUATERNION")
+        rotation = polyscrew.rotation_channels(matrices, mode, previous=previous)
     except ValueError as err:
         raise SmoothError(f"{obj.name}: {err}") from err
     baked = bake.Baked(

@@ -115,20 +115,9 @@ def problems(fcurve: bpy.types.FCurve, keys_only: bool = False) -> list[str]:
 
 
 
-#: The RNA properties of a Cycles modifier passed on (see `polyscrew.evaluate_fcurves`).
-CYCLES_PROPERTIES = (
-    "mode_before",
-    "mode_after",
-    "cycles_before",
-    "cycles_after",
-    "use_restricted_range",
-    "frame_start",
-    "frame_end",
-    "blend_in",
-    "blend_out",
-    "use_influence",
-    "influence",
-)
+#: The RNA properties of a Cycles modifier passed on (the core's list: see
+#: `polyscrew.evaluate_fcurves`).
+CYCLES_PROPERTIES = polyscrew.CYCLES_PROPERTIES
 
 
 def _cycles(fcurve: bpy.types.FCurve) -> dict | None:

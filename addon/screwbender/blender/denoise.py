@@ -250,30 +250,6 @@ def data_notes(c: Cleaned) -> list[str]:
 TAU = 2.0 * np.pi
 
 
-def _like_original(new: np.ndarray, original: np.ndarray, mode: str) -> np.ndarray:
-    """The rotation channel values `new` (n, k), each row the same rotation written like the
-    original key values `original` (n, k): the quaternion sign of the original, the Euler
-    angles (and axis-angle angle) within half a turn of the original's, so that spins and
-    deliberate sign flips of the keys are kept (not continuity's choice)."""
-    new = np.array(new, dtype=np.float64)
-    if mode == "QUATERNION":
-        new[np.sum(new * original, axis=1) < 0] *= -1.0
-        return new
-    if mode == "AXIS_ANGLE":
-        new[np.sum(new[:, 1:] * original[:, 1:], axis=1) < 0] *= -1.0  # (-angle, -axis): the same
-        new[:, 0] += TAU * np.round((original[:, 0] - new[:, 0]) / TAU)
-        return new
-    # An Euler rotation has two triples (a, b, c) and (a + pi, pi - b, c + pi) in its order's
-    # sequence, each up to whole turns per angle: the one nearest the original.
-    first, middle, last = ("XYZ".index(axis) for axis in mode)
-    other = new.copy()
-    other[:, [first, last]] += np.pi
-    other[:, middle] = np.pi - other[:, middle]
-    near = [c + TAU * np.round((original - c) / TAU) for c in (new, other)]
-    use_other = np.abs(near[1] - original).sum(axis=1) < np.abs(near[0] - original).sum(axis=1)
-    return np.where(use_other[:, None], near[1], near[0])
-
-
 def _rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`nearest_rows`, at once when the keys `at` are the key frames `frames` themselves
     (a curve keyed on every key frame: a capture)."""
@@ -317,10 +293,10 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
     in_range = np.zeros(len(motion.frames), dtype=bool)
     in_range[cleaned.rows] = True
     original = _original_rotation(motion)
-    previous = None if mode == "AXIS_ANGLE" else original[cleaned.rows[0]]
     rotation = np.zeros((len(motion.frames), original.shape[1]))
-    written = polyscrew.rotation_channels(cleaned.poses, mode, previous=previous)
-    rotation[cleaned.rows] = _like_original(written, original[cleaned.rows], mode)
+    # Each smoothed key written like the original key value (its quaternion sign, its Euler
+    # twin and whole turns), so spins and deliberate sign flips of the keys are kept.
+    rotation[cleaned.rows] = polyscrew.rotation_channels_near(cleaned.poses, mode, original[cleaned.rows])
     values = {path: rotation}
     if motion.located:
         location = np.zeros((len(motion.frames), 3))

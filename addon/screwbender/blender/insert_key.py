@@ -16,6 +16,15 @@ float32: the inserted pose is the motion's pose rounded to float32 channel value
 The owner is an object or a pose bone (:mod:`owners`): a bone is keyed in its own space
 (`matrix_basis`), its curves in the F-curve group named after it, as Blender keys bones; a
 bone connected to its parent gets no location key (Blender ignores its location).
+
+Each source curve is read once per run (issue 27): its keys are packed once
+(:func:`curves.read`); that read also serves as the undo snapshot (the transaction puts back
+the keys, handles and count of every curve it keyed), and the motion after the insertion is
+that read with the new key spliced in: Blender recomputes the handles of the new key and of
+its two neighbours only (and, on a cyclic curve, of the first and last two keys), which are
+read back one by one, not the whole curve. A curve with Auto Handle Smoothing
+(`auto_smoothing`: every handle may move) has its handles read again in full. Many owners of
+one action (a rig's bones) share one pass over its curves (:func:`owners.curves_by_owner`).
 """
 
 from __future__ import annotations
@@ -26,7 +35,10 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, channels, keys, owners, transaction
+from ..pure.packed_parts import PER_KEY as _PER_KEY
+from ..pure.packed_parts import joined as _joined
+from ..pure.packed_parts import one as _one
+from . import bake, bulk, channels, curves, keys, owners, transaction
 from .keys import SmoothError
 
 
@@ -59,14 +71,7 @@ def check_frames(before: keys.KeyedMotion, frame: float) -> np.ndarray:
 def pose_change(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per pose: origin displacement |t_b - t_a| and rotation angle of `R_a^T R_b` (radians)."""
     translation = np.linalg.norm(b[:, :3, 3] - a[:, :3, 3], axis=1)
-    relative = np.einsum("nji,njk->nik", a[:, :3, :3], b[:, :3, :3])
-    cos = np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    # arccos loses precision near 0: use the antisymmetric part for small angles.
-    skew = np.stack(
-        [relative[:, 2, 1] - relative[:, 1, 2], relative[:, 0, 2] - relative[:, 2, 0], relative[:, 1, 0] - relative[:, 0, 1]],
-        axis=1,
-    )
-    angle = np.arctan2(np.linalg.norm(skew, axis=1) / 2.0, cos)
+    angle = np.linalg.norm(polyscrew.turn_vectors(a, b), axis=1)  # exact near 0 and pi
     return translation, angle
 
 
@@ -77,18 +82,115 @@ def _current_values(target, curves: dict, path: str, size: int, frame: float) ->
     )
 
 
+def _transform_curves(owner: owners.Owner, listed: list) -> list:
+    """The curves :func:`keys.read` reads for `owner` among `listed`, in its order (keyed
+    transform curves, not muted; no location for a connected bone)."""
+    paths = keys.transform_paths(owner.rotation_mode)
+    located = not owner.bone or not owner.obj.data.bones[owner.bone].use_connect
+    found = {}
+    for fc in listed:
+        prop = owner.prop_of(fc.data_path)
+        if prop in paths and not fc.mute and len(fc.keyframe_points) > 0 and (located or prop != "location"):
+            found[prop, fc.array_index] = fc
+    return list(found.values())
+
+
+def _key_codes(point) -> tuple[int, int]:
+    """`polyscrew` codes of one keyframe's interpolation and easing (ValueError: unknown)."""
+    return polyscrew.INTERPOLATIONS.index(point.interpolation), polyscrew.EASINGS.index(point.easing)
+
+
+def _spliced(fcurve: bpy.types.FCurve, before: curves.Packed, frame: float) -> curves.Packed:
+    """The packed keys of `fcurve` after a key was inserted at `frame`, from its keys `before`
+    (one curve, packed): the new key added (or the replaced one updated) and the keys whose
+    handles Blender recomputed read back one by one."""
+    points = fcurve.keyframe_points
+    n, m = int(before.offsets[-1]), len(points)
+    x = before.co[:, 0]
+    if m == n + 1:
+        i = int(np.searchsorted(x, frame))
+        rows = np.concatenate([np.arange(i), [min(i, n - 1)], np.arange(i, n)])  # a row for the new key
+    elif m == n:
+        i = int(np.argmin(np.abs(x - frame)))
+        rows = np.arange(n)
+    else:  # not a single insertion: read the curve as it is now
+        return curves.read([fcurve], keys_only=True)
+    after = curves.Packed(
+        offsets=np.array([0, m], dtype=np.int64), extrapolation=list(before.extrapolation), cycles=list(before.cycles),
+        **{name: getattr(before, name)[rows] for name in _PER_KEY},
+    )
+    window = {j for j in (i - 1, i, i + 1) if 0 <= j < m}
+    if before.cycles and before.cycles[0] is not None:
+        window |= {j for j in (0, 1, m - 2, m - 1) if 0 <= j < m}  # cycle-aware handles wrap
+    for j in sorted(window):
+        point = points[j]
+        after.co[j] = point.co
+        after.handle_left[j] = point.handle_left
+        after.handle_right[j] = point.handle_right
+        after.interpolation[j], after.easing[j] = _key_codes(point)
+        after.back[j], after.amplitude[j], after.period[j] = point.back, point.amplitude, point.period
+    if getattr(fcurve, "auto_smoothing", "NONE") != "NONE":  # every handle may have moved
+        for name in ("handle_left", "handle_right"):
+            flat = np.empty(2 * m, dtype=np.float32)
+            bulk.get(points, name, flat)
+            getattr(after, name)[:] = flat.reshape(-1, 2)
+    return after
+
+
+def _keep_packed(t: transaction.Transaction, fcurve: bpy.types.FCurve, before: curves.Packed, frame: float) -> None:
+    """On failure, `fcurve` (one curve, packed `before`) gets its keys back: the key inserted
+    at `frame` removed, every key's position and handles as they were (the keys' other
+    properties are not touched by an insertion)."""
+    n = int(before.offsets[-1])
+    saved = {name: getattr(before, name).reshape(-1).copy() for name in ("co", "handle_left", "handle_right")}
+    inserted = int(np.searchsorted(before.co[:, 0], frame))
+
+    def undo() -> None:
+        points = fcurve.keyframe_points
+        if len(points) == n + 1:
+            points.remove(points[inserted], fast=True)
+        for name, values in saved.items():
+            bulk.put(points, name, values)
+        fcurve.update()
+
+    t.on_rollback(undo)
+
+
 def insert_key(
-    owner: owners.Owner | bpy.types.Object, frame: float, options: bake.Options, t: transaction.Transaction
+    owner: owners.Owner | bpy.types.Object,
+    frame: float,
+    options: bake.Options,
+    t: transaction.Transaction,
+    fcurves: list | None = None,
+    known: dict | None = None,
 ) -> InsertResult:
     """Keys the pose the smoothed motion of `owner` (an object or a pose bone) has at `frame`
     on its transform channels (inside the transaction `t`: the curves get their old keys back
     if anything fails later).
 
+    `fcurves`: the owner's transform curves when the caller has grouped them
+    (:func:`owners.curves_by_owner`: many bones of one action without a scan of all its curves
+    per bone). `known`, a dict the caller keeps over one run: the packed keys per set of curves
+    read or keyed so far (owners sharing an action read it once, and see the keys inserted).
+
     Raises :class:`SmoothError` (nothing changed) when the keys cannot be smoothed.
     """
     owner = owners.as_owner(owner)
     name = owner.name
-    before = keys.read(owner, options.closed, turns=options.turns)
+    listed = list(channels.object_fcurves(owner.obj) if fcurves is None else fcurves)
+    known = {} if known is None else known
+    chosen = _transform_curves(owner, listed)
+    pointers = tuple(fc.as_pointer() for fc in chosen)
+    packed = known.get(pointers)
+    if packed is None and chosen:
+        try:
+            packed = curves.read(chosen, keys_only=True)
+        except curves.UnsupportedCurve:
+            packed = None  # keys.read says why, and reads the keys alone
+    before = keys.read(
+        owner, options.closed, fcurves=listed, turns=options.turns,
+        packed=(chosen, packed) if packed is not None else None,
+    )
     frames = check_frames(before, frame)
     try:
         poses_before, _ = bake.sample_poses(before, frames, options, owner)
@@ -98,13 +200,13 @@ def insert_key(
 
     mode = owner.rotation_mode
     rotation_path = keys.rotation_path(mode)
-    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
-    curves = {}
-    for fc in channels.object_fcurves(owner.obj):
+    size = keys.rotation_width(mode)
+    by_prop = {}
+    for fc in listed:
         prop = owner.prop_of(fc.data_path)
         if prop is not None:
-            curves[(prop, fc.array_index)] = fc
-    previous = _current_values(owner.target, curves, rotation_path, size, frame)
+            by_prop[(prop, fc.array_index)] = fc
+    previous = _current_values(owner.target, by_prop, rotation_path, size, frame)
     values = {
         "location": pose[0, :3, 3].copy(),
         rotation_path: polyscrew.rotation_channels(pose, mode, previous=previous)[0],
@@ -114,24 +216,53 @@ def insert_key(
     if before.scale_keyed:
         values["scale"] = scale[0]  # only its keyed axes are keyed again (below)
 
+    column = {fc.as_pointer(): c for c, fc in enumerate(chosen)} if packed is not None else {}
     adt = owner.obj.animation_data
     bag = channels.ensure_container(adt.action, channels.assigned_slot(owner.obj))
+    keyed, made = [], []
     for path, vector in values.items():
         for index, value in enumerate(vector):
             if path == "scale" and not before.scale_axes[index]:
                 continue  # unkeyed scale stays unkeyed (a mirrored object's static -1 included)
-            fcurve = curves.get((path, index))
+            fcurve = by_prop.get((path, index))
             if fcurve is None:
                 fcurve = t.new_fcurve(bag, owner.path(path), index, owner.group)
+                made.append(fcurve)
+            elif fcurve.as_pointer() in column:
+                _keep_packed(t, fcurve, _one(packed, column[fcurve.as_pointer()]), frame)
             else:
                 t.keep_keys(fcurve)
             channels.insert_key(fcurve, frame, float(value))
+            keyed.append(fcurve.as_pointer())
 
-    after = keys.read(owner, options.closed, turns=options.turns)
+    given = None
+    if packed is not None:  # the keys now: the read above with the new keys spliced in
+        listed_after = listed + made
+        chosen_after = _transform_curves(owner, listed_after)
+        keyed_set = set(keyed)
+        parts, unread = [], []
+        for fc in chosen_after:
+            c = column.get(fc.as_pointer())
+            if c is None:
+                unread.append(fc)  # a curve without keys before: never read
+                parts.append(None)
+            elif fc.as_pointer() in keyed_set:
+                parts.append(_spliced(fc, _one(packed, c), frame))
+            else:
+                parts.append(_one(packed, c))
+        if unread:
+            fresh = curves.read(unread, keys_only=True)
+            ones = iter(_one(fresh, c) for c in range(len(unread)))
+            parts = [p if p is not None else next(ones) for p in parts]
+        given = (chosen_after, _joined(parts))
+        listed = listed_after
+    after = keys.read(owner, options.closed, fcurves=listed, turns=options.turns, packed=given)
     try:
         poses_after, _ = bake.sample_poses(after, frames, options, owner)
     except ValueError as err:
         raise SmoothError(f"{name}: {err}") from err
+    if given is not None:
+        known[tuple(fc.as_pointer() for fc in given[0])] = given[1]
     translation, angle = pose_change(poses_before, poses_after)
     worst = int(np.argmax(translation))
     return InsertResult(

@@ -31,6 +31,7 @@ from ..pure.keyed import (  # noqa: F401  (re-exported: the pure layer's key pos
     key_motion,
     rotation_matrices,
     rotation_path,
+    rotation_width,
     transform_paths,
 )
 from . import bulk, channels, curves, modifiers, owners
@@ -260,7 +261,7 @@ def _read(
         location, rotation, scale = at_keys["location"], at_keys[paths[1]], at_keys["scale"]
     else:
         location = evaluate("location", 3) if located else np.zeros((len(frames), 3))
-        rotation = evaluate(paths[1], 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)
+        rotation = evaluate(paths[1], rotation_width(mode))
         scale = evaluate("scale", 3)
     for label, values in (("location", location), (paths[1], rotation), ("scale", scale)):
         if not np.all(np.isfinite(values)):

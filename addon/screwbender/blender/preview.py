@@ -33,6 +33,7 @@ from dataclasses import astuple, dataclass, field
 import bpy
 import numpy as np
 
+from ..pure import packed_parts
 from ..pure.preview_geometry import (  # noqa: F401  (re-exported: preview.Space, preview.bone_geometry, ...)
     BONE_EDGES,
     BONE_TRIS,
@@ -189,6 +190,46 @@ class LiveKey:
     scale: np.ndarray
 
 
+def _transform_curves(owner: owners.Owner, fcurves: list) -> list:
+    """The owner's location, rotation (its mode) and scale curves among `fcurves` (not the
+    location of a connected bone, which is not read)."""
+    paths = tuple(owner.path(p) for p in keys.transform_paths(owner.target.rotation_mode))
+    located = not owner.bone or not owner.obj.data.bones[owner.bone].use_connect
+    return [fc for fc in fcurves if fc.data_path in paths and (located or fc.data_path != paths[0])]
+
+
+def _played(listed: list) -> list:
+    """The curves :func:`keys.read` reads among the owner's transform curves: keyed, not muted."""
+    return [fc for fc in listed if not fc.mute and len(fc.keyframe_points)]
+
+
+def read_together(pairs: list[tuple[owners.Owner, list]], memo: dict) -> None:
+    """Reads the played transform curves of every owner of `pairs` ((owner, its curves) each,
+    see :func:`key_hash`) in one `curves.read` call, each curve once, and gives each owner its
+    part in `memo` (:func:`key_hash`'s): a refresh of many objects reads their keys in one
+    pass instead of one per owner. Curves it cannot pack are left to each owner's own read
+    (which says why)."""
+    union, at, wanted = [], {}, []
+    for owner, fcurves in pairs:
+        played = _played(_transform_curves(owner, fcurves))
+        handle = tuple(fc.as_pointer() for fc in played)
+        if not played or handle in memo:
+            continue
+        for fc in played:
+            if fc.as_pointer() not in at:
+                at[fc.as_pointer()] = len(union)
+                union.append(fc)
+        wanted.append((handle, [at[p] for p in handle]))
+    if not union:
+        return
+    try:
+        packed = curves_.read(union, keys_only=True)
+    except curves_.UnsupportedCurve:
+        return
+    for handle, columns in wanted:
+        memo.setdefault(handle, packed_parts.subset(packed, columns))
+
+
 def key_hash(
     owner: owners.Owner | bpy.types.Object,
     options: PreviewOptions,
@@ -242,21 +283,16 @@ def key_hash(
     feature_method = options.smooth.method == "FEATURE"
     curves = {}
     at_key = False
-    listed = []
-    for fc in channels.object_fcurves(obj) if fcurves is None else fcurves:
-        if fc.data_path not in paths:
-            continue
+    listed = _transform_curves(owner, channels.object_fcurves(obj) if fcurves is None else fcurves)
+    for fc in listed:
         prop = props[paths.index(fc.data_path)]
-        if prop == "location" and not located:
-            continue  # a connected bone's location is not read
         curves[(prop, fc.array_index)] = fc
-        listed.append(fc)
         digest.update(
             f"|{fc.data_path}[{fc.array_index}]{len(fc.keyframe_points)}{fc.mute}{fc.extrapolation}"
             f"{[(m.type, m.mute) for m in fc.modifiers]}".encode()
         )
     # The curves keys.read reads (not muted, keyed), packed as it packs them.
-    played = [fc for fc in listed if not fc.mute and len(fc.keyframe_points)]
+    played = _played(listed)
     memo = {} if memo is None else memo
     handle = tuple(fc.as_pointer() for fc in played)
     if handle not in memo:

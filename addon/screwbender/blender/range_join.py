@@ -394,7 +394,7 @@ def end_maps(join: Join, motion: keys.KeyedMotion, played: dict, values: dict, f
     ends, by a factor that changes geometrically along the range."""
     mode = motion.rotation_mode
     path = keys.rotation_path(mode)
-    if mode in ("QUATERNION", "AXIS_ANGLE") and path in values:
+    if keys.rotation_width(mode) == 4 and path in values:
         part = slice(0, 4) if mode == "QUATERNION" else slice(1, 4)
         baked = values[path]
         logs = []

@@ -201,7 +201,7 @@ def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> 
     columns = set(source.columns)
     located = motion.located and any(p == "location" for p, _ in columns)
     rotated = any(p == rot_path for p, _ in columns)
-    size = 4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3
+    size = keys.rotation_width(mode)
     written = [("location", i) for i in range(3)] if located else []
     written += [(rot_path, i) for i in range(size)] if rotated else []
     written += [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
@@ -367,7 +367,7 @@ def measured(batch: Batch, results: list[Reduced]) -> tuple[np.ndarray, np.ndarr
         dense = np.concatenate([it.poses, ref[n:]])
         location = np.stack([values.get((i, ("location", k)), dense[:, k, 3]) for k in range(3)], axis=1)
         rot_path = keys.rotation_path(it.mode)
-        size = 4 if it.mode in ("QUATERNION", "AXIS_ANGLE") else 3
+        size = keys.rotation_width(it.mode)
         if all((i, (rot_path, k)) in values for k in range(size)):
             rotation = keys.rotation_matrices(np.stack([values[i, (rot_path, k)] for k in range(size)], axis=1), it.mode)
         else:

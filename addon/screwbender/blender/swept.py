@@ -32,7 +32,7 @@ import polyscrew
 from mathutils import Matrix, Vector
 from mathutils.bvhtree import BVHTree
 
-from . import bake, bulk, channels, owners, transaction
+from . import bake, bulk, channels, curves, keys, owners, transaction
 
 #: Name of the collection that receives swept regions.
 COLLECTION = "Swept Regions"
@@ -281,28 +281,317 @@ def motion_frames(
     return np.arange(scene.frame_start, scene.frame_end + 1, dtype=np.float64)
 
 
+def _rigid_and_scale(name: str, matrices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rigid poses (N, 4, 4) and the constant scale (3,) of world matrices (N, 4, 4), as
+    `Matrix.decompose` splits them (column lengths, negated for a mirror; the rotation the
+    nearest to the normalised columns); :class:`SweepError` when the scale changes."""
+    linear = matrices[:, :3, :3]
+    scales = np.linalg.norm(linear, axis=1)
+    mirrored = np.linalg.det(linear) < 0.0
+    scales[mirrored] *= -1.0
+    u, _, vt = np.linalg.svd(linear / scales[:, None, :])
+    poses = np.zeros_like(matrices)
+    poses[:, :3, :3] = u @ vt
+    poses[:, :3, 3] = matrices[:, :3, 3]
+    poses[:, 3, 3] = 1.0
+    _check_scale(name, scales)
+    return poses, scales[0]
+
+
+def _check_scale(name: str, scales: np.ndarray) -> None:
+    spread = np.abs(scales - scales[0]).max()
+    if spread > SCALE_TOLERANCE * max(1.0, np.abs(scales).max()):
+        raise SweepError(f"{name}: its scale changes over the frame range (not a rigid motion)")
+
+
+#: Properties whose curves also move an object (a pose bone: `rotation_mode`), which the
+#: poses read from the curves leave out: an owner with one of them keyed is played by Blender.
+_ALSO_MOVING = ("delta_location", "delta_rotation_euler", "delta_rotation_quaternion", "delta_scale", "rotation_mode")
+
+
+class _Curves:
+    """The transform curves, per owner, of the objects and bones whose world motion is read
+    from the curves (:func:`world_poses_all`), with what Blender plays on top of them."""
+
+    def __init__(self) -> None:
+        self.per_owner: dict[tuple[int, str], dict] = {}  # (object, bone) -> {(prop, index): curve}
+        self.steady: dict[tuple[int, str], bool] = {}
+
+    def _action_alone(self, obj: bpy.types.Object) -> bool:
+        """Whether Blender plays `obj`'s active action alone (no drivers, NLA, blending) and
+        nothing else of the object data moves its bones."""
+        key = (obj.as_pointer(), "*")
+        if key not in self.steady:
+            adt = obj.animation_data
+            ok = adt is None or (
+                not len(adt.drivers) and not keys.playing_strips(adt) and not getattr(adt, "use_tweak_mode", False)
+                and not any(track.is_solo for track in adt.nla_tracks)
+                and (adt.action is None or (adt.action_influence == 1.0 and adt.action_blend_type == "REPLACE"
+                                            and adt.action_extrapolation == "HOLD"))
+            )
+            if ok and obj.type == "ARMATURE":
+                data = obj.data.animation_data
+                ok = (obj.data.pose_position == "POSE" and (data is None or (data.action is None and not len(data.drivers)))
+                      and not any(len(pb.constraints) for pb in obj.pose.bones))
+            if ok:
+                listed = channels.object_fcurves(obj) if adt is not None and adt.action is not None else []
+                paths = {fc.data_path for fc in listed}
+                ok = not any(p.endswith(_ALSO_MOVING) for p in paths)
+                grouped = owners.curves_by_owner(listed)
+                for bone, found in grouped.items():
+                    self.per_owner[obj.as_pointer(), bone] = found
+            self.steady[key] = ok
+        return self.steady[key]
+
+    def owner_steady(self, obj: bpy.types.Object, bone: str = "") -> bool:
+        """Whether the local matrix of the object (or its pose bone `bone`) follows from its
+        own curves alone: nothing Blender's depsgraph must solve (constraints, drivers,
+        physics, NLA, delta transforms, non-default bone inheritance)."""
+        if not self._action_alone(obj):
+            return False
+        if bone:
+            data = obj.data.bones[bone]
+            return data.inherit_scale == "FULL" and data.use_inherit_rotation and data.use_local_location
+        return (
+            not len(obj.constraints) and obj.rigid_body is None and obj.rigid_body_constraint is None
+            and not any(obj.delta_location) and tuple(obj.delta_rotation_euler) == (0.0, 0.0, 0.0)
+            and tuple(obj.delta_rotation_quaternion) == (1.0, 0.0, 0.0, 0.0) and tuple(obj.delta_scale) == (1.0, 1.0, 1.0)
+        )
+
+    def played(self, obj: bpy.types.Object, bone: str = "") -> list:
+        """The curves Blender plays on the owner's location, rotation (its mode) and scale
+        (keyed, not muted)."""
+        target = obj.pose.bones[bone] if bone else obj
+        paths = keys.transform_paths(target.rotation_mode)
+        found = []
+        for fc in self.per_owner.get((obj.as_pointer(), bone), []):
+            prop = fc.data_path.rsplit(".", 1)[-1] if bone else fc.data_path
+            group_muted = fc.group is not None and fc.group.mute
+            if prop in paths and len(fc.keyframe_points) and not fc.mute and not group_muted:
+                found.append(fc)
+        return found
+
+
+def _chain(plays: _Curves, obj: bpy.types.Object, driver: BoneDriver | None) -> list[tuple] | None:
+    """The owners ((object, bone)) whose curves make `obj`'s world matrix (and its driver
+    bone's), or None when something else moves one of them (the depsgraph must play it)."""
+    found: list[tuple] = []
+
+    def bones_of(rig: bpy.types.Object, bone: str) -> bool:
+        b = rig.data.bones.get(bone)
+        while b is not None:
+            if not plays.owner_steady(rig, b.name):
+                return False
+            found.append((rig, b.name))
+            b = b.parent
+        return True
+
+    def objects_of(o: bpy.types.Object) -> bool:
+        while o is not None:
+            if not plays.owner_steady(o):
+                return False
+            found.append((o, ""))
+            parent = o.parent
+            if parent is None:
+                return True
+            if o.parent_type == "BONE" and parent.type == "ARMATURE":
+                bone = parent.data.bones.get(o.parent_bone)
+                if bone is None or bone.use_relative_parent or not bones_of(parent, o.parent_bone):
+                    return False
+            elif o.parent_type != "OBJECT" or parent.type == "CURVE":  # a curve parent may move it along its path
+                return False
+            o = parent
+        return True
+
+    if not objects_of(obj):
+        return None
+    if driver is not None and driver.deformed and not (objects_of(driver.armature) and bones_of(driver.armature, driver.bone)):
+        return None
+    return found
+
+
+class _Evaluated:
+    """Local matrices of objects and pose bones at `frames`, from their curves evaluated in
+    one `polyscrew.evaluate_fcurves` call, composed into world matrices as Blender does."""
+
+    def __init__(self, plays: _Curves, frames: np.ndarray, packed: curves.Packed | None, listed: list):
+        self.frames = frames
+        self.values = curves.evaluate_packed(packed, frames) if listed else np.zeros((0, len(frames)))
+        self.row = {fc.as_pointer(): i for i, fc in enumerate(listed)}
+        self.plays = plays
+        self.memo: dict = {}
+
+    def basis(self, obj: bpy.types.Object, bone: str = "") -> np.ndarray:
+        """`matrix_basis` (N, 4, 4): `T R S` of the channels (Blender's BKE_object_to_mat4,
+        BKE_pchan_to_mat4: a connected bone's location ignored)."""
+        target = obj.pose.bones[bone] if bone else obj
+        mode = target.rotation_mode
+        paths = keys.transform_paths(mode)
+        n = len(self.frames)
+        channels_ = {path: np.tile(np.array(getattr(target, path), dtype=np.float64), (n, 1)) for path in paths}
+        for fc in self.plays.played(obj, bone):
+            prop = fc.data_path.rsplit(".", 1)[-1] if bone else fc.data_path
+            channels_[prop][:, fc.array_index] = self.values[self.row[fc.as_pointer()]]
+        if bone and obj.data.bones[bone].use_connect:
+            channels_["location"][:] = 0.0
+        return keys.compose(channels_["location"], keys.rotation_matrices(channels_[paths[1]], mode), channels_["scale"])
+
+    def pose(self, rig: bpy.types.Object, bone: str) -> np.ndarray:
+        """`pose_bone.matrix` (armature space): `P_parent R_parent^-1 R B` (R: rest
+        `matrix_local`, B: basis), full inheritance."""
+        key = ("bone", rig.as_pointer(), bone)
+        if key not in self.memo:
+            data = rig.data.bones[bone]
+            rest = np.array(data.matrix_local, dtype=np.float64)
+            local = rest @ self.basis(rig, bone)
+            if data.parent is not None:
+                offset = np.linalg.inv(np.array(data.parent.matrix_local, dtype=np.float64)) @ rest
+                local = self.pose(rig, data.parent.name) @ offset @ self.basis(rig, bone)
+            self.memo[key] = local
+        return self.memo[key]
+
+    def world(self, obj: bpy.types.Object) -> np.ndarray:
+        """`matrix_world`: parent's world (at a parent bone's tail) `@ matrix_parent_inverse @ basis`."""
+        key = ("object", obj.as_pointer())
+        if key not in self.memo:
+            world = self.basis(obj)
+            parent = obj.parent
+            if parent is not None:
+                inverse = np.array(obj.matrix_parent_inverse, dtype=np.float64)
+                above = self.world(parent)
+                if obj.parent_type == "BONE":
+                    bone = self.pose(parent, obj.parent_bone).copy()
+                    bone[:, :3, 3] += bone[:, :3, 1] * parent.data.bones[obj.parent_bone].length  # to its tail
+                    above = above @ bone
+                world = above @ inverse @ world
+            self.memo[key] = world
+        return self.memo[key]
+
+    def carried(self, obj: bpy.types.Object, driver: BoneDriver | None) -> np.ndarray:
+        """:func:`carried_matrix` at every frame."""
+        world = self.world(obj)
+        if driver is None or not driver.deformed:
+            return world
+        rig = self.world(driver.armature)
+        rest = np.array(driver.armature.data.bones[driver.bone].matrix_local, dtype=np.float64)
+        deform = self.pose(driver.armature, driver.bone) @ np.linalg.inv(rest)
+        return rig @ deform @ np.linalg.inv(rig) @ world
+
+
+@dataclass
+class _Plan:
+    """Which objects' world poses are read from their curves (:func:`world_poses_all`)."""
+
+    plays: _Curves
+    #: Per object: the owners whose curves make its world matrix, None: played by Blender.
+    chains: list
+    #: The curves read, and their keys (None: none).
+    listed: list
+    packed: curves.Packed | None
+
+
+def _plan(pairs: list[tuple[bpy.types.Object, BoneDriver | None]], scene: bpy.types.Scene, read: dict | None, fast: bool) -> _Plan:
+    """Finds the objects ((object, driver) each) whose world matrix follows from curves alone
+    and reads those curves, once (their key frames go into `read`, see :func:`_key_frames`)."""
+    plays = _Curves()
+    remapped = scene.render.frame_map_old != scene.render.frame_map_new
+    chains = [None if remapped or not fast else _chain(plays, obj, driver) for obj, driver in pairs]
+    listed, seen = [], set()
+    for chain in chains:
+        for obj, bone in chain or ():
+            for fc in plays.played(obj, bone):
+                if fc.as_pointer() not in seen:
+                    seen.add(fc.as_pointer())
+                    listed.append(fc)
+    bad = {fc.as_pointer() for fc in listed if curves.problems(fc)}
+    if bad:  # what polyscrew cannot play as Blender does: the depsgraph plays those owners
+        chains = [None if c is None or any(fc.as_pointer() in bad for o, b in c for fc in plays.played(o, b)) else c
+                  for c in chains]
+        listed = [fc for fc in listed if fc.as_pointer() not in bad]
+    packed = None
+    if listed:
+        try:
+            packed = curves.read(listed)
+        except curves.UnsupportedCurve:
+            chains, listed = [None] * len(pairs), []
+    if packed is not None and read is not None:
+        bounds = packed.offsets.tolist()
+        for i, fc in enumerate(listed):
+            read.setdefault(fc.as_pointer(), packed.co[bounds[i] : bounds[i + 1], 0])
+    return _Plan(plays, chains, listed, packed)
+
+
+def world_poses_all(
+    items: list[tuple[bpy.types.Object, np.ndarray, BoneDriver | None]], scene: bpy.types.Scene,
+    read: dict | None = None, fast: bool = True, plan: _Plan | None = None,
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`world_poses` of several objects ((object, frames, driver) each) at once.
+
+    Where an object's world matrix follows from transform curves alone (its own, its parents'
+    and, for a mesh carried by a bone, the bones' and the armature's: no constraints, drivers,
+    NLA, physics, delta transforms or non-default bone inheritance anywhere in the chain, no
+    time remapping), every such curve is read once and evaluated at every frame in one
+    `polyscrew.evaluate_fcurves` call (Blender's own values) and the matrices composed as
+    Blender does. The others are played by Blender: one `frame_set` per frame for all of
+    them together. `read`: the key frames read so far (:func:`_key_frames`), filled with the
+    key frames of the curves read here. `fast=False` plays every object (the reference).
+    `plan`: :func:`_plan` of the same objects, made already.
+    """
+    if plan is None:
+        plan = _plan([(obj, driver) for obj, _, driver in items], scene, read, fast)
+    out: list = [None] * len(items)
+    evaluated = [i for i, chain in enumerate(plan.chains) if chain is not None]
+    if evaluated:
+        frames = np.unique(np.concatenate([items[i][1] for i in evaluated]))
+        matrices = _Evaluated(plan.plays, frames, plan.packed, plan.listed)
+        for i in evaluated:
+            obj, wanted, driver = items[i]
+            out[i] = _rigid_and_scale(obj.name, matrices.carried(obj, driver)[np.searchsorted(frames, wanted)])
+    played = [i for i, chain in enumerate(plan.chains) if chain is None]
+    if played:
+        for i, result in zip(played, _played_poses([items[i] for i in played], scene)):
+            out[i] = result
+    return out
+
+
+def _played_poses(items: list, scene: bpy.types.Scene) -> list[tuple[np.ndarray, np.ndarray]]:
+    """World poses of `items` as Blender plays them: one `frame_set` per frame of all their
+    frames together, each object's carried matrix taken at its own frames."""
+    frame, subframe = scene.frame_current, scene.frame_subframe
+    frames = np.unique(np.concatenate([wanted for _, wanted, _ in items]))
+    taken = [np.empty((len(wanted), 4, 4)) for _, wanted, _ in items]
+    where = [np.searchsorted(frames, wanted) for _, wanted, _ in items]
+    at = [{int(k): j for j, k in enumerate(w)} for w in where]
+    try:
+        for k, f in enumerate(frames):
+            whole = math.floor(f)
+            scene.frame_set(whole, subframe=float(f - whole))
+            for (obj, _, driver), found, mine in zip(items, taken, at):
+                j = mine.get(k)
+                if j is not None:
+                    found[j] = carried_matrix(obj, driver)
+    finally:
+        scene.frame_set(frame, subframe=subframe)
+    out = []
+    for (obj, _, _), found in zip(items, taken):
+        poses, scales = [], []
+        for matrix in found:
+            loc, rot, scale = Matrix(matrix.tolist()).decompose()
+            poses.append(np.array(Matrix.LocRotScale(loc, rot, None)))
+            scales.append(np.array(scale))
+        scales = np.array(scales)
+        _check_scale(obj.name, scales)
+        out.append((np.array(poses), scales[0]))
+    return out
+
+
 def world_poses(
     obj: bpy.types.Object, scene: bpy.types.Scene, frames: np.ndarray, driver: BoneDriver | None = None
 ) -> tuple[np.ndarray, np.ndarray]:
     """Rigid world poses (N, 4, 4) of `obj` (carried by `driver`, see :func:`carried_matrix`)
     at `frames` and its world scale (3,), which must stay constant (a swept region is for
-    rigid motion)."""
-    frame, subframe = scene.frame_current, scene.frame_subframe
-    poses, scales = [], []
-    try:
-        for f in frames:
-            whole = math.floor(f)
-            scene.frame_set(whole, subframe=float(f - whole))
-            loc, rot, scale = Matrix(carried_matrix(obj, driver).tolist()).decompose()
-            poses.append(np.array(Matrix.LocRotScale(loc, rot, None)))
-            scales.append(np.array(scale))
-    finally:
-        scene.frame_set(frame, subframe=subframe)
-    scales = np.array(scales)
-    spread = np.abs(scales - scales[0]).max()
-    if spread > SCALE_TOLERANCE * max(1.0, np.abs(scales).max()):
-        raise SweepError(f"{obj.name}: its scale changes over the frame range (not a rigid motion)")
-    return np.array(poses), scales[0]
+    rigid motion): :func:`world_poses_all` of one object."""
+    return world_poses_all([(obj, np.asarray(frames, dtype=np.float64), driver)], scene)[0]
 
 
 def compute(
@@ -317,26 +606,52 @@ def compute(
     fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
     bounding radius; 0: exactly `steps`). `read`: a dict kept over one run of several objects
     (the key frames read so far: each curve is read once, :func:`_key_frames`)."""
+    return compute_all([obj], context, steps, caps, tolerance, read)[0]
+
+
+def compute_all(
+    objects: list[bpy.types.Object],
+    context: bpy.types.Context,
+    steps: int,
+    caps: bool,
+    tolerance: float | None = None,
+    read: dict | None = None,
+) -> list[Swept]:
+    """:func:`compute` of every object of `objects`, their world poses read together
+    (:func:`world_poses_all`: the curves evaluated in one call where they alone move the
+    objects, else one `frame_set` per frame for all)."""
     scene = context.scene
-    if obj.type != "MESH":
-        raise SweepError(f"{obj.name}: not a mesh object")
-    driver = bone_driver(obj)
-    verts, tris = body_mesh(obj, context.evaluated_depsgraph_get())
-    if driver is not None and driver.deformed:
-        # The evaluated mesh is deformed by the bone's current pose: back into the frame the
-        # bone carries, `C^-1 O v` (C: carried_matrix now, O: the mesh's world matrix).
-        to_body = np.linalg.inv(carried_matrix(obj, driver)) @ np.array(obj.matrix_world, dtype=np.float64)
-        verts = verts @ to_body[:3, :3].T + to_body[:3, 3]
-    frames = motion_frames(obj, scene, driver, read)
-    if len(frames) < 2:
-        raise SweepError(f"{obj.name}: the frame range has a single frame; a motion needs two poses")
-    poses, scale = world_poses(obj, scene, frames, driver)
-    start = time.perf_counter()
-    try:
-        v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
-    except ValueError as err:
-        raise SweepError(f"{obj.name}: {err}") from err
-    return Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"])
+    read = {} if read is None else read
+    prepared = []
+    for obj in objects:
+        if obj.type != "MESH":
+            raise SweepError(f"{obj.name}: not a mesh object")
+        driver = bone_driver(obj)
+        verts, tris = body_mesh(obj, context.evaluated_depsgraph_get())
+        if driver is not None and driver.deformed:
+            # The evaluated mesh is deformed by the bone's current pose: back into the frame the
+            # bone carries, `C^-1 O v` (C: carried_matrix now, O: the mesh's world matrix).
+            to_body = np.linalg.inv(carried_matrix(obj, driver)) @ np.array(obj.matrix_world, dtype=np.float64)
+            verts = verts @ to_body[:3, :3].T + to_body[:3, 3]
+        prepared.append((obj, driver, verts, tris))
+    # The curves evaluated for the poses are read first: their key frames serve motion_frames.
+    plan = _plan([(obj, driver) for obj, driver, _, _ in prepared], scene, read, True)
+    items = []
+    for obj, driver, _, _ in prepared:
+        frames = motion_frames(obj, scene, driver, read)
+        if len(frames) < 2:
+            raise SweepError(f"{obj.name}: the frame range has a single frame; a motion needs two poses")
+        items.append((obj, frames, driver))
+    posed = world_poses_all(items, scene, read, plan=plan)
+    out = []
+    for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
+        start = time.perf_counter()
+        try:
+            v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
+        except ValueError as err:
+            raise SweepError(f"{obj.name}: {err}") from err
+        out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"]))
+    return out
 
 
 def collection(scene: bpy.types.Scene, t: transaction.Transaction | None = None) -> bpy.types.Collection:

@@ -217,10 +217,11 @@ def refresh(scene: bpy.types.Scene) -> bool:
     auto = auto_keying(scene)
     keep = set()
     memo: dict = {}  # the keys read in this refresh: each curve read once (shared actions too)
-    for obj in objects:
-        for owner, curves in owners_with_curves(obj, scene):
-            changed = CACHE.refresh(owner, options, frame, auto, curves, memo)[1] or changed
-            keep.add(preview.cache_key(owner))
+    pairs = [pair for obj in objects for pair in owners_with_curves(obj, scene)]
+    preview.read_together(pairs, memo)  # every owner's curves in one pass
+    for owner, curves in pairs:
+        changed = CACHE.refresh(owner, options, frame, auto, curves, memo)[1] or changed
+        keep.add(preview.cache_key(owner))
     CACHE.forget(keep)
     for uid in [u for u in _gpu_batches if u not in keep]:
         del _gpu_batches[uid]

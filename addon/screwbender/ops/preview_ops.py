@@ -163,13 +163,20 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         selection = _key_owners(context)
         results = []
         errors = []
+        grouped: dict = {}  # object -> its transform curves by owner: one pass over each action
+        known: dict = {}  # the keys read (and keyed) so far: each curve read once per run
 
         def work(progress: pipeline.Progress) -> None:
             with transaction.atomic() as t:  # a failure takes back every key inserted so far
                 for owner in selection:  # an owner that cannot be smoothed is skipped unchanged
+                    by_owner = grouped.get(owner.obj.as_pointer())
+                    if by_owner is None:
+                        by_owner = owners.curves_by_owner(channels.object_fcurves(owner.obj))
+                        grouped[owner.obj.as_pointer()] = by_owner
                     try:
                         with transaction.atomic(t) as one:
-                            results.append((owner, insert_key.insert_key(owner, frame, options, one)))
+                            results.append((owner, insert_key.insert_key(
+                                owner, frame, options, one, by_owner.get(owner.bone, []), known)))
                     except SmoothError as err:
                         errors.append(str(err))
 

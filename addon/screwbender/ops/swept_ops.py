@@ -83,7 +83,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         def work(progress: pipeline.Progress) -> tuple[list, list, list]:
             tolerance = self.tolerance if self.tolerance > 0.0 else None
             read: dict = {}  # each key curve read once, also when meshes share an action or a rig
-            computed = [swept.compute(o, context, self.steps, self.caps, tolerance, read) for o in objects]
+            computed = swept.compute_all(objects, context, self.steps, self.caps, tolerance, read)
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, self.closed, self.voxel_size, t) for s in computed]
                 # Area, volume (a closed result) and the tolerance met, on each new object.

@@ -30,6 +30,7 @@ Remove Noise is for dense keys (a capture: a key every frame or so). The rules, 
 from __future__ import annotations
 
 import numpy as np
+import polyscrew
 
 #: Auto Strength (and sparse keys, whatever the strength) need at least this many keys in
 #: the frame range (GCV of a third-order spline has n - 3 degrees of freedom to tell noise
@@ -90,37 +91,6 @@ def blocked(name: str, spacing: float, rotation_noise: float, translation_noise:
     return None
 
 
-def _log(r: np.ndarray) -> np.ndarray:
-    """Rotation vectors of rotation matrices (n, 3, 3) -> (n, 3)."""
-    cos = np.clip((np.trace(r, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(cos)
-    w = np.stack([r[:, 2, 1] - r[:, 1, 2], r[:, 0, 2] - r[:, 2, 0], r[:, 1, 0] - r[:, 0, 1]], axis=1)
-    sin = np.sin(angle)
-    scale = np.where(sin > 1e-12, angle / (2.0 * np.where(sin > 1e-12, sin, 1.0)), 0.5)
-    return w * scale[:, None]
-
-
-def _exp(v: np.ndarray) -> np.ndarray:
-    """Rotation matrices of rotation vectors (n, 3) (Rodrigues)."""
-    angle = np.linalg.norm(v, axis=1)
-    safe = np.where(angle > 0.0, angle, 1.0)
-    k = v / safe[:, None]
-    kx = np.zeros((len(v), 3, 3))
-    kx[:, 0, 1], kx[:, 0, 2], kx[:, 1, 2] = -k[:, 2], k[:, 1], -k[:, 0]
-    kx -= kx.transpose(0, 2, 1)
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * kx + (1.0 - c) * (kx @ kx)
-
-
-def moves(source: np.ndarray, smoothed: np.ndarray, pivot: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """How far each pose moved: the rotation angle (radians) and the distance of the pivot
-    point (body coordinates) between `source` and `smoothed` (n, 4, 4)."""
-    rel = smoothed[:, :3, :3] @ source[:, :3, :3].transpose(0, 2, 1)
-    angle = np.linalg.norm(_log(rel), axis=1)
-    at = lambda m: m[:, :3, :3] @ pivot + m[:, :3, 3]  # noqa: E731
-    return angle, np.linalg.norm(at(smoothed) - at(source), axis=1)
-
-
 def limit_moves(
     source: np.ndarray, smoothed: np.ndarray, pivot: np.ndarray, rotation_bound: float, translation_bound: float
 ) -> tuple[np.ndarray, int]:
@@ -128,24 +98,6 @@ def limit_moves(
     (a rotation angle, radians; a distance of the pivot point) drawn back towards its source
     pose by the fraction a that brings both within them: the rotation by a of its turn
     (about the same axis), the pivot a of the way along its straight move. Returns the poses
-    and how many were drawn back."""
-    angle, distance = moves(source, smoothed, pivot)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        a = np.minimum.reduce([
-            np.ones(len(angle)),
-            np.where(angle > rotation_bound, rotation_bound / angle, 1.0),
-            np.where(distance > translation_bound, translation_bound / distance, 1.0),
-        ])
-    limited = a < 1.0
-    out = smoothed.copy()
-    if not limited.any():
-        return out, 0
-    s, m = source[limited], smoothed[limited]
-    k = a[limited]
-    turn = _log(m[:, :3, :3] @ s[:, :3, :3].transpose(0, 2, 1))
-    rot = _exp(turn * k[:, None]) @ s[:, :3, :3]
-    p0 = s[:, :3, :3] @ pivot + s[:, :3, 3]
-    p1 = m[:, :3, :3] @ pivot + m[:, :3, 3]
-    out[limited, :3, :3] = rot
-    out[limited, :3, 3] = p0 + k[:, None] * (p1 - p0) - rot @ pivot
-    return out, int(limited.sum())
+    and how many were drawn back (one `polyscrew.partial_moves` call)."""
+    poses, limited = polyscrew.partial_moves(source, smoothed, pivot, rotation_bound, translation_bound)
+    return poses, int(limited.sum())

@@ -16,22 +16,12 @@ import polyscrew
 
 from . import intent
 
-#: Rotation modes and the property holding the rotation in each.
-ROTATION_PATHS = {
-    "QUATERNION": "rotation_quaternion",
-    "AXIS_ANGLE": "rotation_axis_angle",
-    "XYZ": "rotation_euler",
-    "XZY": "rotation_euler",
-    "YXZ": "rotation_euler",
-    "YZX": "rotation_euler",
-    "ZXY": "rotation_euler",
-    "ZYX": "rotation_euler",
-}
-
+#: Rotation modes and the property holding the rotation in each (the core's table,
+#: `polyscrew.ROTATION_MODES`: name -> (property, width)).
+ROTATION_PATHS = {mode: prop for mode, (prop, _) in polyscrew.ROTATION_MODES.items()}
 
 #: Two key frames closer than this (in frames) are the same frame.
 FRAME_TOLERANCE = 1e-4
-
 
 #: A last key whose pose and scale differ from the first by less than this (per matrix entry,
 #: relative to the motion's size) repeats the first pose: it closes a cyclic motion's period.
@@ -118,6 +108,11 @@ def rotation_path(mode: str) -> str:
     return ROTATION_PATHS[mode]
 
 
+def rotation_width(mode: str) -> int:
+    """How many channels the rotation has in mode `mode` (4 or 3)."""
+    return polyscrew.ROTATION_MODES[mode][1]
+
+
 def transform_paths(mode: str) -> tuple[str, str, str]:
     """Location, rotation (for `mode`) and scale property names."""
     return ("location", rotation_path(mode), "scale")
@@ -128,7 +123,7 @@ def baked_channels(mode: str, located: bool, scale_axes: np.ndarray) -> list[tup
     false), every rotation channel of `mode`, the keyed scale axes."""
     rotation = rotation_path(mode)
     out = [("location", i) for i in range(3)] if located else []
-    out += [(rotation, i) for i in range(4 if mode in ("QUATERNION", "AXIS_ANGLE") else 3)]
+    out += [(rotation, i) for i in range(rotation_width(mode))]
     return out + [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
 
 
@@ -235,8 +230,7 @@ def key_motion(
         # Shortest: typed turns whose short screw turns less far than Blender's playback
         shortened = np.zeros(len(held), dtype=bool)
         if turns == "SHORTEST":
-            relative = np.einsum("nji,njk->nik", poses[:-1, :3, :3], poses[1:, :3, :3])
-            short = np.arccos(np.clip((np.trace(relative, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0))
+            short = np.linalg.norm(polyscrew.turn_vectors(poses[:-1], poses[1:]), axis=1)
             longer = (turn > intent.WIND_LIMIT) & (turn > short + intent.WRAP_MARGIN)
             shortened = ~held & longer & ~flips
         spans = np.stack([frames[:-1], frames[1:]], axis=1)

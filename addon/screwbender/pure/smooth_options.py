@@ -8,7 +8,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 #: Subdivision schemes: (identifier, label, description).
-#: (The strays are measured by scripts/measure_schemes.py: the demo scene and 20 random keyed
+#: (The strays are measured by scripts/bench/measure_schemes.py: the demo scene and 20 random keyed
 #: motions spanning about 6 units, at 4 levels.)
 SCHEMES = (
     ("four_point", "4-Point", "Interpolating (the default): the motion passes through every key pose exactly (C1)"),

@@ -182,13 +182,21 @@ pub fn wrong_type(message: String) -> PyErr {
     raise(Kind::WrongType, message)
 }
 
-/// The one place a core error becomes a Python exception, with the function's name:
-/// `OutOfMemory` when the allocator refused memory within the budget, `BudgetExceeded` for a
-/// request over the budget, `InvalidArgument` for every other error.
+/// The one place a core error becomes a Python exception, with the function's name: the
+/// class from what went wrong (under any [`Error::In`] layers naming the entry), the message
+/// the core's, after `"{function}: "`.
+///
+/// | core error | class |
+/// | --- | --- |
+/// | [`Error::Memory`] with no budget (the allocator refused within it) | `OutOfMemory` |
+/// | [`Error::Memory`] over the budget | `BudgetExceeded` |
+/// | [`Error::FitFailed`] | `FitFailed` |
+/// | every other variant (a value, range, shape, count, choice, limit) | `InvalidArgument` |
 pub fn to_py_err(function: &str, err: Error) -> PyErr {
-    let kind = match err {
+    let kind = match err.innermost() {
         Error::Memory { budget: None, .. } => Kind::OutOfMemory,
         Error::Memory { .. } => Kind::Budget,
+        Error::FitFailed { .. } => Kind::FitFailed,
         _ => Kind::Invalid,
     };
     raise(kind, format!("{function}: {err}"))

@@ -538,6 +538,10 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // stub: CYCLE_MODES: tuple[CycleModeName, ...]
     // stub: """Blender's ``FModifierCycles.mode_before`` / ``mode_after`` identifiers."""
     m.add("CYCLE_MODES", PyTuple::new(py, CycleMode::NAMES)?)?;
+    // stub: CYCLES_PROPERTIES: tuple[str, ...]
+    // stub: """The keys a Cycles settings dict of ``evaluate_fcurves`` may hold: the RNA property names of
+    // stub: Blender's ``FModifierCycles`` it reads."""
+    m.add("CYCLES_PROPERTIES", PyTuple::new(py, CYCLES_KEYS)?)?;
     // stub: MAX_FCURVE_KEYS: int
     // stub: """The most keys one ``evaluate_fcurves`` call accepts (2**26)."""
     m.add("MAX_FCURVE_KEYS", MAX_KEYS)?;

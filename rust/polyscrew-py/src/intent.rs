@@ -136,13 +136,8 @@ impl PyPlayback {
                 let index = usize::try_from(*index).map_err(|_| {
                     crate::errors::invalid(format!("{F}: channels[{c}]: index {index} is negative"))
                 })?;
-                Channel::from_property(property, index, mode).map_err(|e| {
-                    let reason = match e {
-                        Error::Invalid { reason, .. } => reason,
-                        e => e.to_string(),
-                    };
-                    crate::errors::invalid(format!("{F}: channels[{c}]: {reason}"))
-                })
+                Channel::from_property(property, index, mode)
+                    .map_err(|e| crate::errors::to_py_err(&format!("{F}: channels[{c}]"), e))
             })
             .collect::<PyResult<Vec<_>>>()?;
         let unkeyed = float_array(F, "unkeyed", unkeyed)?;

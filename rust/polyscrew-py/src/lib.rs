@@ -78,7 +78,8 @@ where
 /// - times (key times, sample times, the end of a period) within ``+-MAX_TIME`` (1e300), key
 ///   times at least 1e-300 apart: the time map only takes differences, ratios and the
 ///   reciprocal of two spacings.
-/// - ``fit_angular_velocity``: times within +-1e30, key times at least 1e-30 apart, target
+/// - ``fit_angular_velocity``: times within +-1e30 (the tenth root of ``MAX_TIME``: the fit
+///   multiplies up to about ten such factors in one product), key times at least 1e-30 apart, target
 ///   angular velocities and speeds within +-1e30, ``alpha`` in 0..=1e30, at most 1,000,000
 ///   fragments, ``max_iterations`` in 1..=1,000,000, ``max_frames`` in 0..=1,000,000
 ///   (``q''`` of a Hermite segment grows like ``1 / h^2`` and ``omega / h``: in these ranges
@@ -105,7 +106,7 @@ where
 /// ``rotation_channels`` 56 per rotation (Euler); ``sweep`` 48 per output vertex and 36 per
 /// output triangle (checked before each screw's quads are added) plus 320 per body triangle;
 /// ``feature_motion`` 640 per output pose; ``denoise`` 1,792 per pose (its scratch measured at
-/// 1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/memory_footprints.py`` prints the
+/// 1,500). Any argument that is not float64 adds 8 bytes per entry, its converted copy. ``scripts/bench/memory_footprints.py`` prints the
 /// estimates beside the peaks measured for the largest uses (all below 160 MB).
 ///
 /// The module releases the GIL while it reads its input, computes and builds its output.

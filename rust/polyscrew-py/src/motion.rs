@@ -3,21 +3,23 @@
 
 use glam::{DQuat, DVec3};
 use numpy::ndarray::{Array2, Array3, ArrayViewD, Ix3};
-use numpy::{IntoPyArray, PyArray2, PyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::motion::sample::sample_footprint;
 use polyscrew::motion::screw::MAX_T;
 use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
+    channels_near as core_channels_near, partial_moves as core_partial_moves,
     rotation_channels as core_rotation_channels, sample as core_sample,
-    subdivide as core_subdivide, subdivided_len, Error, Pose, RotationMode, Scheme, Screw, Timing,
-    MAX_LEVELS,
+    subdivide as core_subdivide, subdivided_len, turn_vectors as core_turn_vectors, Error,
+    MoveBounds, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
 };
 use pyo3::prelude::*;
 
 use crate::args::{
-    self, copy_of, float_array, Choice, FloatArg, FloatArray, Function, RotationChannels, Sample,
-    SampleChannels, SampleVectors, Subdivide, SubdivideVectors,
+    self, copy_of, float_array, Choice, FloatArg, FloatArray, Function, PartialMoves,
+    RotationChannels, RotationChannelsNear, Sample, SampleChannels, SampleVectors, Subdivide,
+    SubdivideVectors, TurnVectors,
 };
 use crate::arrays::{
     fill, key_count, pose_count, poses_to_array, read_keys, read_one_pose, read_poses, read_spec,
@@ -135,7 +137,7 @@ fn check_t(index: usize, t: f64) -> Result<(), Error> {
             what: "t",
             index,
             value: t,
-            range: "+-1e12",
+            limit: MAX_T,
         })
     } else {
         Err(Error::NotFinite { what: "t", index })
@@ -682,6 +684,162 @@ fn rotation_channels<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// rotation_channels_near(
+///     rotations: ArrayLike, mode: RotationModeName, reference: ArrayLike
+/// ) -> FloatArray
+///
+/// Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), each written like
+/// its own row of ``reference`` ((N, 4) or (N, 3) values in ``mode``, for example the keys
+/// an animator typed) rather than continued from the row before: quaternions take the
+/// reference's sign; axis-angle the axis pointing the reference's way and the angle within
+/// half a turn of its angle; Euler angles the one of the two triples of the rotation, each
+/// wrapped by whole turns towards the reference, that is nearer to it. Spins and deliberate
+/// sign flips of the reference are kept. Reference angles within ``+-MAX_PREVIOUS_ANGLE``.
+#[pyfunction]
+fn rotation_channels_near<'py>(
+    py: Python<'py>,
+    rotations: &Bound<'py, PyAny>,
+    mode: Choice<RotationChannelsNear, RotationMode>,
+    reference: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const F: &str = RotationChannelsNear::NAME;
+    let mode = mode.0;
+    let rotations = float_array(F, "rotations", rotations)?;
+    let reference = float_array(F, "reference", reference)?;
+    let n = rotations.shape().first().copied().unwrap_or(0);
+    let width = mode.width();
+    if reference.shape() != [n, width] {
+        return Err(shape_err(
+            F,
+            "reference",
+            &format!("({n}, {width})"),
+            reference.shape(),
+        ));
+    }
+    check_budget(
+        F,
+        rotations.copy()
+            + reference.copy()
+            + Footprint::of::<DQuat>(n)
+            + Footprint::of::<f64>(n.saturating_mul(width).saturating_mul(2)),
+        "the rotation channels",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(F, e))?;
+    let (rotations, reference) = (rotations.read()?, reference.read()?);
+    let (view, rv) = (rotations.as_array(), reference.as_array());
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let quats = read_rotations(F, &view)?;
+        let mut values =
+            try_vec(n.saturating_mul(width), "reference values").map_err(|e| to_py_err(F, e))?;
+        values.extend(rv.iter().copied());
+        let channels = core_channels_near(&quats, mode, &values).map_err(|e| to_py_err(F, e))?;
+        Array2::from_shape_vec((n, width), channels).map_err(|e| invalid(format!("{F}: {e}")))
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
+/// turn_vectors(a: ArrayLike, b: ArrayLike) -> FloatArray
+///
+/// The turn from each rotation of ``a`` to the same row of ``b`` ((N, 3, 3) or (N, 4, 4)
+/// each), in the world frame: (N, 3) rotation vectors ``log(R_b R_a^T)``, axis times angle,
+/// the angle (their length) in [0, pi], exact near 0 and near pi (``atan2`` of the relative
+/// quaternion, not ``arccos`` of a trace). At most ``MAX_ROTATIONS`` rows.
+#[pyfunction]
+fn turn_vectors<'py>(
+    py: Python<'py>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const F: &str = TurnVectors::NAME;
+    let (a, b) = (float_array(F, "a", a)?, float_array(F, "b", b)?);
+    let n = a.shape().first().copied().unwrap_or(0);
+    check_budget(
+        F,
+        a.copy()
+            + b.copy()
+            + Footprint::of::<DQuat>(n.saturating_mul(2))
+            + Footprint::of::<DVec3>(n.saturating_mul(2)),
+        "the turn vectors",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(F, e))?;
+    let (a, b) = (a.read()?, b.read()?);
+    let (av, bv) = (a.as_array(), b.as_array());
+    let out = py.detach(|| -> PyResult<Array2<f64>> {
+        let (qa, qb) = (read_rotations(F, &av)?, read_rotations(F, &bv)?);
+        core_turn_vectors(&qa, &qb)
+            .and_then(|v| vec3s_to_array(&v))
+            .map_err(|e| to_py_err(F, e))
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
+/// The poses of [`partial_moves`] and which were cut short.
+type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// partial_moves(
+///     source: ArrayLike, target: ArrayLike, pivot: ArrayLike, max_angle: float,
+///     max_distance: float
+/// ) -> tuple[FloatArray, npt.NDArray[np.bool_]]
+///
+/// Each pose of ``target`` ((N, 4, 4)), or where its straight move from the same row of
+/// ``source`` turns by more than ``max_angle`` (radians) or carries the point ``pivot`` (3,
+/// body coordinates) further than ``max_distance``, the pose the fraction ``a`` of the way
+/// there that brings both within them: ``a = min(1, max_angle / angle, max_distance /
+/// distance)``, the rotation ``a`` of the turn about the same axis, the pivot ``a`` of the
+/// way along its straight move (not a screw's helix). Returns the poses and which were cut
+/// short. Bounds at least 0 (``inf``: no bound).
+#[pyfunction]
+fn partial_moves<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    target: &Bound<'py, PyAny>,
+    pivot: &Bound<'py, PyAny>,
+    max_angle: &Bound<'py, PyAny>,
+    max_distance: &Bound<'py, PyAny>,
+) -> PyResult<MovedPoses<'py>> {
+    const F: &str = PartialMoves::NAME;
+    let bounds = MoveBounds {
+        angle: args::float_scalar(F, "max_angle", max_angle)?,
+        distance: args::float_scalar(F, "max_distance", max_distance)?,
+    };
+    let source = float_array(F, "source", source)?;
+    let target = float_array(F, "target", target)?;
+    let pivot = float_array(F, "pivot", pivot)?;
+    if pivot.shape() != [3] {
+        return Err(shape_err(F, "pivot", "(3,)", pivot.shape()));
+    }
+    for (what, poses) in [("source", &source), ("target", &target)] {
+        if !matches!(poses.shape(), [_, 4, 4]) {
+            return Err(shape_err(F, what, "(N, 4, 4)", poses.shape()));
+        }
+    }
+    let n = source.shape()[0];
+    check_budget(
+        F,
+        source.copy()
+            + target.copy()
+            + pivot.copy()
+            + Footprint::of::<Pose>(n.saturating_mul(3))
+            + Footprint::of::<bool>(n)
+            + Footprint::of::<[f64; 16]>(n),
+        "the partial moves",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    let (source, target, pivot) = (source.read()?, target.read()?, pivot.read()?);
+    let (sv, tv, pv) = (source.as_array(), target.as_array(), pivot.as_array());
+    let (poses, cut) = py.detach(|| -> PyResult<(Array3<f64>, Vec<bool>)> {
+        let source = read_poses(F, "source", &sv)?;
+        let target = read_poses(F, "target", &tv)?;
+        let p = DVec3::new(pv[0], pv[1], pv[2]);
+        let (poses, cut) =
+            core_partial_moves(&source, &target, p, bounds).map_err(|e| to_py_err(F, e))?;
+        Ok((poses_to_array(&poses).map_err(|e| to_py_err(F, e))?, cut))
+    })?;
+    Ok((poses.into_pyarray(py), cut.into_pyarray(py)))
+}
+
 /// memory_budget() -> int
 ///
 /// The memory budget in bytes: the most one call may hold at its peak (output, working
@@ -714,6 +872,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(subdivide_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
+    m.add_function(wrap_pyfunction!(rotation_channels_near, m)?)?;
+    m.add_function(wrap_pyfunction!(turn_vectors, m)?)?;
+    m.add_function(wrap_pyfunction!(partial_moves, m)?)?;
     m.add_function(wrap_pyfunction!(memory_budget, m)?)?;
     m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
     // stub:
@@ -733,7 +894,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_COORDINATE", polyscrew::motion::pose::MAX_COORDINATE)?;
     // stub:
     // stub: MAX_TIME: float
-    // stub: """The working range of times outside ``fit_angular_velocity``: ``|t| <= 1e300``."""
+    // stub: """The one working range of times: ``|t| <= 1e300`` (``fit_angular_velocity``, which
+    // stub: multiplies times, works within its tenth root, ``|t| <= 1e30``)."""
     m.add("MAX_TIME", polyscrew::motion::timing::MAX_TIME)?;
     // stub:
     // stub: MAX_PREVIOUS_ANGLE: float
@@ -747,5 +909,16 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     // stub: time (a few seconds of one core) whatever the budget; more raise ``ValueError`` before any
     // stub: is read."""
     m.add("MAX_ROTATIONS", polyscrew::MAX_ROTATIONS)?;
+    // stub:
+    // stub: ROTATION_MODES: dict[str, tuple[str, int]]
+    // stub: """Blender's rotation modes, the core's: name -> (the property holding the rotation, the
+    // stub: number of its channels), in Blender's order: ``"QUATERNION"`` -> ``("rotation_quaternion",
+    // stub: 4)``, ``"AXIS_ANGLE"`` -> ``("rotation_axis_angle", 4)``, each Euler order (``"XYZ"``, ...)
+    // stub: -> ``("rotation_euler", 3)``."""
+    let modes = pyo3::types::PyDict::new(m.py());
+    for mode in RotationMode::ALL {
+        modes.set_item(mode.name(), (mode.property(), mode.width()))?;
+    }
+    m.add("ROTATION_MODES", modes)?;
     Ok(())
 }

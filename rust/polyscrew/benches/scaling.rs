@@ -2,7 +2,7 @@
 //! 1 ..= 8 levels, for each scheme, in thread CPU time (`common::CpuTime`).
 //!
 //! Each benchmark is `scaling/<scheme>/<keys>x<levels>` with its output size (poses) as the
-//! throughput, so `scripts/bench_report.py` reads poses per second and fits the growth
+//! throughput, so `scripts/bench/bench_report.py` reads poses per second and fits the growth
 //! exponent of time against output size (log-log least squares) from criterion's JSON.
 //! Combinations above [`MAX_OUTPUT`] poses are skipped (none are at 10,000 keys x 8 levels =
 //! 2,560,000 poses; the bound keeps the run short if the grid is widened).

@@ -20,10 +20,25 @@
 //! | [`fcurve`] | Blender's F-curve evaluation (keys, easing, extrapolation, Cycles), exact and in batches | Blender's `fcurve.cc`, `easing.cc` |
 //! | [`intent`] | what the animator meant between the keys: Blender's playback of an owner's channels, holds, pops, spins, the pace of timing "Keys" | ScrewBender issue 17 |
 //! | [`reduce`](mod@reduce) | key reduction: the fewest Bezier keys whose Blender playback stays within a world-space tolerance | ScrewBender issue 26 |
-//! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, banded solvers | |
+//! | `numeric` (private) | sin/cos and lanes for `s`, small eigenproblems, one banded solver (`L D L^T`, scalar or 3x3-block entries, a cyclic border on top) | |
 //!
 //! Beside them, [`error`] holds the one error type and [`memory`] the memory rule: every
 //! allocation whose size depends on input is checked against one budget before it is made.
+//!
+//! One home for each rule: the rotation modes are [`RotationMode`]'s
+//! ([`motion::channels`]: the list [`RotationMode::ALL`], Blender's names, properties and
+//! widths, channel values to matrices ([`motion::channels::rotation_matrix`]), matrices to
+//! continuous channels ([`rotation_channels`]) or to channels written like a reference
+//! ([`channels_near`]: quaternion signs, Euler twins, whole turns)); the turn between two
+//! orientations and a move cut short are [`motion::moves`]'; the Python module exposes them
+//! (`ROTATION_MODES`, `rotation_matrices`, `rotation_channels`, `rotation_channels_near`,
+//! `turn_vectors`, `partial_moves`) and the add-on calls them. Adding a rotation mode touches
+//! `motion/channels.rs` (its variant, [`RotationMode::ALL`], the name, property and width
+//! matches, the three conversions) and the binding's `lib.rs` (the `RotationModeName` literal
+//! of the generated stub). Adding a timing mode like [`Timing::Smooth`] or [`Timing::Linear`]
+//! touches `motion/timing.rs` (the variant, [`Timing::from_name`], the slopes of
+//! [`TimeMap`]), the binding's `lib.rs` (`TimingName`) and the add-on's option list
+//! (`bake_ops.py`); timing "Keys" is still its own path ([`intent::keys_parameters`]).
 //!
 //! What users reach for is re-exported here.
 //!
@@ -56,11 +71,11 @@ pub mod reduce;
 pub mod sweep;
 
 pub use angular_velocity::{
-    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitFailure, FitOptions,
-    FitStatus, QuatJet, QuatSpline,
+    fit_angular_velocity, AngularVelocityFit, AngularVelocityTarget, FitOptions, FitStatus,
+    QuatJet, QuatSpline,
 };
 pub use denoise::{denoise, denoise_batch, DenoiseOptions, Denoised, Strength};
-pub use error::{Error, PoseDefect, Result};
+pub use error::{At, Error, Expected, PoseDefect, Result};
 pub use fcurve::{
     evaluate_fcurves, CycleMode, Cycles, Easing, Extrapolation, FCurve, Interpolation, Key,
     PackedCurves,
@@ -80,8 +95,9 @@ pub use intent::{
 };
 pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{
-    rotation_channels, EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
+    channels_near, rotation_channels, EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
 };
+pub use motion::moves::{partial_moves, turn_vectors, MoveBounds};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};
 pub use motion::screw::{midpoint, s, s_many, Screw};

@@ -36,7 +36,7 @@ use crate::error::{Error, Result};
 ///
 /// The largest uses the project has need at most about 215 MB by their estimates: 10,000
 /// keys x 8 levels of subdivision in Rust (the scaling benchmark, 215 MB); through Python
-/// (`scripts/memory_footprints.py`, estimate and measured peak) a 100,000-triangle sweep
+/// (`scripts/bench/memory_footprints.py`, estimate and measured peak) a 100,000-triangle sweep
 /// over 64 screws in 8 steps (154 and 118 MB), 1,000 keys x 8 levels of subdivision (54 and
 /// 47 MB), a 100,000-frame bake (18 and 12 MB). The budget leaves 5 times that; the requests
 /// the issue reported aborting asked for 5.6 to 87 GB. Raise it with [`set_memory_budget`]

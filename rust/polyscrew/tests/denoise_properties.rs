@@ -6,7 +6,9 @@
 
 use glam::{DQuat, DVec3};
 use polyscrew::denoise::{MAX_DENOISE_BATCH, MAX_DENOISE_POSES};
-use polyscrew::{denoise, denoise_batch, DenoiseOptions, Error, Pose, PoseDefect, Strength};
+use polyscrew::{
+    denoise, denoise_batch, DenoiseOptions, Error, Expected, Pose, PoseDefect, Strength,
+};
 use proptest::prelude::*;
 
 /// Deterministic pseudo-random numbers in [-1, 1) (xorshift).
@@ -362,7 +364,8 @@ fn bad_input_is_an_error() {
         let bad = DenoiseOptions { order, ..o };
         assert!(matches!(
             denoise(&poses, &times, None, &bad),
-            Err(Error::Invalid { what: "order", .. })
+            Err(Error::Value { what: "order", value, expected: Expected::OneOf(_), .. })
+                if value == order as f64
         ));
     }
     for s in [-1.0, f64::NAN, f64::INFINITY] {
@@ -375,8 +378,9 @@ fn bad_input_is_an_error() {
         };
         assert!(matches!(
             denoise(&poses, &times, None, &bad),
-            Err(Error::Invalid {
+            Err(Error::Value {
                 what: "strength",
+                expected: Expected::NonNegative(_),
                 ..
             })
         ));
@@ -385,15 +389,21 @@ fn bad_input_is_an_error() {
     let long = vec![0.0; MAX_DENOISE_POSES + 1];
     assert!(matches!(
         denoise_batch(&[], 1, &long, None, &o, 1),
-        Err(Error::Invalid { what: "poses", .. })
+        Err(Error::Limit { count, limit: MAX_DENOISE_POSES, .. }) if count == MAX_DENOISE_POSES + 1
     ));
     assert!(matches!(
         denoise_batch(&[], usize::MAX / 2, &times, None, &o, 1),
-        Err(Error::Invalid { what: "poses", .. })
+        Err(Error::Limit {
+            limit: MAX_DENOISE_BATCH,
+            ..
+        })
     ));
     assert!(matches!(
         denoise_batch(&[], MAX_DENOISE_BATCH / 50 + 1, &times, None, &o, 1),
-        Err(Error::Invalid { what: "poses", .. })
+        Err(Error::Limit {
+            limit: MAX_DENOISE_BATCH,
+            ..
+        })
     ));
     assert!(matches!(
         denoise_batch(&poses, 2, &times, None, &o, 1),
@@ -408,7 +418,7 @@ fn bad_input_is_an_error() {
     ));
     assert!(matches!(
         denoise_batch(&[], 0, &times, None, &DenoiseOptions { order: 5, ..o }, 1),
-        Err(Error::Invalid { what: "order", .. })
+        Err(Error::Value { what: "order", .. })
     ));
     assert!(denoise_batch(&[], 0, &times, None, &o, 1)
         .unwrap()
@@ -420,7 +430,7 @@ fn bad_input_is_an_error() {
         .collect();
     assert!(matches!(
         denoise(&huge, &times, None, &o),
-        Err(Error::Invalid { what: "poses", .. })
+        Err(Error::Overflow { what: "poses", .. })
     ));
     // Times in any unit (issue 28: these were refused, the work is now in a normalised
     // time): spaced 1e-120 apart, the result of times spaced 1 apart, strengths scaled.

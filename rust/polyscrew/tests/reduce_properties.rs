@@ -10,7 +10,8 @@
 use glam::{DMat3, DQuat, DVec3};
 use polyscrew::reduce::{ReduceInput, ReduceOptions, Reduced, Tolerance};
 use polyscrew::{
-    reduce_keys, rotation_matrix, s, Error, Extrapolation, FCurve, Group, Key, Pose, RotationMode,
+    reduce_keys, rotation_matrix, s, At, Error, Expected, Extrapolation, FCurve, Group, Key, Pose,
+    RotationMode,
 };
 use proptest::prelude::*;
 
@@ -336,19 +337,24 @@ fn bad_input_is_an_error() {
     let bad = |inp: ReduceInput<'_>, o: ReduceOptions| reduce_keys(&inp, &o).unwrap_err();
     assert!(matches!(
         bad(base, options(0.0, 1.0)),
-        Error::Invalid {
+        Error::Value {
             what: "distance",
+            expected: Expected::Positive(_),
             ..
         }
     ));
     assert!(matches!(
         bad(base, options(1.0, f64::NAN)),
-        Error::Invalid { what: "angle", .. }
+        Error::Value { what: "angle", .. }
     ));
     let back: Vec<f64> = f.iter().rev().copied().collect();
     assert!(matches!(
         bad(input(&poses, &back, &modes, &[1.0]), options(1.0, 1.0)),
-        Error::Invalid { what: "frames", .. }
+        Error::Spacing {
+            what: "frames",
+            at: At { index: 1, .. },
+            ..
+        }
     ));
     assert!(matches!(
         bad(
@@ -359,7 +365,11 @@ fn bad_input_is_an_error() {
     ));
     assert!(matches!(
         bad(input(&poses, &f, &modes, &[-1.0]), options(1.0, 1.0)),
-        Error::Invalid { what: "radius", .. }
+        Error::Value {
+            what: "radius",
+            at: Some(At { index: 0, .. }),
+            ..
+        }
     ));
     let two: Vec<Pose> = poses.iter().chain(&poses).copied().collect();
     let modes2 = [RotationMode::Quaternion; 2];
@@ -367,5 +377,15 @@ fn bad_input_is_an_error() {
     let parents = [Some(1), Some(0)];
     cyc.parents = Some(&parents);
     let e = bad(cyc, options(1.0, 1.0));
+    assert!(
+        matches!(
+            e,
+            Error::Degenerate {
+                what: "parents",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().contains("cycle"), "{e}");
 }

@@ -26,7 +26,7 @@
 
 use glam::{DQuat, DVec3, DVec4};
 
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Expected, Result};
 use crate::motion::timing::check_key_times;
 
 /// Keys shorter than this (as 4-vectors) cannot be normalised and are rejected.
@@ -145,7 +145,7 @@ impl QuatSpline {
     /// # Errors
     /// [`Error::TooFew`] for fewer than 2 control points, [`Error::LengthMismatch`] when the
     /// three slices differ in length, [`Error::KeyTimes`] for times that are not strictly
-    /// increasing, [`Error::NotFinite`] for a NaN or infinite entry and [`Error::Invalid`]
+    /// increasing, [`Error::NotFinite`] for a NaN or infinite entry and [`Error::Value`]
     /// for a value shorter than [`MIN_QUATERNION_LENGTH`].
     pub fn new(times: &[f64], values: &[DQuat], derivatives: &[DVec4]) -> Result<Self> {
         let values = check_keys(times, values)?;
@@ -296,9 +296,11 @@ pub(crate) fn check_keys(times: &[f64], keys: &[DQuat]) -> Result<Vec<DVec4>> {
         }
         let length = v.length();
         if length < MIN_QUATERNION_LENGTH {
-            return Err(Error::Invalid {
+            return Err(Error::Value {
                 what: "key quaternion",
-                reason: format!("key {index} has length {length:e}, cannot be normalised"),
+                at: Some(At::new("key", index)),
+                value: length,
+                expected: Expected::Normalisable(MIN_QUATERNION_LENGTH),
             });
         }
         let mut v = v / length;
@@ -406,7 +408,10 @@ mod tests {
         ));
         assert!(matches!(
             QuatSpline::through(&[0.0, 1.0], &[q, DQuat::from_xyzw(0.0, 0.0, 0.0, 0.0)]),
-            Err(Error::Invalid { .. })
+            Err(Error::Value {
+                expected: Expected::Normalisable(_),
+                ..
+            })
         ));
     }
 }

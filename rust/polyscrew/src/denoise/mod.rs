@@ -50,7 +50,7 @@
 //!   close as `1e-300` apart are served like keys one frame apart. A given strength above
 //!   [`MAX_STRENGTH_SPACINGS`] spacings acts as that many (the one the result reports).
 //!
-//! What was measured to choose this (`scripts/bench_denoise.py`, the tables in
+//! What was measured to choose this (`scripts/bench/bench_denoise.py`, the tables in
 //! BENCHMARKS.md, the alternatives in `docs/denoise.md`): the SE(3) spline on logarithms
 //! relative to each pose (screw motions as the straight lines) smooths a spinning object that
 //! travels along a curve badly, because in its geometry the translation of a spinning body
@@ -58,22 +58,20 @@
 //! 2 on every smooth clip; robust (Huber, Cauchy) reweighting of the penalty rounded a hard
 //! stop almost as much as no reweighting, releasing the rows at detected kinks did not.
 
-mod band;
-mod blockband;
 pub(crate) mod kinks;
 pub(crate) mod pivot;
 pub(crate) mod pops;
 pub(crate) mod rotation;
 mod rows;
 pub(crate) mod smoother;
-mod so3;
+pub(crate) mod so3;
 pub(crate) mod stencil;
 
 pub use rows::{denoise_footprint, denoised_rows, DENOISE_BYTES_PER_POSE, DENOISE_HINT};
 
 use glam::{DQuat, DVec3};
 
-use crate::{Error, Pose, PoseDefect, Result};
+use crate::{Error, Expected, Pose, PoseDefect, Result};
 use rotation::RotationSpline;
 use smoother::{Gcv, Whittaker};
 use stencil::Stencils;
@@ -245,9 +243,9 @@ struct Common {
 /// `held[i]` keeps pose `i` exactly. One call smooths the whole clip in `O(n)`.
 ///
 /// # Errors
-/// [`Error::TooFew`] for fewer than [`MIN_DENOISE_POSES`] poses; [`Error::Invalid`] for more
-/// than [`MAX_DENOISE_POSES`], an order other than 2 or 3, a strength that is negative or not
-/// finite, or values so large that the computation overflows; [`Error::LengthMismatch`] when
+/// [`Error::TooFew`] for fewer than [`MIN_DENOISE_POSES`] poses; [`Error::Limit`] for more
+/// than [`MAX_DENOISE_POSES`], [`Error::Value`] for an order other than 2 or 3, a strength that is negative or not
+/// finite, [`Error::Overflow`] for values so large that the computation overflows; [`Error::LengthMismatch`] when
 /// `times` or `held` do not match `poses`; [`Error::KeyTimes`] for times that are not finite
 /// and increasing; [`Error::BadPose`] for a pose with a non-finite or zero rotation or a
 /// non-finite translation.
@@ -280,19 +278,23 @@ pub fn denoise_batch(
 ) -> Result<Vec<Result<Denoised>>> {
     let n = times.len();
     if n > MAX_DENOISE_POSES {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "poses",
-            reason: format!("{n} poses per clip exceed the limit of {MAX_DENOISE_POSES}"),
+            counted: "poses per clip",
+            count: n,
+            limit: MAX_DENOISE_POSES,
+            hint: "",
         });
     }
     let total = bodies
         .checked_mul(n)
         .filter(|t| *t <= MAX_DENOISE_BATCH)
-        .ok_or_else(|| Error::Invalid {
+        .ok_or(Error::Limit {
             what: "poses",
-            reason: format!(
-                "{bodies} bodies of {n} poses exceed the limit of {MAX_DENOISE_BATCH} poses"
-            ),
+            counted: "poses of all bodies",
+            count: bodies.saturating_mul(n),
+            limit: MAX_DENOISE_BATCH,
+            hint: "",
         })?;
     if poses.len() != total {
         return Err(Error::LengthMismatch {
@@ -348,10 +350,7 @@ pub fn denoise_batch(
     let mut results = Vec::with_capacity(bodies);
     for part in parts {
         // A worker only fails by a bug (the core does not panic on data): report it.
-        results.extend(part.map_err(|_| Error::Invalid {
-            what: "poses",
-            reason: "a worker thread failed".into(),
-        })?);
+        results.extend(part.map_err(|_| Error::Worker { what: "poses" })?);
     }
     Ok(results)
 }
@@ -359,9 +358,12 @@ pub fn denoise_batch(
 /// The checks shared by one clip and a batch.
 fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
     if n > MAX_DENOISE_POSES {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "poses",
-            reason: format!("{n} poses exceed the limit of {MAX_DENOISE_POSES}"),
+            counted: "poses",
+            count: n,
+            limit: MAX_DENOISE_POSES,
+            hint: "",
         });
     }
     if n < MIN_DENOISE_POSES {
@@ -379,9 +381,11 @@ fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
     }
     crate::check_key_times(times)?;
     if !(2..=3).contains(&options.order) {
-        return Err(Error::Invalid {
+        return Err(Error::Value {
             what: "order",
-            reason: format!("{} is not 2 or 3", options.order),
+            at: None,
+            value: options.order as f64,
+            expected: Expected::OneOf(&[2.0, 3.0]),
         });
     }
     if let Strength::Fixed {
@@ -391,9 +395,11 @@ fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
     {
         for v in [rotation, translation] {
             if !(v.is_finite() && v >= 0.0) {
-                return Err(Error::Invalid {
+                return Err(Error::Value {
                     what: "strength",
-                    reason: format!("{v} is not a finite time >= 0"),
+                    at: None,
+                    value: v,
+                    expected: Expected::NonNegative("time"),
                 });
             }
         }
@@ -402,9 +408,10 @@ fn check(n: usize, times: &[f64], options: &DenoiseOptions) -> Result<()> {
 }
 
 fn overflow() -> Error {
-    Error::Invalid {
+    Error::Overflow {
         what: "poses",
-        reason: "values too large: the computation overflowed".into(),
+        at: None,
+        hint: "",
     }
 }
 

@@ -35,9 +35,9 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use super::blockband::BlockBand;
 use super::so3;
 use super::stencil::{Stencils, MAX_ORDER};
+use crate::numeric::band::Band;
 
 /// Steps (largest rotation of any frame, radians) below which the iteration stops (the
 /// remaining error is a few per cent of it: far below what a key stored in `f32` resolves).
@@ -85,7 +85,7 @@ pub(crate) struct RotationSpline<const M: usize> {
     big_e: Vec<DVec3>,
     d: Vec<DVec3>,
     e: Vec<DVec3>,
-    band: BlockBand<M>,
+    band: Band<DMat3, M>,
     rhs: Vec<DVec3>,
     saved: Vec<DQuat>,
     step: Vec<DVec3>,

@@ -16,7 +16,7 @@
 //! RSS = sum_i h_i |x_i - y_i|^2,   tr(A) = sum_i h_i [(H + lambda M)^-1]_ii
 //! ```
 //!
-//! the trace from the band of the inverse ([`super::band`]), so each evaluation is `O(n)`.
+//! the trace from the band of the inverse ([`crate::numeric::band`]), so each evaluation is `O(n)`.
 //! The strengths tried lie on a fixed log-spaced grid, and the factorised systems of the
 //! grid strengths are kept (the matrix depends on the times and the strength only, not on
 //! the data), so the rotation, the translation and the next clip at the same times solve
@@ -27,8 +27,8 @@
 
 use glam::DVec3;
 
-use super::band::Band;
 use super::stencil::Stencils;
+use crate::numeric::band::Band;
 
 /// The fit at one strength: its GCV score, residual and effective degrees of freedom.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -64,7 +64,7 @@ const CACHE_VALUES: usize = 1 << 22;
 #[derive(Debug, Clone, Default)]
 struct Factored<const W: usize> {
     index: usize,
-    band: Band<W>,
+    band: Band<f64, W>,
     trace: f64,
 }
 
@@ -74,7 +74,7 @@ struct Factored<const W: usize> {
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Whittaker<const W: usize> {
     /// The penalty `D^T U D` (for `lambda = 1`).
-    m: Band<W>,
+    m: Band<f64, W>,
     /// What `m` and the cache were built from: rows, data weights, row weights, range.
     rows: Vec<[f64; 4]>,
     h: Vec<f64>,
@@ -87,7 +87,7 @@ pub(crate) struct Whittaker<const W: usize> {
     y: Vec<DVec3>,
     my: Vec<DVec3>,
     cache: Vec<Factored<W>>,
-    band: Band<W>,
+    band: Band<f64, W>,
     zinv: Vec<[f64; 4]>,
     diag: Vec<f64>,
     /// The last correction `y - x`.

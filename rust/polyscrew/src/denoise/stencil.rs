@@ -15,7 +15,7 @@
 //! densely the motion is sampled: on even samples the smoother's frequency response is
 //! `1 / (1 + (tau omega)^(2m))` at low frequencies.
 
-use crate::{Error, Result};
+use crate::{At, Error, Result};
 
 /// The largest order of differences used (third differences: the quintic spline).
 pub(crate) const MAX_ORDER: usize = 3;
@@ -36,7 +36,7 @@ impl Stencils {
     /// `order + 1` of them: checked by the caller).
     ///
     /// # Errors
-    /// [`Error::Invalid`] when a weight overflows (times so close or so far apart that their
+    /// [`Error::Overflow`] when a weight overflows (times so close or so far apart that their
     /// powers leave `f64`).
     #[cfg(test)]
     pub(crate) fn new(times: &[f64], order: usize) -> Result<Self> {
@@ -67,12 +67,10 @@ impl Stencils {
                 row[j] = q * fact / p;
             }
             if row.iter().any(|v| !v.is_finite()) {
-                return Err(Error::Invalid {
+                return Err(Error::Overflow {
                     what: "times",
-                    reason: format!(
-                        "times {k} to {} are too close together or too far apart for f64",
-                        k + order
-                    ),
+                    at: Some(At::new("time", k)),
+                    hint: "the times from here are too close together or too far apart for f64",
                 });
             }
             self.rows.push(row);
@@ -140,7 +138,7 @@ mod tests {
         let times = [0.0, 1e-120, 2e-120, 3e-120];
         assert!(matches!(
             Stencils::new(&times, 3),
-            Err(Error::Invalid { .. })
+            Err(Error::Overflow { what: "times", .. })
         ));
     }
 }

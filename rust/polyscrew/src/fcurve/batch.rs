@@ -6,7 +6,7 @@ use super::curve::{Extrapolation, FCurve};
 use super::cycles::Cycles;
 use super::key::{Easing, Interpolation, Key};
 use super::limits::check_batch;
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Expected, Result};
 use crate::memory::try_vec;
 
 /// The keys of `C` curves packed one curve after the other (`K` keys in all), as numbers and
@@ -55,34 +55,36 @@ impl PackedCurves<'_> {
     /// Checks every length against `C` and `K` (the last offset).
     fn check_lengths(&self) -> Result<usize> {
         if self.offsets.is_empty() {
-            return Err(Error::Invalid {
-                what: "offsets",
-                reason: "needs C + 1 entries (at least [0])".into(),
+            return Err(Error::Count {
+                what: "offsets (one per curve, plus one)",
+                got: 0,
+                need: 1,
             });
         }
         let c = self.len();
         if self.offsets[0] != 0 {
-            return Err(Error::Invalid {
-                what: "offsets",
-                reason: format!("offsets[0] is {}, not 0", self.offsets[0]),
+            return Err(Error::Value {
+                what: "first offset",
+                at: None,
+                value: self.offsets[0] as f64,
+                expected: Expected::OneOf(&[0.0]),
             });
         }
         for i in 1..self.offsets.len() {
             if self.offsets[i] < self.offsets[i - 1] {
-                return Err(Error::Invalid {
+                return Err(Error::Spacing {
                     what: "offsets",
-                    reason: format!(
-                        "offsets[{i}] = {} is less than offsets[{}] = {}",
-                        self.offsets[i],
-                        i - 1,
-                        self.offsets[i - 1]
-                    ),
+                    at: At::new("offset", i),
+                    gap: (self.offsets[i] - self.offsets[i - 1]) as f64,
+                    min: 0.0,
                 });
             }
         }
-        let k = usize::try_from(self.offsets[c]).map_err(|_| Error::Invalid {
-            what: "offsets",
-            reason: "the last offset is negative".into(),
+        let k = usize::try_from(self.offsets[c]).map_err(|_| Error::Value {
+            what: "last offset",
+            at: None,
+            value: self.offsets[c] as f64,
+            expected: Expected::NonNegative("offset"),
         })?;
         let lengths: [(&'static str, usize, usize); 10] = [
             ("co", self.co.len(), k.saturating_mul(2)),
@@ -115,9 +117,10 @@ impl PackedCurves<'_> {
     /// The curves, validated (see [`FCurve::new`]; errors name the curve and the key).
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] for an array of the wrong length, [`Error::Invalid`] for bad
-    /// offsets, a batch over the size limits ([`check_batch`]), an unknown code, a number that
-    /// is not finite in `float32`, keys out of time order, or a curve without keys;
+    /// [`Error::LengthMismatch`] for an array of the wrong length; [`Error::Count`],
+    /// [`Error::Value`] or [`Error::Spacing`] for bad offsets; [`Error::Limit`] for a batch
+    /// over the size limits ([`check_batch`]); inside [`Error::In`] naming the curve and the
+    /// key, [`Error::Index`] for an unknown code and the errors of [`FCurve::new`];
     /// [`Error::Memory`] when the curves exceed the memory budget or the allocator refuses.
     pub fn to_curves(&self) -> Result<Vec<FCurve>> {
         let k = self.check_lengths()?;
@@ -129,13 +132,7 @@ impl PackedCurves<'_> {
             let (lo, hi) = (self.offsets[c] as usize, self.offsets[c + 1] as usize);
             let mut keys = try_vec(hi - lo, "F-curve keys")?;
             for i in lo..hi {
-                let code_err = |e: Error| match e {
-                    Error::Invalid { what, reason } => Error::Invalid {
-                        what,
-                        reason: format!("curve {c}, key {}: {reason}", i - lo),
-                    },
-                    e => e,
-                };
+                let code_err = |e: Error| e.within("key", i - lo).within("curve", c);
                 keys.push(Key {
                     co: [f(self.co[2 * i]), f(self.co[2 * i + 1])],
                     handle_left: [f(self.handle_left[2 * i]), f(self.handle_left[2 * i + 1])],
@@ -166,8 +163,8 @@ impl PackedCurves<'_> {
 /// `O(K + C T log K)`.
 ///
 /// # Errors
-/// [`Error::Invalid`] for a batch over the size limits ([`check_batch`]) or a value that is
-/// not finite (naming the curve and the time), [`Error::NotFinite`] for a time that is not
+/// [`Error::Limit`] for a batch over the size limits ([`check_batch`]), [`Error::Evaluates`]
+/// for a value that is not finite (naming the curve and the time), [`Error::NotFinite`] for a time that is not
 /// finite in `float32`, [`Error::Memory`] when the evaluation exceeds the memory budget
 /// ([`check_batch`]: the curves, the times and the values) or the allocator refuses.
 pub fn evaluate_fcurves(curves: &[FCurve], times: &[f64]) -> Result<Vec<f64>> {
@@ -189,11 +186,11 @@ pub fn evaluate_fcurves(curves: &[FCurve], times: &[f64]) -> Result<Vec<f64>> {
         for (i, &t) in t32.iter().enumerate() {
             let v = curve.evaluate_f32(t);
             if !v.is_finite() {
-                return Err(Error::Invalid {
-                    what: "value",
-                    reason: format!(
-                        "curve {c} evaluates to {v} at time {i} (frame {t}), as Blender would"
-                    ),
+                return Err(Error::Evaluates {
+                    curve: Some(c),
+                    value: v.into(),
+                    time: Some(i),
+                    frame: t.into(),
                 });
             }
             out.push(v as f64);

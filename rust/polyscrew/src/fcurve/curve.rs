@@ -6,7 +6,7 @@ use super::bezier::BezierSegment;
 use super::cycles::Cycles;
 use super::easing::ease;
 use super::key::{from_code, from_name, Interpolation, Key};
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Expected, Result};
 use crate::memory::try_vec;
 
 /// Blender's key search threshold in `fcurve_eval_keyframes_interpolate` (`0.0001`): a time
@@ -42,7 +42,7 @@ impl Extrapolation {
     /// The extrapolation named by its RNA identifier.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         from_name("extrapolation", name, &Self::NAMES, &Self::ALL)
     }
@@ -50,7 +50,7 @@ impl Extrapolation {
     /// The extrapolation with code `code` (its index in [`Extrapolation::ALL`]).
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a code outside `0..2`.
+    /// [`Error::Index`] for a code outside `0..2`.
     pub fn from_code(code: i64) -> Result<Self> {
         from_code("extrapolation", code, &Self::ALL)
     }
@@ -73,9 +73,9 @@ impl FCurve {
     /// an optional Cycles modifier.
     ///
     /// # Errors
-    /// [`Error::Invalid`] when `keys` is empty, a key has a non-finite number (naming the key
-    /// and the field), a key's frame is before the previous key's, or the modifier has a
-    /// non-finite number; [`Error::Memory`] when the allocator refuses the Bezier segments.
+    /// [`Error::Count`] when `keys` is empty, [`Error::Value`] when a key has a non-finite
+    /// number (naming the key and the field) or the modifier has one, [`Error::Spacing`] when
+    /// a key's frame is before the previous key's; [`Error::Memory`] when the allocator refuses the Bezier segments.
     pub fn new(
         keys: Vec<Key>,
         extrapolation: Extrapolation,
@@ -91,48 +91,38 @@ impl FCurve {
         cycles: Option<Cycles>,
         curve: Option<usize>,
     ) -> Result<Self> {
-        let at = |key: Option<usize>| match (curve, key) {
-            (Some(c), Some(k)) => format!("curve {c}, key {k}: "),
-            (Some(c), None) => format!("curve {c}: "),
-            (None, Some(k)) => format!("key {k}: "),
-            (None, None) => String::new(),
+        let at = |e: Error| match curve {
+            Some(c) => e.within("curve", c),
+            None => e,
         };
         if keys.is_empty() {
-            return Err(Error::Invalid {
+            // (Blender does not evaluate an empty curve.)
+            return Err(at(Error::Count {
                 what: "keys",
-                reason: format!(
-                    "{}no keys (Blender does not evaluate an empty curve)",
-                    at(None)
-                ),
-            });
+                got: 0,
+                need: 1,
+            }));
         }
         for (k, key) in keys.iter().enumerate() {
-            if let Some(field) = key.non_finite_field() {
-                return Err(Error::Invalid {
+            if let Some((field, value)) = key.non_finite_field() {
+                return Err(at(Error::Value {
                     what: "keys",
-                    reason: format!("{}{field} is not finite in float32", at(Some(k))),
-                });
+                    at: Some(At::new("key", k)),
+                    value,
+                    expected: Expected::FiniteInF32(field),
+                }));
             }
             if k > 0 && key.co[0] < keys[k - 1].co[0] {
-                return Err(Error::Invalid {
-                    what: "keys",
-                    reason: format!(
-                        "{}frame {} is before the previous key's frame {} (keys must be in time order)",
-                        at(Some(k)),
-                        key.co[0],
-                        keys[k - 1].co[0]
-                    ),
-                });
+                return Err(at(Error::Spacing {
+                    what: "key frames",
+                    at: At::new("key", k),
+                    gap: f64::from(key.co[0] - keys[k - 1].co[0]),
+                    min: 0.0,
+                }));
             }
         }
         if let Some(c) = &cycles {
-            c.validate().map_err(|e| match e {
-                Error::Invalid { what, reason } => Error::Invalid {
-                    what,
-                    reason: format!("{}{reason}", at(None)),
-                },
-                e => e,
-            })?;
+            c.validate().map_err(at)?;
         }
         let mut bezier = try_vec(keys.len() - 1, "Bezier segments")?;
         bezier.extend(keys.windows(2).map(|w| {
@@ -167,7 +157,7 @@ impl FCurve {
     /// interpolation, the modifier's offset. The result is Blender's `float32` value.
     ///
     /// # Errors
-    /// [`Error::NotFinite`] for a frame that is not finite in `float32`, [`Error::Invalid`]
+    /// [`Error::NotFinite`] for a frame that is not finite in `float32`, [`Error::Evaluates`]
     /// when the value is not finite (Blender would return NaN or infinity: huge handles,
     /// values near the `float32` limit).
     pub fn evaluate(&self, frame: f64) -> Result<f64> {
@@ -180,9 +170,11 @@ impl FCurve {
         }
         let v = self.evaluate_f32(t);
         if !v.is_finite() {
-            return Err(Error::Invalid {
-                what: "value",
-                reason: format!("the curve evaluates to {v} at frame {t}"),
+            return Err(Error::Evaluates {
+                curve: None,
+                value: v.into(),
+                time: None,
+                frame: t.into(),
             });
         }
         Ok(v as f64)

@@ -15,7 +15,7 @@
 //! ramped over its blend-in and blend-out.
 
 use super::key::{from_code, from_name};
-use crate::error::{Error, Result};
+use crate::error::{Error, Expected, Result};
 
 /// What a Cycles modifier does on one side of the keys (`FModifierCycles.mode_before`,
 /// `mode_after`).
@@ -46,7 +46,7 @@ impl CycleMode {
     /// The mode named by its RNA identifier.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         from_name("cycle mode", name, &Self::NAMES, &Self::ALL)
     }
@@ -54,7 +54,7 @@ impl CycleMode {
     /// The mode with code `code` (its index in [`CycleMode::ALL`]).
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a code outside `0..4`.
+    /// [`Error::Index`] for a code outside `0..4`.
     pub fn from_code(code: i64) -> Result<Self> {
         from_code("cycle mode", code, &Self::ALL)
     }
@@ -110,12 +110,14 @@ impl Cycles {
     /// Checks that every number is finite.
     ///
     /// # Errors
-    /// [`Error::Invalid`] naming the field.
+    /// [`Error::Value`] naming the field.
     pub fn validate(&self) -> Result<()> {
-        let bad = |what: &str| {
-            Err(Error::Invalid {
+        let bad = |field, value| {
+            Err(Error::Value {
                 what: "cycles",
-                reason: format!("{what} is not finite"),
+                at: None,
+                value,
+                expected: Expected::Finite(field),
             })
         };
         if let Some(r) = self.range {
@@ -126,12 +128,12 @@ impl Cycles {
                 ("blend_out", r.blend_out),
             ] {
                 if !v.is_finite() {
-                    return bad(name);
+                    return bad(name, f64::from(v));
                 }
             }
         }
-        if self.influence.is_some_and(|i| !i.is_finite()) {
-            return bad("influence");
+        if let Some(i) = self.influence.filter(|i| !i.is_finite()) {
+            return bad("influence", f64::from(i));
         }
         Ok(())
     }

@@ -69,7 +69,7 @@ impl Interpolation {
     /// The interpolation named by its RNA identifier.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         from_name("interpolation", name, &Self::NAMES, &Self::ALL)
     }
@@ -77,7 +77,7 @@ impl Interpolation {
     /// The interpolation with code `code` (its index in [`Interpolation::ALL`]).
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a code outside `0..13`.
+    /// [`Error::Index`] for a code outside `0..13`.
     pub fn from_code(code: i64) -> Result<Self> {
         from_code("interpolation", code, &Self::ALL)
     }
@@ -118,7 +118,7 @@ impl Easing {
     /// The easing named by its RNA identifier.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         from_name("easing", name, &Self::NAMES, &Self::ALL)
     }
@@ -126,7 +126,7 @@ impl Easing {
     /// The easing with code `code` (its index in [`Easing::ALL`]).
     ///
     /// # Errors
-    /// [`Error::Invalid`] for a code outside `0..4`.
+    /// [`Error::Index`] for a code outside `0..4`.
     pub fn from_code(code: i64) -> Result<Self> {
         from_code("easing", code, &Self::ALL)
     }
@@ -211,23 +211,19 @@ impl Key {
     }
 
     /// The first field that is not finite, by name (`None` when all are).
-    pub(crate) fn non_finite_field(&self) -> Option<&'static str> {
-        let pair = |p: [f32; 2]| p[0].is_finite() && p[1].is_finite();
-        if !pair(self.co) {
-            Some("co")
-        } else if !pair(self.handle_left) {
-            Some("handle_left")
-        } else if !pair(self.handle_right) {
-            Some("handle_right")
-        } else if !self.back.is_finite() {
-            Some("back")
-        } else if !self.amplitude.is_finite() {
-            Some("amplitude")
-        } else if !self.period.is_finite() {
-            Some("period")
-        } else {
-            None
-        }
+    pub(crate) fn non_finite_field(&self) -> Option<(&'static str, f64)> {
+        let pair = |p: [f32; 2]| p.into_iter().find(|v| !v.is_finite());
+        let one = |v: f32| (!v.is_finite()).then_some(v);
+        [
+            ("co", pair(self.co)),
+            ("handle_left", pair(self.handle_left)),
+            ("handle_right", pair(self.handle_right)),
+            ("back", one(self.back)),
+            ("amplitude", one(self.amplitude)),
+            ("period", one(self.period)),
+        ]
+        .into_iter()
+        .find_map(|(field, v)| v.map(|v| (field, f64::from(v))))
     }
 }
 
@@ -235,16 +231,17 @@ impl Key {
 pub(crate) fn from_name<T: Copy>(
     what: &'static str,
     name: &str,
-    names: &[&str],
+    names: &'static [&'static str],
     all: &[T],
 ) -> Result<T> {
     names
         .iter()
         .position(|n| *n == name)
         .map(|i| all[i])
-        .ok_or_else(|| Error::Invalid {
+        .ok_or_else(|| Error::Choice {
             what,
-            reason: format!("{name:?} is not one of {}", names.join(", ")),
+            got: name.to_owned(),
+            expected: names,
         })
 }
 
@@ -253,8 +250,11 @@ pub(crate) fn from_code<T: Copy>(what: &'static str, code: i64, all: &[T]) -> Re
     usize::try_from(code)
         .ok()
         .and_then(|i| all.get(i).copied())
-        .ok_or_else(|| Error::Invalid {
+        .ok_or(Error::Index {
             what,
-            reason: format!("code {code} is outside 0..{}", all.len()),
+            at: None,
+            item: "code",
+            index: code,
+            len: all.len(),
         })
 }

@@ -46,7 +46,7 @@ pub fn packed_footprint(curves: usize, keys: usize) -> Footprint {
 /// budget.
 ///
 /// # Errors
-/// [`Error::Invalid`] naming the size that is too large; [`Error::Memory`] over the budget.
+/// [`Error::Limit`] naming the size that is too large; [`Error::Memory`] over the budget.
 pub fn check_batch(curves: usize, keys: usize, times: usize) -> Result<()> {
     check_batch_with(curves, keys, times, Footprint::ZERO)
 }
@@ -58,19 +58,26 @@ pub fn check_batch(curves: usize, keys: usize, times: usize) -> Result<()> {
 /// As [`check_batch`].
 pub fn check_batch_with(curves: usize, keys: usize, times: usize, extra: Footprint) -> Result<()> {
     if keys > MAX_KEYS {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "keys",
-            reason: format!("{keys} keys exceed the limit of {MAX_KEYS} in one call"),
+            counted: "keys",
+            count: keys,
+            limit: MAX_KEYS,
+            hint: "",
         });
     }
     match curves.checked_mul(times) {
         Some(values) if values <= MAX_VALUES => (batch_footprint(curves, keys, times) + extra)
-            .check("the F-curve evaluation", "evaluate fewer curves or times in one call"),
-        _ => Err(Error::Invalid {
-            what: "times",
-            reason: format!(
-                "{curves} curves x {times} times exceed the limit of {MAX_VALUES} values in one call"
+            .check(
+                "the F-curve evaluation",
+                "evaluate fewer curves or times in one call",
             ),
+        _ => Err(Error::Limit {
+            what: "times",
+            counted: "values (curves x times)",
+            count: curves.saturating_mul(times),
+            limit: MAX_VALUES,
+            hint: "evaluate fewer curves or times in one call",
         }),
     }
 }

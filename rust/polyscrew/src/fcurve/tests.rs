@@ -8,7 +8,7 @@ use proptest::prelude::*;
 use super::bezier::{correct_bezpart, solve_cubic, BezierSegment};
 use super::easing::ease;
 use super::*;
-use crate::error::Error;
+use crate::error::{At, Error, Expected};
 
 /// A curve through `(frame, value)` pairs, every key with `interpolation`.
 fn curve(points: &[(f32, f32)], interpolation: Interpolation, ext: Extrapolation) -> FCurve {
@@ -493,11 +493,16 @@ impl Packed {
     }
 }
 
-fn invalid_reason(e: Error) -> String {
-    match e {
-        Error::Invalid { what, reason } => format!("{what}: {reason}"),
-        e => format!("{e}"),
+/// The entries an error is about (outermost first, from its [`Error::In`] layers) and the
+/// error under them.
+fn located(e: &Error) -> (Vec<(&'static str, usize)>, &Error) {
+    let mut at = Vec::new();
+    let mut e = e;
+    while let Error::In { at: a, source, .. } = e {
+        at.push((a.item, a.index));
+        e = source;
     }
+    (at, e)
 }
 
 #[test]
@@ -520,53 +525,108 @@ fn packed_curves_evaluate_like_the_curves() {
 fn bad_input_is_an_error_naming_curve_and_key() {
     let good = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     let times = [0.0, 1.0];
-    let err = |p: &Packed| invalid_reason(evaluate_packed(&p.view(), &times).unwrap_err());
+    let err = |p: &Packed| evaluate_packed(&p.view(), &times).unwrap_err();
 
     let mut p = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     p.co[6] = 0.5; // curve 1, key 1 before key 0
+    let e = err(&p);
     assert!(
-        err(&p).contains("curve 1, key 1") && err(&p).contains("time order"),
-        "{}",
-        err(&p)
+        matches!(
+            located(&e),
+            (at, Error::Spacing { what: "key frames", at: At { item: "key", index: 1 }, gap, .. })
+                if at == [("curve", 1)] && *gap == -0.5
+        ),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .contains("curve 1: key frames: key 1 is less than"),
+        "{e}"
     );
 
     let mut p = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     p.hr[3] = f64::NAN;
+    let e = err(&p);
     assert!(
-        err(&p).contains("curve 0, key 1: handle_right"),
-        "{}",
-        err(&p)
+        matches!(
+            located(&e),
+            (at, Error::Value {
+                what: "keys",
+                at: Some(At { item: "key", index: 1 }),
+                expected: Expected::FiniteInF32("handle_right"),
+                value,
+            }) if at == [("curve", 0)] && value.is_nan()
+        ),
+        "{e:?}"
     );
     p.hr[3] = 1e39; // finite in f64, infinite in float32
+    let e = err(&p);
     assert!(
-        err(&p).contains("handle_right is not finite in float32"),
-        "{}",
-        err(&p)
+        matches!(
+            located(&e).1,
+            Error::Value { expected: Expected::FiniteInF32("handle_right"), value, .. }
+                if *value == f64::INFINITY
+        ),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .contains("handle_right is not finite in float32"),
+        "{e}"
     );
 
     let mut p = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     p.ipo[2] = 13;
+    let e = err(&p);
     assert!(
-        err(&p).contains("curve 1, key 0") && err(&p).contains("code 13"),
-        "{}",
-        err(&p)
+        matches!(
+            located(&e),
+            (at, Error::Index { what: "interpolation", index: 13, len: 13, .. })
+                if at == [("curve", 1), ("key", 0)]
+        ),
+        "{e:?}"
     );
     p.ipo[2] = 2;
     p.ease[3] = -1;
+    let e = err(&p);
     assert!(
-        err(&p).contains("curve 1, key 1") && err(&p).contains("easing"),
-        "{}",
-        err(&p)
+        matches!(
+            located(&e),
+            (at, Error::Index { what: "easing", index: -1, len: 4, .. })
+                if at == [("curve", 1), ("key", 1)]
+        ),
+        "{e:?}"
     );
 
     let mut p = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     p.offsets = vec![0, 2, 2, 4];
     p.ext.push(Extrapolation::Constant);
-    assert!(err(&p).contains("curve 1: no keys"), "{}", err(&p));
+    let e = err(&p);
+    assert!(
+        matches!(
+            located(&e),
+            (at, Error::Count { what: "keys", got: 0, need: 1 }) if at == [("curve", 1)]
+        ),
+        "{e:?}"
+    );
     p.offsets = vec![0, 3, 2];
-    assert!(err(&p).contains("offsets[2]"), "{}", err(&p));
+    assert!(
+        matches!(
+            err(&p),
+            Error::Spacing { what: "offsets", at: At { index: 2, .. }, gap, .. } if gap == -1.0
+        ),
+        "{:?}",
+        err(&p)
+    );
     p.offsets = vec![1, 2, 4];
-    assert!(err(&p).contains("offsets[0]"), "{}", err(&p));
+    assert!(
+        matches!(
+            err(&p),
+            Error::Value { what: "first offset", at: None, value, .. } if value == 1.0
+        ),
+        "{:?}",
+        err(&p)
+    );
 
     let mut p = Packed::new(&[&[(0.0, 1.0), (4.0, 2.0)], &[(1.0, 5.0), (2.0, 1.0)]]);
     p.back.pop();
@@ -605,7 +665,11 @@ fn a_value_blender_would_make_infinite_is_an_error() {
     ];
     let c = FCurve::new(keys, Extrapolation::Linear, None).unwrap();
     let e = evaluate_fcurves(&[c], &[1.0, -2.0]).unwrap_err();
-    assert!(invalid_reason(e).contains("curve 0 evaluates to"));
+    assert!(
+        matches!(e, Error::Evaluates { curve: Some(0), time: Some(1), value, .. } if value.is_infinite()),
+        "{e:?}"
+    );
+    assert!(e.to_string().contains("curve 0 evaluates to"), "{e}");
 }
 
 #[test]
@@ -622,7 +686,14 @@ fn sizes_are_checked_before_allocating() {
     let curves = vec![c; 2];
     // Times are not even converted when the output would be too large.
     let e = evaluate_fcurves(&curves, &vec![0.0; MAX_VALUES / 2 + 1]).unwrap_err();
-    assert!(invalid_reason(e).contains("exceed the limit"));
+    assert!(
+        matches!(
+            e,
+            Error::Limit { counted: "values (curves x times)", count, limit: MAX_VALUES, .. }
+                if count == MAX_VALUES + 2
+        ),
+        "{e:?}"
+    );
 }
 
 #[test]

@@ -26,7 +26,7 @@
 use glam::{DMat3, DVec3};
 
 use crate::error::{Error, Result};
-use crate::motion::pose::{COORDINATE_RANGE, MAX_COORDINATE};
+use crate::motion::pose::MAX_COORDINATE;
 use crate::numeric::eigen::symmetric_eigen;
 
 /// A cloud counts as collinear (its rotation about the line undetermined) when the second
@@ -51,7 +51,7 @@ impl InertiaFrame {
     /// The inertia frame of `points` (the paper's unit point masses).
     ///
     /// # Errors
-    /// [`Error::NotFinite`] for a NaN or infinite point, [`Error::Invalid`]
+    /// [`Error::NotFinite`] for a NaN or infinite point, [`Error::Count`] or [`Error::Degenerate`]
     /// (`what = "feature points"`) for fewer than 3 points or collinear points (within
     /// [`COLLINEAR_TOLERANCE`]): they do not fix a rigid motion.
     pub fn of(points: &[DVec3]) -> Result<Self> {
@@ -62,9 +62,10 @@ impl InertiaFrame {
             });
         }
         if points.len() < 3 {
-            return Err(Error::Invalid {
+            return Err(Error::Count {
                 what: "feature points",
-                reason: format!("{} given, at least 3 needed", points.len()),
+                got: points.len(),
+                need: 3,
             });
         }
         if let Some(index) = points
@@ -75,7 +76,7 @@ impl InertiaFrame {
                 what: "feature point",
                 index,
                 value: points[index].abs().max_element(),
-                range: COORDINATE_RANGE,
+                limit: MAX_COORDINATE,
             });
         }
         let centroid = points.iter().sum::<DVec3>() / points.len() as f64;
@@ -101,11 +102,11 @@ impl InertiaFrame {
         }
         let (values, vectors) = symmetric_eigen(&j);
         if !(values[1] > COLLINEAR_TOLERANCE * values[0]) {
-            return Err(Error::Invalid {
+            return Err(Error::Degenerate {
                 what: "feature points",
+                at: None,
                 reason: "they are collinear (or coincide): the rotation about their line is \
-                         undetermined"
-                    .into(),
+                         undetermined",
             });
         }
         let e0 = DVec3::from_array(vectors[0]);
@@ -244,7 +245,7 @@ mod tests {
             .collect();
         assert!(matches!(
             InertiaFrame::of(&line),
-            Err(Error::Invalid {
+            Err(Error::Degenerate {
                 what: "feature points",
                 ..
             })

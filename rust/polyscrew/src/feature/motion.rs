@@ -81,7 +81,7 @@ impl CurveScheme {
     /// Parses `"four_point"`, `"bspline"`, `"jarek"` or `"variational"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "variational" => Ok(Self::Variational),
@@ -89,12 +89,10 @@ impl CurveScheme {
                 Ok(Scheme::FourPoint) => Ok(Self::FourPoint),
                 Ok(Scheme::BSpline) => Ok(Self::BSpline),
                 Ok(Scheme::Jarek) => Ok(Self::Jarek),
-                Err(_) => Err(Error::Invalid {
+                Err(_) => Err(Error::Choice {
                     what: "scheme",
-                    reason: format!(
-                        "{name:?} is not one of \"variational\", \"four_point\", \"bspline\", \
-                         \"jarek\""
-                    ),
+                    got: name.to_owned(),
+                    expected: &["variational", "four_point", "bspline", "jarek"],
                 }),
             },
         }
@@ -189,11 +187,12 @@ pub fn feature_footprint(keys: usize, feature_points: usize, spec: &FeatureSpec)
 /// `feature_points` are in the body (local) frame; `None` takes [`UNIT_FRAME_POINTS`].
 ///
 /// # Errors
-/// [`Error::TooFew`] / [`Error::Levels`] as [`crate::subdivide`]; [`Error::Invalid`] for
-/// stiffness or a centripetal parametrisation given to a local scheme, for collinear feature
-/// points, for coincident consecutive keys under the centripetal parametrisation, and the
-/// errors of [`Stiffness::check`]; [`Error::Invalid`] (`what = "registration"`) naming the
-/// first sample where the distorted body cannot be registered uniquely.
+/// [`Error::TooFew`] / [`Error::Levels`] as [`crate::subdivide`]; [`Error::Conflict`] for
+/// stiffness or a centripetal parametrisation given to a local scheme, [`Error::Degenerate`]
+/// for collinear feature points and for coincident consecutive keys under the centripetal
+/// parametrisation, and the errors of [`Stiffness::check`]; [`Error::NotUnique`]
+/// (`what = "registration"`) inside [`Error::In`] naming the key span and the first sample
+/// where the distorted body cannot be registered uniquely.
 pub fn feature_motion(
     keys: &[Pose],
     feature_points: Option<&[DVec3]>,
@@ -206,13 +205,13 @@ pub fn feature_motion(
         .check("the feature-point motion", FEATURE_HINT)?;
     if spec.scheme != CurveScheme::Variational {
         if spec.stiffness != Stiffness::default() {
-            return Err(Error::Invalid {
+            return Err(Error::Conflict {
                 what: "stiffness",
                 reason: "only the variational scheme takes springs".into(),
             });
         }
         if spec.parametrization != Parametrization::Uniform {
-            return Err(Error::Invalid {
+            return Err(Error::Conflict {
                 what: "parametrization",
                 reason: "only the variational scheme takes a non-uniform parametrisation".into(),
             });
@@ -265,19 +264,8 @@ pub fn feature_motion(
             ];
             let distorted = frame.affine_images(&images);
             let (xbar, ybar, s) = cross_covariance(&six, &distorted, None)?;
-            let rotation = rotation_from_covariance_warm(&s, &mut basis).map_err(|e| {
-                let key = j / per_span;
-                Error::Invalid {
-                    what: "registration",
-                    reason: format!(
-                        "sample {j} (after key {key}): {}",
-                        match e {
-                            Error::Invalid { reason, .. } => reason,
-                            other => other.to_string(),
-                        }
-                    ),
-                }
-            })?;
+            let rotation = rotation_from_covariance_warm(&s, &mut basis)
+                .map_err(|e| e.within("sample", j).within("key span", j / per_span))?;
             Pose {
                 rotation,
                 translation: ybar - rotation * xbar,
@@ -634,7 +622,13 @@ mod tests {
         };
         let err = feature_motion(&pair, None, &spec).unwrap_err();
         assert!(
-            matches!(&err, Error::Invalid { what: "registration", reason } if reason.contains("sample")),
+            matches!(
+                err.innermost(),
+                Error::NotUnique {
+                    what: "registration",
+                    ..
+                }
+            ) && err.to_string().contains("sample"),
             "{err}"
         );
         let bad = FeatureSpec {
@@ -644,7 +638,7 @@ mod tests {
         };
         assert!(matches!(
             feature_motion(&k, None, &bad),
-            Err(Error::Invalid {
+            Err(Error::Conflict {
                 what: "stiffness",
                 ..
             })
@@ -652,7 +646,7 @@ mod tests {
         let line = [DVec3::ZERO, DVec3::X, 2.0 * DVec3::X];
         assert!(matches!(
             feature_motion(&k, Some(&line), &FeatureSpec::default()),
-            Err(Error::Invalid {
+            Err(Error::Degenerate {
                 what: "feature points",
                 ..
             })

@@ -32,8 +32,8 @@
 
 use glam::{DMat3, DQuat, DVec3};
 
-use crate::error::{Error, Result};
-use crate::motion::pose::{Pose, COORDINATE_RANGE, MAX_COORDINATE};
+use crate::error::{At, Error, Expected, Result};
+use crate::motion::pose::{Pose, MAX_COORDINATE};
 use crate::numeric::eigen::symmetric_eigen_from;
 
 /// The largest eigenvalue of Horn's matrix counts as repeated when the gap to the second is
@@ -121,7 +121,7 @@ pub fn horn_matrix(s: &DMat3) -> [[f64; 4]; 4] {
 /// The rotation of a cross-covariance `S` (Horn's eigenvector, eq. 5 and 7), with `w >= 0`.
 ///
 /// # Errors
-/// [`Error::Invalid`] (`what = "registration"`) when the largest eigenvalue of `N` is
+/// [`Error::NotUnique`] (`what = "registration"`) when the largest eigenvalue of `N` is
 /// repeated within [`REPEATED_EIGENVALUE_GAP`] (the best rotation is not unique).
 pub fn rotation_from_covariance(s: &DMat3) -> Result<DQuat> {
     let mut basis = IDENTITY4;
@@ -149,13 +149,10 @@ pub fn rotation_from_covariance_warm(s: &DMat3, basis: &mut [[f64; 4]; 4]) -> Re
     let radius = values[0].abs().max(values[3].abs());
     if !(values[0] - values[1] > REPEATED_EIGENVALUE_GAP * radius) {
         *basis = IDENTITY4;
-        return Err(Error::Invalid {
+        return Err(Error::NotUnique {
             what: "registration",
-            reason: format!(
-                "the best rotation is not unique (largest eigenvalue of Horn's matrix repeated: \
-                 {:.6e} and {:.6e}); the points are collinear or the target is too distorted",
-                values[0], values[1]
-            ),
+            largest: values[0],
+            next: values[1],
         });
     }
     *basis = vectors;
@@ -172,8 +169,9 @@ pub fn rotation_from_covariance_warm(s: &DMat3, basis: &mut [[f64; 4]; 4]) -> Re
 ///
 /// # Errors
 /// [`Error::LengthMismatch`] when the clouds (or the weights) differ in length,
-/// [`Error::Invalid`] for fewer than [`MIN_POINTS`] points, negative or zero total weight,
-/// [`Error::NotFinite`] for NaN or infinite coordinates or weights, and [`Error::Invalid`]
+/// [`Error::Count`] for fewer than [`MIN_POINTS`] points, [`Error::Value`] for a negative
+/// weight, [`Error::Degenerate`] for a zero total weight, [`Error::NotFinite`] for NaN or
+/// infinite coordinates or weights, and [`Error::NotUnique`]
 /// (`what = "registration"`) when the best rotation is not unique (see
 /// [`rotation_from_covariance`]).
 pub fn register(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result<Pose> {
@@ -194,9 +192,10 @@ fn check_clouds(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result
         });
     }
     if src.len() < MIN_POINTS {
-        return Err(Error::Invalid {
+        return Err(Error::Count {
             what: "points",
-            reason: format!("{} given, at least {MIN_POINTS} needed", src.len()),
+            got: src.len(),
+            need: MIN_POINTS,
         });
     }
     for (what, cloud) in [("source point", src), ("target point", dst)] {
@@ -211,7 +210,7 @@ fn check_clouds(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result
                 what,
                 index,
                 value: cloud[index].abs().max_element(),
-                range: COORDINATE_RANGE,
+                limit: MAX_COORDINATE,
             });
         }
     }
@@ -230,15 +229,18 @@ fn check_clouds(src: &[DVec3], dst: &[DVec3], weights: Option<&[f64]>) -> Result
             });
         }
         if let Some(index) = w.iter().position(|&x| x < 0.0) {
-            return Err(Error::Invalid {
+            return Err(Error::Value {
                 what: "weights",
-                reason: format!("weight {index} is negative"),
+                at: Some(At::new("weight", index)),
+                value: w[index],
+                expected: Expected::NonNegative("weight"),
             });
         }
         if w.iter().sum::<f64>() <= 0.0 {
-            return Err(Error::Invalid {
+            return Err(Error::Degenerate {
                 what: "weights",
-                reason: "they sum to zero".into(),
+                at: None,
+                reason: "they sum to zero",
             });
         }
     }
@@ -449,14 +451,18 @@ pub(crate) mod tests {
         let moved: Vec<DVec3> = line.iter().map(|p| *p + DVec3::Y).collect();
         assert!(matches!(
             register(&line, &moved, None),
-            Err(Error::Invalid {
+            Err(Error::NotUnique {
                 what: "registration",
                 ..
             })
         ));
         assert!(matches!(
             register(&line[..2], &moved[..2], None),
-            Err(Error::Invalid { what: "points", .. })
+            Err(Error::Count {
+                what: "points",
+                got: 2,
+                need: MIN_POINTS
+            })
         ));
         assert!(matches!(
             register(&line, &moved[..3], None),
@@ -471,8 +477,9 @@ pub(crate) mod tests {
         let tri = [DVec3::ZERO, DVec3::X, DVec3::Y];
         assert!(matches!(
             register(&tri, &tri, Some(&[1.0, -1.0, 1.0])),
-            Err(Error::Invalid {
+            Err(Error::Value {
                 what: "weights",
+                at: Some(At { index: 1, .. }),
                 ..
             })
         ));

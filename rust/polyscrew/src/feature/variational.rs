@@ -41,7 +41,7 @@
 
 use glam::DVec3;
 
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Expected, Result};
 use crate::motion::subdivision::{check_subdivision, subdivided_len};
 use crate::numeric::cyclic_band::BandMatrix;
 
@@ -59,14 +59,15 @@ impl Parametrization {
     /// Parses `"uniform"` or `"centripetal"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "uniform" => Ok(Self::Uniform),
             "centripetal" => Ok(Self::Centripetal),
-            _ => Err(Error::Invalid {
+            _ => Err(Error::Choice {
                 what: "parametrization",
-                reason: format!("{name:?} is not one of \"uniform\", \"centripetal\""),
+                got: name.to_owned(),
+                expected: &["uniform", "centripetal"],
             }),
         }
     }
@@ -120,22 +121,21 @@ impl Stiffness {
     /// Checks the weights for `n` keys.
     ///
     /// # Errors
-    /// [`Error::LengthMismatch`] for a wrong number of key springs; [`Error::Invalid`]
+    /// [`Error::LengthMismatch`] for a wrong number of key springs; [`Error::Value`] or
+    /// [`Error::Count`]
     /// (`what = "stiffness"`) for a NaN or negative spring, a non-positive inserted spring,
     /// or too few positive springs to pin the curve (an open curve needs two, a closed one
     /// one: otherwise the fairness term alone leaves a straight line or a point free to
     /// slide).
     pub fn check(&self, n: usize, closed: bool) -> Result<()> {
-        let invalid = |reason: String| Error::Invalid {
-            what: "stiffness",
-            reason,
-        };
         let in_range = |l: f64| l == f64::INFINITY || l <= MAX_STIFFNESS;
         if !(self.inserted > 0.0) || !in_range(self.inserted) {
-            return Err(invalid(format!(
-                "inserted-point stiffness {} must be positive and at most 1e100 (or infinite)",
-                self.inserted
-            )));
+            return Err(Error::Value {
+                what: "stiffness",
+                at: Some(At::new("inserted point", 0)),
+                value: self.inserted,
+                expected: Expected::PositiveUpToOrInfinite(MAX_STIFFNESS),
+            });
         }
         if let Some(k) = &self.keys {
             if k.len() != n {
@@ -146,18 +146,24 @@ impl Stiffness {
                 });
             }
             if let Some(i) = k.iter().position(|l| !(*l >= 0.0) || !in_range(*l)) {
-                return Err(invalid(format!(
-                    "key {i} has stiffness {}, need 0..=1e100 or inf",
-                    k[i]
-                )));
+                return Err(Error::Value {
+                    what: "stiffness",
+                    at: Some(At::new("key", i)),
+                    value: k[i],
+                    expected: Expected::WithinOrInfinite {
+                        low: 0.0,
+                        high: MAX_STIFFNESS,
+                    },
+                });
             }
             let need = if closed { 1 } else { 2 };
             let positive = k.iter().filter(|l| **l > 0.0).count();
             if positive < need {
-                return Err(invalid(format!(
-                    "{positive} keys have positive stiffness, at least {need} needed to pin \
-                     the curve"
-                )));
+                return Err(Error::Count {
+                    what: "stiffness: keys with a positive spring (to pin the curve)",
+                    got: positive,
+                    need,
+                });
             }
         }
         Ok(())
@@ -181,7 +187,7 @@ pub const MIN_RELATIVE_SPACING: f64 = 1e-9;
 /// Centripetal: `D_i = (sum_k |f^k_{i+1} - f^k_i|^2)^(1/4)` (eq. 18 in the stacked metric).
 ///
 /// # Errors
-/// [`Error::Invalid`] (`what = "keys"`) when two consecutive keys coincide (a zero
+/// [`Error::Degenerate`] (`what = "keys"`) when two consecutive keys coincide (a zero
 /// centripetal spacing), within [`MIN_RELATIVE_SPACING`] of the mean.
 pub fn spans_spacing(
     curves: &[Vec<DVec3>],
@@ -224,13 +230,11 @@ pub fn spans_spacing(
                 .collect();
             let mean = d.iter().sum::<f64>() / spans.max(1) as f64;
             if let Some(i) = d.iter().position(|x| !(*x > MIN_RELATIVE_SPACING * mean)) {
-                return Err(Error::Invalid {
+                return Err(Error::Degenerate {
                     what: "keys",
-                    reason: format!(
-                        "keys {i} and {} coincide: the centripetal parametrisation needs \
-                         distinct consecutive keys",
-                        (i + 1) % n
-                    ),
+                    at: Some(At::new("key", i)),
+                    reason: "coincides with the next key: the centripetal parametrisation needs \
+                             distinct consecutive keys",
                 });
             }
             Ok(d)
@@ -257,8 +261,8 @@ impl VariationalLevel {
     ///
     /// # Errors
     /// [`Error::TooFew`] for fewer than 2 points, [`Error::LengthMismatch`] for a wrong
-    /// number of spacings or springs, [`Error::Invalid`] for a spacing that is not finite and
-    /// positive, and [`Error::Invalid`] (`what = "stiffness"`) when the system is not positive
+    /// number of spacings or springs, [`Error::Value`] for a spacing that is not finite and
+    /// positive, and [`Error::Degenerate`] (`what = "stiffness"`) when the system is not positive
     /// definite (too few springs to pin the curve, or a NaN spring).
     pub fn new(n: usize, closed: bool, spacing: &[f64], lambda: &[f64]) -> Result<Self> {
         if n < 2 {
@@ -280,12 +284,11 @@ impl VariationalLevel {
             });
         }
         if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
-            return Err(Error::Invalid {
+            return Err(Error::Value {
                 what: "spacing",
-                reason: format!(
-                    "span {i} has spacing {}, need finite and positive",
-                    spacing[i]
-                ),
+                at: Some(At::new("span", i)),
+                value: spacing[i],
+                expected: Expected::Positive("spacing"),
             });
         }
         let m = if closed { 2 * n } else { 2 * n - 1 };
@@ -331,9 +334,10 @@ impl VariationalLevel {
                 matrix.add(u, u, *l);
             }
         }
-        let factor = matrix.factor().map_err(|_| Error::Invalid {
+        let factor = matrix.factor().map_err(|_| Error::Degenerate {
             what: "stiffness",
-            reason: "the variational system is singular: too few keys are pinned".into(),
+            at: None,
+            reason: "the variational system is singular: too few keys are pinned",
         })?;
         Ok(Self {
             n,
@@ -472,7 +476,7 @@ impl VariationalLevel {
 ///
 /// # Errors
 /// [`Error::TooFew`] / [`Error::Levels`] as [`crate::subdivide`], [`Error::LengthMismatch`]
-/// for curves of different lengths or a wrong number of spacings, [`Error::Invalid`] for
+/// for curves of different lengths or a wrong number of spacings, [`Error::Value`] for
 /// non-positive spacings, and the errors of [`Stiffness::check`].
 pub fn variational_subdivide(
     curves: &[Vec<DVec3>],
@@ -499,12 +503,11 @@ pub fn variational_subdivide(
         });
     }
     if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
-        return Err(Error::Invalid {
+        return Err(Error::Value {
             what: "spacing",
-            reason: format!(
-                "span {i} has spacing {}, need finite and positive",
-                spacing[i]
-            ),
+            at: Some(At::new("span", i)),
+            value: spacing[i],
+            expected: Expected::Positive("spacing"),
         });
     }
     stiffness.check(n, closed)?;
@@ -930,8 +933,9 @@ mod tests {
         ));
         assert!(matches!(
             variational_curve(&f, 2, false, p, &Stiffness::keys(vec![0.0, 0.0, 0.0, 1.0])),
-            Err(Error::Invalid {
-                what: "stiffness",
+            Err(Error::Count {
+                got: 1,
+                need: 2,
                 ..
             })
         ));
@@ -943,8 +947,9 @@ mod tests {
                 p,
                 &Stiffness::keys(vec![1.0, f64::NAN, 0.0, 1.0])
             ),
-            Err(Error::Invalid {
+            Err(Error::Value {
                 what: "stiffness",
+                at: Some(At { index: 1, .. }),
                 ..
             })
         ));
@@ -957,7 +962,11 @@ mod tests {
                 Parametrization::Centripetal,
                 &Stiffness::default()
             ),
-            Err(Error::Invalid { what: "keys", .. })
+            Err(Error::Degenerate {
+                what: "keys",
+                at: Some(At { index: 1, .. }),
+                ..
+            })
         ));
         // Closed: one spring pins the cycle; zero springs elsewhere are fine.
         assert!(

@@ -103,10 +103,7 @@ pub fn departure(
     });
     for part in parts {
         // A worker only fails by a bug (the core does not panic on data): report it.
-        part.map_err(|_| Error::Invalid {
-            what: "frames",
-            reason: "a worker thread failed".into(),
-        })??;
+        part.map_err(|_| Error::Worker { what: "frames" })??;
     }
     Ok(Departure { distance, angle })
 }

@@ -9,7 +9,9 @@ use super::playback::Playback;
 use crate::memory::try_vec;
 use crate::motion::pose::MAX_COORDINATE;
 use crate::motion::timing::{check_period, check_time};
-use crate::{check_key_times, Error, Motion, MotionSpec, Pose, Result, Scheme, Timing};
+use crate::{
+    check_key_times, At, Error, Expected, Motion, MotionSpec, Pose, Result, Scheme, Timing,
+};
 
 /// Steps per key span along which the travel of Blender's playback and of the smoothed
 /// motion is measured (the output frames inside a span are measured too).
@@ -140,7 +142,7 @@ pub struct KeysTiming<'a> {
 /// [`Error::TooFew`] for fewer than two keys, the errors of
 /// [`check_key_times`] for the key frames (strictly increasing,
 /// within the time range), [`Error::Period`] for a period [`check_period`] refuses,
-/// [`Error::Invalid`] for a size outside `(0, 1e150]` or a frame so far outside the keys that
+/// [`Error::Value`] for a size outside `(0, 1e150]`, [`Error::Overflow`] for a frame so far outside the keys that
 /// its parameter is not finite, [`Error::NotFinite`] or [`Error::OutOfRange`] for a frame
 /// outside the time range, [`Error::LengthMismatch`] when `smooth` does not hold
 /// `PACE_SAMPLES + 1` poses per span, [`Error::BadPose`] for a smoothed pose outside the
@@ -164,9 +166,11 @@ pub fn keys_parameters(
     let spans = ends.len() - 1;
     let size = timing.size;
     if !(size > 0.0 && size <= MAX_COORDINATE) {
-        return Err(Error::Invalid {
+        return Err(Error::Value {
             what: "size",
-            reason: format!("{size} is not in the working range (0, {MAX_COORDINATE:e}]"),
+            at: None,
+            value: size,
+            expected: Expected::PositiveUpTo(MAX_COORDINATE),
         });
     }
     for (index, &f) in frames.iter().enumerate() {
@@ -280,12 +284,11 @@ pub fn keys_parameters(
     // Outside the keys the parameter extrapolates: a frame far from keys very close together
     // could leave the floating-point range.
     if let Some(index) = out.iter().position(|u| !u.is_finite()) {
-        return Err(Error::Invalid {
+        return Err(Error::Overflow {
             what: "frames",
-            reason: format!(
-                "frame {index} ({}) is too far from the keys for their spacing: its motion parameter is not finite",
-                frames[index]
-            ),
+            at: Some(At::new("frame", index)),
+            hint: "the frame is too far from the keys for their spacing: its motion parameter \
+                   is not finite",
         });
     }
     Ok(out)

@@ -5,7 +5,7 @@
 //! `rotation_quaternion` `w, x, y, z` or `rotation_axis_angle` `angle, x, y, z`); scale
 //! `x, y, z`: `6 + w` numbers, `w` the mode's [`RotationMode::width`].
 
-use glam::{DMat3, DQuat, DVec3};
+use glam::DMat3;
 
 use super::limits::{check_footprint, collected};
 use crate::memory::try_reserve;
@@ -28,30 +28,27 @@ impl Channel {
     /// `"rotation_axis_angle"`) at `index`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for another property (a rotation property of another mode
-    /// included) or an index out of the property's range.
+    /// [`Error::Choice`] for another property (a rotation property of another mode
+    /// included), [`Error::Index`] for an index out of the property's range.
     pub fn from_property(property: &str, index: usize, mode: RotationMode) -> Result<Self> {
         let rotation = rotation_property(mode);
-        let (channel, size) = match property {
-            "location" => (Self::Location(index), 3),
-            "scale" => (Self::Scale(index), 3),
-            p if p == rotation => (Self::Rotation(index), mode.width()),
+        let channel = match property {
+            "location" => Self::Location(index),
+            "scale" => Self::Scale(index),
+            p if p == rotation => Self::Rotation(index),
             _ => {
-                return Err(Error::Invalid {
-                    what: "channels",
-                    reason: format!(
-                        "{property:?} is not location, {rotation} (rotation mode {}) or scale",
-                        mode_name(mode)
-                    ),
+                return Err(Error::Choice {
+                    what: "property",
+                    got: property.to_owned(),
+                    expected: match mode {
+                        RotationMode::Quaternion => &["location", "rotation_quaternion", "scale"],
+                        RotationMode::AxisAngle => &["location", "rotation_axis_angle", "scale"],
+                        RotationMode::Euler(_) => &["location", "rotation_euler", "scale"],
+                    },
                 })
             }
         };
-        if index >= size {
-            return Err(Error::Invalid {
-                what: "channels",
-                reason: format!("{property}[{index}]: index out of range 0..{size}"),
-            });
-        }
+        channel.check(mode)?;
         Ok(channel)
     }
 
@@ -70,94 +67,32 @@ impl Channel {
     /// scale, `0..mode.width()` for the rotation.
     ///
     /// # Errors
-    /// [`Error::Invalid`] (`"channels"`) naming the channel and the range.
+    /// [`Error::Index`] naming the property and the range.
     pub fn check(self, mode: RotationMode) -> Result<()> {
-        let (index, size) = match self {
-            Self::Location(i) | Self::Scale(i) => (i, 3),
-            Self::Rotation(i) => (i, mode.width()),
+        let (property, index, size) = match self {
+            Self::Location(i) => ("location", i, 3),
+            Self::Scale(i) => ("scale", i, 3),
+            Self::Rotation(i) => (rotation_property(mode), i, mode.width()),
         };
         if index >= size {
-            return Err(Error::Invalid {
-                what: "channels",
-                reason: format!(
-                    "{self:?}: index out of range 0..{size} (rotation mode {})",
-                    mode_name(mode)
-                ),
+            return Err(Error::Index {
+                what: property,
+                item: "index",
+                at: None,
+                index: i64::try_from(index).unwrap_or(i64::MAX),
+                len: size,
             });
         }
         Ok(())
     }
 }
 
-/// Blender's rotation property of `mode`.
+/// Blender's rotation property of `mode` ([`RotationMode::property`]).
 pub fn rotation_property(mode: RotationMode) -> &'static str {
-    match mode {
-        RotationMode::Quaternion => "rotation_quaternion",
-        RotationMode::AxisAngle => "rotation_axis_angle",
-        RotationMode::Euler(_) => "rotation_euler",
-    }
+    mode.property()
 }
 
-fn mode_name(mode: RotationMode) -> &'static str {
-    use crate::EulerOrder::*;
-    match mode {
-        RotationMode::Quaternion => "QUATERNION",
-        RotationMode::AxisAngle => "AXIS_ANGLE",
-        RotationMode::Euler(Xyz) => "XYZ",
-        RotationMode::Euler(Xzy) => "XZY",
-        RotationMode::Euler(Yxz) => "YXZ",
-        RotationMode::Euler(Yzx) => "YZX",
-        RotationMode::Euler(Zxy) => "ZXY",
-        RotationMode::Euler(Zyx) => "ZYX",
-    }
-}
-
-/// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
-/// it:
-///
-/// - quaternion `(w, x, y, z)`, normalised (zero: the identity);
-/// - axis-angle `(angle, x, y, z)`, a rotation by `angle` about the normalised axis
-///   (Rodrigues, `I + sin(a) K + (1 - cos(a)) K^2`; a zero axis: the identity);
-/// - Euler `(x, y, z)` radians, order `"XYZ"` meaning X applied first: `R = Rz Ry Rx`
-///   ([`EulerOrder::to_mat3`](crate::EulerOrder::to_mat3)).
-///
-/// `values` has [`RotationMode::width`] numbers (extra ones are ignored, missing ones read
-/// as 0); they are assumed finite.
-pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
-    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
-    match mode {
-        RotationMode::Quaternion => {
-            // scaled by its largest component first: no overflow for huge values
-            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
-            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
-            if largest > 0.0 {
-                let q = q / largest;
-                DMat3::from_quat(q / q.length())
-            } else {
-                DMat3::IDENTITY
-            }
-        }
-        RotationMode::AxisAngle => {
-            let axis = DVec3::new(v(1), v(2), v(3));
-            let largest = axis.abs().max_element();
-            if largest > 0.0 {
-                let axis = axis / largest;
-                let k = axis / axis.length();
-                let (s, c) = v(0).sin_cos();
-                // K v = k x v, as columns of the skew matrix.
-                let skew = DMat3::from_cols(
-                    DVec3::new(0.0, k.z, -k.y),
-                    DVec3::new(-k.z, 0.0, k.x),
-                    DVec3::new(k.y, -k.x, 0.0),
-                );
-                DMat3::IDENTITY + skew * s + (skew * skew) * (1.0 - c)
-            } else {
-                DMat3::IDENTITY
-            }
-        }
-        RotationMode::Euler(order) => order.to_mat3(DVec3::new(v(0), v(1), v(2))),
-    }
-}
+pub use crate::motion::channels::rotation_matrix;
 
 /// [`rotation_matrix`] of every row of `values` (row-major, `N x width` numbers).
 ///
@@ -220,9 +155,9 @@ impl Playback {
     ///
     /// # Errors
     /// [`Error::LengthMismatch`] when `channels` and `curves`, or `statics` and the row
-    /// width `6 + mode.width()`, differ in length; [`Error::Invalid`] for a channel whose
-    /// index is outside its property ([`Channel::check`]) or when two curves drive one
-    /// channel; [`Error::NotFinite`] for a static value that is not finite.
+    /// width `6 + mode.width()`, differ in length; [`Error::Index`] inside [`Error::In`] for a
+    /// channel whose index is outside its property ([`Channel::check`]), [`Error::Conflict`]
+    /// when two curves drive one channel; [`Error::NotFinite`] for a static value that is not finite.
     pub fn new(
         curves: Vec<FCurve>,
         channels: &[Channel],
@@ -252,18 +187,12 @@ impl Playback {
             });
         }
         for (c, channel) in channels.iter().enumerate() {
-            channel.check(mode).map_err(|e| match e {
-                Error::Invalid { what, reason } => Error::Invalid {
-                    what,
-                    reason: format!("channel {c}: {reason}"),
-                },
-                e => e,
-            })?;
+            channel.check(mode).map_err(|e| e.within("channel", c))?;
         }
         let columns: Vec<usize> = channels.iter().map(|c| c.column(mode)).collect();
         for (c, column) in columns.iter().enumerate() {
             if let Some(first) = columns[..c].iter().position(|o| o == column) {
-                return Err(Error::Invalid {
+                return Err(Error::Conflict {
                     what: "channels",
                     reason: format!(
                         "curves {first} and {c} drive the same channel {:?}",
@@ -306,8 +235,8 @@ impl Playback {
     /// widened), the others the owner's own.
     ///
     /// # Errors
-    /// [`Error::NotFinite`] for a time that is not finite in `float32`, [`Error::Invalid`]
-    /// for a value that is not finite (as [`crate::evaluate_fcurves`]) and a request over the
+    /// [`Error::NotFinite`] for a time that is not finite in `float32`, [`Error::Evaluates`]
+    /// for a value that is not finite (as [`crate::evaluate_fcurves`]), [`Error::Limit`] for a request over the
     /// size limit ([`check_footprint`]).
     pub fn channels(&self, times: &[f64]) -> Result<Vec<f64>> {
         check_footprint(
@@ -357,11 +286,11 @@ impl Playback {
                 }
                 let v = curve.evaluate_f32(t32);
                 if !v.is_finite() {
-                    return Err(Error::Invalid {
-                        what: "value",
-                        reason: format!(
-                            "curve {c} evaluates to {v} at time {index} (frame {t32}), as Blender would"
-                        ),
+                    return Err(Error::Evaluates {
+                        curve: Some(c),
+                        value: v.into(),
+                        time: Some(index),
+                        frame: t32.into(),
                     });
                 }
                 row[column] = v as f64;

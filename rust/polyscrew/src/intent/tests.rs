@@ -9,7 +9,8 @@ use glam::{DMat3, DQuat, DVec3};
 
 use super::*;
 use crate::{
-    Error, EulerOrder, Extrapolation, FCurve, Interpolation, Key, Pose, RotationMode, Scheme,
+    At, Error, EulerOrder, Expected, Extrapolation, FCurve, Interpolation, Key, Pose, RotationMode,
+    Scheme,
 };
 
 const XYZ: RotationMode = RotationMode::Euler(EulerOrder::Xyz);
@@ -142,7 +143,10 @@ fn channels_take_curves_statics_and_ignore_location_when_not_located() {
             XYZ,
             true
         ),
-        Err(Error::Invalid { .. })
+        Err(Error::Conflict {
+            what: "channels",
+            ..
+        })
     ));
     assert!(matches!(
         Playback::new(vec![x.clone()], &channels, vec![0.0; 10], XYZ, true),
@@ -150,11 +154,16 @@ fn channels_take_curves_statics_and_ignore_location_when_not_located() {
     ));
     assert!(matches!(
         Channel::from_property("rotation_quaternion", 0, XYZ),
-        Err(Error::Invalid { .. })
+        Err(Error::Choice { what: "property", expected, .. }) if expected.contains(&"rotation_euler")
     ));
     assert!(matches!(
         Channel::from_property("scale", 3, XYZ),
-        Err(Error::Invalid { .. })
+        Err(Error::Index {
+            what: "scale",
+            index: 3,
+            len: 3,
+            ..
+        })
     ));
     assert_eq!(
         Channel::from_property("scale", 2, RotationMode::Quaternion)
@@ -188,13 +197,18 @@ fn playback_refuses_channels_outside_their_property() {
         let statics = vec![0.0; 6 + mode.width()];
         let got = Playback::new(vec![x.clone()], &[channel], statics, mode, true);
         match got {
-            Err(Error::Invalid {
-                what: "channels",
-                reason,
+            Err(Error::In {
+                at:
+                    At {
+                        item: "channel",
+                        index: 0,
+                    },
+                source,
+                ..
             }) => {
                 assert!(
-                    reason.contains("channel 0") && reason.contains("out of range"),
-                    "{reason}"
+                    matches!(*source, Error::Index { index, len, .. } if index >= len as i64),
+                    "{source:?}"
                 )
             }
             other => panic!("{channel:?} in {mode:?}: {other:?}"),
@@ -561,7 +575,11 @@ fn keys_timing_of_a_cycle_and_its_errors() {
             &[1.0],
             &smooth
         ),
-        Error::Invalid { what: "size", .. }
+        Error::Value {
+            what: "size",
+            expected: Expected::PositiveUpTo(_),
+            ..
+        }
     ));
     assert!(matches!(
         bad(
@@ -638,7 +656,14 @@ fn span_analysis_refuses_more_samples_than_its_cap_before_taking_any() {
     let (p, frames) = spin(514);
     let err = analyse_spans(&p, &frames).unwrap_err();
     assert!(
-        matches!(&err, Error::Invalid { what: "frames", reason } if reason.starts_with("the 513 key spans would take 2101248 samples of the playback, more than 2097152")),
+        matches!(
+            err,
+            Error::Limit {
+                count: 2101248,
+                limit: 2097152,
+                ..
+            }
+        ),
         "{err}"
     );
     let (p, frames) = spin(513);

@@ -52,15 +52,16 @@ impl Turns {
     /// Parses `"AUTO"`, `"BLENDER"` (as Blender plays) or `"SHORTEST"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for anything else.
+    /// [`Error::Choice`] for anything else.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "AUTO" => Ok(Self::Auto),
             "BLENDER" => Ok(Self::AsPlayed),
             "SHORTEST" => Ok(Self::Shortest),
-            _ => Err(Error::Invalid {
+            _ => Err(Error::Choice {
                 what: "turns",
-                reason: format!("{name:?} is not one of AUTO, BLENDER, SHORTEST"),
+                got: name.to_owned(),
+                expected: &["AUTO", "BLENDER", "SHORTEST"],
             }),
         }
     }

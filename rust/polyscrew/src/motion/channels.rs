@@ -9,12 +9,13 @@
 //! two Euler triples of a matrix, each wrapped by multiples of 2 pi towards the previous
 //! frame, the one nearer to it (sum of absolute differences) is kept.
 
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use glam::{DMat3, DQuat, DVec3};
 
 use crate::error::{Error, Result};
 use crate::memory::{try_vec, Footprint};
+use crate::numeric::fastmath;
 
 /// Below this `cos(middle angle)` an Euler triple is in gimbal lock: the first and last axes
 /// coincide and the last angle is set to 0 (as Blender does, with its f32 threshold scaled).
@@ -75,34 +76,52 @@ impl EulerOrder {
 
     /// Both Euler triples of a rotation matrix (equal in gimbal lock).
     fn two_triples(self, m: &DMat3) -> (DVec3, DVec3) {
-        let ([i, j, k], odd) = self.axes();
-        // Blender's mat[a][b] is column a, row b.
-        let at = |a: usize, b: usize| m.col(a)[b];
-        let cy = at(i, i).hypot(at(i, j));
-        let mut e1 = [0.0; 3];
-        let mut e2 = [0.0; 3];
-        if cy > GIMBAL_LOCK_COS {
-            e1[i] = at(j, k).atan2(at(k, k));
-            e1[j] = (-at(i, k)).atan2(cy);
-            e1[k] = at(i, j).atan2(at(i, i));
-            // The second triple, atan2(-y, -x) and atan2(-s, -cy) in Blender, from the first:
-            // three atan2 instead of six (Euler extraction is most of a bake's per-frame cost).
-            e2[i] = half_turn_opposite(e1[i], at(j, k));
-            e2[j] = reflected_middle(e1[j], -at(i, k));
-            e2[k] = half_turn_opposite(e1[k], at(i, j));
-        } else {
-            e1[i] = (-at(k, j)).atan2(at(j, j));
-            e1[j] = (-at(i, k)).atan2(cy);
-            e1[k] = 0.0;
-            e2 = e1;
+        let m = m.to_cols_array();
+        match self {
+            Self::Xyz => two_triples_of::<0, 1, 2, false>(&m),
+            Self::Xzy => two_triples_of::<0, 2, 1, true>(&m),
+            Self::Yxz => two_triples_of::<1, 0, 2, true>(&m),
+            Self::Yzx => two_triples_of::<1, 2, 0, false>(&m),
+            Self::Zxy => two_triples_of::<2, 0, 1, false>(&m),
+            Self::Zyx => two_triples_of::<2, 1, 0, true>(&m),
         }
-        let (mut a, mut b) = (DVec3::from_array(e1), DVec3::from_array(e2));
-        if odd {
-            a = -a;
-            b = -b;
-        }
-        (a, b)
     }
+}
+
+/// [`EulerOrder::two_triples`] of the column-major matrix `m` for the order whose axes are
+/// applied `I, J, K` (`ODD`: an odd permutation), the indices known at compile time so that
+/// a caller that builds `m` from a quaternion computes only the five entries read.
+#[inline(always)]
+fn two_triples_of<const I: usize, const J: usize, const K: usize, const ODD: bool>(
+    m: &[f64; 9],
+) -> (DVec3, DVec3) {
+    // Blender's mat[a][b] is column a, row b.
+    let at = |a: usize, b: usize| m[3 * a + b];
+    // hypot without the library call: the entries of a rotation are at most 1.
+    let cy = (at(I, I) * at(I, I) + at(I, J) * at(I, J)).sqrt();
+    let mut e1 = [0.0; 3];
+    let mut e2 = [0.0; 3];
+    if cy > GIMBAL_LOCK_COS {
+        e1[I] = atan2(at(J, K), at(K, K));
+        e1[J] = atan2(-at(I, K), cy);
+        e1[K] = atan2(at(I, J), at(I, I));
+        // The second triple, atan2(-y, -x) and atan2(-s, -cy) in Blender, from the first:
+        // three atan2 instead of six (Euler extraction is most of a bake's per-frame cost).
+        e2[I] = half_turn_opposite(e1[I], at(J, K));
+        e2[J] = reflected_middle(e1[J], -at(I, K));
+        e2[K] = half_turn_opposite(e1[K], at(I, J));
+    } else {
+        e1[I] = atan2(-at(K, J), at(J, J));
+        e1[J] = atan2(-at(I, K), cy);
+        e1[K] = 0.0;
+        e2 = e1;
+    }
+    let (mut a, mut b) = (DVec3::from_array(e1), DVec3::from_array(e2));
+    if ODD {
+        a = -a;
+        b = -b;
+    }
+    (a, b)
 }
 
 impl RotationMode {
@@ -110,26 +129,77 @@ impl RotationMode {
     /// `"XZY"`, `"YXZ"`, `"YZX"`, `"ZXY"`, `"ZYX"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for anything else.
+    /// [`Error::Choice`] for anything else.
     pub fn from_name(name: &str) -> Result<Self> {
-        Ok(match name {
-            "QUATERNION" => Self::Quaternion,
-            "AXIS_ANGLE" => Self::AxisAngle,
-            "XYZ" => Self::Euler(EulerOrder::Xyz),
-            "XZY" => Self::Euler(EulerOrder::Xzy),
-            "YXZ" => Self::Euler(EulerOrder::Yxz),
-            "YZX" => Self::Euler(EulerOrder::Yzx),
-            "ZXY" => Self::Euler(EulerOrder::Zxy),
-            "ZYX" => Self::Euler(EulerOrder::Zyx),
-            _ => {
-                return Err(Error::Invalid {
-                    what: "rotation mode",
-                    reason: format!(
-                    "{name:?} is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
-                ),
-                })
-            }
-        })
+        Self::ALL
+            .into_iter()
+            .find(|mode| mode.name() == name)
+            .ok_or_else(|| Error::Choice {
+                what: "rotation mode",
+                got: name.to_owned(),
+                expected: &Self::NAMES,
+            })
+    }
+
+    /// Every rotation mode, in Blender's order of the `rotation_mode` enum's values that
+    /// [`RotationMode::from_name`] parses. Adding a mode: its variant, its entry here, its
+    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), and
+    /// its conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all
+    /// in this file.
+    pub const ALL: [Self; 8] = [
+        Self::Quaternion,
+        Self::AxisAngle,
+        Self::Euler(EulerOrder::Xyz),
+        Self::Euler(EulerOrder::Xzy),
+        Self::Euler(EulerOrder::Yxz),
+        Self::Euler(EulerOrder::Yzx),
+        Self::Euler(EulerOrder::Zxy),
+        Self::Euler(EulerOrder::Zyx),
+    ];
+
+    /// [`name`](Self::name) of every mode of [`ALL`](Self::ALL), in its order.
+    pub const NAMES: [&'static str; 8] = {
+        let mut names = [""; 8];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = Self::ALL[i].name();
+            i += 1;
+        }
+        names
+    };
+
+    /// Blender's name of the mode (`"QUATERNION"`, `"AXIS_ANGLE"`, `"XYZ"`, ...).
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Quaternion => "QUATERNION",
+            Self::AxisAngle => "AXIS_ANGLE",
+            Self::Euler(EulerOrder::Xyz) => "XYZ",
+            Self::Euler(EulerOrder::Xzy) => "XZY",
+            Self::Euler(EulerOrder::Yxz) => "YXZ",
+            Self::Euler(EulerOrder::Yzx) => "YZX",
+            Self::Euler(EulerOrder::Zxy) => "ZXY",
+            Self::Euler(EulerOrder::Zyx) => "ZYX",
+        }
+    }
+
+    /// Blender's property holding the rotation in this mode: `"rotation_quaternion"`,
+    /// `"rotation_axis_angle"` or `"rotation_euler"`.
+    pub fn property(self) -> &'static str {
+        match self {
+            Self::Quaternion => "rotation_quaternion",
+            Self::AxisAngle => "rotation_axis_angle",
+            Self::Euler(_) => "rotation_euler",
+        }
+    }
+
+    /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
+    /// quaternions, the angle of axis-angle, the three Euler angles.
+    fn angles(self) -> usize {
+        match self {
+            Self::Quaternion => 0,
+            Self::AxisAngle => 1,
+            Self::Euler(_) => 3,
+        }
     }
 
     /// The number of channels: 4 for quaternion and axis-angle, 3 for Euler.
@@ -166,13 +236,79 @@ fn reflected_middle(a: f64, s: f64) -> f64 {
 /// `x` plus the multiple of `2 pi` that brings it within `pi` of `reference`.
 #[inline]
 fn wrap_towards(x: f64, reference: f64) -> f64 {
-    x - ((x - reference) / TAU).round() * TAU
+    // Within 3 of the reference the multiple is 0 (the common case, continuous motion).
+    if (x - reference).abs() < 3.0 {
+        return x;
+    }
+    x - round_half_away((x - reference) / TAU) * TAU
 }
 
-/// Euler angles of `m` in `order`, compatible with `previous` when given (Blender's
-/// `mat3_normalized_to_compatible_eulO`), else the triple with the smaller absolute sum.
-pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -> DVec3 {
-    let (e1, e2) = order.two_triples(m);
+/// `v.round()` (half away from zero) without the library call baseline x86-64 makes of it:
+/// adding and subtracting `1.5 * 2^52` rounds half to even, a tie is moved away from zero
+/// and the sign is `v`'s (`-0.2` rounds to `-0`); beyond `2^51` std.
+#[inline(always)]
+fn round_half_away(v: f64) -> f64 {
+    if v.is_nan() || v.abs() >= 2_251_799_813_685_248.0 {
+        return v.round();
+    }
+    let r = (v + fastmath::ROUNDING_SHIFT) - fastmath::ROUNDING_SHIFT;
+    if (r - v).abs() == 0.5 {
+        v + 0.5f64.copysign(v)
+    } else {
+        r.copysign(v)
+    }
+}
+
+// fdlibm's `atan(0.5)` and `atan(1)` in two parts (`s_atan.c`, `atanhi`, `atanlo`; its
+// `atanhi[1]` is `FRAC_PI_4`), digit for digit.
+#[allow(clippy::excessive_precision)]
+const ATAN_HALF_HI: f64 = 4.636_476_090_008_060_935_15e-1;
+#[allow(clippy::excessive_precision)]
+const ATAN_HALF_LO: f64 = 2.269_877_745_296_168_709_24e-17;
+const ATAN_ONE_HI: f64 = std::f64::consts::FRAC_PI_4;
+#[allow(clippy::excessive_precision)]
+const ATAN_ONE_LO: f64 = 3.061_616_997_868_383_017_93e-17;
+// The parts of pi / 2 and pi below their nearest doubles.
+const FRAC_PI_2_LO: f64 = 6.123_233_995_736_766e-17;
+const PI_LO: f64 = 1.224_646_799_147_353_2e-16;
+
+/// `atan2(y, x)` within about one ulp of std's, without its library call: the ratio of the
+/// smaller to the larger of `|x|`, `|y|` in `[0, 1]`, fdlibm's `atan` on it (`s_atan.c`: the
+/// polynomial below `7/16`, `atan(1/2) + atan((2t - 1) / (2 + t))` below `11/16`,
+/// `atan(1) + atan((t - 1) / (t + 1))` above), then the octant (`pi / 2 - a`, `pi - a` with
+/// the low parts of `pi`) and the sign of `y` (signed zeros as std). Both zero, infinities
+/// and NaN go to std.
+#[inline(always)]
+fn atan2(y: f64, x: f64) -> f64 {
+    let (ax, ay) = (x.abs(), y.abs());
+    let (small, large) = if ay > ax { (ax, ay) } else { (ay, ax) };
+    if !(large > 0.0 && large < f64::INFINITY) {
+        return y.atan2(x);
+    }
+    let t = small / large;
+    let mut a = if t < 7.0 / 16.0 {
+        t - fastmath::atan_poly(t)
+    } else if t < 11.0 / 16.0 {
+        let u = (2.0 * t - 1.0) / (2.0 + t);
+        ATAN_HALF_HI - ((fastmath::atan_poly(u) - ATAN_HALF_LO) - u)
+    } else {
+        let u = (t - 1.0) / (t + 1.0);
+        ATAN_ONE_HI - ((fastmath::atan_poly(u) - ATAN_ONE_LO) - u)
+    };
+    if ay > ax {
+        a = (FRAC_PI_2 - a) + FRAC_PI_2_LO;
+    }
+    if x < 0.0 {
+        a = (PI - a) + PI_LO;
+    }
+    a.copysign(y)
+}
+
+/// Of the two Euler triples `e1`, `e2` of one rotation: each wrapped towards `previous` and
+/// the nearer kept (sum of absolute differences; `e1` on a tie); without `previous` the one
+/// of smaller absolute sum.
+#[inline(always)]
+fn nearer_triple(e1: DVec3, e2: DVec3, previous: Option<DVec3>) -> DVec3 {
     match previous {
         None => {
             if e1.abs().element_sum() > e2.abs().element_sum() {
@@ -199,6 +335,28 @@ pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -
     }
 }
 
+/// Euler angles of `m` in `order`, compatible with `previous` when given (Blender's
+/// `mat3_normalized_to_compatible_eulO`), else the triple with the smaller absolute sum.
+pub fn euler_compatible(m: &DMat3, order: EulerOrder, previous: Option<DVec3>) -> DVec3 {
+    let (e1, e2) = order.two_triples(m);
+    nearer_triple(e1, e2, previous)
+}
+
+/// [`euler_compatible`] of every rotation in turn, each compatible with the one before,
+/// appended to `out` (3 values a row), the order's axes fixed at compile time.
+fn euler_rows<const I: usize, const J: usize, const K: usize, const ODD: bool>(
+    rotations: &[DQuat],
+    mut previous: Option<DVec3>,
+    out: &mut Vec<f64>,
+) {
+    for q in rotations {
+        let (e1, e2) = two_triples_of::<I, J, K, ODD>(&DMat3::from_quat(*q).to_cols_array());
+        let e = nearer_triple(e1, e2, previous);
+        out.extend_from_slice(&e.to_array());
+        previous = Some(e);
+    }
+}
+
 /// The largest `previous` angle (radians, either sign) [`rotation_channels`] continues from:
 /// Euler angles and the axis-angle angle. A continued angle is `previous` plus less than
 /// half a turn; within this range a double holds it to about 1e-7 radians (its spacing at
@@ -215,14 +373,15 @@ pub const MAX_ROTATIONS: usize = 1 << 24;
 /// Refuses more than [`MAX_ROTATIONS`] rotations in one call.
 ///
 /// # Errors
-/// [`Error::Invalid`] (`rotations`) naming the count and the limit.
+/// [`Error::Limit`] (`rotations`) naming the count and the limit.
 pub fn check_rotation_count(count: usize) -> Result<()> {
     if count > MAX_ROTATIONS {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "rotations",
-            reason: format!(
-                "{count} rotations, more than {MAX_ROTATIONS} in one call: {CHANNELS_HINT}"
-            ),
+            counted: "rotations",
+            count,
+            limit: MAX_ROTATIONS,
+            hint: CHANNELS_HINT,
         });
     }
     Ok(())
@@ -230,6 +389,41 @@ pub fn check_rotation_count(count: usize) -> Result<()> {
 
 /// How to ask [`rotation_channels`] for less memory.
 pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
+
+/// Checks reference channel values (`previous`, or the rows of a reference): `expected`
+/// numbers, finite, the angles of each row of `mode` within [`MAX_PREVIOUS_ANGLE`].
+fn check_reference(
+    values: &[f64],
+    expected: usize,
+    mode: RotationMode,
+    what: &'static str,
+    value: &'static str,
+) -> Result<()> {
+    if values.len() != expected {
+        return Err(Error::LengthMismatch {
+            what,
+            expected,
+            got: values.len(),
+        });
+    }
+    if let Some(index) = values.iter().position(|v| !v.is_finite()) {
+        return Err(Error::NotFinite { what: value, index });
+    }
+    let (width, angles) = (mode.width(), mode.angles());
+    if let Some(index) = values
+        .iter()
+        .enumerate()
+        .position(|(i, v)| i % width < angles && v.abs() > MAX_PREVIOUS_ANGLE)
+    {
+        return Err(Error::OutOfRange {
+            what: value,
+            index,
+            value: values[index],
+            limit: MAX_PREVIOUS_ANGLE,
+        });
+    }
+    Ok(())
+}
 
 /// Channel values of a sequence of rotations in `mode`, continuous frame to frame.
 ///
@@ -241,7 +435,7 @@ pub const CHANNELS_HINT: &str = "convert fewer rotations at once";
 /// # Errors
 /// [`Error::LengthMismatch`] when `previous` has the wrong width, [`Error::NotFinite`] when
 /// it holds NaN or infinity, [`Error::OutOfRange`] when one of its angles (Euler, or the
-/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Invalid`] for more than
+/// axis-angle angle) is beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Limit`] for more than
 /// [`MAX_ROTATIONS`] rotations, [`Error::Memory`] when the channels exceed the memory budget.
 pub fn rotation_channels(
     rotations: &[DQuat],
@@ -250,35 +444,7 @@ pub fn rotation_channels(
 ) -> Result<Vec<f64>> {
     let width = mode.width();
     if let Some(p) = previous {
-        if p.len() != width {
-            return Err(Error::LengthMismatch {
-                what: "previous",
-                expected: width,
-                got: p.len(),
-            });
-        }
-        if let Some(index) = p.iter().position(|v| !v.is_finite()) {
-            return Err(Error::NotFinite {
-                what: "previous value",
-                index,
-            });
-        }
-        let angles = match mode {
-            RotationMode::Quaternion => 0,
-            RotationMode::AxisAngle => 1,
-            RotationMode::Euler(_) => 3,
-        };
-        if let Some(index) = p[..angles]
-            .iter()
-            .position(|v| v.abs() > MAX_PREVIOUS_ANGLE)
-        {
-            return Err(Error::OutOfRange {
-                what: "previous value",
-                index,
-                value: p[index],
-                range: "+-1e9",
-            });
-        }
+        check_reference(p, width, mode, "previous", "previous value")?;
     }
     let values = rotations.len().saturating_mul(width);
     Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
@@ -321,37 +487,149 @@ pub fn rotation_channels(
                     q = -q;
                 }
                 prev_q = Some(q);
-                let v = q.xyz();
-                let sin_h = v.length();
-                let mut angle = 2.0 * sin_h.atan2(q.w);
-                let mut axis = if sin_h > 0.0 {
-                    v / sin_h
-                } else {
-                    prev.map_or(first_axis, |(_, a)| a)
-                };
-                if let Some((prev_angle, prev_axis)) = prev {
-                    // (angle, axis) and (-angle, -axis) are the same rotation; so are angles
-                    // 2 pi apart: pick the representative nearest the previous frame.
-                    if axis.dot(prev_axis) < 0.0 {
-                        axis = -axis;
-                        angle = -angle;
-                    }
-                    angle = wrap_towards(angle, prev_angle);
-                }
+                let (angle, axis) = axis_angle_near(q, prev, first_axis);
                 out.extend_from_slice(&[angle, axis.x, axis.y, axis.z]);
                 prev = Some((angle, axis));
             }
         }
         RotationMode::Euler(order) => {
-            let mut prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
-            for q in rotations {
-                let e = euler_compatible(&DMat3::from_quat(*q), order, prev);
-                out.extend_from_slice(&e.to_array());
-                prev = Some(e);
+            let prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
+            let out = &mut out;
+            match order {
+                EulerOrder::Xyz => euler_rows::<0, 1, 2, false>(rotations, prev, out),
+                EulerOrder::Xzy => euler_rows::<0, 2, 1, true>(rotations, prev, out),
+                EulerOrder::Yxz => euler_rows::<1, 0, 2, true>(rotations, prev, out),
+                EulerOrder::Yzx => euler_rows::<1, 2, 0, false>(rotations, prev, out),
+                EulerOrder::Zxy => euler_rows::<2, 0, 1, false>(rotations, prev, out),
+                EulerOrder::Zyx => euler_rows::<2, 1, 0, true>(rotations, prev, out),
             }
         }
     }
     Ok(out)
+}
+
+/// The axis-angle `(angle, axis)` of the unit quaternion `q` nearest `reference`:
+/// `angle = 2 atan2(|v|, w)` about `v / |v|` (the reference's axis, else `fallback`, for no
+/// rotation), then `(angle, axis)` or its twin `(-angle, -axis)`, whichever axis points the
+/// reference's way, its angle wrapped by whole turns to within `pi` of the reference's.
+fn axis_angle_near(q: DQuat, reference: Option<(f64, DVec3)>, fallback: DVec3) -> (f64, DVec3) {
+    let v = q.xyz();
+    let sin_h = v.length();
+    let mut angle = 2.0 * sin_h.atan2(q.w);
+    let mut axis = if sin_h > 0.0 {
+        v / sin_h
+    } else {
+        reference.map_or(fallback, |(_, a)| a)
+    };
+    if let Some((ref_angle, ref_axis)) = reference {
+        // (angle, axis) and (-angle, -axis) are the same rotation; so are angles
+        // 2 pi apart: pick the representative nearest the reference.
+        if axis.dot(ref_axis) < 0.0 {
+            axis = -axis;
+            angle = -angle;
+        }
+        angle = wrap_towards(angle, ref_angle);
+    }
+    (angle, axis)
+}
+
+/// Channel values of each rotation in `mode` written like its own row of `reference`
+/// (`N x width` values, for example the keys an animator typed), not continued from the
+/// rotation before: the representative of rotation `i` nearest `reference[i]`. Quaternions
+/// take the reference's sign (`q . r >= 0`); axis-angle the axis that points the
+/// reference's way and the angle within half a turn of its angle; Euler angles the one of
+/// the two triples, each wrapped by whole turns towards the reference, that is nearer to
+/// it (sum of absolute differences, [`euler_compatible`]). Spins and deliberate sign flips
+/// of the reference are kept; a rotation equal to its reference's gives the reference back
+/// (to rounding).
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `reference` does not hold `N x width` values,
+/// [`Error::NotFinite`] for NaN or infinity in it, [`Error::OutOfRange`] for one of its angles
+/// beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Limit`] for more than [`MAX_ROTATIONS`]
+/// rotations, [`Error::Memory`] when the channels exceed the memory budget.
+pub fn channels_near(
+    rotations: &[DQuat],
+    mode: RotationMode,
+    reference: &[f64],
+) -> Result<Vec<f64>> {
+    let width = mode.width();
+    let values = rotations.len().saturating_mul(width);
+    check_rotation_count(rotations.len())?;
+    check_reference(reference, values, mode, "reference", "reference value")?;
+    Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    let mut out = try_vec(values, "rotation channels")?;
+    for (q, r) in rotations.iter().zip(reference.chunks_exact(width)) {
+        let q = q.normalize();
+        match mode {
+            RotationMode::Quaternion => {
+                let q = if q.dot(DQuat::from_xyzw(r[1], r[2], r[3], r[0])) < 0.0 {
+                    -q
+                } else {
+                    q
+                };
+                out.extend_from_slice(&[q.w, q.x, q.y, q.z]);
+            }
+            RotationMode::AxisAngle => {
+                let q = if q.w < 0.0 { -q } else { q };
+                let reference = (r[0], DVec3::new(r[1], r[2], r[3]));
+                let (angle, axis) = axis_angle_near(q, Some(reference), DVec3::Y);
+                out.extend_from_slice(&[angle, axis.x, axis.y, axis.z]);
+            }
+            RotationMode::Euler(order) => {
+                let e = euler_compatible(&DMat3::from_quat(q), order, Some(DVec3::from_slice(r)));
+                out.extend_from_slice(&e.to_array());
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
+/// it:
+///
+/// - quaternion `(w, x, y, z)`, normalised (zero: the identity);
+/// - axis-angle `(angle, x, y, z)`, a rotation by `angle` about the normalised axis
+///   (Rodrigues, `I + sin(a) K + (1 - cos(a)) K^2`; a zero axis: the identity);
+/// - Euler `(x, y, z)` radians, order `"XYZ"` meaning X applied first: `R = Rz Ry Rx`
+///   ([`EulerOrder::to_mat3`]).
+///
+/// `values` has [`RotationMode::width`] numbers (extra ones are ignored, missing ones read
+/// as 0); they are assumed finite.
+pub fn rotation_matrix(mode: RotationMode, values: &[f64]) -> DMat3 {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            // scaled by its largest component first: no overflow for huge values
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            if largest > 0.0 {
+                let q = q / largest;
+                DMat3::from_quat(q / q.length())
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::AxisAngle => {
+            let axis = DVec3::new(v(1), v(2), v(3));
+            let largest = axis.abs().max_element();
+            if largest > 0.0 {
+                let axis = axis / largest;
+                let k = axis / axis.length();
+                let (s, c) = v(0).sin_cos();
+                // K v = k x v, as columns of the skew matrix.
+                let skew = DMat3::from_cols(
+                    DVec3::new(0.0, k.z, -k.y),
+                    DVec3::new(-k.z, 0.0, k.x),
+                    DVec3::new(k.y, -k.x, 0.0),
+                );
+                DMat3::IDENTITY + skew * s + (skew * skew) * (1.0 - c)
+            } else {
+                DMat3::IDENTITY
+            }
+        }
+        RotationMode::Euler(order) => order.to_mat3(DVec3::new(v(0), v(1), v(2))),
+    }
 }
 
 /// The largest jump between consecutive rows on any channel (for tests and reports).
@@ -378,6 +656,90 @@ mod tests {
         EulerOrder::Zxy,
         EulerOrder::Zyx,
     ];
+
+    #[test]
+    fn atan2_matches_std() {
+        // Every octant, ratios across fdlibm's ranges and their edges, tiny and huge values,
+        // signed zeros and non-finite values.
+        let mut worst: f64 = 0.0;
+        let mut check = |y: f64, x: f64| {
+            let (got, want) = (atan2(y, x), y.atan2(x));
+            if want.is_nan() {
+                assert!(got.is_nan(), "atan2({y}, {x}) = {got}, std NaN");
+                return;
+            }
+            assert_eq!(
+                got.is_sign_negative(),
+                want.is_sign_negative(),
+                "atan2({y}, {x}): {got} vs {want}"
+            );
+            let ulp = f64::EPSILON * want.abs().max(f64::MIN_POSITIVE);
+            worst = worst.max((got - want).abs() / ulp);
+        };
+        for i in 0..=100_000 {
+            let a = i as f64 / 100_000.0 * TAU - PI;
+            let (s, c) = a.sin_cos();
+            for r in [1.0, 1e-200, 3.7e150] {
+                check(s * r, c * r);
+            }
+        }
+        for t in [
+            7.0 / 16.0,
+            11.0 / 16.0,
+            1.0,
+            0.4375f64.next_down(),
+            0.6875f64.next_up(),
+        ] {
+            for (y, x) in [(t, 1.0), (1.0, t), (-t, 1.0), (t, -1.0), (-1.0, -t)] {
+                check(y, x);
+            }
+        }
+        for (y, x) in [
+            (0.0, 1.0),
+            (-0.0, 1.0),
+            (0.0, -1.0),
+            (-0.0, -1.0),
+            (1.0, 0.0),
+            (1.0, -0.0),
+            (-1.0, -0.0),
+            (0.0, 0.0),
+            (-0.0, -0.0),
+            (0.0, -0.0),
+            (1e-320, 1.0),
+            (1.0, 1e-320),
+            (f64::INFINITY, 1.0),
+            (1.0, f64::NEG_INFINITY),
+            (f64::INFINITY, f64::INFINITY),
+            (f64::NAN, 1.0),
+            (1.0, f64::NAN),
+        ] {
+            check(y, x);
+        }
+        assert!(worst <= 2.0, "worst {worst} ulps");
+    }
+
+    #[test]
+    fn round_half_away_is_round() {
+        for v in [
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            2.4999999999999996,
+            0.49999999999999994,
+            3.0,
+            -0.0,
+            7e15,
+            1e300,
+            -4.5e9 + 0.5,
+        ] {
+            let (got, want) = (round_half_away(v), v.round());
+            assert!(
+                got == want && got.is_sign_negative() == want.is_sign_negative(),
+                "{v}: {got} vs {want}"
+            );
+        }
+    }
 
     #[test]
     fn euler_round_trip_every_order() {
@@ -514,8 +876,85 @@ mod tests {
         assert!(check_rotation_count(MAX_ROTATIONS).is_ok());
         let err = check_rotation_count(MAX_ROTATIONS + 1).unwrap_err();
         assert_eq!(
+            err,
+            Error::Limit {
+                what: "rotations",
+                counted: "rotations",
+                count: MAX_ROTATIONS + 1,
+                limit: MAX_ROTATIONS,
+                hint: CHANNELS_HINT,
+            }
+        );
+        assert_eq!(
             err.to_string(),
-            "rotations: 16777217 rotations, more than 16777216 in one call: convert fewer rotations at once"
+            "rotations: 16777217 rotations exceed the limit of 16777216 in one call: convert fewer rotations at once"
+        );
+    }
+
+    #[test]
+    fn every_mode_parses_its_own_name() {
+        for mode in RotationMode::ALL {
+            assert_eq!(RotationMode::from_name(mode.name()).unwrap(), mode);
+            assert!(mode.property().starts_with("rotation_"), "{mode:?}");
+        }
+        let err = RotationMode::from_name("xyz").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "rotation mode: \"xyz\" is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
+        );
+    }
+
+    #[test]
+    fn channels_near_keep_the_reference_spins_and_signs() {
+        let axis = DVec3::new(0.2, 0.5, 1.0).normalize();
+        let rots: Vec<DQuat> = (0..400)
+            .map(|i| DQuat::from_axis_angle(axis, i as f64 * 0.05))
+            .collect();
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let continuous = rotation_channels(&rots, mode, None).unwrap();
+            // the continuous channels are their own nearest representative
+            let near = channels_near(&rots, mode, &continuous).unwrap();
+            for (a, b) in near.iter().zip(&continuous) {
+                assert!((a - b).abs() < 1e-12, "{mode:?}: {a} vs {b}");
+            }
+            // a reference a whole turn (or a sign) away is followed, rotation unchanged
+            let shifted: Vec<f64> = continuous
+                .chunks_exact(w)
+                .flat_map(|row| {
+                    let mut row = row.to_vec();
+                    match mode {
+                        RotationMode::Quaternion => row.iter_mut().for_each(|v| *v = -*v),
+                        RotationMode::AxisAngle => row[0] += TAU,
+                        RotationMode::Euler(_) => row[1] -= 2.0 * TAU,
+                    }
+                    row
+                })
+                .collect();
+            let near = channels_near(&rots, mode, &shifted).unwrap();
+            for (row, (want, q)) in near.chunks_exact(w).zip(shifted.chunks_exact(w).zip(&rots)) {
+                for (a, b) in row.iter().zip(want) {
+                    assert!((a - b).abs() < 1e-9, "{mode:?}: {row:?} vs {want:?}");
+                }
+                let m = rotation_matrix(mode, row);
+                let err = (m - DMat3::from_quat(*q))
+                    .to_cols_array()
+                    .iter()
+                    .fold(0.0f64, |a, v| a.max(v.abs()));
+                assert!(err < 1e-12, "{mode:?}: {row:?}");
+            }
+        }
+        let err = channels_near(&rots[..1], RotationMode::AxisAngle, &[1.0, 0.0, 0.0]).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::LengthMismatch {
+                    expected: 4,
+                    got: 3,
+                    ..
+                }
+            ),
+            "{err:?}"
         );
     }
 }

@@ -10,9 +10,12 @@
 //! [`pose`] validates rigid poses, [`screw`] computes screws and `s`, [`subdivision`] refines
 //! polyscrews (and polygons) by Split&Tweak, [`timing`] maps frames to the parameter,
 //! [`sample`] evaluates the subdivided motion at any time, [`channels`] turns rotations into
-//! Blender's quaternion, axis-angle and Euler channels, continuous frame to frame.
+//! Blender's quaternion, axis-angle and Euler channels, continuous frame to frame (and owns
+//! the rotation modes: names, properties, widths, conversions), [`moves`] measures turns
+//! between orientations and cuts moves short.
 
 pub mod channels;
+pub mod moves;
 pub mod pose;
 pub mod sample;
 pub mod screw;

@@ -22,9 +22,6 @@ pub const RIGID_TOLERANCE: f64 = 1e-6;
 /// coordinates of many points (registration, inertia) it scales them by a power of two first.
 pub const MAX_COORDINATE: f64 = 1e150;
 
-/// [`MAX_COORDINATE`] as it reads in messages.
-pub const COORDINATE_RANGE: &str = "+-1e150";
-
 /// A rigid transform `x -> R x + o` with `R` a unit quaternion.
 ///
 /// The rotation is kept normalised by every constructor, so a pose converted back to a

@@ -28,7 +28,7 @@ use glam::DVec3;
 
 use crate::error::{Error, Result};
 use crate::memory::{try_vec, Footprint};
-use crate::motion::pose::{Pose, COORDINATE_RANGE, MAX_COORDINATE};
+use crate::motion::pose::{Pose, MAX_COORDINATE};
 use crate::motion::screw::Screw;
 
 /// The largest number of subdivision levels accepted (closed output `n 2^12` poses).
@@ -52,15 +52,16 @@ impl Scheme {
     /// Parses `"four_point"`, `"bspline"` or `"jarek"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "four_point" => Ok(Self::FourPoint),
             "bspline" => Ok(Self::BSpline),
             "jarek" => Ok(Self::Jarek),
-            _ => Err(Error::Invalid {
+            _ => Err(Error::Choice {
                 what: "scheme",
-                reason: format!("{name:?} is not one of \"four_point\", \"bspline\", \"jarek\""),
+                got: name.to_owned(),
+                expected: &["four_point", "bspline", "jarek"],
             }),
         }
     }
@@ -162,7 +163,7 @@ impl Interpolant for DVec3 {
                 what: "vector",
                 index,
                 value,
-                range: COORDINATE_RANGE,
+                limit: MAX_COORDINATE,
             });
         }
         Ok(())

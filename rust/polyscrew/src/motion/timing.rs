@@ -8,7 +8,7 @@
 
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(x > y)` also catches NaN
 
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Result};
 
 /// The working range of times (key times, sample times, the end of a closed motion's
 /// period): `|t| <= MAX_TIME`.
@@ -17,9 +17,6 @@ use crate::error::{Error, Result};
 /// period), their ratios and the reciprocal of a sum of two key spacings; no time is
 /// squared, so any range short of `f64::MAX / 4` keeps it finite.
 pub const MAX_TIME: f64 = 1e300;
-
-/// [`MAX_TIME`] as it reads in messages.
-pub const TIME_RANGE: &str = "+-1e300";
 
 /// The smallest spacing of consecutive key times (and of the last key and the end of a
 /// closed motion's period): the slopes of the time map are `3 / (h_prev + h)` at most, finite
@@ -40,14 +37,15 @@ impl Timing {
     /// Parses `"smooth"` or `"linear"`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for any other name.
+    /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "smooth" => Ok(Self::Smooth),
             "linear" => Ok(Self::Linear),
-            _ => Err(Error::Invalid {
+            _ => Err(Error::Choice {
                 what: "timing",
-                reason: format!("{name:?} is not one of \"smooth\", \"linear\""),
+                got: name.to_owned(),
+                expected: &["smooth", "linear"],
             }),
         }
     }
@@ -71,7 +69,7 @@ pub struct TimeMap {
 /// # Errors
 /// [`Error::KeyTimes`] with the index of the first time that is not finite or not greater
 /// than the one before, [`Error::OutOfRange`] for a time beyond [`MAX_TIME`],
-/// [`Error::Invalid`] (`"key times"`) for two keys closer than [`MIN_KEY_SPACING`].
+/// [`Error::Spacing`] (`"key times"`) for two keys closer than [`MIN_KEY_SPACING`].
 pub fn check_key_times(times: &[f64]) -> Result<()> {
     for (i, t) in times.iter().enumerate() {
         if !t.is_finite() || (i > 0 && *t <= times[i - 1]) {
@@ -82,17 +80,15 @@ pub fn check_key_times(times: &[f64]) -> Result<()> {
                 what: "key time",
                 index: i,
                 value: *t,
-                range: TIME_RANGE,
+                limit: MAX_TIME,
             });
         }
         if i > 0 && *t - times[i - 1] < MIN_KEY_SPACING {
-            return Err(Error::Invalid {
+            return Err(Error::Spacing {
                 what: "key times",
-                reason: format!(
-                    "key times {} and {i} are {:e} apart, closer than {MIN_KEY_SPACING:e}",
-                    i - 1,
-                    *t - times[i - 1]
-                ),
+                at: At::new("key time", i),
+                gap: *t - times[i - 1],
+                min: MIN_KEY_SPACING,
             });
         }
     }
@@ -137,7 +133,7 @@ pub fn check_time(what: &'static str, index: usize, t: f64) -> Result<()> {
             what,
             index,
             value: t,
-            range: TIME_RANGE,
+            limit: MAX_TIME,
         })
     } else {
         Err(Error::NotFinite { what, index })

@@ -2,8 +2,9 @@
 //! variational subdivision systems of Hofer-Pottmann-Ravani, *From curve design algorithms to the design of rigid body motions*, eqs. 23, 24, 26-27 and their closed and
 //! non-uniform versions).
 //!
-//! Open: a band Cholesky `H = L L^T` in `O(n)`. Cyclic: the last `b = 2` unknowns form a
-//! border; with `H = [[H11, H12], [H21, H22]]` and `H11` banded (no wrap-around entries),
+//! Open: the band kernel [`Band`] (`H = L D L^T`) in `O(n)`. Cyclic: the last `b = 2`
+//! unknowns form a border; with `H = [[H11, H12], [H21, H22]]` and `H11` banded (no
+//! wrap-around entries, factorised by [`Band`]),
 //!
 //! ```text
 //! Y = H11^-1 H12,   S = H22 - H21 Y          (b x b Schur complement)
@@ -16,6 +17,8 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)] // `!(d > 0.0)` rejects NaN pivots too
 
 use std::ops::{Mul, Sub};
+
+use super::band::Band;
 
 /// Values a system can be solved for: scalars and 3D points (one coordinate at a time, the
 /// matrix being the same for all three).
@@ -42,9 +45,8 @@ pub(crate) struct BandMatrix {
     n1: usize,
     /// Border size `b` (0 open, 2 cyclic).
     b: usize,
-    diag: Vec<f64>,
-    sub1: Vec<f64>,
-    sub2: Vec<f64>,
+    /// `H11`.
+    band: Band<f64, 2>,
     /// `cross[i][k] = H[i][n1 + k]`.
     cross: Vec<[f64; BORDER]>,
     corner: [[f64; BORDER]; BORDER],
@@ -55,10 +57,8 @@ pub(crate) struct BandMatrix {
 pub(crate) struct BandFactor {
     n1: usize,
     b: usize,
-    /// `L` of `H11 = L L^T`: diagonal, first and second subdiagonal.
-    l0: Vec<f64>,
-    l1: Vec<f64>,
-    l2: Vec<f64>,
+    /// `H11 = L D L^T`.
+    band: Band<f64, 2>,
     cross: Vec<[f64; BORDER]>,
     /// `Y = H11^-1 H12`, row by row.
     y: Vec<[f64; BORDER]>,
@@ -74,9 +74,7 @@ impl BandMatrix {
         Self {
             n1,
             b,
-            diag: vec![0.0; n1],
-            sub1: vec![0.0; n1],
-            sub2: vec![0.0; n1],
+            band: Band::zeros(n1),
             cross: vec![[0.0; BORDER]; n1],
             corner: [[0.0; BORDER]; BORDER],
         }
@@ -88,12 +86,8 @@ impl BandMatrix {
         let (i, j) = if i >= j { (i, j) } else { (j, i) };
         let n1 = self.n1;
         if i < n1 {
-            match i - j {
-                0 => self.diag[i] += v,
-                1 => self.sub1[i] += v,
-                2 => self.sub2[i] += v,
-                d => debug_assert!(false, "entry ({i}, {j}) outside the band ({d})"),
-            }
+            debug_assert!(i - j <= 2, "entry ({i}, {j}) outside the band");
+            self.band.add(i, j, v);
         } else if j < n1 {
             self.cross[j][i - n1] += v;
         } else {
@@ -110,12 +104,11 @@ impl BandMatrix {
         let n1 = self.n1;
         let mut out = vec![T::ZERO; n1 + self.b];
         for i in 0..n1 {
-            out[i] = out[i] + x[i] * self.diag[i];
-            for (d, s) in [(1, &self.sub1), (2, &self.sub2)] {
-                if i >= d {
-                    out[i] = out[i] + x[i - d] * s[i];
-                    out[i - d] = out[i - d] + x[i] * s[i];
-                }
+            out[i] = out[i] + x[i] * self.band.get(i, i);
+            for d in 1..=2.min(i) {
+                let s = self.band.get(i, i - d);
+                out[i] = out[i] + x[i - d] * s;
+                out[i - d] = out[i - d] + x[i] * s;
             }
             for k in 0..self.b {
                 out[i] = out[i] + x[n1 + k] * self.cross[i][k];
@@ -130,40 +123,20 @@ impl BandMatrix {
         out
     }
 
-    /// Cholesky factorisation.
+    /// Factorisation: `H11 = L D L^T` by [`Band`], then the border's Schur complement by
+    /// Cholesky.
     ///
     /// # Errors
     /// The index of the first non-positive (or non-finite) pivot: the matrix is not
     /// positive definite.
     pub(crate) fn factor(&self) -> Result<BandFactor, usize> {
         let n1 = self.n1;
-        let (mut l0, mut l1, mut l2) = (vec![0.0; n1], vec![0.0; n1], vec![0.0; n1]);
-        for i in 0..n1 {
-            let a2 = if i >= 2 {
-                self.sub2[i] / l0[i - 2]
-            } else {
-                0.0
-            };
-            let a1 = if i >= 1 {
-                let prev = if i >= 2 { l1[i - 1] } else { 0.0 };
-                (self.sub1[i] - a2 * prev) / l0[i - 1]
-            } else {
-                0.0
-            };
-            let d = self.diag[i] - a1 * a1 - a2 * a2;
-            if !(d > 0.0) || !d.is_finite() {
-                return Err(i);
-            }
-            l0[i] = d.sqrt();
-            l1[i] = a1;
-            l2[i] = a2;
-        }
+        let mut band = self.band.clone();
+        band.factor_or_pivot()?;
         let mut f = BandFactor {
             n1,
             b: self.b,
-            l0,
-            l1,
-            l2,
+            band,
             cross: self.cross.clone(),
             y: vec![[0.0; BORDER]; n1],
             schur: [[0.0; BORDER]; BORDER],
@@ -205,29 +178,9 @@ impl BandMatrix {
 }
 
 impl BandFactor {
-    /// Solves `H11 x = g` in place (forward then backward substitution).
+    /// Solves `H11 x = g` in place.
     fn band_solve<T: Lin>(&self, g: &mut [T]) {
-        let n1 = self.n1;
-        for i in 0..n1 {
-            let mut v = g[i];
-            if i >= 1 {
-                v = v - g[i - 1] * self.l1[i];
-            }
-            if i >= 2 {
-                v = v - g[i - 2] * self.l2[i];
-            }
-            g[i] = v * (1.0 / self.l0[i]);
-        }
-        for i in (0..n1).rev() {
-            let mut v = g[i];
-            if i + 1 < n1 {
-                v = v - g[i + 1] * self.l1[i + 1];
-            }
-            if i + 2 < n1 {
-                v = v - g[i + 2] * self.l2[i + 2];
-            }
-            g[i] = v * (1.0 / self.l0[i]);
-        }
+        self.band.solve(g);
     }
 
     /// Solves `H x = g` in place.

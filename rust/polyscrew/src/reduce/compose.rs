@@ -47,21 +47,30 @@ pub fn rotation(mode: RotationMode, r: &[f64]) -> DQuat {
         RotationMode::Euler(order) => {
             // `from_rotation_x(a)` is `(sin(a / 2), 0, 0, cos(a / 2))`; the sines and cosines
             // by the crate's one-reduction kernel (std's `sin_cos` is two library calls).
-            let (sx, cx) = fastmath::sin_cos(0.5 * r[0]);
-            let (sy, cy) = fastmath::sin_cos(0.5 * r[1]);
-            let (sz, cz) = fastmath::sin_cos(0.5 * r[2]);
-            let x = DQuat::from_xyzw(sx, 0.0, 0.0, cx);
-            let y = DQuat::from_xyzw(0.0, sy, 0.0, cy);
-            let z = DQuat::from_xyzw(0.0, 0.0, sz, cz);
-            match order {
-                EulerOrder::Xyz => z * y * x,
-                EulerOrder::Xzy => y * z * x,
-                EulerOrder::Yxz => z * x * y,
-                EulerOrder::Yzx => x * z * y,
-                EulerOrder::Zxy => y * x * z,
-                EulerOrder::Zyx => x * y * z,
-            }
+            // `z * y * x` for "XYZ" (the last axis applied on the left), each product with a
+            // one-axis quaternion written out without its zero terms: the same values as
+            // glam's products (every component has at most two terms that are not zero).
+            let [a1, a2, a3] = euler_axes(order);
+            let (s1, c1) = fastmath::sin_cos(0.5 * r[a1]);
+            let (s2, c2) = fastmath::sin_cos(0.5 * r[a2]);
+            let (s3, c3) = fastmath::sin_cos(0.5 * r[a3]);
+            let mut q = [0.0; 3];
+            q[a3] = s3;
+            let q = DQuat::from_xyzw(q[0], q[1], q[2], c3);
+            times_axis(times_axis(q, a2, s2, c2), a1, s1, c1)
         }
+    }
+}
+
+/// `p * (c + s e_a)`, the product with the one-axis quaternion of axis `a` (0: x, 1: y,
+/// 2: z), sine `s` and cosine `c`: glam's product without the terms that are zero.
+#[inline(always)]
+fn times_axis(p: DQuat, a: usize, s: f64, c: f64) -> DQuat {
+    let DQuat { x, y, z, w } = p;
+    match a {
+        0 => DQuat::from_xyzw(w * s + x * c, y * c + z * s, z * c - y * s, w * c - x * s),
+        1 => DQuat::from_xyzw(x * c - z * s, w * s + y * c, x * s + z * c, w * c - y * s),
+        _ => DQuat::from_xyzw(x * c + y * s, y * c - x * s, w * s + z * c, w * c - z * s),
     }
 }
 
@@ -135,6 +144,7 @@ pub fn relative_angle(a: DQuat, b: DQuat) -> (f64, f64) {
 /// - Euler, axes applied `a1, a2, a3`: `omega = R3 R2 u1 de1 + R3 u2 de2 + u3 de3` (world
 ///   frame; its length is the angle in any frame);
 /// - axis-angle: `None` (the model composes it exactly).
+#[inline]
 pub fn jacobian(mode: RotationMode, r: &[f64], q: DQuat) -> Option<[[f64; 4]; 3]> {
     match mode {
         RotationMode::Quaternion => {
@@ -163,14 +173,13 @@ pub fn jacobian(mode: RotationMode, r: &[f64], q: DQuat) -> Option<[[f64; 4]; 3]
             let c3 = unit(a3);
             // R3 R2 u1 = R u1 (R1 keeps u1); R3 u2 is perpendicular to both: c3 x c1 =
             // cos(e2) R3 u2 for an even order, -cos(e2) R3 u2 for an odd one.
-            let c1 = q * unit(a1);
+            let c1 = matrix_column(q, a1);
             let cross = c3.cross(c1);
             let len = cross.length();
             let c2 = if len > GIMBAL_JACOBIAN {
                 // The sign of cos(e2) from e2 itself: even half-turn count -> positive.
-                let turns = (r[a2] / std::f64::consts::PI + 0.5).floor();
                 let even_order = (a2 + 3 - a1) % 3 == 1;
-                let positive = (turns.rem_euclid(2.0) == 0.0) == even_order;
+                let positive = even_half_turns(r[a2]) == even_order;
                 if positive {
                     cross / len
                 } else {
@@ -188,6 +197,44 @@ pub fn jacobian(mode: RotationMode, r: &[f64], q: DQuat) -> Option<[[f64; 4]; 3]
             Some(j)
         }
     }
+}
+
+/// Column `a` (0: x, 1: y, 2: z) of the rotation matrix of unit `q`, `q * e_a`, by the
+/// entries of glam's `DMat3::from_quat` (a third of the work of rotating the vector).
+#[inline(always)]
+fn matrix_column(q: DQuat, a: usize) -> DVec3 {
+    let (x2, y2, z2) = (q.x + q.x, q.y + q.y, q.z + q.z);
+    match a {
+        0 => DVec3::new(
+            1.0 - (q.y * y2 + q.z * z2),
+            q.x * y2 + q.w * z2,
+            q.x * z2 - q.w * y2,
+        ),
+        1 => DVec3::new(
+            q.x * y2 - q.w * z2,
+            1.0 - (q.x * x2 + q.z * z2),
+            q.y * z2 + q.w * x2,
+        ),
+        _ => DVec3::new(
+            q.x * z2 + q.w * y2,
+            q.y * z2 - q.w * x2,
+            1.0 - (q.x * x2 + q.y * y2),
+        ),
+    }
+}
+
+/// Whether `floor(angle / pi + 1/2)`, the number of half turns nearest `angle`, is even
+/// (`cos(angle) >= 0` away from the ties, where `cos(angle) = 0`), without the library
+/// calls of `floor` and `rem_euclid`: rounding by the `1.5 * 2^52` shift (half to even,
+/// which differs from `floor(x + 1/2)` only at those ties); std beyond `2^51` half turns.
+#[inline(always)]
+fn even_half_turns(angle: f64) -> bool {
+    let x = angle / std::f64::consts::PI;
+    if x.is_nan() || x.abs() >= 2_251_799_813_685_248.0 {
+        return (x + 0.5).floor().rem_euclid(2.0) == 0.0;
+    }
+    let n = (x + fastmath::ROUNDING_SHIFT) - fastmath::ROUNDING_SHIFT;
+    (n as i64) & 1 == 0
 }
 
 /// Below this `|cos(e2)|` the Euler Jacobian's middle column is built with trigonometry.
@@ -330,6 +377,64 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn euler_rotation_equals_glams_products() {
+        for i in 0..300 {
+            let f = i as f64;
+            let r = [
+                (1.7 * f).sin() * 4.0,
+                (0.3 * f).cos() * 2.0,
+                f * 0.11 - 15.0,
+                0.0,
+            ];
+            let (sx, cx) = fastmath::sin_cos(0.5 * r[0]);
+            let (sy, cy) = fastmath::sin_cos(0.5 * r[1]);
+            let (sz, cz) = fastmath::sin_cos(0.5 * r[2]);
+            let x = DQuat::from_xyzw(sx, 0.0, 0.0, cx);
+            let y = DQuat::from_xyzw(0.0, sy, 0.0, cy);
+            let z = DQuat::from_xyzw(0.0, 0.0, sz, cz);
+            for (order, want) in [
+                (EulerOrder::Xyz, z * y * x),
+                (EulerOrder::Xzy, y * z * x),
+                (EulerOrder::Yxz, z * x * y),
+                (EulerOrder::Yzx, x * z * y),
+                (EulerOrder::Zxy, y * x * z),
+                (EulerOrder::Zyx, x * y * z),
+            ] {
+                let got = rotation(RotationMode::Euler(order), &r);
+                assert!(
+                    got.to_array() == want.to_array(),
+                    "{order:?} {r:?}: {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn matrix_columns_and_half_turns_agree_with_their_definitions() {
+        for i in 0..500 {
+            let f = i as f64;
+            let q = DQuat::from_scaled_axis(DVec3::new(
+                (1.3 * f).sin() * 3.0,
+                (0.7 * f).cos() * 2.0,
+                (0.31 * f).sin(),
+            ));
+            for (a, unit) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+                let d = (matrix_column(q, a) - q * unit).abs().max_element();
+                assert!(d < 1e-15, "{q} column {a}: {d}");
+            }
+            let angle = (f - 250.0) * 0.0731;
+            let want = (angle / std::f64::consts::PI + 0.5).floor().rem_euclid(2.0) == 0.0;
+            assert_eq!(even_half_turns(angle), want, "{angle}");
+            assert_eq!(even_half_turns(angle), angle.cos() >= 0.0, "{angle}");
+        }
+        assert!(even_half_turns(0.0) && even_half_turns(-0.0) && !even_half_turns(3.0));
+        assert!(
+            even_half_turns(1e300)
+                == ((1e300 / std::f64::consts::PI + 0.5).floor().rem_euclid(2.0) == 0.0)
+        );
     }
 
     #[test]

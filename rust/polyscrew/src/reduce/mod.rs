@@ -24,7 +24,10 @@
 //!   source's own first values when given;
 //! - rigs: owners are reduced parents first; a child's target is
 //!   `(world_parent_reduced @ offset)^-1 @ world_child_dense`, so it compensates its parent's
-//!   error and the tolerance holds in world space at every owner.
+//!   error and the tolerance holds in world space at every owner. It is formed from the
+//!   parent's error transform `E = world_reduced^-1 @ world_dense` as
+//!   `offset^-1 @ E_parent @ offset @ local_dense`, and the child's own `E` is
+//!   `played^-1 @ target`: no world pose is formed.
 //!
 //! Owners are independent within a depth of the hierarchy and are spread over threads.
 //! Every size that input drives is checked against the memory budget ([`reduce_footprint`])
@@ -35,7 +38,7 @@ mod owner;
 
 use glam::DVec3;
 
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Expected, Result};
 use crate::fcurve::Interpolation;
 use crate::memory::{try_vec, Footprint};
 use crate::motion::channels::RotationMode;
@@ -180,16 +183,17 @@ impl Between {
     /// The variant named `name`.
     ///
     /// # Errors
-    /// [`Error::Invalid`] for another name.
+    /// [`Error::Choice`] for another name.
     pub fn from_name(name: &str) -> Result<Self> {
         match name {
             "screw" => Ok(Self::Screw),
             "cubic" => Ok(Self::Cubic),
             "linear" => Ok(Self::Linear),
-            _ => Err(invalid(
-                "between",
-                format!("{name:?} is not one of screw, cubic, linear"),
-            )),
+            _ => Err(Error::Choice {
+                what: "between",
+                got: name.to_owned(),
+                expected: &Self::NAMES,
+            }),
         }
     }
 }
@@ -248,9 +252,10 @@ pub fn sample_count(n: usize) -> usize {
 }
 
 /// The most bytes [`reduce_keys`] holds for `bodies` owners of `n` frames on `threads`
-/// workers (0: the machine's), `with_parents` when world poses are kept for children: the
-/// sample times, one working set per worker (targets, channels, reduced poses), the world
-/// poses, and the curves when each of the 10 channels keeps up to one key per frame.
+/// workers (0: the machine's), `with_parents` when error transforms are kept for children: the
+/// sample times, one working set per worker (targets, channels, reduced poses), one error
+/// transform per sample of every owner, and the curves when each of the 10 channels keeps up
+/// to one key per frame.
 pub fn reduce_footprint(bodies: usize, n: usize, threads: usize, with_parents: bool) -> Footprint {
     let m = sample_count(n);
     let workers = effective_threads(threads, bodies).max(1);
@@ -260,7 +265,7 @@ pub fn reduce_footprint(bodies: usize, n: usize, threads: usize, with_parents: b
         .and::<[f64; compose::STRIDE]>(m.saturating_mul(2))
         .and::<usize>(m);
     let worlds = if with_parents {
-        Footprint::of::<Pose>(m.saturating_mul(2)).times(bodies)
+        Footprint::of::<Pose>(m).times(bodies)
     } else {
         Footprint::ZERO
     };
@@ -277,10 +282,6 @@ fn effective_threads(threads: usize, bodies: usize) -> usize {
         .min(bodies.max(1))
 }
 
-fn invalid(what: &'static str, reason: String) -> Error {
-    Error::Invalid { what, reason }
-}
-
 /// Checks every input against `B = modes.len()` owners and `N = frames.len()` frames.
 fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, usize)> {
     let n = input.frames.len();
@@ -288,44 +289,51 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
     if n < 2 {
         return Err(Error::TooFew { got: n, need: 2 });
     }
-    if n > MAX_REDUCE_FRAMES || b.saturating_mul(n) > MAX_REDUCE_POSES {
-        return Err(invalid(
-            "poses",
-            format!(
-                "{b} owners x {n} frames exceed the limits ({MAX_REDUCE_FRAMES} frames per owner, {MAX_REDUCE_POSES} poses in all)"
-            ),
-        ));
+    if n > MAX_REDUCE_FRAMES {
+        return Err(Error::Limit {
+            what: "frames",
+            counted: "frames per owner",
+            count: n,
+            limit: MAX_REDUCE_FRAMES,
+            hint: "",
+        });
+    }
+    if b.saturating_mul(n) > MAX_REDUCE_POSES {
+        return Err(Error::Limit {
+            what: "poses",
+            counted: "poses (owners x frames)",
+            count: b.saturating_mul(n),
+            limit: MAX_REDUCE_POSES,
+            hint: "reduce fewer owners at once",
+        });
     }
     for (i, f) in input.frames.iter().enumerate() {
-        if !f.is_finite() || f.abs() > crate::motion::timing::MAX_TIME {
-            return Err(invalid(
-                "frames",
-                format!("frame {i} ({f}) is not finite or outside the working range"),
-            ));
-        }
+        crate::motion::timing::check_time("frame", i, *f)?;
         if i > 0 && *f <= input.frames[i - 1] {
-            return Err(invalid(
-                "frames",
-                format!(
-                    "frame {i} ({f}) is not greater than frame {} ({}): frames must increase strictly",
-                    i - 1,
-                    input.frames[i - 1]
-                ),
-            ));
+            return Err(Error::Spacing {
+                what: "frames",
+                at: At::new("frame", i),
+                gap: *f - input.frames[i - 1],
+                min: f64::MIN_POSITIVE,
+            });
         }
     }
     let Tolerance { distance, angle } = options.tolerance;
     if !(distance.is_finite() && distance > 0.0) {
-        return Err(invalid(
-            "distance",
-            format!("{distance} is not a positive finite distance"),
-        ));
+        return Err(Error::Value {
+            what: "distance",
+            at: None,
+            value: distance,
+            expected: Expected::Positive("distance"),
+        });
     }
     if !(angle.is_finite() && angle > 0.0) {
-        return Err(invalid(
-            "angle",
-            format!("{angle} is not a positive finite angle"),
-        ));
+        return Err(Error::Value {
+            what: "angle",
+            at: None,
+            value: angle,
+            expected: Expected::Positive("angle"),
+        });
     }
     let len = |what: &'static str, got: usize, expected: usize| {
         if got == expected {
@@ -342,14 +350,19 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
     len("radius", input.radius.len(), b)?;
     for (g, p) in input.poses.iter().enumerate() {
         p.check_range(g % n)
-            .map_err(|e| invalid("poses", format!("owner {}: {e}", g / n)))?;
+            .map_err(|e| e.within_argument("poses", "owner", g / n))?;
     }
     for (o, r) in input.radius.iter().enumerate() {
         if !(r.is_finite() && *r >= 0.0 && *r <= crate::motion::pose::MAX_COORDINATE) {
-            return Err(invalid(
-                "radius",
-                format!("owner {o}: {r} is not a finite radius >= 0"),
-            ));
+            return Err(Error::Value {
+                what: "radius",
+                at: Some(At::new("owner", o)),
+                value: *r,
+                expected: Expected::Within {
+                    low: 0.0,
+                    high: crate::motion::pose::MAX_COORDINATE,
+                },
+            });
         }
     }
     if let Some(s) = input.scales {
@@ -359,14 +372,18 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
                 && v.min_element() > 0.0
                 && v.max_element() <= crate::motion::pose::MAX_COORDINATE;
             if !ok {
-                return Err(invalid(
-                    "scales",
-                    format!(
-                        "owner {}, frame {}: {v} is not a positive finite scale",
-                        g / n,
-                        g % n
-                    ),
-                ));
+                let worst = v
+                    .to_array()
+                    .into_iter()
+                    .find(|x| !(*x > 0.0 && *x <= crate::motion::pose::MAX_COORDINATE))
+                    .unwrap_or(f64::NAN);
+                return Err(Error::Value {
+                    what: "scale",
+                    at: Some(At::new("frame", g % n)),
+                    value: worst,
+                    expected: Expected::PositiveUpTo(crate::motion::pose::MAX_COORDINATE),
+                }
+                .within_argument("scales", "owner", g / n));
             }
         }
     }
@@ -374,10 +391,10 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
         len("channels", c.len(), b)?;
         if input.scales.is_none() {
             if let Some(o) = c.iter().position(|row| row[2]) {
-                return Err(invalid(
-                    "channels",
-                    format!("owner {o} keys scale but no scales were given"),
-                ));
+                return Err(Error::Conflict {
+                    what: "channels",
+                    reason: format!("owner {o} keys scale but no scales were given"),
+                });
             }
         }
     }
@@ -385,7 +402,7 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
         len("offsets", o.len(), b)?;
         for (i, p) in o.iter().enumerate() {
             p.check_range(i)
-                .map_err(|e| invalid("offsets", format!("owner {i}: {e}")))?;
+                .map_err(|e| e.within_argument("offsets", "owner", i))?;
         }
     }
     if let Some(c) = input.constant {
@@ -394,11 +411,13 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
     if let Some(s) = input.start {
         len("start", s.len(), b)?;
         for (o, row) in s.iter().enumerate() {
-            if row.iter().any(|v| !v.is_finite()) {
-                return Err(invalid(
-                    "start",
-                    format!("owner {o}: {row:?} is not finite"),
-                ));
+            if let Some(v) = row.iter().find(|v| !v.is_finite()) {
+                return Err(Error::Value {
+                    what: "start",
+                    at: Some(At::new("owner", o)),
+                    value: *v,
+                    expected: Expected::Finite("channel value"),
+                });
             }
         }
     }
@@ -407,13 +426,20 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
         for (o, parent) in p.iter().enumerate() {
             if let Some(q) = parent {
                 if *q >= b {
-                    return Err(invalid(
-                        "parents",
-                        format!("owner {o}: parent {q} is not an owner of the batch (0..{b})"),
-                    ));
+                    return Err(Error::Index {
+                        what: "parents",
+                        item: "owner",
+                        at: Some(At::new("owner", o)),
+                        index: i64::try_from(*q).unwrap_or(i64::MAX),
+                        len: b,
+                    });
                 }
                 if *q == o {
-                    return Err(invalid("parents", format!("owner {o} is its own parent")));
+                    return Err(Error::Degenerate {
+                        what: "parents",
+                        at: Some(At::new("owner", o)),
+                        reason: "is its own parent",
+                    });
                 }
             }
         }
@@ -424,7 +450,7 @@ fn validate(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<(usize, 
 /// The depth of every owner in the hierarchy (roots 0).
 ///
 /// # Errors
-/// [`Error::Invalid`] naming an owner whose parents form a cycle.
+/// [`Error::Degenerate`] naming an owner whose parents form a cycle.
 fn depths(parents: Option<&[Option<usize>]>, b: usize) -> Result<Vec<usize>> {
     let mut depth = try_vec::<usize>(b, "owner depths")?;
     depth.resize(b, usize::MAX);
@@ -445,10 +471,11 @@ fn depths(parents: Option<&[Option<usize>]>, b: usize) -> Result<Vec<usize>> {
                 Some(p) => {
                     chain += 1;
                     if chain > b {
-                        return Err(invalid(
-                            "parents",
-                            format!("owner {o}: its parents form a cycle"),
-                        ));
+                        return Err(Error::Degenerate {
+                            what: "parents",
+                            at: Some(At::new("owner", o)),
+                            reason: "its parents form a cycle",
+                        });
                     }
                     cur = p;
                 }
@@ -483,10 +510,11 @@ fn depths(parents: Option<&[Option<usize>]>, b: usize) -> Result<Vec<usize>> {
 /// reported are the ones measured.
 ///
 /// # Errors
-/// [`Error::TooFew`] for fewer than 2 frames, [`Error::LengthMismatch`] for arrays of the wrong length, [`Error::Invalid`]
-/// (naming the argument and the owner) for non-finite or out-of-range poses, radii, scales,
+/// [`Error::TooFew`] for fewer than 2 frames, [`Error::LengthMismatch`] for arrays of the wrong length, errors
+/// naming the argument and the owner ([`Error::In`], [`Error::Value`], [`Error::Index`],
+/// [`Error::Degenerate`], [`Error::Conflict`]) for non-finite or out-of-range poses, radii, scales,
 /// offsets or start values, tolerances that are not positive, scale keyed without scales,
-/// parents out of range or forming a cycle, sizes over [`MAX_REDUCE_FRAMES`] /
+/// parents out of range or forming a cycle, [`Error::Limit`] for sizes over [`MAX_REDUCE_FRAMES`] /
 /// [`MAX_REDUCE_POSES`]; [`Error::Memory`] when [`reduce_footprint`] exceeds the memory budget
 /// or the allocator refuses.
 pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<Reduced> {
@@ -518,7 +546,9 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
                 .map(|&o| {
                     let parent = input.parents.and_then(|p| p[o]).map(|q| {
                         let r = results[q].as_ref().expect("parents first");
-                        r.world.as_ref().expect("a parent keeps its world poses")
+                        r.world
+                            .as_ref()
+                            .expect("a parent keeps its error transforms")
                     });
                     (o, ctx.reduce_owner(ws, o, parent, has_children[o]))
                 })
@@ -537,18 +567,15 @@ pub fn reduce_keys(input: &ReduceInput<'_>, options: &ReduceOptions) -> Result<R
             });
             let mut all = Vec::with_capacity(owners.len());
             for part in parts {
-                all.extend(part.map_err(|_| invalid("poses", "a worker thread failed".into()))?);
+                all.extend(part.map_err(|_| Error::Worker { what: "poses" })?);
             }
             all
         };
         for (o, r) in done {
-            results[o] = Some(r.map_err(|e| match e {
-                Error::Invalid { what, reason } => invalid(what, format!("owner {o}: {reason}")),
-                e => e,
-            })?);
+            results[o] = Some(r.map_err(|e| e.within("owner", o))?);
         }
-        // The owners one level up have no children left to reduce: their world poses go
-        // (their memory is reused by the next level's).
+        // The owners one level up have no children left to reduce: their error transforms
+        // go (their memory is reused by the next level's).
         if let Some(up) = level.checked_sub(1) {
             for o in (0..b).filter(|o| depth[*o] == up) {
                 if let Some(r) = results[o].as_mut() {

@@ -10,7 +10,7 @@ use super::{
     interpolation, Between, Group, HandleType, ReduceInput, ReduceOptions, ReducedCurve, Tolerance,
     SEARCH_MARGIN, SUBSAMPLES,
 };
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::fcurve::bezier::BezierSegment;
 use crate::fcurve::curve::KEY_THRESHOLD;
 use crate::fcurve::{Extrapolation, FCurve, Interpolation, Key};
@@ -46,11 +46,14 @@ pub struct ReducedKey {
     pub interpolation: Interpolation,
 }
 
-/// An owner's world poses at every sample, kept for its children.
+/// What an owner's children need of it at every sample: its error transform
+/// `E = W_reduced^-1 @ W_dense` (its played world pose's inverse times its dense world pose,
+/// `played^-1 @ target` in its own channels' space). A child of offset `O` and dense local
+/// motion `L` then has the target `(W_reduced @ O)^-1 @ W_dense @ O @ L = O^-1 @ E @ O @ L`,
+/// and its own `E` is again `played^-1 @ target`: no world pose is ever formed.
 #[derive(Debug, Clone)]
 pub(crate) struct World {
-    pub dense: Vec<Pose>,
-    pub reduced: Vec<Pose>,
+    pub error: Vec<Pose>,
 }
 
 /// What one owner's reduction gives.
@@ -242,34 +245,25 @@ impl<'a> Context<'a> {
         } else {
             ws.scale.resize(m, DVec3::ONE);
         }
-        // The target of the owner's own channels, and its dense world motion.
-        ws.target.clear();
-        ws.target.reserve(m);
-        let mut dense_world = if keep_world {
-            try_vec(m, "world poses")?
-        } else {
-            Vec::new()
-        };
-        for j in 0..m {
-            let l = ws.local[j];
-            match parent {
-                Some(p) => {
-                    // (parent_reduced @ offset)^-1 @ parent_dense @ offset @ local.
-                    let w = mul(&mul(&p.dense[j], &offset), &l);
-                    let base = mul(&p.reduced[j], &offset);
-                    ws.target.push(mul_inverse(&base, &w));
-                    if keep_world {
-                        dense_world.push(w);
+        // The target of the owner's own channels: `O^-1 @ E_parent @ O @ L` (module docs).
+        if let Some(p) = parent {
+            let o = offset;
+            // An offset without rotation (exactly) skips the two quaternion products with the
+            // identity.
+            let pure = o.rotation == DQuat::IDENTITY;
+            for (l, e) in ws.local.iter_mut().zip(&p.error) {
+                let c = if pure {
+                    Pose {
+                        rotation: e.rotation,
+                        translation: e.rotation * o.translation + e.translation - o.translation,
                     }
-                }
-                None => {
-                    ws.target.push(l);
-                    if keep_world {
-                        dense_world.push(mul(&offset, &l));
-                    }
-                }
+                } else {
+                    mul_inverse(&o, &mul(e, &o))
+                };
+                *l = mul(&c, l);
             }
         }
+        std::mem::swap(&mut ws.local, &mut ws.target);
         // Channels, continuous along the samples.
         ws.quats.clear();
         ws.quats.extend(ws.target.iter().map(|p| p.rotation));
@@ -324,6 +318,7 @@ impl<'a> Context<'a> {
             mode,
             keyed,
             radius: self.input.radius[o],
+            keyed_cols: cols.len(),
         };
         let constant: Vec<bool> = (0..n - 1).map(|f| self.constant(o, f)).collect();
         let (curves, keys, distance_error, angle_error) = if self.per_channel && cols.len() > 1 {
@@ -346,18 +341,14 @@ impl<'a> Context<'a> {
             (curves, keys, d, a)
         };
         let world = if keep_world {
-            let mut reduced = try_vec(m, "world poses")?;
-            for j in 0..m {
-                let l = ws.reduced[j];
-                reduced.push(match parent {
-                    Some(p) => mul(&mul(&p.reduced[j], &offset), &l),
-                    None => mul(&offset, &l),
-                });
-            }
-            Some(World {
-                dense: dense_world,
-                reduced,
-            })
+            let mut error = try_vec(m, "error transforms")?;
+            error.extend(
+                ws.reduced
+                    .iter()
+                    .zip(&ws.target)
+                    .map(|(played, target)| mul_inverse(played, target)),
+            );
+            Some(World { error })
         } else {
             None
         };
@@ -490,6 +481,9 @@ struct Fitter<'w> {
     mode: RotationMode,
     keyed: Keyed,
     radius: f64,
+    /// The number of keyed columns (a search over all of them takes
+    /// [`Fitter::model_ok_groups`]).
+    keyed_cols: usize,
 }
 
 /// Cubic Bernstein basis at `u`.
@@ -525,29 +519,59 @@ impl Sums {
         }
     }
 
-    /// Adds the samples `self.last + 1 ..= last` of columns `cols`.
+    /// Adds the samples `self.last + 1 ..= last` of columns `cols` (of every column when
+    /// `cols` has more than one).
     #[inline]
     fn extend(&mut self, fitter: &Fitter<'_>, last: usize, cols: &[usize]) {
+        if last <= self.last {
+            return;
+        }
         let t0 = fitter.times[self.key];
-        for j in self.last + 1..=last {
-            let tau = fitter.times[j] - t0;
+        let range = self.last + 1..last + 1;
+        let samples = fitter.times[range.clone()].iter().zip(&fitter.v[range]);
+        // The sums in locals while they are added to (kept in registers, stored once).
+        let mut powers = self.powers;
+        let mut values = self.values;
+        // The keyed groups' columns at fixed places: a group holds all its columns or none
+        // (one column alone: per-channel keys). The fourth rotation column of an Euler
+        // owner is zero; a sum that is not read may take any value.
+        let group = |first: usize| cols.contains(&first);
+        let (loc, rot, scale) = match cols {
+            [_] => (false, false, false),
+            _ => (group(0), group(ROT), group(SCALE)),
+        };
+        for (t, v) in samples {
+            let tau = t - t0;
             let t2 = tau * tau;
             let t3 = t2 * tau;
-            self.powers[1] += tau;
-            self.powers[2] += t2;
-            self.powers[3] += t3;
-            self.powers[4] += t2 * t2;
-            self.powers[5] += t2 * t3;
-            self.powers[6] += t3 * t3;
-            let v = &fitter.v[j];
-            for &c in cols {
-                let sum = &mut self.values[c];
+            powers[1] += tau;
+            powers[2] += t2;
+            powers[3] += t3;
+            powers[4] += t2 * t2;
+            powers[5] += t2 * t3;
+            powers[6] += t3 * t3;
+            let mut add = |c: usize| {
+                let sum = &mut values[c];
                 sum[0] += tau * v[c];
                 sum[1] += t2 * v[c];
                 sum[2] += t3 * v[c];
+            };
+            if let [c] = cols {
+                add(*c);
+            }
+            if loc {
+                (0..3).for_each(&mut add);
+            }
+            if rot {
+                (ROT..ROT + 4).for_each(&mut add);
+            }
+            if scale {
+                (SCALE..SCALE + 3).for_each(&mut add);
             }
         }
-        self.last = self.last.max(last);
+        self.powers = powers;
+        self.values = values;
+        self.last = last;
     }
 }
 
@@ -611,6 +635,98 @@ impl Fitter<'_> {
                 y[SCALE + 1] - v[SCALE + 1],
                 y[SCALE + 2] - v[SCALE + 2],
             );
+            d += self.radius * (a * a + b * b + c * c).sqrt();
+        }
+        (d, theta)
+    }
+
+    /// [`Self::model_ok`] when every keyed column is fitted and the rotation has a Jacobian:
+    /// the groups' columns at fixed places, so the loop holds no lookup. The columns of a
+    /// group that is not keyed are computed and not read; the fourth rotation column of an
+    /// Euler owner is zero in the dense rows, the handles and the Jacobian, so its terms are
+    /// zeros: the same numbers as the general path, in the same order.
+    fn model_ok_groups(
+        &self,
+        jac: &[[[f64; 4]; 3]],
+        s: usize,
+        e: usize,
+        h1: &[f64; STRIDE],
+        h2: &[f64; STRIDE],
+        limit: Tolerance,
+    ) -> bool {
+        let (p0, p3) = (&self.v[s], &self.v[e]);
+        let ts = self.times[s];
+        let inv = 1.0 / (self.times[e] - ts);
+        let Keyed {
+            location,
+            rotation,
+            scale,
+        } = self.keyed;
+        let radius = self.radius;
+        let within = |j: usize| -> bool {
+            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
+            let v = &self.v[j];
+            let dy = |c: usize| (p0[c] * b0 + h1[c] * b1 + h2[c] * b2 + p3[c] * b3) - v[c];
+            let mut d = 0.0;
+            if location {
+                let (a, b, c) = (dy(0), dy(1), dy(2));
+                d += (a * a + b * b + c * c).sqrt();
+            }
+            let mut theta = 0.0;
+            if rotation {
+                let dr = [dy(ROT), dy(ROT + 1), dy(ROT + 2), dy(ROT + 3)];
+                let jj = &jac[j];
+                let w = |row: &[f64; 4]| {
+                    row[0] * dr[0] + row[1] * dr[1] + row[2] * dr[2] + row[3] * dr[3]
+                };
+                let (a, b, c) = (w(&jj[0]), w(&jj[1]), w(&jj[2]));
+                theta = (a * a + b * b + c * c).sqrt();
+                d += radius * theta;
+            }
+            if scale {
+                let (a, b, c) = (dy(SCALE), dy(SCALE + 1), dy(SCALE + 2));
+                d += radius * (a * a + b * b + c * c).sqrt();
+            }
+            !(d > limit.distance || theta > limit.angle)
+        };
+        // The middle of every frame first, where a span that is too long fails soonest,
+        // then the other samples.
+        let half = SUBSAMPLES / 2;
+        let mut j = s + half;
+        while j < e {
+            if !within(j) {
+                return false;
+            }
+            j += SUBSAMPLES;
+        }
+        for j in s + 1..e {
+            if (j - s) % SUBSAMPLES != half && !within(j) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// [`Self::model_error`] from the differences `dy` of the channel row to the dense one
+    /// and the sample's rotation Jacobian `jj` (the same operations on the same numbers).
+    #[inline(always)]
+    fn model_error_of(&self, jj: &[[f64; 4]; 3], dy: &[f64; STRIDE]) -> (f64, f64) {
+        let mut d = 0.0;
+        if self.keyed.location {
+            let (a, b, c) = (dy[0], dy[1], dy[2]);
+            d += (a * a + b * b + c * c).sqrt();
+        }
+        let mut theta = 0.0;
+        if self.keyed.rotation {
+            let dr = [dy[ROT], dy[ROT + 1], dy[ROT + 2], dy[ROT + 3]];
+            let w =
+                |row: &[f64; 4]| row[0] * dr[0] + row[1] * dr[1] + row[2] * dr[2] + row[3] * dr[3];
+            let (a, b, c) = (w(&jj[0]), w(&jj[1]), w(&jj[2]));
+            theta = (a * a + b * b + c * c).sqrt();
+            d += self.radius * theta;
+        }
+        if self.keyed.scale {
+            let (a, b, c) = (dy[SCALE], dy[SCALE + 1], dy[SCALE + 2]);
             d += self.radius * (a * a + b * b + c * c).sqrt();
         }
         (d, theta)
@@ -701,25 +817,51 @@ impl Fitter<'_> {
         h2: &[f64; STRIDE],
         limit: Tolerance,
     ) -> bool {
+        if let (Some(jac), true) = (self.jac, cols.len() == self.keyed_cols) {
+            return self.model_ok_groups(jac, s, e, h1, h2, limit);
+        }
         let (v0, v3) = (&self.v[s], &self.v[e]);
         let ts = self.times[s];
         let inv = 1.0 / (self.times[e] - ts);
-        // The middle of every frame first, where a span that is too long fails soonest.
-        let half = SUBSAMPLES / 2;
-        let mids = (s + half..e).step_by(SUBSAMPLES);
-        let rest = (s + 1..e).filter(|j| (j - s) % SUBSAMPLES != half);
-        for j in mids.chain(rest) {
-            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
-            let mut y = self.v[j];
-            for &c in cols {
-                y[c] = v0[c] * b0 + h1[c] * b1 + h2[c] * b2 + v3[c] * b3;
-            }
-            let (d, a) = self.model_error(j, &y);
-            if d > limit.distance || a > limit.angle {
-                return false;
-            }
+        // Each column's four Bezier values, gathered once per span.
+        let mut coef = [(0usize, [0.0f64; 4]); STRIDE];
+        for (slot, &c) in coef.iter_mut().zip(cols) {
+            *slot = (c, [v0[c], h1[c], h2[c], v3[c]]);
         }
-        true
+        let coef = &coef[..cols.len()];
+        let within = |j: usize| {
+            let [b0, b1, b2, b3] = bernstein((self.times[j] - ts) * inv);
+            match self.jac {
+                Some(jac) => {
+                    // The cubic minus the dense values (zero in the other columns): the
+                    // same numbers `model_error` forms from the whole row.
+                    let v = &self.v[j];
+                    let mut dy = [0.0; STRIDE];
+                    for &(c, [p0, p1, p2, p3]) in coef {
+                        dy[c] = (p0 * b0 + p1 * b1 + p2 * b2 + p3 * b3) - v[c];
+                    }
+                    let (d, a) = self.model_error_of(&jac[j], &dy);
+                    !(d > limit.distance || a > limit.angle)
+                }
+                None => {
+                    let mut y = self.v[j];
+                    for &(c, [p0, p1, p2, p3]) in coef {
+                        y[c] = p0 * b0 + p1 * b1 + p2 * b2 + p3 * b3;
+                    }
+                    let (d, a) = self.model_error(j, &y);
+                    !(d > limit.distance || a > limit.angle)
+                }
+            }
+        };
+        // The middle of every frame first, where a span that is too long fails soonest,
+        // then the other samples.
+        let half = SUBSAMPLES / 2;
+        if !(s + half..e).step_by(SUBSAMPLES).all(within) {
+            return false;
+        }
+        (s + 1..e)
+            .filter(|j| (j - s) % SUBSAMPLES != half)
+            .all(within)
     }
 
     /// Blender's evaluation of the span's `float32` keys at every sample of `s..=e` (the
@@ -1035,13 +1177,7 @@ impl Fitter<'_> {
         for (j, slot) in out.iter_mut().enumerate() {
             let mut y = self.v[j];
             for (&c, curve) in cols.iter().zip(&fcurves) {
-                y[c] = curve.evaluate(self.times[j]).map_err(|e| match e {
-                    Error::Invalid { reason, .. } => Error::Invalid {
-                        what: "keys",
-                        reason,
-                    },
-                    e => e,
-                })?;
+                y[c] = curve.evaluate(self.times[j])?;
             }
             let (d, turn, q, t) = self.error(j, &y);
             let a = turn.angle();
@@ -1136,6 +1272,7 @@ mod tests {
                 scale: true,
             },
             radius: 1.0,
+            keyed_cols: STRIDE,
         };
         let cols: Vec<usize> = (0..STRIDE).collect();
         for key in [0usize, 37, 400] {

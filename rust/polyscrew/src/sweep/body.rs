@@ -11,7 +11,7 @@
 
 use glam::DVec3;
 
-use crate::error::{Error, Result};
+use crate::error::{At, Error, Result};
 use crate::memory::Footprint;
 
 /// A triangle whose cross product `|(b - a) x (c - a)|` is at most this fraction of the
@@ -103,27 +103,34 @@ impl Body {
     /// turned around (every triangle's winding reversed, see [`Body::is_reoriented`]).
     ///
     /// # Errors
-    /// - [`Error::Invalid`] (`"vertices"`, `"triangles"`) when either is empty;
+    /// - [`Error::Degenerate`] (`"vertices"`, `"triangles"`) when either is empty,
+    ///   [`Error::Limit`] when either has more than `2^32 - 2` entries;
     /// - [`Error::NotFinite`] (`"vertex"`, index) for a NaN or infinite coordinate;
-    /// - [`Error::Invalid`] (`"triangles"`) naming the triangle, for an index that is negative
-    ///   or not below the vertex count, and for a zero-area triangle (see [`ZERO_AREA_REL`]).
+    /// - [`Error::Index`] (`"triangles"`) naming the triangle, for an index that is negative
+    ///   or not below the vertex count, and [`Error::Degenerate`] for a zero-area triangle
+    ///   (see [`ZERO_AREA_REL`]).
     pub fn new(vertices: &[DVec3], triangles: &[[i64; 3]]) -> Result<Self> {
         if vertices.is_empty() {
-            return Err(Error::Invalid {
+            return Err(Error::Degenerate {
                 what: "vertices",
-                reason: "the mesh has no vertices".into(),
+                at: None,
+                reason: "the mesh has no vertices",
             });
         }
         if triangles.is_empty() {
-            return Err(Error::Invalid {
+            return Err(Error::Degenerate {
                 what: "triangles",
-                reason: "the mesh has no triangles".into(),
+                at: None,
+                reason: "the mesh has no triangles",
             });
         }
         if vertices.len() > (u32::MAX - 1) as usize || triangles.len() > (u32::MAX - 1) as usize {
-            return Err(Error::Invalid {
+            return Err(Error::Limit {
                 what: "vertices",
-                reason: "more than 2^32 - 2 vertices or triangles".into(),
+                counted: "vertices or triangles",
+                count: vertices.len().max(triangles.len()),
+                limit: (u32::MAX - 1) as usize,
+                hint: "",
             });
         }
         if let Some(i) = vertices.iter().position(|v| !v.is_finite()) {
@@ -140,7 +147,7 @@ impl Body {
                 what: "vertex",
                 index: i,
                 value: vertices[i].abs().max_element(),
-                range: "+-1e75",
+                limit: MAX_VERTEX_COORDINATE,
             });
         }
         body_footprint(vertices.len(), triangles.len()).check("the swept body", SWEEP_HINT)?;
@@ -151,11 +158,12 @@ impl Body {
             let mut idx = [0u32; 3];
             for (k, &v) in t.iter().enumerate() {
                 if v < 0 || v as u64 >= n as u64 {
-                    return Err(Error::Invalid {
+                    return Err(Error::Index {
                         what: "triangles",
-                        reason: format!(
-                            "triangle {i} refers to vertex {v}, but the vertices are 0..{n}"
-                        ),
+                        item: "vertex",
+                        at: Some(At::new("triangle", i)),
+                        index: v,
+                        len: n,
                     });
                 }
                 idx[k] = v as u32;
@@ -171,12 +179,10 @@ impl Body {
                 || idx[2] == idx[0]
                 || cross.length() <= ZERO_AREA_REL * longest
             {
-                return Err(Error::Invalid {
+                return Err(Error::Degenerate {
                     what: "triangles",
-                    reason: format!(
-                        "triangle {i} (vertices {}, {}, {}) has zero area",
-                        idx[0], idx[1], idx[2]
-                    ),
+                    at: Some(At::new("triangle", i)),
+                    reason: "has zero area",
                 });
             }
             tris.push(idx);
@@ -445,14 +451,14 @@ mod tests {
         let (v, t) = cube();
         assert!(matches!(
             Body::new(&[], &t),
-            Err(Error::Invalid {
+            Err(Error::Degenerate {
                 what: "vertices",
                 ..
             })
         ));
         assert!(matches!(
             Body::new(&v, &[]),
-            Err(Error::Invalid {
+            Err(Error::Degenerate {
                 what: "triangles",
                 ..
             })

@@ -64,7 +64,7 @@ pub use generator::{
     Generator, Scratch, Segment, SegmentKind, Velocity, MOTIONLESS_REL, TANGENT_REL,
 };
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Expected, Result};
 use crate::memory::{try_reserve, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::screw::Screw;
@@ -199,9 +199,9 @@ pub struct SweptMesh {
 /// # Errors
 /// - [`Error::TooFew`] for fewer than 2 poses;
 /// - [`Error::BadPose`] (`NotFinite`) for a pose with a NaN or infinite entry;
-/// - [`Error::Invalid`] (`"steps"`) for `steps` outside `1..=MAX_STEPS`, or an output of
-///   more than `u32::MAX` vertices;
-/// - [`Error::Invalid`] (`"tolerance"`) for a tolerance that is not finite and positive;
+/// - [`Error::Value`] (`"steps"`) for `steps` outside `1..=MAX_STEPS`, [`Error::Limit`] for
+///   an output of more than `u32::MAX` vertices;
+/// - [`Error::Value`] (`"tolerance"`) for a tolerance that is not finite and positive;
 /// - [`Error::Memory`] before the span whose quads would take the mesh (with its Python
 ///   copy, [`BYTES_PER_OUTPUT_VERTEX`], [`BYTES_PER_OUTPUT_TRIANGLE`]) and the body's
 ///   buffers ([`body_footprint`]) over the memory budget.
@@ -218,9 +218,14 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         .try_for_each(|(index, p)| p.check_range(index))?;
     let k = options.steps;
     if k == 0 || k > MAX_STEPS {
-        return Err(Error::Invalid {
+        return Err(Error::Value {
             what: "steps",
-            reason: format!("{k} is outside 1..={MAX_STEPS}"),
+            at: None,
+            value: k as f64,
+            expected: Expected::Within {
+                low: 1.0,
+                high: MAX_STEPS as f64,
+            },
         });
     }
     let tolerance = match options.accuracy {
@@ -230,9 +235,11 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
     };
     if let Some(t) = tolerance {
         if !(t.is_finite() && t > 0.0) {
-            return Err(Error::Invalid {
+            return Err(Error::Value {
                 what: "tolerance",
-                reason: format!("{t} is not a positive length"),
+                at: None,
+                value: t,
+                expected: Expected::Positive("length"),
             });
         }
     }
@@ -343,9 +350,12 @@ pub fn sweep(body: &Body, poses: &[Pose], options: &SweepOptions) -> Result<Swep
         let g = points.len();
         let total = out.vertices.len() as u64 + (k as u64 + 1) * g as u64;
         if total > u32::MAX as u64 {
-            return Err(Error::Invalid {
+            return Err(Error::Limit {
                 what: "steps",
-                reason: format!("the swept mesh would have {total} vertices, over 2^32 - 1"),
+                counted: "vertices of the swept mesh",
+                count: usize::try_from(total).unwrap_or(usize::MAX),
+                limit: u32::MAX as usize,
+                hint: "use fewer steps or a larger tolerance",
             });
         }
         reserve(

@@ -435,7 +435,7 @@ fn bad_input_errors() {
                     accuracy: Accuracy::Steps
                 }
             ),
-            Err(Error::Invalid { what: "steps", .. })
+            Err(Error::Value { what: "steps", .. })
         ));
     }
     let mut nan = two;
@@ -446,7 +446,7 @@ fn bad_input_errors() {
     ));
     assert!(matches!(
         sweep_mesh(&[], &[], &two, &SweepOptions::default()),
-        Err(Error::Invalid {
+        Err(Error::Degenerate {
             what: "vertices",
             ..
         })

@@ -375,8 +375,9 @@ fn a_bad_tolerance_is_refused() {
         assert!(
             matches!(
                 sweep(&cube, &two, &options),
-                Err(Error::Invalid {
+                Err(Error::Value {
                     what: "tolerance",
+                    expected: Expected::Positive("length"),
                     ..
                 })
             ),

@@ -1,7 +1,7 @@
 """bpy benchmark of Build Swept Region: a 100,000-triangle mesh over 64 screws.
 
 Run with the bpy wheel and the built extension (as the demo scripts do):
-    PYTHONPATH=<pylib>:.venv/bpy/<ver> .venv/bin/python scripts/bench_sweep_blender.py
+    PYTHONPATH=<pylib>:.venv/bpy/<ver> .venv/bin/python scripts/bench/bench_sweep_blender.py
 Prints the triangles in and out and the times of `polyscrew.sweep` alone and of the whole
 operator (reading the evaluated mesh and the motion at 65 frames, sweeping, writing the new
 mesh object), against stroboscopic instancing at the same pose density (64 x 8 + 1 linked
@@ -15,14 +15,15 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parent))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-import bench_shapes  # noqa: E402  (scripts/, numpy only)
+import bench_shapes  # noqa: E402  (scripts/bench, numpy only)
 
 STEPS = 8
 SCREWS = 64

@@ -1,6 +1,6 @@
 """Where Smooth Motion's time goes when it bakes many objects (issue 16's scene-scale case).
 
-The objects of scripts/bench_bake.py (ten keys at uneven frames on location, XYZ Euler
+The objects of scripts/bench/bench_bake.py (ten keys at uneven frames on location, XYZ Euler
 rotation and scale) are smoothed with the default options (4-point, 4 levels, timing Keys)
 in one Blender session:
   1. `--runs` times: Smooth Motion (wall clock), its phases timed apart (`keys.read`,
@@ -17,7 +17,7 @@ in one Blender session:
      own Python (cProfile does not see Blender's other RNA calls, `fcurves.new`,
      `keyframe_points.add` and property reads: they count in their Python caller).
 Run with the bpy wheel after scripts/build_extension.sh:
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/profile_bake.py [--objects 300] [--frames 250] [--runs 5]
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/profile_bake.py [--objects 300] [--frames 250] [--runs 5]
 """
 
 from __future__ import annotations

@@ -12,13 +12,19 @@ scheme, 5 levels, smooth timing. Timed, each as the median of many repetitions:
   hash      what the handler costs when nothing changed: the key hash check only;
   vertices  placing a 1,000-vertex mesh at the 64 instances (the GPU batch's positions).
 
+With `--objects N` (issue 27: the refresh on many objects) it times instead the refresh of a
+scene of N previewed objects (10 uneven keys each, location and XYZ Euler), as the depsgraph
+handler runs it (`preview_draw.refresh`): `first` (every preview computed), `edited` (a key of
+one object moved: that one recomputed, every other's key hash checked) and `unchanged` (the key
+hashes alone). SCREWBENDER_EXTENSION_ZIP=<zip> runs it against another build (before/after).
+
 Wall-clock medians, fastest runs and the median CPU time of the calling thread are printed;
 the target is judged on the CPU median, which does not count time the process spends
 waiting for a core on a shared machine (polyscrew runs on the calling thread).
 
 Run with the bpy wheel after scripts/build_extension.sh (the add-on is installed from the
 built .zip into a temporary Blender user directory):
-    PYTHONPATH=<polyscrew target>:.venv/bpy/5.0 .venv/bin/python scripts/bench_preview.py [--quick]
+    PYTHONPATH=<polyscrew target>:.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_preview.py [--quick]
 """
 
 from __future__ import annotations
@@ -32,7 +38,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
@@ -80,11 +86,52 @@ def median_ms(run, repeat: int) -> dict[str, float]:
     return {"wall": statistics.median(wall), "fastest": min(wall), "cpu": statistics.median(cpu)}
 
 
+def many_objects(count: int, repeat: int) -> None:
+    """The scene refresh of `count` previewed objects (see the module docstring)."""
+    draw = importlib.import_module("bl_ext.user_default.screwbender.ops.preview_draw")
+    bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
+    scene = bpy.context.scene
+    objects = []
+    for n in range(count):
+        obj = bpy.data.objects.new(f"Body{n:04d}", None)
+        scene.collection.objects.link(obj)
+        for k in range(10):
+            u = k / 9
+            obj.location = (3 * math.cos(7 * u + n), 3 * math.sin(5 * u), 2 * u)
+            obj.rotation_euler = (0.5 * math.sin(9 * u), 0.3 * u + 0.01 * n, 12 * u)
+            for path in ("location", "rotation_euler"):
+                obj.keyframe_insert(path, frame=1 + round(200 * u**1.1) + k)
+        objects.append(obj)
+    for obj in objects:
+        obj.screwbender_preview = True
+    point = channels.object_fcurves(objects[0])[0].keyframe_points[4]
+    sign = [1.0]
+
+    def first() -> None:
+        draw.CACHE.forget()
+        draw.refresh(scene)
+
+    def edited() -> None:
+        sign[0] = -sign[0]
+        point.co[1] += 0.01 * sign[0]
+        draw.refresh(scene)
+
+    rows = [("first", median_ms(first, max(3, repeat // 10))), ("edited", median_ms(edited, repeat)),
+            ("unchanged", median_ms(lambda: draw.refresh(scene), repeat))]
+    print(f"Blender {bpy.app.version_string}; refresh of {count} previewed objects (10 keys each); median of {repeat} runs")
+    for name, t in rows:
+        print(f"  {name:<9} wall median {t['wall']:8.2f} ms   fastest {t['fastest']:8.2f} ms   CPU median {t['cpu']:8.2f} ms")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("--quick", action="store_true", help="fewer repetitions")
+    parser.add_argument("--objects", type=int, help="time the refresh of a scene of this many previewed objects instead")
     args = parser.parse_args()
     repeat = 50 if args.quick else 500
+    if args.objects:
+        many_objects(args.objects, 5 if args.quick else 20)
+        return
 
     obj = keyed_object()
     options = preview.PreviewOptions(

@@ -27,10 +27,10 @@ is measured on one object over a few frame counts that finish (1,000, 2,000, 4,0
 100,000 frames (--quick: 10,000) is extrapolated from the fitted growth exponent (marked
 "extrapolated" wherever it appears).
 
-Writes the results as JSON (`--out`, rendered by scripts/bench_report.py) and prints them.
+Writes the results as JSON (`--out`, rendered by scripts/bench/bench_report.py) and prints them.
 Run with the bpy wheel after scripts/build_extension.sh (the add-on is installed from the
 built .zip into a temporary Blender user directory):
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_bake.py [--quick] [--out bake.json]
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_bake.py [--quick] [--out bake.json]
 """
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ import sys
 import time
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import demo_common  # noqa: E402
 

@@ -38,7 +38,7 @@ Keys: keyframe points over the owners' transform curves (what Blender stores and
 edits; Decimate keys each curve on its own frames), and key frames (distinct frames per owner)
 as a fraction of the frames (each owner's own key range). Also: Smooth Motion with Keys: Reduced against Every Step (time).
 
-Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_reduce.py [--json out.json] [--quick]
+Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_reduce.py [--json out.json] [--quick]
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
@@ -276,7 +276,7 @@ def clip_bvh(n: int = 300):
 
 
 def load_demo_scene() -> None:
-    spec = importlib.util.spec_from_file_location("demo_scene", Path(__file__).resolve().parent / "demo" / "10_scene.py")
+    spec = importlib.util.spec_from_file_location("demo_scene", Path(__file__).resolve().parents[1] / "demo" / "10_scene.py")
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     module.build()

@@ -11,7 +11,7 @@ the refusal the module gives with the budget set to 0 bytes (for `sweep`, whose 
 checked screw by screw, the body's estimate plus 48 bytes per output vertex and 36 per
 output triangle: what its last check counts).
 
-    .venv/bin/python scripts/memory_footprints.py
+    .venv/bin/python scripts/bench/memory_footprints.py
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import sys
 SETUP = r"""
 import json, re, sys
 import numpy as np, polyscrew as ps
-sys.path.insert(0, "scripts")
+sys.path.insert(0, "scripts/bench")
 from bench_shapes import bumpy_torus
 
 def keys(n, seed=1):

@@ -16,7 +16,7 @@ Cases (each a fresh scene, one object, Smooth Motion with its default options):
 
 Run with the extension to measure (default: the newest dist/ zip):
     SCREWBENDER_EXTENSION_ZIP=dist/screwbender-...zip PYTHONPATH=.venv/bpy/5.0 \\
-        .venv/bin/python scripts/measure_intent.py [--json out.json]
+        .venv/bin/python scripts/bench/measure_intent.py [--json out.json]
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()

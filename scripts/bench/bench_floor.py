@@ -50,9 +50,9 @@ objects run once: the full run took 31 minutes on the shared 2-core machine at l
 Each operator's time is given as a multiple of its floor (median over median of the same
 run), Smooth Motion and Remove Noise also against Blender's counterpart; the growth
 exponent against owners and frames is fitted per operator (bench_report.growth_exponent).
-Writes JSON (--out, rendered into BENCHMARKS.md by scripts/bench_report.py) and prints a table.
+Writes JSON (--out, rendered into BENCHMARKS.md by scripts/bench/bench_report.py) and prints a table.
 Run after scripts/build_extension.sh:
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_floor.py [--quick] [--out floor.json]
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_floor.py [--quick] [--out floor.json]
 """
 
 from __future__ import annotations
@@ -68,7 +68,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import demo_common  # noqa: E402
 
@@ -109,7 +109,7 @@ QUICK_CASES = [("objects", 1, 50, 2), ("objects", 20, 50, 2), ("objects", 20, 10
 #: about half a second per object over 50 frames, and grows with the frames).
 SWEEP_MAX_OBJECT_FRAMES, SWEEP_EVERY_RUN = 25_000, 1_000
 #: Reduce Keys and graph.decimate run on scenes of up to this many source keys (decimate takes
-#: about 0.1 ms per key; scripts/bench_reduce.py compares the two in full).
+#: about 0.1 ms per key; scripts/bench/bench_reduce.py compares the two in full).
 REDUCE_MAX_KEYS = 200_000
 #: Scenes of this many owners or more run once (the full run stays near ten minutes).
 ONE_RUN_OWNERS = 2000

@@ -1,12 +1,12 @@
 """Writes BENCHMARKS.md from one run of scripts/bench.sh.
 
 Reads criterion's JSON (target/criterion/**/new/{benchmark,estimates}.json: the median per
-iteration), the callgrind outputs, the JSON of scripts/bench_python.py and the text of
-scripts/bench_bake.py from the run directory (target/bench), and writes every median and
+iteration), the callgrind outputs, the JSON of scripts/bench/bench_python.py and the text of
+scripts/bench/bench_bake.py from the run directory (target/bench), and writes every median and
 every ratio, each ratio taken between figures of the same run. Also importable: the growth
 exponent fit (`growth_exponent`) is tested in tests/python/test_bench_tools.py.
 
-    python scripts/bench_report.py --run target/bench --criterion target/criterion --out BENCHMARKS.md
+    python scripts/bench/bench_report.py --run target/bench --criterion target/criterion --out BENCHMARKS.md
 """
 
 from __future__ import annotations
@@ -382,7 +382,7 @@ class Report:
             self.targets.append(("bake >= 20x nla.bake", "not measured", "n/a"))
             return
         text = path.read_text().strip()
-        self.w("`scripts/bench_bake.py` (ScrewBender's bake against `bpy.ops.nla.bake`, same objects and frames):", "",
+        self.w("`scripts/bench/bench_bake.py` (ScrewBender's bake against `bpy.ops.nla.bake`, same objects and frames):", "",
                "```", text, "```", "")
         # The "best of N" line of each case when present, else every "ratio X x".
         ratios = [float(x) for x in re.findall(r"best of \d+:.*ratio\s+([\d.]+)x", text)] or \
@@ -392,11 +392,11 @@ class Report:
                                  verdict(min(ratios) >= TARGET_BAKE_VS_NLA)))
         if "keyframe_insert" not in text:
             self.w("not available: the comparison against a `keyframe_insert` loop on the same objects and frames "
-                   "is not in scripts/bench_bake.py yet.", "")
+                   "is not in scripts/bench/bench_bake.py yet.", "")
 
     def bake_table(self, data: dict) -> None:
-        """The bake comparison from scripts/bench_bake.py's JSON."""
-        self.w(f"`scripts/bench_bake.py`, Blender {data['blender']}: every baker writes the same ten dense F-curves "
+        """The bake comparison from scripts/bench/bench_bake.py's JSON."""
+        self.w(f"`scripts/bench/bench_bake.py`, Blender {data['blender']}: every baker writes the same ten dense F-curves "
                "per object (location, XYZ Euler rotation, scale; one key per frame) for the same objects and frames. "
                "ScrewBender: the Smooth Motion operator's whole work (read keys, sample, write the action); "
                "`nla.bake`: the operator call; both best of "
@@ -437,12 +437,12 @@ class Report:
                              verdict(min(ratios) >= TARGET_BAKE_VS_NLA) if ratios else "n/a"))
 
     def bones_section(self) -> None:
-        """The 100-bone rig against nla.bake POSE, from scripts/bench_bake.py's JSON ("bones")."""
+        """The 100-bone rig against nla.bake POSE, from scripts/bench/bench_bake.py's JSON ("bones")."""
         self.w("## Bake in Blender: bones", "")
         js = self.run / "bake.json"
         data = json.loads(js.read_text()).get("bones") if js.exists() else None
         if not data:
-            self.w("not available: no bone case in this run's scripts/bench_bake.py results", "")
+            self.w("not available: no bone case in this run's scripts/bench/bench_bake.py results", "")
             self.targets.append(("bake of a 100-bone rig >= 20x nla.bake POSE", "not measured", "n/a"))
             return
         self.bones_table(data, json.loads(js.read_text()).get("blender", "?"))
@@ -451,7 +451,7 @@ class Report:
         """The bone case: medians of wall-clock and CPU time, ours (per timing) and nla.bake,
         and their ratios."""
         runs, m = data["runs"], data["median"]
-        self.w(f"`scripts/bench_bake.py`, Blender {blender}: a rig of {data['bones']} bones (ten chains of ten, not "
+        self.w(f"`scripts/bench/bench_bake.py`, Blender {blender}: a rig of {data['bones']} bones (ten chains of ten, not "
                "connected), every bone keyed on location, XYZ Euler rotation and scale at ten uneven frames. "
                "ScrewBender: Smooth Motion of all its bones (Object Mode, the armature selected, Armatures: Bones "
                "Only: the selection, reading, sampling and the new action), Jarek 4 levels; nla.bake: "
@@ -549,7 +549,7 @@ class Report:
                    "")
 
     def reduce_section(self) -> None:
-        """Reduce Keys against graph.decimate, from scripts/bench_reduce.py's JSON (issue 26)."""
+        """Reduce Keys against graph.decimate, from scripts/bench/bench_reduce.py's JSON (issue 26)."""
         self.w("## Reduce Keys against graph.decimate", "")
         js = self.run / "reduce.json"
         if not js.exists():
@@ -558,7 +558,7 @@ class Report:
             self.targets.append(("Reduce Keys <= 0.6x the keys of the best graph.decimate margin", "not measured", "n/a"))
             return
         d = json.loads(js.read_text())
-        self.w(f"`scripts/bench_reduce.py`, Blender {d['blender']}. Ours: the Reduce Keys operator (all of it: read, "
+        self.w(f"`scripts/bench/bench_reduce.py`, Blender {d['blender']}. Ours: the Reduce Keys operator (all of it: read, "
                "one `polyscrew.reduce_keys` call, write). Theirs: `graph.decimate` in ERROR mode, every other option at "
                f"its default, its margin searched (regula falsi on the logarithms, to the resolution of {d['steps']} bisection steps in log scale) for the largest value whose result "
                "meets the same world-space tolerance; its time is one decimate call at that margin. Both results "
@@ -656,7 +656,7 @@ class Report:
             return
         d = json.loads(js.read_text())
         case, ref = d["case"], d["reference"]
-        self.w(f"`scripts/bench_sweep_peers.py`{' (quick: a smoke run)' if d.get('quick') else ''}. Case: a "
+        self.w(f"`scripts/bench/bench_sweep_peers.py`{' (quick: a smoke run)' if d.get('quick') else ''}. Case: a "
                f"{case['body']} ({case['triangles']:,} triangles) along a polyscrew of {case['poses']} poses "
                f"({case['screws']} screws; {case.get('motion', '')}).", "",
                f"Method. Reference: the union of {ref['stamps']:,} stamps, the body at poses sampled along the "
@@ -748,19 +748,50 @@ class Report:
                "`benches/angular_velocity.rs` (`top_20_keys`: the spinning top, 20 keys).", "")
 
     def denoise_section(self) -> None:
-        """The section scripts/bench_denoise.py wrote into the run folder (denoise.md)."""
+        """The section scripts/bench/bench_denoise.py wrote into the run folder (denoise.md)."""
         path = self.run / "denoise.md"
         text = path.read_text() if path.exists() else ""
         if begin("denoise") in text and end("denoise") in text:
             text = text[text.index(begin("denoise")) + len(begin("denoise")):text.index(end("denoise"))]
             self.w(text.strip(), "")
         else:
-            self.w("## Denoise (issue 19)", "", "not available: scripts/bench_denoise.py did not write its section "
+            self.w("## Denoise (issue 19)", "", "not available: scripts/bench/bench_denoise.py did not write its section "
                    "(see the bench.sh log)", "")
+
+    #: The measurement scripts of the "measure" part, in the order of their sections: (script,
+    #: what it measures).
+    MEASUREMENTS = (
+        ("measure_intent", "what Smooth Motion keeps of the animator's intent, against Blender's playback (issue 17)"),
+        ("measure_schemes", "how far each subdivision scheme strays from the key poses (the Scheme tooltips)"),
+        ("profile_bake", "where Smooth Motion's time goes on many objects, and Blender's own read and write calls"),
+        ("bench_preview", "the live preview's recompute (issue 8: 50 keys, 5 levels, 64 instances)"),
+        ("bench_sweep_blender", "Build Swept Region on a 100,000-triangle mesh against stroboscopic instancing"),
+        ("measure_reduce", "key fractions of reduce_keys on synthetic and captured-like motion (issue 26)"),
+        ("memory_footprints", "the module's memory estimates beside the peaks measured"),
+        ("plot_smoothness", "the ScrewBender paper's smoothness figures (docs/smoothness_fig10.png, docs/circle_fig11.png)"),
+    )
+
+    def measure_section(self) -> None:
+        """The printouts of the measurement scripts (target/bench/measure-<name>.txt), each as
+        it printed them: the figures README.md and docs/ quote."""
+        self.w("## Measurements the docs quote", "",
+               "Each script in `scripts/bench/`, run by `scripts/bench.sh` (part `measure`), as it printed its figures.", "")
+        if (self.run / "measure.missing").exists():
+            self.w(f"not available: {(self.run / 'measure.missing').read_text().strip()}", "")
+            return
+        for name, what in self.MEASUREMENTS:
+            self.w(f"### `scripts/bench/{name}.py`: {what}", "")
+            text, missing = self.run / f"measure-{name}.txt", self.run / f"measure-{name}.missing"
+            if text.exists() and not missing.exists():
+                self.w("```", text.read_text().rstrip(), "```", "")
+            elif missing.exists():
+                self.w(f"not available: {missing.read_text().strip()}", "")
+            else:
+                self.w(f"not available: measure-{name}.txt was not written (see the bench.sh log).", "")
 
     def floor_section(self) -> None:
         """Every writing operator against its floor and Blender's counterpart, and how each grows,
-        from scripts/bench_floor.py's JSON (issue 27)."""
+        from scripts/bench/bench_floor.py's JSON (issue 27)."""
         self.w("## Operators against their floor", "")
         js = self.run / "floor.json"
         if not js.exists():
@@ -772,7 +803,7 @@ class Report:
         end_ = d.get("date_end", "")
         when = (f"{d['date']} to {end_[11:] if end_[:10] == d['date'][:10] else end_}" if end_
                 else f"ended {d['date']}")
-        self.w(f"`scripts/bench_floor.py`{' (quick: a smoke run)' if d.get('quick') else ''}, Blender {d['blender']}, "
+        self.w(f"`scripts/bench/bench_floor.py`{' (quick: a smoke run)' if d.get('quick') else ''}, Blender {d['blender']}, "
                f"{when}, load average {d['load_start']} at its start, {d['seconds']:.0f} s in all. Each operator "
                "through `bpy.ops` with its defaults, against its *floor*: only the Blender calls no implementation "
                "through Blender's Python API can avoid (one `foreach_get` of `co` and of `interpolation` per source "
@@ -880,7 +911,7 @@ class Report:
                              verdict(not steep) if rows else "n/a"))
 
 
-#: The writing operators measured against their floor (scripts/bench_floor.py), and labels.
+#: The writing operators measured against their floor (scripts/bench/bench_floor.py), and labels.
 FLOOR_OPERATORS = ("smooth", "revert", "denoise", "reduce", "insert_key", "sweep")
 FLOOR_LABELS = {
     "smooth": "Smooth Motion", "revert": "Revert", "denoise": "Remove Noise", "reduce": "Reduce Keys",
@@ -922,7 +953,7 @@ def growth_of(cases: list[dict], name: str, family: str, axis: str):
 
 
 #: The parts of scripts/bench.sh (BENCH_ONLY=<part>[,<part>]).
-PARTS = ("criterion", "callgrind", "python", "bake", "reduce", "floor", "denoise", "sweep")
+PARTS = ("criterion", "callgrind", "python", "bake", "reduce", "floor", "denoise", "sweep", "measure")
 #: The blocks of BENCHMARKS.md in order: (name, the parts whose results it shows, its methods).
 #: Each is written between ``<!-- name:begin -->`` and ``<!-- name:end -->``; a refresh of some
 #: parts rewrites the blocks that show them and keeps the others as they are.
@@ -939,6 +970,7 @@ BLOCKS = (
     ("reduce", ("reduce",), ("reduce_section",)),
     ("papers", ("criterion",), ("papers_section",)),
     ("denoise", ("denoise",), ("denoise_section",)),
+    ("measure", ("measure",), ("measure_section",)),
 )
 #: A file written before the blocks had markers: the block of each "## " heading (prefix).
 LEGACY_HEADINGS = (
@@ -1020,6 +1052,8 @@ def parts_at_hand(run: Path, crit: dict) -> set[str]:
     for part, names in files.items():
         if any((run / n).exists() for n in names):
             have.add(part)
+    if (run / "measure.missing").exists() or any(run.glob("measure-*.txt")) or any(run.glob("measure-*.missing")):
+        have.add("measure")
     return have
 
 

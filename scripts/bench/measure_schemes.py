@@ -7,7 +7,7 @@ mode). For each scheme: the largest distance of the object's origin from the key
 key frames (scene units) and the largest angle (degrees) between the smoothed and keyed
 orientations there, over every key of every scene.
 
-Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/measure_schemes.py
+Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/measure_schemes.py
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 bake = demo_common.blender_with_addon()

@@ -1,7 +1,7 @@
 """Benchmarks of the Python API, each comparison side by side in one process run.
 
 Plain Python (the project venv, numpy 2):
-    python scripts/bench_python.py --out target/bench/python.json
+    python scripts/bench/bench_python.py --out target/bench/python.json
   * polyscrew.interpolate(a, b, ts) for 10,000 t in one call (batch), against a Python loop
     of pytransform3d's transform_sclerp and against a Python loop of polyscrew.interpolate
     with one float t per call;
@@ -9,7 +9,7 @@ Plain Python (the project venv, numpy 2):
     6 keys x 7 levels, the case of Hofer et al. Table 1) and angular-velocity fitting
     (polyscrew.fit_angular_velocity, 20 keys, the case of Xie et al.).
 Inside Blender (PYTHONPATH=.venv/bpy/5.0, numpy 1.26):
-    python scripts/bench_python.py --blender --out target/bench/blender.json
+    python scripts/bench/bench_python.py --blender --out target/bench/blender.json
   * mathutils.Matrix.lerp (Blender's decoupled matrix interpolation) one call per t in a
     Python loop, against polyscrew.interpolate batch and per call in the same process.
 

@@ -7,7 +7,7 @@ Clips (30 frames per second, metres, built here with numpy and scipy):
 - captured: the walk root with 0.5 mm / 0.05 degree sensor noise per frame, the noise
   removed by `polyscrew.denoise` (Remove Noise) first, as a capture would be;
 - rig: 20 bones in two chains of ten (the walk's hips, limbs swinging), world-space tolerance;
-- bench walk: `scripts/bench_reduce.py`'s 13-bone walk (its formulas, rest pose and bone
+- bench walk: `scripts/bench/bench_reduce.py`'s 13-bone walk (its formulas, rest pose and bone
   lengths as radii, built here without Blender), at its 24 frames per second and sampled
   at 120 (the same motion, five times the frames): the key fraction of a clip is a density
   per frame, so it depends on the frame rate.
@@ -20,7 +20,7 @@ total), the largest errors measured, and the time of the call (one thread). Then
 walk's hip bob alone: its keys at 1 mm, and the error of the best cubic over a span of 0.28 s
 and of 10 frames at 24 fps (why 10 % of that clip's frames is out of reach at 1 mm).
 
-Run: PYTHONPATH=<polyscrew> .venv/bin/python scripts/measure_reduce.py
+Run: PYTHONPATH=<polyscrew> .venv/bin/python scripts/bench/measure_reduce.py
 """
 
 import time
@@ -105,7 +105,7 @@ def bone_rest(head, tail):
 
 
 def bench_walk(n, fps):
-    """`scripts/bench_reduce.py`'s walk at `fps` over the same time as its `n` frames at 24:
+    """`scripts/bench/bench_reduce.py`'s walk at `fps` over the same time as its `n` frames at 24:
     each bone's `matrix_basis` (B, N, 4, 4), parents, offsets (parent rest^-1 @ rest), lengths."""
     bones = [("Hips", None, (0, 0, 1.0), (0, 0, 1.1)), ("Spine", "Hips", (0, 0, 1.1), (0, 0, 1.45)),
              ("Head", "Spine", (0, 0, 1.45), (0, 0, 1.75))]

@@ -12,7 +12,7 @@ per-channel interpolation does not.
 
 Run with the project venv (numpy, matplotlib) and polyscrew importable; the Blender part
 runs in a child process with the bpy module on its path (default .venv/bpy/5.0):
-    PYTHONPATH=<polyscrew> .venv/bin/python scripts/plot_smoothness.py [--out-dir docs]
+    PYTHONPATH=<polyscrew> .venv/bin/python scripts/bench/plot_smoothness.py [--out-dir docs]
 Derivatives are central differences of the dense samples (`derivatives`, tested in
 tests/python/test_bench_tools.py against an analytic curve).
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FPS = 24  # frames per second; one key per second in both figures
 SPAN_FRAMES = 24
 LEVELS = 6  # 2**6 = 64 samples per key span for every curve

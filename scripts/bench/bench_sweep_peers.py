@@ -37,7 +37,7 @@ Compared, all fed the same screw motion:
     extrapolated (and labelled so). The kernels are compiled by a warm-up call, not timed.
 
 Run (bench.sh does, with the bench requirements installed):
-    PYTHONPATH=<pylib> .venv/bin/python scripts/bench_sweep_peers.py --out target/bench/sweep.json [--quick]
+    PYTHONPATH=<pylib> .venv/bin/python scripts/bench/bench_sweep_peers.py --out target/bench/sweep.json [--quick]
 The pure helpers (hausdorff, visible_points, first_match, ...) are tested in
 tests/python/test_bench_tools.py without gpytoolbox or warp.
 """
@@ -58,7 +58,7 @@ from scipy.spatial import cKDTree
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_shapes  # noqa: E402
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 #: Instances per screw tried for stroboscopic instancing, in this order (stops at the first match).
 STROBE_LEVELS = (8, 16, 32, 64, 128, 256)

@@ -21,11 +21,12 @@ the keys as Blender stores them (float32) and are measured on the keys they writ
 For each: location and rotation RMS and max error to the truth, RMS over the first and last
 5 frames and over the rest, and on the stop clip the location error at the stop frame.
 
-Writes JSON (--json), the Markdown section "Denoise" of BENCHMARKS.md (replaced between its
-markers, or appended) and the figure docs/denoise_error.png (error over time, ours against
+Writes JSON (--json), the Markdown section "Denoise" (--section, between its markers: a file of
+its own, target/bench/denoise.md by default, that scripts/bench/bench_report.py, the one writer of
+BENCHMARKS.md, puts into it) and the figure docs/denoise_error.png (error over time, ours against
 the three filters at their defaults; drawn by this script run again with plain Python and
 matplotlib, since Blender's numpy is older). Run:
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_denoise.py
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_denoise.py
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FPS = 24
 N = 240
 LEVELS = {"low": (0.005, 0.125), "high": (0.02, 0.5)}  # metres, degrees per axis
@@ -519,7 +520,7 @@ def verdict(ok):
 def markdown(results, meta):
     lines = [BEGIN, "## Denoise (issue 19)", ""]
     lines.append(
-        f"Written by `scripts/bench_denoise.py` ({meta['seconds']:.0f} s) on {meta['date']}: "
+        f"Written by `scripts/bench/bench_denoise.py` ({meta['seconds']:.0f} s) on {meta['date']}: "
         f"Blender {meta['blender']}, {meta['cpu']}, load average {meta['load']}. "
         "Noise per axis: low 5 mm and 0.125 degrees, high 20 mm and 0.5 degrees (the issue's camera track). "
         "Errors are to the known truth, measured on the keys each side writes back (float32). "
@@ -604,13 +605,12 @@ def markdown(results, meta):
     return "\n".join(lines)
 
 
-def update_benchmarks(text, path):
-    old = path.read_text() if path.exists() else ""
-    if BEGIN in old and END in old:
-        new = old[: old.index(BEGIN)] + text + old[old.index(END) + len(END):]
-    else:
-        new = old.rstrip() + "\n\n" + text + "\n"
-    path.write_text(new)
+def write_section(text, path):
+    """The section alone, for bench_report.py (never BENCHMARKS.md itself: one writer)."""
+    if path.resolve() == (ROOT / "BENCHMARKS.md").resolve():
+        sys.exit("bench_denoise: BENCHMARKS.md is written by scripts/bench/bench_report.py; give --section a file of its own")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text + "\n")
 
 
 def figure(json_path, png_path):
@@ -651,7 +651,8 @@ def figure(json_path, png_path):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--json", type=Path, default=ROOT / "out" / "bench_denoise.json")
-    parser.add_argument("--benchmarks", type=Path, default=ROOT / "BENCHMARKS.md")
+    parser.add_argument("--section", type=Path, default=ROOT / "target" / "bench" / "denoise.md",
+                        help="where the Denoise section goes (bench_report.py puts it into BENCHMARKS.md)")
     parser.add_argument("--figure", type=Path, default=ROOT / "docs" / "denoise_error.png")
     parser.add_argument("--figure-only", action="store_true", help="draw the figure from --json (plain Python)")
     args = parser.parse_args()
@@ -670,11 +671,11 @@ def main():
     )
     args.json.parent.mkdir(parents=True, exist_ok=True)
     args.json.write_text(json.dumps(dict(meta=meta, results=results)))
-    update_benchmarks(markdown(results, meta), args.benchmarks)
+    write_section(markdown(results, meta), args.section)
     env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
     subprocess.run([sys.executable, __file__, "--figure-only", "--json", str(args.json), "--figure", str(args.figure)],
                    check=True, env=env)
-    print(f"wrote {args.json}, {args.benchmarks} (Denoise section), {args.figure}")
+    print(f"wrote {args.json}, {args.section} (Denoise section), {args.figure}")
 
 
 if __name__ == "__main__":

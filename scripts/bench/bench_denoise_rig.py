@@ -14,7 +14,7 @@ from the same noisy keys, the two alternating (ours, Gaussian, ours, ...); media
 of a cProfile of one more run of ours; `--reads` counts the keyframe reads of one more run of
 ours per F-curve and property (every `bulk.get`: issue 27's read-once rule).
 
-Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench_denoise_rig.py [--bones 30,100] [--runs 5]
+Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/bench_denoise_rig.py [--bones 30,100] [--runs 5]
      [--profile 25] [--reads] [--json out.json]
 """
 
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent / "demo"))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "demo"))
 import demo_common  # noqa: E402
 
 demo_common.blender_with_addon()
