@@ -211,7 +211,7 @@ fn sweep<'py>(
 /// ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame (closed:
 /// every edge in two faces); ``poses`` (N >= 2, 4, 4) its world poses, one screw per span.
 /// The region's signed distance (the minimum over the motion of the body's, the body's
-/// sampled on a grid three times finer than ``cell``, the motion sampled so that no point
+/// sampled on a grid six times finer than ``cell``, the motion sampled so that no point
 /// moves more than a cell between samples) is contoured on a grid of spacing ``cell`` by
 /// marching tetrahedra, and every vertex moved along its grid edge to the zero of the
 /// distance refined between the samples. ``cell=None``: ``DEFAULT_CLOSED_CELL`` (1.5 %) of

@@ -43,7 +43,7 @@ use crate::motion::screw::Screw;
 pub const DEFAULT_CELL_REL: f64 = 0.015;
 
 /// The body's distance grid is this many times finer than the world grid.
-pub const BODY_SUBCELLS: f64 = 3.0;
+pub const BODY_SUBCELLS: f64 = 6.0;
 
 /// Distances are exact within this many world cells of the body's surface (and clamped to
 /// it beyond): enough for the trilinear reads of every grid point whose cube the surface
@@ -56,9 +56,11 @@ pub const REFINE_POSES: usize = 8;
 /// Regula falsi steps of a vertex's refinement along its edge.
 pub const REFINE_ITERATIONS: usize = 5;
 
-/// A vertex is kept at least this fraction of its edge from either end (no zero-length
-/// surface edge).
-pub const EDGE_MARGIN: f64 = 1e-4;
+/// A vertex is kept at least this fraction of its edge from either end: where the zero set
+/// passes through a grid point, the triangles around it stay far above round-off (and the
+/// float32 copy Blender keeps) instead of shrinking into a fan of slivers that rounding can
+/// fold through each other.
+pub const EDGE_MARGIN: f64 = 0.02;
 
 /// A cell below `extent / MAX_CELLS_PER_EXTENT` (the body's extent) is refused.
 pub const MAX_CELLS_PER_EXTENT: f64 = 1000.0;
@@ -68,6 +70,11 @@ pub const MAX_POSES: usize = 1 << 20;
 
 /// Bytes per world-grid point: its value (4) and the pose that gave it (4).
 const WORLD_BYTES_PER_POINT: usize = 8;
+
+/// The body grid's origin is shifted by these fractions of its spacing (irrational-looking,
+/// unequal per axis), so that its columns do not run along the edges or diagonals of bodies
+/// made of round numbers.
+const GRID_JITTER: [f64; 3] = [0.313_725_49, 0.271_826_3, 0.141_4];
 
 /// Options of [`sweep_closed`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -136,7 +143,7 @@ impl BodyField {
             .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
         // An origin off any round position, so grid columns do not run along the body's
         // edges (ray parity counts each face crossed once).
-        let jitter = DVec3::new(0.318_309_886, 0.271_828_182, 0.141_421_356) * h;
+        let jitter = DVec3::from_array(GRID_JITTER) * h;
         let origin = lo - DVec3::splat(band + 2.0 * h) - jitter;
         let size = hi + DVec3::splat(band + 2.0 * h) - origin;
         let n = [
