@@ -23,9 +23,8 @@ import polyscrew
 import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from test_sweep_tolerance import CUBE_T, CUBE_V, screw_poses  # noqa: E402
-
 from screws import screw_matrix  # noqa: E402  (tests/fixtures)
+from test_sweep_tolerance import CUBE_T, CUBE_V, screw_poses  # noqa: E402
 
 
 def box_sd(local, lo, hi):
