@@ -20,7 +20,8 @@
 #     animator's intent (measure_intent.py), how far each scheme strays from the keys
 #     (measure_schemes.py), where a bake's time goes (profile_bake.py), the live preview's
 #     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
-#     (bench_sweep_blender.py), key fractions of reduce_keys (measure_reduce.py), memory
+#     (bench_sweep_blender.py), the closed swept boundary against the open sweep
+#     (bench_sweep_closed.py), key fractions of reduce_keys (measure_reduce.py), memory
 #     estimates beside measured peaks (memory_footprints.py), and the paper's smoothness
 #     figures (plot_smoothness.py, into docs/): each one's printout in BENCHMARKS.md.
 # Every script bench.sh runs is in scripts/bench/; bench_report.py is the one writer of
@@ -270,6 +271,7 @@ else
   measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
   measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
   measure bench_sweep_blender "$pylib:$bpy_dir"
+  measure bench_sweep_closed "$pylib"
   measure measure_reduce "$pylib"
   measure memory_footprints "$pylib"
   measure plot_smoothness "$pylib" --bpy "$bpy_dir" --out-dir docs

@@ -3,7 +3,7 @@ superset) on issue 29's cases: a unit cube on a 120-degree screw with a slide, a
 half turn, a ~2,000-triangle torus on a smoothed 4-key motion, and (``--big``) a
 100,000-triangle bumpy torus over 64 screws. CPU-time medians of alternating runs.
 
-    PYTHONPATH=.pylib .venv/bin/python scripts/bench_sweep_closed.py [--repeat 3] [--big]
+    PYTHONPATH=.pylib .venv/bin/python scripts/bench/bench_sweep_closed.py [--repeat 3] [--big]
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import polyscrew
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "tests" / "python"))
 sys.path.insert(0, str(ROOT / "tests" / "fixtures"))
 from screws import screw_matrix  # noqa: E402
