@@ -173,6 +173,9 @@ class Baked:
     unkeyed: frozenset = frozenset()
     #: Keys: Reduced: the reduced curves (:class:`reduce.Reduced`), written instead of `values`.
     reduced: object | None = None
+    #: Blender's playback of the source at `frames` where the bake played it already
+    #: (:attr:`sampling.Sampled.played`; NaN rows elsewhere), for the departure measure.
+    played: np.ndarray | None = None
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -354,7 +357,7 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        sampled = sampling.sample(motion, frames, options, owner, channels=True, previous=previous)
+        sampled = sampling.sample(motion, frames, options, owner, channels=True, previous=previous, played=True)
         location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
         values = {"location": location, keys.rotation_path(mode): rotation}
         if not motion.located:
@@ -376,7 +379,7 @@ def sample_channels(
     modes = motion.cycle_modes if whole_period and motion.cycle_modes else None
     return Baked(
         owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes,
-        join=join, end_maps=end_maps, unkeyed=unkeyed,
+        join=join, end_maps=end_maps, unkeyed=unkeyed, played=sampled.played,
     )
 
 
@@ -839,9 +842,10 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
     if motion.source is None:
         return None
     mode = motion.rotation_mode
+    played = part.played if part.motion.source is motion.source else None  # (rows of this playback only)
     found = intent.departure(
         motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)],
-        motion.frames,
+        motion.frames, played,
     )
     causes = list(motion.causes)
     if options.method == "FEATURE" and options.approximate:

@@ -201,3 +201,64 @@ def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     differ = np.setxor1d(every.frames, sampled.frames)
     assert len(differ) <= 4 * spacing, (len(differ), spacing)
     assert intent.frame_runs(sampled.frames).count("-") == intent.frame_runs(every.frames).count("-")
+
+
+def departure_plays(intent) -> tuple[list, object]:
+    """Wraps `intent.departure` (what Smooth Motion measures each owner's result with): per
+    call, (rows the owner's playback had played before it, rows the departure played, frames
+    measured). Returns the list and the original, to put back."""
+    seen = []
+    original = intent.departure
+
+    def counted(source, size, frames, *args, **kwargs):
+        before = source.playback.rows_evaluated
+        found = original(source, size, frames, *args, **kwargs)
+        seen.append((before, source.playback.rows_evaluated - before, len(frames)))
+        return found
+
+    intent.departure = counted
+    return seen, original
+
+
+def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
+    """Smooth Motion plays each owner's source curves once per baked frame: timing Keys plays
+    them at the baked frames (to follow Blender's pace) and the departure measure compares the
+    result with those rows instead of playing them again (issue 24 item 5 at the cost of a
+    comparison). Counted with the playback's own counter of rows played, for objects, a rig in
+    Pose Mode, and a long bake whose spans are measured on a grid (there the departure plays
+    at most DEPARTURE_SPAN_FRAMES frames a span). Before: it played every measured frame again."""
+    intent = addon_module("intent")
+    objects = [keyed(f"Once{n}", 40 + n, mode=mode) for n, mode in enumerate(("XYZ", "QUATERNION", "ZXY"))]
+    seen, original = departure_plays(intent)
+    try:
+        h.select_only(*objects)
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+        rig = bh.armature()
+        for n, bone in enumerate(("Upper", "Fore", "Hand")):
+            bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=50 + n, gentle=True))
+        h.select_only(rig)
+        bpy.ops.object.mode_set(mode="POSE")
+        bh.select_bones(rig, ["Upper", "Fore", "Hand"])
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+        bpy.ops.object.mode_set(mode="OBJECT")
+        short = list(seen)
+        long = h.new_object("LongOnce")
+        for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
+            long.location = (x, 0.3 * x, 0.0)
+            long.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
+            long.keyframe_insert("location", frame=frame)
+            long.keyframe_insert("rotation_euler", frame=frame)
+        h.select_only(long)
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    finally:
+        intent.departure = original
+    for before, played, frames in short:
+        print(f"{frames} baked frames: the owner's playback played {before} rows before the departure "
+              f"(span analysis and timing Keys), the departure {played} (before this change: {frames})")
+    assert len(short) == 6, "three objects and three bones measured"
+    assert all(played == 0 for _, played, _ in short)
+    assert all(before >= frames for before, _, frames in short), "timing Keys played every baked frame"
+    (before, played, frames), = seen[len(short):]
+    print(f"long bake, {frames} frames: timing Keys played {before} rows, the departure {played} "
+          f"(at most {2 * intent.DEPARTURE_SPAN_FRAMES}: the frames of its grid timing Keys did not play)")
+    assert 0 < played <= 2 * intent.DEPARTURE_SPAN_FRAMES

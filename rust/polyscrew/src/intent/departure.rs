@@ -3,9 +3,10 @@
 
 use glam::DVec3;
 
-use super::limits::{check_footprint, filled};
+use super::limits::{check_footprint, collected, filled};
 use super::playback::{rotation_matrix, Playback};
 use super::spans::rotation_angle;
+use crate::memory::try_vec;
 use crate::{Error, Result};
 
 /// Frames evaluated at once (bounds the work buffer whatever the number of frames).
@@ -123,7 +124,6 @@ pub(crate) fn measure(
 ) -> Result<()> {
     let w = playback.mode().width();
     let width = playback.width();
-    let located = playback.located();
     let mut rows = Vec::new();
     for start in (0..frames.len()).step_by(CHUNK) {
         let end = (start + CHUNK).min(frames.len());
@@ -131,13 +131,242 @@ pub(crate) fn measure(
         playback.pose_channels_into(&frames[start..end], &mut rows)?;
         for (j, row) in rows.chunks_exact(width).enumerate() {
             let i = start + j;
-            if located {
-                let ours = DVec3::from_slice(&location[3 * i..3 * i + 3]);
-                distance[i] = (ours - DVec3::from_slice(&row[..3])).length();
-            }
-            let ours = rotation_matrix(playback.mode(), &rotation[w * i..w * (i + 1)]);
-            angle[i] = rotation_angle(&playback.rotation(row), &ours);
+            (distance[i], angle[i]) = compare(
+                playback,
+                row,
+                &location[3 * i..3 * i + 3],
+                &rotation[w * i..w * (i + 1)],
+            );
         }
     }
     Ok(())
+}
+
+/// The distance (0 when the playback is not `located`) and angle between the played pose
+/// `row` (a channel row, or its location and rotation) and a result's `location` (3) and
+/// `rotation` (the mode's width).
+fn compare(playback: &Playback, row: &[f64], location: &[f64], rotation: &[f64]) -> (f64, f64) {
+    let distance = if playback.located() {
+        (DVec3::from_slice(location) - DVec3::from_slice(&row[..3])).length()
+    } else {
+        0.0
+    };
+    let ours = rotation_matrix(playback.mode(), rotation);
+    (distance, rotation_angle(&playback.rotation(row), &ours))
+}
+
+/// What the report needs of a departure (see [`measure_departure`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct DepartureSummary {
+    /// The largest angle over the measured frames, in degrees (`angle.to_degrees()`), 0
+    /// without frames.
+    pub degrees: f64,
+    /// The largest distance over the measured frames, 0 without frames.
+    pub distance: f64,
+    /// Per frame: whether it departs by more than the limits (a frame not measured: as the
+    /// nearest measured frame, the earlier one when both are as near).
+    pub over: Vec<bool>,
+}
+
+/// Limits of a [`measure_departure`]: a frame departs when its angle exceeds `degrees` or
+/// its distance exceeds `distance`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepartureLimits {
+    /// Degrees.
+    pub degrees: f64,
+    /// Units of location.
+    pub distance: f64,
+}
+
+/// The add-on's departure measure in one call: [`departure`] of a result at its baked
+/// `frames` (sorted), at every frame or, with `spans` (`(key_frames, most)`, `most >= 2`),
+/// only at [`measured_frames`]; the largest angle (degrees) and distance, and per frame
+/// whether it departs beyond `limits` (a frame not measured as its nearest measured one).
+///
+/// `played`, when given, holds a pose row (`3 + w` numbers: location, rotation) per frame as
+/// [`super::keys_parameters_played`] returns them: a frame whose row is not NaN is compared
+/// with that row (the row the playback gives there, played once already) instead of being
+/// played again. The result is the same as without it, bit for bit.
+///
+/// # Errors
+/// As [`departure`]; [`Error::LengthMismatch`] for `played` not of `frames.len()` rows,
+/// [`Error::Invalid`] for `most < 2`.
+pub fn measure_departure(
+    playback: &Playback,
+    frames: &[f64],
+    location: &[f64],
+    rotation: &[f64],
+    played: Option<&[f64]>,
+    spans: Option<(&[f64], usize)>,
+    limits: DepartureLimits,
+) -> Result<DepartureSummary> {
+    let t = frames.len();
+    let w = playback.mode().width();
+    let pw = 3 + w;
+    if let Some(rows) = played {
+        if rows.len() != t.saturating_mul(pw) {
+            return Err(Error::LengthMismatch {
+                what: "played rows",
+                expected: t.saturating_mul(pw),
+                got: rows.len(),
+            });
+        }
+    }
+    for (values, per) in [(location, 3), (rotation, w)] {
+        if values.len() != t.saturating_mul(per) {
+            return Err(Error::LengthMismatch {
+                what: "result channels",
+                expected: t.saturating_mul(per),
+                got: values.len(),
+            });
+        }
+    }
+    if let Some(index) = location.iter().chain(rotation).position(|v| !v.is_finite()) {
+        return Err(Error::NotFinite {
+            what: "result channel value",
+            index,
+        });
+    }
+    let measured = match spans {
+        Some((key_frames, most)) => measured_frames(frames, key_frames, most)?,
+        None => None,
+    };
+    let count = measured.as_ref().map_or(t, Vec::len);
+    let index = |k: usize| measured.as_ref().map_or(k, |m| m[k]);
+    check_footprint(
+        count
+            .saturating_mul(4 + pw + 3)
+            .saturating_add(t)
+            .saturating_mul(std::mem::size_of::<f64>()),
+        "departure",
+        "measure fewer frames",
+    )?;
+    // the measured frames the playback has not played yet: measured as `departure` does
+    let is_played = |i: usize| played.is_some_and(|rows| !rows[i * pw].is_nan());
+    let mut again = try_vec(count, "departure frames")?;
+    again.extend((0..count).map(index).filter(|&i| !is_played(i)));
+    let gather = |per: usize, values: &[f64]| -> Result<Vec<f64>> {
+        collected(
+            again.len().saturating_mul(per),
+            again
+                .iter()
+                .flat_map(|&i| values[per * i..per * (i + 1)].iter().copied()),
+            "departure frames",
+        )
+    };
+    let fresh = departure(
+        playback,
+        &collected(
+            again.len(),
+            again.iter().map(|&i| frames[i]),
+            "departure frames",
+        )?,
+        &gather(3, location)?,
+        &gather(w, rotation)?,
+    )?;
+    let mut degrees = 0.0f64;
+    let mut distance = 0.0f64;
+    let mut over_measured = try_vec(count, "departure")?;
+    let mut next = 0; // into `again`
+    for k in 0..count {
+        let i = index(k);
+        let (d, a) = if next < again.len() && again[next] == i {
+            next += 1;
+            (fresh.distance[next - 1], fresh.angle[next - 1])
+        } else {
+            let rows = played.unwrap_or_default();
+            compare(
+                playback,
+                &rows[i * pw..(i + 1) * pw],
+                &location[3 * i..3 * i + 3],
+                &rotation[w * i..w * (i + 1)],
+            )
+        };
+        let deg = a.to_degrees();
+        degrees = degrees.max(deg);
+        distance = distance.max(d);
+        over_measured.push(deg > limits.degrees || d > limits.distance);
+    }
+    let over = match &measured {
+        None => over_measured,
+        Some(m) => {
+            // every frame departs as its nearest measured frame
+            let fm = collected(m.len(), m.iter().map(|&i| frames[i]), "departure")?;
+            let last = m.len().saturating_sub(1).max(1);
+            collected(
+                t,
+                frames.iter().map(|&f| {
+                    let at = fm.partition_point(|&x| x < f).clamp(1, last);
+                    let (before, after) = (fm[at - 1], fm[at.min(m.len() - 1)]);
+                    over_measured[if f - before <= after - f { at - 1 } else { at }]
+                }),
+                "departure",
+            )?
+        }
+    };
+    Ok(DepartureSummary {
+        degrees,
+        distance,
+        over,
+    })
+}
+
+/// Indices of the frames (sorted) a departure measures: every frame of a key span (of
+/// `key_frames`) baked at no more than `most` frames; of a span of `c > most` frames, the
+/// `most` frames `round(k (c - 1) / (most - 1))` (evenly spaced, its first and last
+/// included; rounding half to even). `None` when that is every frame.
+///
+/// # Errors
+/// [`Error::Invalid`] for `most < 2`; a request over the size limit.
+pub fn measured_frames(
+    frames: &[f64],
+    key_frames: &[f64],
+    most: usize,
+) -> Result<Option<Vec<usize>>> {
+    if most < 2 {
+        return Err(Error::Invalid {
+            what: "most",
+            reason: format!("{most} frames per span: at least 2 are measured"),
+        });
+    }
+    let t = frames.len();
+    // the span of each frame: key frames at or before it (a run of equal spans is one span)
+    let span = |f: f64| key_frames.partition_point(|&k| k <= f);
+    let mut runs: Vec<(usize, usize)> = Vec::new(); // (start, count)
+    let mut previous = None;
+    for (i, &f) in frames.iter().enumerate() {
+        let s = span(f);
+        if previous == Some(s) {
+            if let Some(last) = runs.last_mut() {
+                last.1 += 1;
+            }
+        } else {
+            runs.push((i, 1));
+            previous = Some(s);
+        }
+    }
+    if runs.iter().all(|&(_, c)| c <= most) {
+        return Ok(None);
+    }
+    check_footprint(
+        t.saturating_mul(std::mem::size_of::<usize>()),
+        "departure frames",
+        "measure fewer frames",
+    )?;
+    let mut out = try_vec(t, "departure frames")?;
+    for &(start, c) in &runs {
+        if c <= most {
+            out.extend(start..start + c);
+            continue;
+        }
+        let step = (c - 1).max(1) as f64 / (most - 1) as f64;
+        out.extend((0..c).filter_map(|i| {
+            let i = i as f64;
+            ((i / step).round_ties_even() * step)
+                .round_ties_even()
+                .eq(&i)
+                .then_some(start + i as usize)
+        }));
+    }
+    Ok(Some(out))
 }
