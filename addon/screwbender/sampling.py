@@ -204,9 +204,10 @@ def sample(
     keep_played = played and options.timing == "keys" and motion.source is not None
     played_rows = None
     for seg in segments(motion, frames):
-        rows = seg.rows
+        # (every frame in one piece, the usual case: a slice, no index arrays to scatter through)
+        rows = slice(None) if len(seg.rows) == n else seg.rows
         if seg.held:
-            pose = np.repeat(motion.poses[seg.lo][None], len(rows), axis=0)
+            pose = np.repeat(motion.poses[seg.lo][None], len(seg.rows), axis=0)
             if channels:
                 location[rows] = pose[:, :3, 3]
                 values = polyscrew.rotation_channels(pose, mode, previous=last_rotation)
@@ -224,9 +225,12 @@ def sample(
                 key_times, period = _parameter_motion(piece)
                 if keep_played:
                     at, rows_played = keys_parameters(piece, t, options, owner, played=True)
-                    if played_rows is None:
-                        played_rows = np.full((n, rows_played.shape[1]), np.nan)
-                    played_rows[rows] = rows_played
+                    if len(seg.rows) == n:
+                        played_rows = rows_played
+                    else:
+                        if played_rows is None:
+                            played_rows = np.full((n, rows_played.shape[1]), np.nan)
+                        played_rows[rows] = rows_played
                 else:
                     at = keys_parameters(piece, t, options, owner)
                 spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")

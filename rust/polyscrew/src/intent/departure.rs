@@ -62,8 +62,14 @@ pub fn departure(
     }
     // Long bakes are measured on every core: the playback's curves are evaluated at every
     // frame, the cost of this function (bounded: each worker has one chunk's buffer).
-    let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
-    let workers = cores.min(t / PARALLEL_FRAMES).max(1);
+    // (the cores asked only when there is work for two: asking reads the process's CPU
+    // limits, which costs more than measuring a short bake)
+    let workers = if t < 2 * PARALLEL_FRAMES {
+        1
+    } else {
+        let cores = std::thread::available_parallelism().map_or(1, |p| p.get());
+        cores.min(t / PARALLEL_FRAMES).max(1)
+    };
     check_footprint(
         t.saturating_mul(2)
             .saturating_add(workers.saturating_mul(CHUNK).saturating_mul(width))
@@ -254,16 +260,23 @@ pub fn measure_departure(
             "departure frames",
         )
     };
-    let fresh = departure(
-        playback,
-        &collected(
-            again.len(),
-            again.iter().map(|&i| frames[i]),
-            "departure frames",
-        )?,
-        &gather(3, location)?,
-        &gather(w, rotation)?,
-    )?;
+    let fresh = if again.is_empty() {
+        Departure {
+            distance: Vec::new(),
+            angle: Vec::new(),
+        }
+    } else {
+        departure(
+            playback,
+            &collected(
+                again.len(),
+                again.iter().map(|&i| frames[i]),
+                "departure frames",
+            )?,
+            &gather(3, location)?,
+            &gather(w, rotation)?,
+        )?
+    };
     let mut degrees = 0.0f64;
     let mut distance = 0.0f64;
     let mut over_measured = try_vec(count, "departure")?;

@@ -308,7 +308,11 @@ fn curves_keyed_together_share_their_roots_and_give_each_curves_own_value() {
     for (i, &t) in times.iter().enumerate() {
         for (channel, curve) in &curves {
             let got = rows[i * all.width() + channel.column(XYZ)];
-            assert_eq!(got.to_bits(), curve.evaluate(t).unwrap().to_bits(), "{channel:?} at {t}");
+            assert_eq!(
+                got.to_bits(),
+                curve.evaluate(t).unwrap().to_bits(),
+                "{channel:?} at {t}"
+            );
         }
     }
 }
