@@ -40,7 +40,8 @@ def child(runs: int, only: list[str]) -> None:
     sys.path.insert(0, str(Path.cwd() / "scripts"))
     import bench_bake  # installs this checkout's extension
 
-    import bpy
+    # isort: split
+    import bpy  # (after bench_bake: it must install the extension first)
 
     bake = bench_bake.bake
     out = {}

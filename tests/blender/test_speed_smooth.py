@@ -168,18 +168,25 @@ def test_revert_of_many_objects_scans_the_scene_once(count):
     assert len(bpy.data.actions) == actions  # the smoothed copies removed (in one batch)
 
 
+def long_object(name: str) -> bpy.types.Object:
+    """An object keyed at frames 1, 3001 and 6001 (location and rotation): spans of 3,000
+    frames, far off the screw between their keys."""
+    obj = h.new_object(name)
+    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
+        obj.location = (x, 0.3 * x, 0.0)
+        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
+        obj.keyframe_insert("location", frame=frame)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    return obj
+
+
 def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
     frames: the largest departure and the frames over the thresholds agree with measuring
     every frame (a screw between two keys against Blender's independent channel curves)."""
     intent = addon_module("intent")
     bake = addon_module("bake")
-    obj = h.new_object("Long")
-    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
-        obj.location = (x, 0.3 * x, 0.0)
-        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
-        obj.keyframe_insert("location", frame=frame)
-        obj.keyframe_insert("rotation_euler", frame=frame)
+    obj = long_object("Long")
     actions, skipped, _ = bake.prepare([obj], bake.Options())
     part = actions[0].parts[0]
     motion = part.motion
@@ -242,13 +249,7 @@ def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
         assert bpy.ops.screwbender.smooth() == {"FINISHED"}
         bpy.ops.object.mode_set(mode="OBJECT")
         short = list(seen)
-        long = h.new_object("LongOnce")
-        for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
-            long.location = (x, 0.3 * x, 0.0)
-            long.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
-            long.keyframe_insert("location", frame=frame)
-            long.keyframe_insert("rotation_euler", frame=frame)
-        h.select_only(long)
+        h.select_only(long_object("LongOnce"))
         assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     finally:
         intent.departure = original

@@ -47,6 +47,21 @@ fn playback_arg<'a, 'py>(
     })
 }
 
+/// The values of `view` (any shape) row-major, allocated fallibly.
+fn flat_values(function: &str, view: &numpy::ndarray::ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+    let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(function, e))?;
+    out.extend(view.iter().copied());
+    Ok(out)
+}
+
+/// A `ValueError` unless `shape` is `(t, width)`.
+fn check_rows(function: &str, what: &str, shape: &[usize], t: usize, width: usize) -> PyResult<()> {
+    if shape.len() != 2 || shape[1] != width || shape[0] != t {
+        return Err(shape_err(function, what, &format!("({t}, {width})"), shape));
+    }
+    Ok(())
+}
+
 /// `played` of `keys_parameters`, a bool.
 fn played_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     args::bool_arg(KeysParameters::NAME, "played", obj)
@@ -273,10 +288,7 @@ impl PyPlayback {
         let location = float_array(F, "location", location)?;
         let rotation = float_array(F, "rotation", rotation)?;
         for (array, what, width) in [(&location, "location", 3), (&rotation, "rotation", w)] {
-            let shape = array.shape();
-            if shape.len() != 2 || shape[1] != width || shape[0] != t {
-                return Err(shape_err(F, what, &format!("({t}, {width})"), shape));
-            }
+            check_rows(F, what, array.shape(), t, width)?;
         }
         // the arguments' conversions, the values read, the playback's rows, the two outputs
         check_budget(
@@ -295,11 +307,7 @@ impl PyPlayback {
         let out = py.detach(|| -> PyResult<_> {
             let frames = read_vector(F, "frames", &frames)?;
             // (shapes checked above) row-major values
-            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| -> PyResult<Vec<f64>> {
-                let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(F, e))?;
-                out.extend(view.iter().copied());
-                Ok(out)
-            };
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| flat_values(F, view);
             let location = flat(&location)?;
             let rotation = flat(&rotation)?;
             core_departure(inner, &frames, &location, &rotation).map_err(|e| to_py_err(F, e))
@@ -373,10 +381,8 @@ impl PyPlayback {
             (Some(&rotation), "rotation", w),
             (played.as_ref(), "played", 3 + w),
         ] {
-            let Some(array) = array else { continue };
-            let shape = array.shape();
-            if shape.len() != 2 || shape[1] != width || shape[0] != t {
-                return Err(shape_err(F, what, &format!("({t}, {width})"), shape));
+            if let Some(array) = array {
+                check_rows(F, what, array.shape(), t, width)?;
             }
         }
         // the arguments' conversions, the values read, the core's work (per measured frame
@@ -413,11 +419,7 @@ impl PyPlayback {
                 .map(|k| read_vector(F, "key_frames", k))
                 .transpose()?;
             // (shapes checked above) row-major values
-            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| -> PyResult<Vec<f64>> {
-                let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(F, e))?;
-                out.extend(view.iter().copied());
-                Ok(out)
-            };
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| flat_values(F, view);
             let location = flat(&location)?;
             let rotation = flat(&rotation)?;
             let played = played.as_ref().map(flat).transpose()?;

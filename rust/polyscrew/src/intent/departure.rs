@@ -45,21 +45,7 @@ pub fn departure(
     let t = frames.len();
     let w = playback.mode().width();
     let width = playback.width();
-    for (values, per) in [(location, 3), (rotation, w)] {
-        if values.len() != t.saturating_mul(per) {
-            return Err(Error::LengthMismatch {
-                what: "result channels",
-                expected: t.saturating_mul(per),
-                got: values.len(),
-            });
-        }
-    }
-    if let Some(index) = location.iter().chain(rotation).position(|v| !v.is_finite()) {
-        return Err(Error::NotFinite {
-            what: "result channel value",
-            index,
-        });
-    }
+    check_result(t, w, location, rotation)?;
     // Long bakes are measured on every core: the playback's curves are evaluated at every
     // frame, the cost of this function (bounded: each worker has one chunk's buffer).
     // (the cores asked only when there is work for two: asking reads the process's CPU
@@ -116,6 +102,27 @@ pub fn departure(
         })??;
     }
     Ok(Departure { distance, angle })
+}
+
+/// Checks a result's channels for `t` frames: `location` `t x 3`, `rotation` `t x w`, all
+/// finite.
+fn check_result(t: usize, w: usize, location: &[f64], rotation: &[f64]) -> Result<()> {
+    for (values, per) in [(location, 3), (rotation, w)] {
+        if values.len() != t.saturating_mul(per) {
+            return Err(Error::LengthMismatch {
+                what: "result channels",
+                expected: t.saturating_mul(per),
+                got: values.len(),
+            });
+        }
+    }
+    if let Some(index) = location.iter().chain(rotation).position(|v| !v.is_finite()) {
+        return Err(Error::NotFinite {
+            what: "result channel value",
+            index,
+        });
+    }
+    Ok(())
 }
 
 /// [`departure`] of the frames `frames` into `distance` and `angle` (one value per frame),
@@ -218,21 +225,7 @@ pub fn measure_departure(
             });
         }
     }
-    for (values, per) in [(location, 3), (rotation, w)] {
-        if values.len() != t.saturating_mul(per) {
-            return Err(Error::LengthMismatch {
-                what: "result channels",
-                expected: t.saturating_mul(per),
-                got: values.len(),
-            });
-        }
-    }
-    if let Some(index) = location.iter().chain(rotation).position(|v| !v.is_finite()) {
-        return Err(Error::NotFinite {
-            what: "result channel value",
-            index,
-        });
-    }
+    check_result(t, w, location, rotation)?;
     let measured = match spans {
         Some((key_frames, most)) => measured_frames(frames, key_frames, most)?,
         None => None,
