@@ -263,3 +263,42 @@ def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
     print(f"long bake, {frames} frames: timing Keys played {before} rows, the departure {played} "
           f"(at most {2 * intent.DEPARTURE_SPAN_FRAMES}: the frames of its grid timing Keys did not play)")
     assert 0 < played <= 2 * intent.DEPARTURE_SPAN_FRAMES
+
+
+def test_the_written_digest_notices_every_kind_of_edit():
+    # the result's digest (a CRC per curve, issue 24 item 6 made cheaper) as written equals the
+    # one read back, and changes for a moved key (frame or value), a changed interpolation,
+    # an added and a deleted key; put back, it is the written one again
+    bake = addon_module("bake")
+    obj = keyed("Edited", 7)
+    h.select_only(obj)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    result = obj.animation_data.action
+    identifier = addon_channels().slot_identifier(obj)
+    written = result[bake.WRITTEN_KEY]
+    assert written == bake.keys_digest(result, identifier) and not bake.was_edited(result, identifier)
+    fcurve = next(fc for fc in addon_channels().action_fcurves(result, identifier) if fc.data_path == "location")
+    point = fcurve.keyframe_points[3]
+    frame, value, kind = point.co[0], point.co[1], point.interpolation
+
+    def edited(change, undo) -> bool:
+        change()
+        seen = bake.was_edited(result, identifier)
+        undo()
+        assert bake.keys_digest(result, identifier) == written, "the edit put back gives the written digest"
+        return seen
+
+    kinds = {
+        "value moved": edited(lambda: setattr(point, "co", (frame, value + 1e-3)), lambda: setattr(point, "co", (frame, value))),
+        "frame moved": edited(lambda: setattr(point, "co", (frame + 0.25, value)), lambda: setattr(point, "co", (frame, value))),
+        "interpolation": edited(lambda: setattr(point, "interpolation", "BEZIER"), lambda: setattr(point, "interpolation", kind)),
+    }
+    count = len(fcurve.keyframe_points)
+    fcurve.keyframe_points.insert(frame + 0.5, value)
+    kinds["key added"] = bake.was_edited(result, identifier)
+    fcurve.keyframe_points.remove(fcurve.keyframe_points[4])
+    assert len(fcurve.keyframe_points) == count
+    fcurve.keyframe_points.remove(fcurve.keyframe_points[3])
+    kinds["key deleted"] = bake.was_edited(result, identifier)
+    print(f"digest {written}; edits seen: {kinds}")
+    assert kinds == dict.fromkeys(kinds, True)
