@@ -1,13 +1,13 @@
 //! How far a result departs from the playback it was made from: per frame, the distance
 //! between the origins and the angle between the rotations.
 
-use glam::DVec3;
+use glam::{DQuat, DVec3};
 
 use super::limits::{check_footprint, collected, filled};
 use super::playback::{rotation_matrix, Playback};
 use super::spans::rotation_angle;
 use crate::memory::try_vec;
-use crate::{Error, Result};
+use crate::{Error, EulerOrder, Result, RotationMode};
 
 /// Frames evaluated at once (bounds the work buffer whatever the number of frames).
 const CHUNK: usize = 4096;
@@ -164,8 +164,60 @@ fn compare(playback: &Playback, row: &[f64], location: &[f64], rotation: &[f64])
     } else {
         0.0
     };
-    let ours = rotation_matrix(playback.mode(), rotation);
-    (distance, rotation_angle(&playback.rotation(row), &ours))
+    let played = row.get(3..).unwrap_or(&[]);
+    let angle = match (
+        rotation_quat(playback.mode(), played),
+        rotation_quat(playback.mode(), rotation),
+    ) {
+        // `2 atan2(|v|, |w|)` of `(v, w) = conj(q_played) q_ours`: the angle between the
+        // rotations, whatever the quaternions' lengths (a third of the matrices' work)
+        (Some(a), Some(b)) => {
+            let d = a.conjugate() * b;
+            2.0 * DVec3::new(d.x, d.y, d.z).length().atan2(d.w.abs())
+        }
+        _ => rotation_angle(
+            &rotation_matrix(playback.mode(), played),
+            &rotation_matrix(playback.mode(), rotation),
+        ),
+    };
+    (distance, angle)
+}
+
+/// The rotation of `values` in `mode` as a quaternion of any non-zero length, as
+/// [`rotation_matrix`] reads them: a quaternion scaled by its largest component (the
+/// identity for zero), Euler angles as the product of their axes' half-angle quaternions
+/// (`q = q(a3) q(a2) q(a1)`, `R = R(a3) R(a2) R(a1)`); `None` for axis-angle.
+fn rotation_quat(mode: RotationMode, values: &[f64]) -> Option<DQuat> {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            Some(if largest > 0.0 {
+                q / largest
+            } else {
+                DQuat::IDENTITY
+            })
+        }
+        RotationMode::AxisAngle => None,
+        RotationMode::Euler(order) => {
+            let about = |axis: usize| match axis {
+                0 => DQuat::from_rotation_x(v(0)),
+                1 => DQuat::from_rotation_y(v(1)),
+                _ => DQuat::from_rotation_z(v(2)),
+            };
+            // (the axes in the order they apply, as `EulerOrder::to_mat3`)
+            let [first, second, third] = match order {
+                EulerOrder::Xyz => [0, 1, 2],
+                EulerOrder::Xzy => [0, 2, 1],
+                EulerOrder::Yxz => [1, 0, 2],
+                EulerOrder::Yzx => [1, 2, 0],
+                EulerOrder::Zxy => [2, 0, 1],
+                EulerOrder::Zyx => [2, 1, 0],
+            };
+            Some(about(third) * about(second) * about(first))
+        }
+    }
 }
 
 /// What the report needs of a departure (see [`measure_departure`]).
@@ -375,4 +427,76 @@ pub fn measured_frames(
         }));
     }
     Ok(Some(out))
+}
+
+#[cfg(test)]
+mod angle_tests {
+    use super::*;
+
+    /// The angle between two rotations as [`compare`] takes it from quaternions equals
+    /// [`rotation_angle`] of their matrices, in every quaternion and Euler mode (unnormalised,
+    /// sign-flipped and zero quaternions, angles beyond a turn, near 0 and near pi).
+    #[test]
+    fn quaternion_angle_equals_the_matrices_angle() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let orders = [
+            EulerOrder::Xyz,
+            EulerOrder::Xzy,
+            EulerOrder::Yxz,
+            EulerOrder::Yzx,
+            EulerOrder::Zxy,
+            EulerOrder::Zyx,
+        ];
+        let modes = orders
+            .map(RotationMode::Euler)
+            .into_iter()
+            .chain([RotationMode::Quaternion]);
+        let mut worst = 0.0f64;
+        let mut count = 0;
+        for mode in modes {
+            for case in 0..2000 {
+                let scale = if mode == RotationMode::Quaternion {
+                    3.0
+                } else {
+                    9.0
+                };
+                let a: Vec<f64> = (0..4).map(|_| scale * next()).collect();
+                let mut b: Vec<f64> = match case % 4 {
+                    0 => (0..4).map(|_| scale * next()).collect(),
+                    1 => a.iter().map(|x| x + 1e-7 * next()).collect(), // near 0
+                    2 if mode == RotationMode::Quaternion => a.iter().map(|x| -2.5 * x).collect(),
+                    _ => a.iter().map(|x| x + 0.3 * next()).collect(),
+                };
+                if case == 7 && mode == RotationMode::Quaternion {
+                    b = vec![0.0; 4]; // the identity, as rotation_matrix reads it
+                }
+                if case % 4 == 3 && mode != RotationMode::Quaternion {
+                    b[0] = a[0] + std::f64::consts::PI - 1e-6 * next().abs(); // near pi
+                    b[1..3].copy_from_slice(&a[1..3]);
+                }
+                let (qa, qb) = (
+                    rotation_quat(mode, &a).unwrap(),
+                    rotation_quat(mode, &b).unwrap(),
+                );
+                let d = qa.conjugate() * qb;
+                let ours = 2.0 * DVec3::new(d.x, d.y, d.z).length().atan2(d.w.abs());
+                let reference =
+                    rotation_angle(&rotation_matrix(mode, &a), &rotation_matrix(mode, &b));
+                assert!(
+                    (ours - reference).abs() < 1e-9,
+                    "{mode:?} {a:?} {b:?}: {ours} against {reference}"
+                );
+                worst = worst.max((ours - reference).abs());
+                count += 1;
+            }
+        }
+        println!("{count} pairs, largest difference {worst:e} rad");
+        assert!(rotation_quat(RotationMode::AxisAngle, &[1.0, 0.0, 0.0, 1.0]).is_none());
+    }
 }
