@@ -38,6 +38,8 @@
 #      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
 #      other parts' results in target/bench; a section that shows a refreshed part and another
 #      part whose results are not there is kept as it was (bench_report.py says which).
+#      BENCH_AGAINST=<checkout>[:<checkout>...] also times Smooth Motion (part bake) against other
+#      checkouts of this repository, interleaved (scripts/bench/bench_bake_against.py; log only).
 set -uo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -185,6 +187,13 @@ else
   else
     tail -5 "$run/bake.out"
     echo "scripts/bench/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
+  fi
+  # BENCH_AGAINST=<checkout>[:<checkout>...]: Smooth Motion's CPU time against those checkouts
+  # (each with its extension built in its dist/), interleaved processes; printed to the log only.
+  if [ -n "${BENCH_AGAINST:-}" ]; then
+    IFS=: read -r -a against <<<"$BENCH_AGAINST"
+    PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_bake_against.py "${against[@]}" "$root" \
+      || echo "bench: scripts/bench/bench_bake_against.py failed"
   fi
 fi
 fi

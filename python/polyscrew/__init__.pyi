@@ -746,6 +746,37 @@ class Playback:
         match or values that are not finite.
         """
 
+    def measure_departure(
+        self,
+        frames: ArrayLike,
+        location: ArrayLike,
+        rotation: ArrayLike,
+        *,
+        degrees: float,
+        distance: float,
+        played: ArrayLike | None = None,
+        key_frames: ArrayLike | None = None,
+        most: int = 64,
+    ) -> tuple[float, float, npt.NDArray[np.bool_]]:
+        """What a report needs of ``departure`` in one call: ``(largest angle in degrees,
+        largest distance, over)`` of a result's ``location`` (T, 3) and ``rotation`` (T, 3 or
+        4) at ``frames`` (T,), sorted, ``over`` (T,) true where a frame departs by more than
+        ``degrees`` or ``distance``. With ``key_frames``, a key span baked at more than
+        ``most`` frames is measured at ``most`` of them, evenly spaced (its first and last
+        included), and a frame not measured departs as its nearest measured frame. ``played``
+        (T, 3 + 3 or 4): the playback's location and rotation per frame as
+        ``keys_parameters(..., played=True)`` returns them, NaN where not known: those frames
+        are compared without being played again (the same figures, bit for bit). GIL
+        released. Raises ValueError for shapes that do not match, values that are not finite
+        or ``most`` below 2.
+        """
+
+    @property
+    def rows_evaluated(self) -> int:
+        """How many frames this playback has played (one channel row each) since it was made, by
+        every function that plays it: how often a caller plays the same curves.
+        """
+
 def analyse_spans(
     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
 ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:
@@ -796,7 +827,8 @@ def keys_parameters(
     scheme: SchemeName = "four_point",
     levels: int = 4,
     smooth: ArrayLike | None = None,
-) -> FloatArray:
+    played: bool = False,
+) -> FloatArray | tuple[FloatArray, FloatArray]:
     """Timing "Keys": the motion parameter (key i at i) of each of ``frames`` (T,).
 
     Within span s (keys s, s + 1; for a ``closed`` cycle of ``period`` frames the last span
@@ -811,7 +843,13 @@ def keys_parameters(
 
     The smoothed motion: the screw motion of the key ``poses`` (K, 4, 4) by ``scheme`` and
     ``levels`` (keys at parameters 0..K-1, linear timing), or ``smooth``, its poses at
-    ``pace_parameters(spans)`` computed by the caller (feature points). GIL released.
+    ``pace_parameters(spans)`` computed by the caller (feature points).
+
+    ``played=True`` returns ``(parameters, rows)`` instead: ``rows`` (T, 3 + 3 or 4), the
+    playback's location and rotation at each frame where this call played it at exactly that
+    frame (the frames from the first key to the last, but those of a span with more than 256
+    frames, which is measured on a grid), NaN elsewhere (without ``playback``: (T, 0)): what
+    ``Playback.measure_departure`` takes as ``played``. GIL released.
     Raises ValueError naming the argument: key frames that do not increase, a period not
     beyond the keys, a size that is not positive, frames not finite, neither or both of
     ``poses`` and ``smooth``, or ``smooth`` of the wrong length.

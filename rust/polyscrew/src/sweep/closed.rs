@@ -33,7 +33,7 @@
 use glam::{DAffine3, DVec3};
 
 use super::{axis_distance, Body};
-use crate::error::{Error, Result};
+use crate::error::{Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::screw::Screw;
@@ -67,6 +67,9 @@ pub const MAX_CELLS_PER_EXTENT: f64 = 1000.0;
 
 /// Most dense poses [`sweep_closed`] takes.
 pub const MAX_POSES: usize = 1 << 20;
+
+/// How to ask [`sweep_closed`] for less.
+const CELL_HINT: &str = "use a larger cell";
 
 /// Bytes per world-grid point: its value (4) and the pose that gave it (4).
 const WORLD_BYTES_PER_POINT: usize = 8;
@@ -309,11 +312,12 @@ impl DenseMotion {
             let travel = (screw.angle() * rho).hypot(screw.slide());
             let k = (travel / step).ceil().max(1.0);
             if out.poses.len() as f64 + k > MAX_POSES as f64 {
-                return Err(Error::Invalid {
+                return Err(Error::Limit {
                     what: "cell",
-                    reason: format!(
-                        "the motion would take more than {MAX_POSES} poses at this cell"
-                    ),
+                    counted: "poses",
+                    count: (out.poses.len() as f64 + k).min(usize::MAX as f64) as usize,
+                    limit: MAX_POSES,
+                    hint: CELL_HINT,
                 });
             }
             let k = k as u32;
@@ -334,8 +338,8 @@ impl DenseMotion {
 ///
 /// # Errors
 /// - [`Error::TooFew`] for fewer than 2 poses; [`Error::BadPose`] for a pose out of range;
-/// - [`Error::Invalid`] (`"body"`) for a body that is not closed (no inside);
-/// - [`Error::Invalid`] (`"cell"`) for a cell that is not finite and positive, below
+/// - [`Error::Value`] (`"body"`) for a body that is not closed (no inside);
+/// - [`Error::Value`] (`"cell"`) for a cell that is not finite and positive, below
 ///   `extent /` [`MAX_CELLS_PER_EXTENT`], or a motion needing more than [`MAX_POSES`] poses;
 /// - [`Error::Memory`] for grids or a mesh over the memory budget.
 pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedMesh> {
@@ -350,20 +354,24 @@ pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Res
         .enumerate()
         .try_for_each(|(index, p)| p.check_range(index))?;
     if !body.is_closed() {
-        return Err(Error::Invalid {
+        return Err(Error::Degenerate {
             what: "body",
-            reason: "the mesh is not closed (every edge in two faces): it has no inside to sweep"
-                .into(),
+            at: None,
+            reason: "the mesh is not closed (every edge in two faces): it has no inside to sweep",
         });
     }
     let extent = body.extent();
     let cell = options.cell.unwrap_or(DEFAULT_CELL_REL * extent);
     if !(cell.is_finite() && cell > 0.0 && cell * MAX_CELLS_PER_EXTENT >= extent) {
-        return Err(Error::Invalid {
+        return Err(Error::Value {
             what: "cell",
-            reason: format!(
-                "{cell} is not a positive length of at least 1/{MAX_CELLS_PER_EXTENT} of the body's extent {extent}"
-            ),
+            at: None,
+            value: cell,
+            expected: Expected::AtLeast {
+                min: extent / MAX_CELLS_PER_EXTENT,
+                limit: MAX_CELLS_PER_EXTENT as usize,
+                counted: "cells across the body's extent",
+            },
         });
     }
     let band = BAND_CELLS * cell;
@@ -408,9 +416,12 @@ pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Res
     ];
     let total = dims[0] * dims[1] * dims[2];
     if total > (usize::MAX / WORLD_BYTES_PER_POINT) as f64 {
-        return Err(Error::Invalid {
+        return Err(Error::Limit {
             what: "cell",
-            reason: format!("the region's grid would have {total:.3e} points"),
+            counted: "grid points",
+            count: total.min(usize::MAX as f64) as usize,
+            limit: usize::MAX / WORLD_BYTES_PER_POINT,
+            hint: CELL_HINT,
         });
     }
     let n = dims.map(|d| d as usize);
@@ -578,9 +589,12 @@ fn contour(
         residual = residual.max(refine.near(x, js).abs().min(cell));
         let v = out.vertices.len();
         if v >= u32::MAX as usize {
-            return Err(Error::Invalid {
+            return Err(Error::Limit {
                 what: "cell",
-                reason: "the closed mesh would have over 2^32 - 1 vertices".into(),
+                counted: "vertices",
+                count: v + 1,
+                limit: u32::MAX as usize,
+                hint: CELL_HINT,
             });
         }
         out.vertices.push(x);
