@@ -20,7 +20,8 @@
 #     animator's intent (measure_intent.py), how far each scheme strays from the keys
 #     (measure_schemes.py), where a bake's time goes (profile_bake.py), the live preview's
 #     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
-#     (bench_sweep_blender.py), key fractions of reduce_keys (measure_reduce.py), memory
+#     (bench_sweep_blender.py), the closed swept boundary against the open sweep
+#     (bench_sweep_closed.py), key fractions of reduce_keys (measure_reduce.py), memory
 #     estimates beside measured peaks (memory_footprints.py), and the paper's smoothness
 #     figures (plot_smoothness.py, into docs/): each one's printout in BENCHMARKS.md.
 # Every script bench.sh runs is in scripts/bench/; bench_report.py is the one writer of
@@ -37,6 +38,8 @@
 #      A refresh uses .venv as it is (no bootstrap when .venv/bin/python exists) and keeps the
 #      other parts' results in target/bench; a section that shows a refreshed part and another
 #      part whose results are not there is kept as it was (bench_report.py says which).
+#      BENCH_AGAINST=<checkout>[:<checkout>...] also times Smooth Motion (part bake) against other
+#      checkouts of this repository, interleaved (scripts/bench/bench_bake_against.py; log only).
 set -uo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 cd "$root"
@@ -185,6 +188,13 @@ else
     tail -5 "$run/bake.out"
     echo "scripts/bench/bench_bake.py failed: $(tail -1 "$run/bake.out")" | tee "$run/bake.missing"
   fi
+  # BENCH_AGAINST=<checkout>[:<checkout>...]: Smooth Motion's CPU time against those checkouts
+  # (each with its extension built in its dist/), interleaved processes; printed to the log only.
+  if [ -n "${BENCH_AGAINST:-}" ]; then
+    IFS=: read -r -a against <<<"$BENCH_AGAINST"
+    PYTHONPATH="$bpy_dir" "$py" scripts/bench/bench_bake_against.py "${against[@]}" "$root" \
+      || echo "bench: scripts/bench/bench_bake_against.py failed"
+  fi
 fi
 fi
 
@@ -270,6 +280,7 @@ else
   measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
   measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
   measure bench_sweep_blender "$pylib:$bpy_dir"
+  measure bench_sweep_closed "$pylib"
   measure measure_reduce "$pylib"
   measure memory_footprints "$pylib"
   measure plot_smoothness "$pylib" --bpy "$bpy_dir" --out-dir docs

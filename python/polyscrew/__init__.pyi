@@ -491,11 +491,60 @@ def sweep(
     are added: 48 bytes per vertex, 36 per triangle).
     """
 
+class ClosedSweepInfo(TypedDict):
+    cell: float
+    error_bound: float
+    poses: int
+
+@overload
+def sweep_closed(
+    vertices: ArrayLike,
+    triangles: ArrayLike,
+    poses: ArrayLike,
+    cell: float | None = None,
+    info: Literal[False] = False,
+) -> tuple[FloatArray, IntArray]: ...
+@overload
+def sweep_closed(
+    vertices: ArrayLike,
+    triangles: ArrayLike,
+    poses: ArrayLike,
+    cell: float | None = None,
+    *,
+    info: Literal[True],
+) -> tuple[FloatArray, IntArray, ClosedSweepInfo]:
+    """The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
+    one closed, consistently oriented, self-intersection-free triangle mesh.
+
+    ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame (closed:
+    every edge in two faces); ``poses`` (N >= 2, 4, 4) its world poses, one screw per span.
+    The region's signed distance (the minimum over the motion of the body's, the body's
+    sampled on a grid six times finer than ``cell``, the motion sampled so that no point
+    moves more than a cell between samples) is contoured on a grid of spacing ``cell`` by
+    marching tetrahedra, and every vertex moved along its grid edge to the zero of the
+    distance refined between the samples. ``cell=None``: ``DEFAULT_CLOSED_CELL`` (1.5 %) of
+    the body's extent (its bounding box's diagonal). Slower than ``sweep`` (seconds, not
+    milliseconds) and many more triangles: for meshes that must be closed.
+
+    Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
+    triangles counter-clockwise seen from outside, every edge in exactly two; with
+    ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
+    boundary: the distance left at a vertex plus the body grid's interpolation bound) and
+    ``poses`` (the dense poses sampled).
+
+    Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
+    that is not positive or below 1/1000 of the body's extent, or grids over the memory
+    budget.
+    """
+
 MAX_STEPS: int
 """The largest accepted number of sweep steps per screw (4096)."""
 
 DEFAULT_SWEEP_TOLERANCE: float
 """The default tolerance of ``sweep``, as a fraction of the body's bounding radius (0.002)."""
+
+DEFAULT_CLOSED_CELL: float
+"""The default cell of ``sweep_closed``, as a fraction of the body's extent (0.015)."""
 
 CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
 ParametrizationName = Literal["uniform", "centripetal"]
@@ -697,6 +746,37 @@ class Playback:
         match or values that are not finite.
         """
 
+    def measure_departure(
+        self,
+        frames: ArrayLike,
+        location: ArrayLike,
+        rotation: ArrayLike,
+        *,
+        degrees: float,
+        distance: float,
+        played: ArrayLike | None = None,
+        key_frames: ArrayLike | None = None,
+        most: int = 64,
+    ) -> tuple[float, float, npt.NDArray[np.bool_]]:
+        """What a report needs of ``departure`` in one call: ``(largest angle in degrees,
+        largest distance, over)`` of a result's ``location`` (T, 3) and ``rotation`` (T, 3 or
+        4) at ``frames`` (T,), sorted, ``over`` (T,) true where a frame departs by more than
+        ``degrees`` or ``distance``. With ``key_frames``, a key span baked at more than
+        ``most`` frames is measured at ``most`` of them, evenly spaced (its first and last
+        included), and a frame not measured departs as its nearest measured frame. ``played``
+        (T, 3 + 3 or 4): the playback's location and rotation per frame as
+        ``keys_parameters(..., played=True)`` returns them, NaN where not known: those frames
+        are compared without being played again (the same figures, bit for bit). GIL
+        released. Raises ValueError for shapes that do not match, values that are not finite
+        or ``most`` below 2.
+        """
+
+    @property
+    def rows_evaluated(self) -> int:
+        """How many frames this playback has played (one channel row each) since it was made, by
+        every function that plays it: how often a caller plays the same curves.
+        """
+
 def analyse_spans(
     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
 ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:
@@ -747,7 +827,8 @@ def keys_parameters(
     scheme: SchemeName = "four_point",
     levels: int = 4,
     smooth: ArrayLike | None = None,
-) -> FloatArray:
+    played: bool = False,
+) -> FloatArray | tuple[FloatArray, FloatArray]:
     """Timing "Keys": the motion parameter (key i at i) of each of ``frames`` (T,).
 
     Within span s (keys s, s + 1; for a ``closed`` cycle of ``period`` frames the last span
@@ -762,7 +843,13 @@ def keys_parameters(
 
     The smoothed motion: the screw motion of the key ``poses`` (K, 4, 4) by ``scheme`` and
     ``levels`` (keys at parameters 0..K-1, linear timing), or ``smooth``, its poses at
-    ``pace_parameters(spans)`` computed by the caller (feature points). GIL released.
+    ``pace_parameters(spans)`` computed by the caller (feature points).
+
+    ``played=True`` returns ``(parameters, rows)`` instead: ``rows`` (T, 3 + 3 or 4), the
+    playback's location and rotation at each frame where this call played it at exactly that
+    frame (the frames from the first key to the last, but those of a span with more than 256
+    frames, which is measured on a grid), NaN elsewhere (without ``playback``: (T, 0)): what
+    ``Playback.measure_departure`` takes as ``played``. GIL released.
     Raises ValueError naming the argument: key frames that do not increase, a period not
     beyond the keys, a size that is not positive, frames not finite, neither or both of
     ``poses`` and ``smooth``, or ``smooth`` of the wrong length.

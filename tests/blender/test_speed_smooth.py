@@ -168,18 +168,25 @@ def test_revert_of_many_objects_scans_the_scene_once(count):
     assert len(bpy.data.actions) == actions  # the smoothed copies removed (in one batch)
 
 
+def long_object(name: str) -> bpy.types.Object:
+    """An object keyed at frames 1, 3001 and 6001 (location and rotation): spans of 3,000
+    frames, far off the screw between their keys."""
+    obj = h.new_object(name)
+    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
+        obj.location = (x, 0.3 * x, 0.0)
+        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
+        obj.keyframe_insert("location", frame=frame)
+        obj.keyframe_insert("rotation_euler", frame=frame)
+    return obj
+
+
 def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
     frames: the largest departure and the frames over the thresholds agree with measuring
     every frame (a screw between two keys against Blender's independent channel curves)."""
     intent = addon_module("pure.intent")
     bake = addon_module("blender.bake")
-    obj = h.new_object("Long")
-    for frame, x in ((1, 0.0), (3001, 4.0), (6001, 4.5)):
-        obj.location = (x, 0.3 * x, 0.0)
-        obj.rotation_euler = (0.2 * x, 0.0, 0.4 * x)
-        obj.keyframe_insert("location", frame=frame)
-        obj.keyframe_insert("rotation_euler", frame=frame)
+    obj = long_object("Long")
     actions, skipped, _ = bake.prepare([obj], bake.Options())
     part = actions[0].parts[0]
     motion = part.motion
@@ -201,3 +208,97 @@ def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     differ = np.setxor1d(every.frames, sampled.frames)
     assert len(differ) <= 4 * spacing, (len(differ), spacing)
     assert intent.frame_runs(sampled.frames).count("-") == intent.frame_runs(every.frames).count("-")
+
+
+def departure_plays(intent) -> tuple[list, object]:
+    """Wraps `intent.departure` (what Smooth Motion measures each owner's result with): per
+    call, (rows the owner's playback had played before it, rows the departure played, frames
+    measured). Returns the list and the original, to put back."""
+    seen = []
+    original = intent.departure
+
+    def counted(source, size, frames, *args, **kwargs):
+        before = source.playback.rows_evaluated
+        found = original(source, size, frames, *args, **kwargs)
+        seen.append((before, source.playback.rows_evaluated - before, len(frames)))
+        return found
+
+    intent.departure = counted
+    return seen, original
+
+
+def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
+    """Smooth Motion plays each owner's source curves once per baked frame: timing Keys plays
+    them at the baked frames (to follow Blender's pace) and the departure measure compares the
+    result with those rows instead of playing them again (issue 24 item 5 at the cost of a
+    comparison). Counted with the playback's own counter of rows played, for objects, a rig in
+    Pose Mode, and a long bake whose spans are measured on a grid (there the departure plays
+    at most DEPARTURE_SPAN_FRAMES frames a span). Before: it played every measured frame again."""
+    intent = addon_module("pure.intent")
+    objects = [keyed(f"Once{n}", 40 + n, mode=mode) for n, mode in enumerate(("XYZ", "QUATERNION", "ZXY"))]
+    seen, original = departure_plays(intent)
+    try:
+        h.select_only(*objects)
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+        rig = bh.armature()
+        for n, bone in enumerate(("Upper", "Fore", "Hand")):
+            bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=50 + n, gentle=True))
+        h.select_only(rig)
+        bpy.ops.object.mode_set(mode="POSE")
+        bh.select_bones(rig, ["Upper", "Fore", "Hand"])
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+        bpy.ops.object.mode_set(mode="OBJECT")
+        short = list(seen)
+        h.select_only(long_object("LongOnce"))
+        assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    finally:
+        intent.departure = original
+    for before, played, frames in short:
+        print(f"{frames} baked frames: the owner's playback played {before} rows before the departure "
+              f"(span analysis and timing Keys), the departure {played} (before this change: {frames})")
+    assert len(short) == 6, "three objects and three bones measured"
+    assert all(played == 0 for _, played, _ in short)
+    assert all(before >= frames for before, _, frames in short), "timing Keys played every baked frame"
+    (before, played, frames), = seen[len(short):]
+    print(f"long bake, {frames} frames: timing Keys played {before} rows, the departure {played} "
+          f"(at most {2 * intent.DEPARTURE_SPAN_FRAMES}: the frames of its grid timing Keys did not play)")
+    assert 0 < played <= 2 * intent.DEPARTURE_SPAN_FRAMES
+
+
+def test_the_written_digest_notices_every_kind_of_edit():
+    # the result's digest (a CRC per curve, issue 24 item 6 made cheaper) as written equals the
+    # one read back, and changes for a moved key (frame or value), a changed interpolation,
+    # an added and a deleted key; put back, it is the written one again
+    bake = addon_module("blender.bake")
+    obj = keyed("Edited", 7)
+    h.select_only(obj)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    result = obj.animation_data.action
+    identifier = addon_channels().slot_identifier(obj)
+    written = result[bake.WRITTEN_KEY]
+    assert written == bake.keys_digest(result, identifier) and not bake.was_edited(result, identifier)
+    fcurve = next(fc for fc in addon_channels().action_fcurves(result, identifier) if fc.data_path == "location")
+    point = fcurve.keyframe_points[3]
+    frame, value, kind = point.co[0], point.co[1], point.interpolation
+
+    def edited(change, undo) -> bool:
+        change()
+        seen = bake.was_edited(result, identifier)
+        undo()
+        assert bake.keys_digest(result, identifier) == written, "the edit put back gives the written digest"
+        return seen
+
+    kinds = {
+        "value moved": edited(lambda: setattr(point, "co", (frame, value + 1e-3)), lambda: setattr(point, "co", (frame, value))),
+        "frame moved": edited(lambda: setattr(point, "co", (frame + 0.25, value)), lambda: setattr(point, "co", (frame, value))),
+        "interpolation": edited(lambda: setattr(point, "interpolation", "BEZIER"), lambda: setattr(point, "interpolation", kind)),
+    }
+    count = len(fcurve.keyframe_points)
+    fcurve.keyframe_points.insert(frame + 0.5, value)
+    kinds["key added"] = bake.was_edited(result, identifier)
+    fcurve.keyframe_points.remove(fcurve.keyframe_points[4])
+    assert len(fcurve.keyframe_points) == count
+    fcurve.keyframe_points.remove(fcurve.keyframe_points[3])
+    kinds["key deleted"] = bake.was_edited(result, identifier)
+    print(f"digest {written}; edits seen: {kinds}")
+    assert kinds == dict.fromkeys(kinds, True)

@@ -18,7 +18,7 @@ leaves the scene as it was.
 
 from __future__ import annotations
 
-import hashlib
+import zlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
@@ -99,6 +99,9 @@ class Baked:
     unkeyed: frozenset = frozenset()
     #: Keys: Reduced: the reduced curves (:class:`reduce.Reduced`), written instead of `values`.
     reduced: object | None = None
+    #: Blender's playback of the source at `frames` where the bake played it already
+    #: (:attr:`sampling.Sampled.played`; NaN rows elsewhere), for the departure measure.
+    played: np.ndarray | None = None
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -222,7 +225,9 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        sampled = sampling.sample(motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous)
+        sampled = sampling.sample(
+            motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous, played=True
+        )
         location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
         values = {"location": location, keys.rotation_path(mode): rotation}
         if not motion.located:
@@ -244,7 +249,7 @@ def sample_channels(
     modes = motion.cycle_modes if whole_period and motion.cycle_modes else None
     return Baked(
         owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes,
-        join=join, end_maps=end_maps, unkeyed=unkeyed,
+        join=join, end_maps=end_maps, unkeyed=unkeyed, played=sampled.played,
     )
 
 
@@ -326,7 +331,7 @@ def _write_curves(
         kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
         interpolation = tuple(kinds.tolist())
     if digests is not None:  # (:func:`curve_digest` of each curve, its shared parts hashed once)
-        prefix = hashlib.sha256(f"{len(frames)}:".encode())
+        prefix = zlib.crc32(f"{len(frames)}:".encode())
         kinds = kinds.tobytes()
     for column in range(values.shape[1]):
         index = int(indices[column]) if indices is not None else column
@@ -337,10 +342,8 @@ def _write_curves(
         bulk.put(points, "co", co.ravel())
         bulk.put(points, "interpolation", interpolation)
         if digests is not None:
-            digest = prefix.copy()
-            digest.update(co)  # (C-contiguous float32: hashed in place, the bytes tobytes() gives)
-            digest.update(kinds)
-            digests[path, index] = digest.digest()
+            # (C-contiguous float32: summed in place, the bytes tobytes() gives)
+            digests[path, index] = zlib.crc32(kinds, zlib.crc32(co, prefix))
         if cyclic:
             fcurve.modifiers.new("CYCLES")
         elif cycle_modes and (prop, index) in cycle_modes:
@@ -401,14 +404,14 @@ def new_result(
     return result
 
 
-def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> bytes:
-    """A digest of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
-    interpolations (Blender's enum values, as `foreach_get` gives them)."""
-    digest = hashlib.sha256(f"{len(interpolation)}:".encode())
-    # (the arrays' bytes hashed in place: no copy when they are float32 / uint8 already)
-    digest.update(np.ascontiguousarray(co, dtype=np.float32))
-    digest.update(np.ascontiguousarray(interpolation, dtype=np.uint8))
-    return digest.digest()
+def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> int:
+    """A checksum of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
+    interpolations (Blender's enum values, as `foreach_get` gives them). CRC-32 of the key
+    count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
+    of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
+    # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), zlib.crc32(f"{len(interpolation)}:".encode()))
+    return zlib.crc32(np.ascontiguousarray(interpolation, dtype=np.uint8), digest)
 
 
 def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
@@ -416,7 +419,7 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     key frames, values and interpolations (one `foreach_get` each, but for the curves whose
     :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
     added or deleted, its interpolation changed, a curve added or removed, changes it."""
-    digest = hashlib.sha256()
+    digest = zlib.crc32(b"keys:")
     for fcurve in sorted(channels.action_fcurves(action, identifier), key=lambda fc: (fc.data_path, fc.array_index)):
         key = (fcurve.data_path, fcurve.array_index)
         sub = known.get(key) if known else None
@@ -427,9 +430,8 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
             interpolation = np.empty(len(points), dtype=np.uint8)
             bulk.get(points, "interpolation", interpolation)
             sub = curve_digest(co, interpolation)
-        digest.update(f"{key[0]}[{key[1]}]:".encode())
-        digest.update(sub)
-    return digest.hexdigest()
+        digest = zlib.crc32(f"{key[0]}[{key[1]}]:{sub}|".encode(), digest)
+    return f"crc32:{digest:08x}"
 
 
 def was_edited(action: bpy.types.Action, identifier: str) -> bool:
@@ -711,9 +713,10 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
     if motion.source is None:
         return None
     mode = motion.rotation_mode
+    played = part.played if part.motion.source is motion.source else None  # (rows of this playback only)
     found = intent.departure(
         motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)],
-        motion.frames,
+        motion.frames, played,
     )
     causes = list(motion.causes)
     if options.method == "FEATURE" and options.approximate:

@@ -12,8 +12,9 @@ The pipeline, per object (Rossignac-Kim, "Swept volumes"):
 3. `polyscrew.sweep` builds the swept mesh (each pair of samples is one screw), each screw in
    the fewest steps that keep the swept surfaces within a tolerance of the exact ones (by
    default 0.2 % of the body's bounding radius);
-4. :func:`create_object` writes it into a new object of the "Swept Regions" collection,
-   optionally closed into a manifold volume by Blender's voxel remesh.
+   or, with Closed Volume, `polyscrew.sweep_closed` builds the region's boundary as a closed,
+   consistently oriented, self-intersection-free mesh (slower: seconds, many more triangles);
+4. :func:`create_object` writes it into a new object of the "Swept Regions" collection.
 
 Steps 1 to 3 run for every object before anything is created, so a refusal leaves the scene
 as it was. :func:`clearance` measures a swept region against another object with
@@ -59,6 +60,9 @@ class Swept:
     #: `info`): every swept triangle within `error_bound` of the exact swept surface.
     tolerance: float = 0.0
     error_bound: float = 0.0
+    #: The grid cell of a closed boundary (`polyscrew.sweep_closed`; 0 for the open sweep):
+    #: every vertex then within `error_bound` of the exact swept boundary.
+    cell: float = 0.0
 
 
 def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
@@ -601,12 +605,16 @@ def compute(
     caps: bool,
     tolerance: float | None = None,
     read: dict | None = None,
+    closed: bool = False,
+    cell: float | None = None,
 ) -> Swept:
     """The swept mesh of `obj` along its world motion (nothing is created): each screw in the
     fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
     bounding radius; 0: exactly `steps`). `read`: a dict kept over one run of several objects
-    (the key frames read so far: each curve is read once, :func:`_key_frames`)."""
-    return compute_all([obj], context, steps, caps, tolerance, read)[0]
+    (the key frames read so far: each curve is read once, :func:`_key_frames`). `closed`: the
+    region's closed boundary instead (`polyscrew.sweep_closed`, grid `cell` in world units;
+    None: 1.5 % of the body's extent; `steps`, `caps` and `tolerance` do not apply)."""
+    return compute_all([obj], context, steps, caps, tolerance, read, closed, cell)[0]
 
 
 def compute_all(
@@ -616,6 +624,8 @@ def compute_all(
     caps: bool,
     tolerance: float | None = None,
     read: dict | None = None,
+    closed: bool = False,
+    cell: float | None = None,
 ) -> list[Swept]:
     """:func:`compute` of every object of `objects`, their world poses read together
     (:func:`world_poses_all`: the curves evaluated in one call where they alone move the
@@ -647,6 +657,10 @@ def compute_all(
     for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
         start = time.perf_counter()
         try:
+            if closed:
+                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, cell=cell, info=True)
+                out.append(Swept(obj, v, t, poses, time.perf_counter() - start, 0.0, info["error_bound"], info["cell"]))
+                continue
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:
             raise SweepError(f"{obj.name}: {err}") from err
@@ -697,33 +711,15 @@ def mesh_from_arrays(name: str, vertices: np.ndarray, triangles: np.ndarray) -> 
     return mesh
 
 
-def create_object(
-    swept: Swept, context: bpy.types.Context, closed: bool, voxel_size: float, t: transaction.Transaction | None = None
-) -> bpy.types.Object:
-    """A new object in the "Swept Regions" collection holding the swept mesh (world frame);
-    `closed` turns it into a closed manifold volume with a voxel remesh of `voxel_size`. `t`
-    undoes the linking of the collection when the operator fails."""
+def create_object(swept: Swept, context: bpy.types.Context, t: transaction.Transaction | None = None) -> bpy.types.Object:
+    """A new object in the "Swept Regions" collection holding the swept mesh (world frame:
+    the open sweep or, computed with `closed`, the closed boundary). `t` undoes the linking
+    of the collection when the operator fails."""
     name = f"{swept.obj.name} swept"
     mesh = mesh_from_arrays(name, swept.vertices, swept.triangles)
     obj = bpy.data.objects.new(name, mesh)
     collection(context.scene, t).objects.link(obj)
     obj[SOURCE_KEY] = swept.obj.name
-    if closed:
-        mod = obj.modifiers.new("Voxel Remesh", "REMESH")
-        mod.mode = "VOXEL"
-        mod.voxel_size = voxel_size
-        mod.adaptivity = 0.0
-        depsgraph = context.evaluated_depsgraph_get()
-        depsgraph.update()
-        remeshed = bpy.data.meshes.new_from_object(obj.evaluated_get(depsgraph))
-        obj.modifiers.remove(mod)
-        obj.data = remeshed
-        remeshed.name = name
-        bpy.data.meshes.remove(mesh)
-        if len(remeshed.polygons) == 0:
-            bpy.data.objects.remove(obj)
-            bpy.data.meshes.remove(remeshed)
-            raise SweepError(f"{swept.obj.name}: the voxel remesh gave an empty mesh (voxel size {voxel_size:g})")
     return obj
 
 
@@ -742,12 +738,10 @@ def mesh_triangles(mesh: bpy.types.Mesh) -> tuple[np.ndarray, np.ndarray]:
     return verts.reshape(-1, 3), tris.reshape(-1, 3)
 
 
-def created_triangles(swept: Swept, mesh: bpy.types.Mesh, remeshed: bool) -> tuple[np.ndarray, np.ndarray]:
+def created_triangles(swept: Swept) -> tuple[np.ndarray, np.ndarray]:
     """Vertices (V, 3) and triangles (T, 3) of the mesh made from `swept` by
     :func:`create_object`: what was written into it (float32, as the mesh holds it), not read
-    back; read (:func:`mesh_triangles`) when a voxel remesh made it (`remeshed`)."""
-    if remeshed:
-        return mesh_triangles(mesh)
+    back."""
     vertices = np.ascontiguousarray(swept.vertices, dtype=np.float32).astype(np.float64)
     return vertices, np.asarray(swept.triangles, dtype=np.int64)
 
@@ -817,8 +811,9 @@ def clearance(a: bpy.types.Object, b: bpy.types.Object, depsgraph: bpy.types.Dep
     """Whether `a` and `b` intersect (BVH overlap of their polygons, or, for a closed mesh,
     one holding a vertex of the other inside) and their smallest distance (every vertex of
     each against the other's surface: exact for face-to-vertex and face-to-face closeness,
-    within the edge length for edge-to-edge). The open superset made by Build Swept Region
-    without Closed Volume has no inside: only its surface counts."""
+    within the edge length for edge-to-edge). The closed boundary made by Build Swept Region
+    with Closed Volume has an inside (an object wholly within the region intersects it); the
+    open superset made without it has none: only its surface counts."""
     va, pa = world_polygons(a, depsgraph)
     vb, pb = world_polygons(b, depsgraph)
     if not pa or not pb:

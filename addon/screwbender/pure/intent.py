@@ -27,7 +27,8 @@ for the following, each one `polyscrew` call per owner (`polyscrew.analyse_spans
   Shortest takes the short screw between every two key poses. The removed flips are
   reported with their frames.
 - **Departure.** After a bake the result is measured against Blender's playback of the
-  source at every baked frame (`polyscrew.Playback.departure`, one call per owner): where it
+  source at every baked frame (`polyscrew.Playback.measure_departure`, one call per owner,
+  comparing with the playback timing "Keys" has played already at those frames): where it
   departs by more than :data:`DEPARTURE_DEGREES` or :data:`DEPARTURE_FRACTION` of the
   owner's size, the report names the owner, the frames and the size (:func:`departure_note`).
 - **Holds and pops.** A span where every channel stays still (CONSTANT interpolation, or
@@ -228,47 +229,24 @@ def departure(
     location: np.ndarray | None,
     rotation: np.ndarray,
     key_frames: np.ndarray | None = None,
+    played: np.ndarray | None = None,
 ) -> Departure:
     """The departure of the channels `location` (T, 3; None for a connected bone) and
     `rotation` (T, k) at `frames` (T, sorted) from Blender's playback of `source`: one
-    `polyscrew.Playback.departure` call; frames above :data:`DEPARTURE_DEGREES` or
+    `polyscrew.Playback.measure_departure` call; frames above :data:`DEPARTURE_DEGREES` or
     :data:`DEPARTURE_FRACTION` of `size`. With the motion's `key_frames`, a span baked at
-    more than :data:`DEPARTURE_SPAN_FRAMES` frames is measured at that many of them."""
+    more than :data:`DEPARTURE_SPAN_FRAMES` frames is measured at that many of them (a frame
+    not measured departs as its nearest measured frame). `played`: the playback's rows at
+    `frames` the bake has played already (:attr:`sampling.Sampled.played`, NaN elsewhere):
+    those frames are not played again (the same result)."""
     frames = np.asarray(frames, dtype=np.float64)
     if location is None:
         location = np.zeros((len(frames), 3))
-    measured = _measured(frames, key_frames, DEPARTURE_SPAN_FRAMES) if key_frames is not None else None
-    if measured is None:
-        distance, angle = source.playback.departure(frames, location, rotation)
-    else:
-        distance, angle = source.playback.departure(frames[measured], location[measured], rotation[measured])
-    degrees = np.degrees(angle)
-    over = (degrees > DEPARTURE_DEGREES) | (distance > DEPARTURE_FRACTION * size)
-    if measured is not None:  # every frame departs as its nearest measured frame
-        at = np.clip(np.searchsorted(frames[measured], frames), 1, len(measured) - 1)
-        before, after = frames[measured][at - 1], frames[measured][at]
-        over = over[np.where(frames - before <= after - frames, at - 1, at)]
-    return Departure(
-        degrees=float(degrees.max(initial=0.0)), distance=float(distance.max(initial=0.0)), frames=frames[over]
+    degrees, distance, over = source.playback.measure_departure(
+        frames, location, rotation, degrees=DEPARTURE_DEGREES, distance=DEPARTURE_FRACTION * size,
+        played=played, key_frames=key_frames, most=DEPARTURE_SPAN_FRAMES,
     )
-
-
-def _measured(frames: np.ndarray, key_frames: np.ndarray, most: int) -> np.ndarray | None:
-    """Indices of the frames (sorted) measured: every frame of a key span (of `key_frames`)
-    baked at no more than `most` frames; of a span of `c > most` frames, the `most` frames
-    `round(k (c - 1) / (most - 1))` (evenly spaced, its first and last included). None when
-    that is every frame. Arrays over the frames, no Python step per frame or span."""
-    span = np.searchsorted(np.asarray(key_frames, dtype=np.float64), frames, side="right")
-    first = np.concatenate(([True], span[1:] != span[:-1]))
-    starts = np.flatnonzero(first)
-    counts = np.diff(np.append(starts, len(frames)))
-    if not len(counts) or counts.max() <= most:
-        return None
-    run = np.cumsum(first) - 1
-    c, i = counts[run], np.arange(len(frames)) - starts[run]
-    step = np.maximum(c - 1, 1) / (most - 1)
-    # (steps longer than a frame: frame i is picked when the nearest k picks it back)
-    return np.flatnonzero((c <= most) | (np.round(np.round(i / step) * step) == i))
+    return Departure(degrees=degrees, distance=distance, frames=frames[over])
 
 
 def departure_note(name: str, found: Departure, size: float, causes: list[str]) -> str | None:

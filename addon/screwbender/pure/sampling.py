@@ -108,7 +108,7 @@ def _parameter_motion(motion: keys.KeyedMotion) -> tuple[np.ndarray, float | Non
     return np.arange(k, dtype=np.float64), (float(k) if motion.closed else None)
 
 
-def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, features=None) -> np.ndarray:
+def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, features=None, played: bool = False):
     """Timing "keys": the motion parameter of each frame of `frames`.
 
     Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
@@ -121,10 +121,14 @@ def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, featu
     One `polyscrew.keys_parameters` call: it samples Blender's playback (the motion's
     `polyscrew.Playback`) and the smoothed screw motion itself; for the Feature Points
     method the smoothed motion's poses at `polyscrew.pace_parameters` are sampled here first.
+    With `played`, returns `(parameters, rows)`: also the playback's location and rotation at
+    the frames it played (NaN elsewhere), which the departure measure then need not play again.
     """
     frames = np.asarray(frames, dtype=np.float64)
     playback = motion.source.playback if motion.source is not None else None
     common = dict(size=motion.size, closed=motion.closed, period=motion.period, playback=playback)
+    if played:
+        common["played"] = True
     if options.method == "FEATURE" and features is not None:
         k = len(motion.frames)
         u = polyscrew.pace_parameters(k if motion.closed else k - 1)
@@ -149,14 +153,24 @@ class Sampled:
     scales: np.ndarray | None
     #: Per frame: in a held span that pops at its end (its baked keys must be CONSTANT).
     constant: np.ndarray
+    #: With `played`: Blender's playback of the source (location, rotation: (T, 3 + k)) at the
+    #: frames timing "Keys" played, NaN elsewhere (`polyscrew.Playback.measure_departure`).
+    played: np.ndarray | None = None
 
 
 def sample(
-    motion: keys.KeyedMotion, frames: np.ndarray, options, features=None, channels: bool = False, previous=None
+    motion: keys.KeyedMotion,
+    frames: np.ndarray,
+    options,
+    features=None,
+    channels: bool = False,
+    previous=None,
+    played: bool = False,
 ) -> Sampled:
     """The smoothed motion at `frames` (any order; channels are continuous in time order from
     `previous`), as poses or, with `channels`, as Blender's location and rotation channels;
-    and scales when keyed.
+    and scales when keyed. With `played` (timing "keys", a motion with Blender's curves), also
+    the playback's rows timing "keys" played at these frames (:attr:`Sampled.played`).
 
     One polyscrew call per piece for the motion (and per hold for channels), one for scale;
     timing "keys" computes each piece's parameters once for both. `features`: the Feature
@@ -165,7 +179,7 @@ def sample(
     frames = np.asarray(frames, dtype=np.float64)
     if len(frames) > 1 and np.any(np.diff(frames) < 0.0):
         order = np.argsort(frames, kind="stable")
-        done = sample(motion, frames[order], options, features, channels, previous)
+        done = sample(motion, frames[order], options, features, channels, previous, played)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
         return Sampled(
@@ -174,6 +188,7 @@ def sample(
             rotation=None if done.rotation is None else done.rotation[back],
             scales=None if done.scales is None else done.scales[back],
             constant=done.constant[back],
+            played=None if done.played is None else done.played[back],
         )
     mode = motion.rotation_mode
     n = len(frames)
@@ -187,10 +202,13 @@ def sample(
     logs = np.log(np.where(motion.scale_axes, motion.scales, 1.0)) if scaled else None
     log_scales = np.empty((n, 3)) if scaled else None
     last_rotation = previous
+    keep_played = played and options.timing == "keys" and motion.source is not None
+    played_rows = None
     for seg in segments(motion, frames):
-        rows = seg.rows
+        # (every frame in one piece, the usual case: a slice, no index arrays to scatter through)
+        rows = slice(None) if len(seg.rows) == n else seg.rows
         if seg.held:
-            pose = np.repeat(motion.poses[seg.lo][None], len(rows), axis=0)
+            pose = np.repeat(motion.poses[seg.lo][None], len(seg.rows), axis=0)
             if channels:
                 location[rows] = pose[:, :3, 3]
                 values = polyscrew.rotation_channels(pose, mode, previous=last_rotation)
@@ -206,7 +224,16 @@ def sample(
             t = frames[rows]
             if options.timing == "keys":
                 key_times, period = _parameter_motion(piece)
-                at = keys_parameters(piece, t, options, features)
+                if keep_played:
+                    at, rows_played = keys_parameters(piece, t, options, features, played=True)
+                    if len(seg.rows) == n:
+                        played_rows = rows_played
+                    else:
+                        if played_rows is None:
+                            played_rows = np.full((n, rows_played.shape[1]), np.nan)
+                        played_rows[rows] = rows_played
+                else:
+                    at = keys_parameters(piece, t, options, features)
                 spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")
             else:
                 spec = _spec(piece, options)
@@ -237,4 +264,6 @@ def sample(
         scales[:] = motion.scales[0]  # unkeyed axes: the owner's own scale, possibly negative
         axes = motion.scale_axes
         scales[:, axes] = np.exp(log_scales[:, axes])
-    return Sampled(poses=poses, location=location, rotation=rotation, scales=scales, constant=constant)
+    return Sampled(
+        poses=poses, location=location, rotation=rotation, scales=scales, constant=constant, played=played_rows
+    )

@@ -48,11 +48,15 @@ def measures(vertices: np.ndarray, triangles: np.ndarray) -> Measures:
 
 
 def summary(objects: int, triangles: int, seconds: float, sweep_ms: float, tolerance: float, bound: float,
-            area: float, volume: float | None) -> str:
+            area: float, volume: float | None, cell: float = 0.0) -> str:
     """``Swept 1 object(s): 6536 triangles in 0.05 s (sweep 2.1 ms); tolerance 0.00173 (met
-    within 0.00164); area 12.3; volume 5.08`` (volume only for a closed result)."""
+    within 0.00164); area 12.3; volume 5.08`` (volume only for a closed result). A closed
+    boundary (`cell` > 0) names its cell and the bound its vertices meet: ``closed boundary,
+    cell 0.026 (vertices within 0.016 of the swept boundary)``."""
     text = f"Swept {objects} object(s): {triangles} triangles in {seconds:.2f} s (sweep {sweep_ms:.1f} ms)"
-    if tolerance > 0.0:
+    if cell > 0.0:
+        text += f"; closed boundary, cell {cell:.3g} (vertices within {bound:.3g} of the swept boundary)"
+    elif tolerance > 0.0:
         text += f"; tolerance {tolerance:.3g} (met within {bound:.3g})"
     text += f"; area {area:.6g}"
     if volume is not None:

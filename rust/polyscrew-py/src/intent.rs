@@ -10,10 +10,11 @@ use pyo3::prelude::*;
 
 use polyscrew::intent::{
     analyse_turns as core_analyse_turns, departure as core_departure,
-    keys_parameters as core_keys_parameters, pace_parameters as core_pace_parameters,
-    rotation_matrices as core_rotation_matrices, screw_pace_poses, Channel, KeysTiming, Playback,
-    Spans, Turns, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES, PACE_SAMPLES,
-    RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
+    keys_parameters as core_keys_parameters, keys_parameters_played as core_keys_parameters_played,
+    measure_departure as core_measure_departure, pace_parameters as core_pace_parameters,
+    rotation_matrices as core_rotation_matrices, screw_pace_poses, Channel, DepartureLimits,
+    KeysTiming, Playback, Spans, Turns, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES,
+    PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode, Scheme};
@@ -44,6 +45,32 @@ fn playback_arg<'a, 'py>(
     obj.cast::<PyPlayback>().map_err(|_| {
         crate::errors::wrong_type(format!("{function}: {what}: expected a polyscrew.Playback"))
     })
+}
+
+/// The values of `view` (any shape) row-major, allocated fallibly.
+fn flat_values(function: &str, view: &numpy::ndarray::ArrayViewD<'_, f64>) -> PyResult<Vec<f64>> {
+    let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(function, e))?;
+    out.extend(view.iter().copied());
+    Ok(out)
+}
+
+/// A `ValueError` unless `shape` is `(t, width)`.
+fn check_rows(function: &str, what: &str, shape: &[usize], t: usize, width: usize) -> PyResult<()> {
+    if shape.len() != 2 || shape[1] != width || shape[0] != t {
+        return Err(shape_err(function, what, &format!("({t}, {width})"), shape));
+    }
+    Ok(())
+}
+
+/// `played` of `keys_parameters`, a bool.
+fn played_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    args::bool_arg(KeysParameters::NAME, "played", obj)
+}
+
+/// `most` of `Playback.measure_departure`: frames measured per span, at least 2.
+fn most_arg(obj: &Bound<'_, PyAny>) -> PyResult<usize> {
+    let most = args::int_in("Playback.measure_departure", "most", obj, 2, i64::MAX)?;
+    Ok(usize::try_from(most).unwrap_or(usize::MAX))
 }
 
 /// `located`, a bool.
@@ -256,10 +283,7 @@ impl PyPlayback {
         let location = float_array(F, "location", location)?;
         let rotation = float_array(F, "rotation", rotation)?;
         for (array, what, width) in [(&location, "location", 3), (&rotation, "rotation", w)] {
-            let shape = array.shape();
-            if shape.len() != 2 || shape[1] != width || shape[0] != t {
-                return Err(shape_err(F, what, &format!("({t}, {width})"), shape));
-            }
+            check_rows(F, what, array.shape(), t, width)?;
         }
         // the arguments' conversions, the values read, the playback's rows, the two outputs
         check_budget(
@@ -278,16 +302,143 @@ impl PyPlayback {
         let out = py.detach(|| -> PyResult<_> {
             let frames = read_vector(F, "frames", &frames)?;
             // (shapes checked above) row-major values
-            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| -> PyResult<Vec<f64>> {
-                let mut out = try_vec(view.len(), "input values").map_err(|e| to_py_err(F, e))?;
-                out.extend(view.iter().copied());
-                Ok(out)
-            };
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| flat_values(F, view);
             let location = flat(&location)?;
             let rotation = flat(&rotation)?;
             core_departure(inner, &frames, &location, &rotation).map_err(|e| to_py_err(F, e))
         })?;
         Ok((out.distance.into_pyarray(py), out.angle.into_pyarray(py)))
+    }
+
+    /// measure_departure(
+    ///     frames: ArrayLike,
+    ///     location: ArrayLike,
+    ///     rotation: ArrayLike,
+    ///     *,
+    ///     degrees: float,
+    ///     distance: float,
+    ///     played: ArrayLike | None = None,
+    ///     key_frames: ArrayLike | None = None,
+    ///     most: int = 64,
+    /// ) -> tuple[float, float, npt.NDArray[np.bool_]]
+    ///
+    /// What a report needs of ``departure`` in one call: ``(largest angle in degrees,
+    /// largest distance, over)`` of a result's ``location`` (T, 3) and ``rotation`` (T, 3 or
+    /// 4) at ``frames`` (T,), sorted, ``over`` (T,) true where a frame departs by more than
+    /// ``degrees`` or ``distance``. With ``key_frames``, a key span baked at more than
+    /// ``most`` frames is measured at ``most`` of them, evenly spaced (its first and last
+    /// included), and a frame not measured departs as its nearest measured frame. ``played``
+    /// (T, 3 + 3 or 4): the playback's location and rotation per frame as
+    /// ``keys_parameters(..., played=True)`` returns them, NaN where not known: those frames
+    /// are compared without being played again (the same figures, bit for bit). GIL
+    /// released. Raises ValueError for shapes that do not match, values that are not finite
+    /// or ``most`` below 2.
+    #[pyo3(signature = (frames, location, rotation, *, degrees, distance, played=None, key_frames=None, most=64))]
+    #[allow(clippy::too_many_arguments, clippy::type_complexity)]
+    fn measure_departure<'py>(
+        &self,
+        py: Python<'py>,
+        frames: &Bound<'py, PyAny>,
+        location: &Bound<'py, PyAny>,
+        rotation: &Bound<'py, PyAny>,
+        degrees: &Bound<'py, PyAny>,
+        distance: &Bound<'py, PyAny>,
+        played: Option<&Bound<'py, PyAny>>,
+        key_frames: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = most_arg)] most: usize,
+    ) -> PyResult<(f64, f64, Bound<'py, PyArray1<bool>>)> {
+        const F: &str = "Playback.measure_departure";
+        let inner = &self.inner;
+        let limits = DepartureLimits {
+            degrees: args::float_scalar(F, "degrees", degrees)?,
+            distance: args::float_scalar(F, "distance", distance)?,
+        };
+        let frames = float_array(F, "frames", frames)?;
+        let t = vector_len(F, "frames", &frames)?;
+        let w = inner.mode().width();
+        let location = float_array(F, "location", location)?;
+        let rotation = float_array(F, "rotation", rotation)?;
+        let played = played
+            .filter(|p| !p.is_none())
+            .map(|p| float_array(F, "played", p))
+            .transpose()?;
+        let key_frames = key_frames
+            .filter(|k| !k.is_none())
+            .map(|k| float_array(F, "key_frames", k))
+            .transpose()?;
+        let k = key_frames
+            .as_ref()
+            .map(|a| vector_len(F, "key_frames", a))
+            .transpose()?
+            .unwrap_or(0);
+        for (array, what, width) in [
+            (Some(&location), "location", 3),
+            (Some(&rotation), "rotation", w),
+            (played.as_ref(), "played", 3 + w),
+        ] {
+            if let Some(array) = array {
+                check_rows(F, what, array.shape(), t, width)?;
+            }
+        }
+        // the arguments' conversions, the values read, the core's work (per measured frame
+        // the result, a row and the figures; the playback's rows of one chunk), the output
+        check_budget(
+            F,
+            frames.copy()
+                + location.copy()
+                + rotation.copy()
+                + played
+                    .as_ref()
+                    .map_or(Footprint::of::<f64>(0), |p| p.copy())
+                + key_frames
+                    .as_ref()
+                    .map_or(Footprint::of::<f64>(0), |a| a.copy())
+                + Footprint::of::<f64>(t.saturating_mul(3 + w + 3 + w + 1).saturating_add(k))
+                + Footprint::of::<f64>(t.saturating_mul(4 + 3 + w + 3))
+                    .and::<f64>(4096 * inner.width())
+                    .and::<bool>(t),
+            "the departure",
+            HINT,
+        )?;
+        let (frames, location, rotation) = (frames.read()?, location.read()?, rotation.read()?);
+        let played = played.as_ref().map(|p| p.read()).transpose()?;
+        let key_frames = key_frames.as_ref().map(|a| a.read()).transpose()?;
+        let (frames, location, rotation) =
+            (frames.as_array(), location.as_array(), rotation.as_array());
+        let played = played.as_ref().map(|p| p.as_array());
+        let key_frames = key_frames.as_ref().map(|a| a.as_array());
+        let out = py.detach(|| -> PyResult<_> {
+            let frames = read_vector(F, "frames", &frames)?;
+            let key_frames = key_frames
+                .as_ref()
+                .map(|k| read_vector(F, "key_frames", k))
+                .transpose()?;
+            // (shapes checked above) row-major values
+            let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| flat_values(F, view);
+            let location = flat(&location)?;
+            let rotation = flat(&rotation)?;
+            let played = played.as_ref().map(flat).transpose()?;
+            core_measure_departure(
+                inner,
+                &frames,
+                &location,
+                &rotation,
+                played.as_deref(),
+                key_frames.as_deref().map(|k| (k, most)),
+                limits,
+            )
+            .map_err(|e| to_py_err(F, e))
+        })?;
+        Ok((out.degrees, out.distance, out.over.into_pyarray(py)))
+    }
+
+    /// rows_evaluated -> int
+    ///
+    /// How many frames this playback has played (one channel row each) since it was made, by
+    /// every function that plays it: how often a caller plays the same curves.
+    #[getter]
+    fn rows_evaluated(&self) -> u64 {
+        self.inner.rows_evaluated()
     }
 }
 
@@ -449,7 +600,8 @@ enum Smoothed {
 ///     scheme: SchemeName = "four_point",
 ///     levels: int = 4,
 ///     smooth: ArrayLike | None = None,
-/// ) -> FloatArray
+///     played: bool = False,
+/// ) -> FloatArray | tuple[FloatArray, FloatArray]
 ///
 /// Timing "Keys": the motion parameter (key i at i) of each of ``frames`` (T,).
 ///
@@ -465,14 +617,20 @@ enum Smoothed {
 ///
 /// The smoothed motion: the screw motion of the key ``poses`` (K, 4, 4) by ``scheme`` and
 /// ``levels`` (keys at parameters 0..K-1, linear timing), or ``smooth``, its poses at
-/// ``pace_parameters(spans)`` computed by the caller (feature points). GIL released.
+/// ``pace_parameters(spans)`` computed by the caller (feature points).
+///
+/// ``played=True`` returns ``(parameters, rows)`` instead: ``rows`` (T, 3 + 3 or 4), the
+/// playback's location and rotation at each frame where this call played it at exactly that
+/// frame (the frames from the first key to the last, but those of a span with more than 256
+/// frames, which is measured on a grid), NaN elsewhere (without ``playback``: (T, 0)): what
+/// ``Playback.measure_departure`` takes as ``played``. GIL released.
 /// Raises ValueError naming the argument: key frames that do not increase, a period not
 /// beyond the keys, a size that is not positive, frames not finite, neither or both of
 /// ``poses`` and ``smooth``, or ``smooth`` of the wrong length.
 #[pyfunction]
-#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme=Choice::of(Scheme::FourPoint), levels=4, smooth=None))]
+#[pyo3(signature = (key_frames, frames, *, size, closed=false, period=None, playback=None, poses=None, scheme=Choice::of(Scheme::FourPoint), levels=4, smooth=None, played=false))]
 #[pyo3(
-    text_signature = "(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme='four_point', levels=4, smooth=None)"
+    text_signature = "(key_frames, frames, *, size, closed=False, period=None, playback=None, poses=None, scheme='four_point', levels=4, smooth=None, played=False)"
 )]
 #[allow(clippy::too_many_arguments)]
 fn keys_parameters<'py>(
@@ -487,7 +645,8 @@ fn keys_parameters<'py>(
     scheme: Choice<KeysParameters, Scheme>,
     #[pyo3(from_py_with = args::levels::<KeysParameters>)] levels: u32,
     smooth: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    #[pyo3(from_py_with = played_arg)] played: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     const F: &str = KeysParameters::NAME;
     let size = args::float_scalar(F, "size", size)?;
     let period = args::optional_float(F, "period", period)?;
@@ -531,9 +690,17 @@ fn keys_parameters<'py>(
     // checks again on its own): per frame four values, per pace sample five, per pose of
     // the pace grid two and (from the keys) the smoothed pose itself
     let grid = k.saturating_mul(PACE_SAMPLES + 1);
+    // (and, played, a pose row per frame and per span end)
+    let rows = if played {
+        t.saturating_add(2 * k)
+            .saturating_mul(3 + playback.map_or(0, |p| p.get().inner.mode().width()))
+    } else {
+        0
+    };
     let work = Footprint::of::<f64>(t).times(4)
-        + Footprint::of::<f64>(grid.saturating_add(t)).times(5)
+        + Footprint::of::<f64>(grid.saturating_add(t)).times(6)
         + Footprint::of::<f64>(grid).times(2)
+        + Footprint::of::<f64>(rows)
         + Footprint::of::<Pose>(if is_keys { grid } else { 0 });
     check_budget(
         F,
@@ -548,7 +715,7 @@ fn keys_parameters<'py>(
     let (key_frames, frames, array) = (key_frames.read()?, frames.read()?, array.read()?);
     let inner = playback.map(|p| &p.get().inner);
     let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
-    let out = py.detach(|| -> PyResult<Vec<f64>> {
+    let (out, rows) = py.detach(|| -> PyResult<(Vec<f64>, Vec<f64>)> {
         let key_frames = read_vector(F, "key_frames", &kv)?;
         let frames = read_vector(F, "frames", &fv)?;
         let smoothed = if is_keys {
@@ -562,14 +729,32 @@ fn keys_parameters<'py>(
             size,
             playback: inner,
         };
+        let run = |smooth: &[Pose]| {
+            if played {
+                core_keys_parameters_played(&timing, &frames, smooth)
+            } else {
+                core_keys_parameters(&timing, &frames, smooth).map(|u| (u, Vec::new()))
+            }
+        };
         match &smoothed {
-            Smoothed::Keys(keys) => screw_pace_poses(keys, scheme, levels, closed)
-                .and_then(|smooth| core_keys_parameters(&timing, &frames, &smooth)),
-            Smoothed::Given(smooth) => core_keys_parameters(&timing, &frames, smooth),
+            Smoothed::Keys(keys) => {
+                screw_pace_poses(keys, scheme, levels, closed).and_then(|smooth| run(&smooth))
+            }
+            Smoothed::Given(smooth) => run(smooth),
         }
         .map_err(|e| to_py_err(F, e))
     })?;
-    Ok(out.into_pyarray(py))
+    let out = out.into_pyarray(py).into_any();
+    if !played {
+        return Ok(out);
+    }
+    // (T, 0) without a playback: nothing played
+    let width = inner.map_or(0, |p| 3 + p.mode().width());
+    let rows = Array2::from_shape_vec((t, width), rows)
+        .expect("a row per frame")
+        .into_pyarray(py)
+        .into_any();
+    Ok((out, rows).into_pyobject(py)?.into_any())
 }
 
 /// pace_parameters(spans: int) -> FloatArray

@@ -168,6 +168,17 @@ pub struct BezierSegment {
     yc: [f32; 4],
 }
 
+/// A root of [`BezierSegment::parameter`] and what it depends on (the frame, the segment's
+/// key and handle frames), for the next segment evaluated at the same frame
+/// ([`BezierSegment::eval_sharing`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SharedRoot {
+    frame: f32,
+    x0: f32,
+    xc: [f64; 3],
+    root: Option<f32>,
+}
+
 impl BezierSegment {
     /// The segment from key `v1` with right handle `v2` to key `v4` with left handle `v3`
     /// (`(frame, value)` each, as stored).
@@ -215,6 +226,34 @@ impl BezierSegment {
         };
         let [c0, c1, c2, c3] = self.yc;
         c0 + t * c1 + t * t * c2 + t * t * t * c3
+    }
+
+    /// [`BezierSegment::eval`], the root taken from `shared` when it was solved there for
+    /// the same `frame` on a segment with the same key and handle frames, else solved and
+    /// kept there: the same value, bit for bit.
+    pub(crate) fn eval_sharing(&self, frame: f32, shared: &mut Option<SharedRoot>) -> f32 {
+        if self.flat {
+            return self.yc[0];
+        }
+        let same = |s: &SharedRoot| {
+            s.frame.to_bits() == frame.to_bits()
+                && s.x0.to_bits() == self.x0.to_bits()
+                && s.xc.map(f64::to_bits) == self.xc.map(f64::to_bits)
+        };
+        let root = match shared {
+            Some(s) if same(s) => s.root,
+            _ => {
+                let root = self.parameter(frame);
+                *shared = Some(SharedRoot {
+                    frame,
+                    x0: self.x0,
+                    xc: self.xc,
+                    root,
+                });
+                root
+            }
+        };
+        self.value_at(root)
     }
 
     /// The parameter `u` Blender's root finder gives `frame` on this segment (`None` where it

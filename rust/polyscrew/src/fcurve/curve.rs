@@ -2,7 +2,7 @@
 //! does (`fcurve_eval_keyframes` with its extrapolation and interpolation, inside the Cycles
 //! modifier's time and value stages).
 
-use super::bezier::BezierSegment;
+use super::bezier::{BezierSegment, SharedRoot};
 use super::cycles::Cycles;
 use super::easing::ease;
 use super::key::{from_code, from_name, Interpolation, Key};
@@ -182,17 +182,25 @@ impl FCurve {
 
     /// `evaluate_fcurve` at a `float` time (may be non-finite for extreme curves).
     pub(crate) fn evaluate_f32(&self, time: f32) -> f32 {
+        self.evaluate_f32_sharing(time, &mut None)
+    }
+
+    /// [`FCurve::evaluate_f32`], the root of a BEZIER segment taken from `shared` when the
+    /// curve evaluated before at the same time had a segment with the same key and handle
+    /// frames (curves keyed together), and kept there for the next: the same value, bit for
+    /// bit, with one cubic solved for several curves.
+    pub(crate) fn evaluate_f32_sharing(&self, time: f32, shared: &mut Option<SharedRoot>) -> f32 {
         let Some(cycles) = &self.cycles else {
-            return self.eval_keys(time);
+            return self.eval_keys(time, shared);
         };
         let first = self.keys[0].co;
         let last = self.keys[self.keys.len() - 1].co;
         let (mapped, offset) = cycles.map_time(time, first, last);
-        cycles.apply_value(self.eval_keys(mapped), mapped, offset)
+        cycles.apply_value(self.eval_keys(mapped, shared), mapped, offset)
     }
 
     /// `fcurve_eval_keyframes`.
-    fn eval_keys(&self, time: f32) -> f32 {
+    fn eval_keys(&self, time: f32, shared: &mut Option<SharedRoot>) -> f32 {
         let n = self.keys.len();
         if time <= self.keys[0].co[0] {
             return self.extrapolate(time, true);
@@ -200,7 +208,7 @@ impl FCurve {
         if self.keys[n - 1].co[0] <= time {
             return self.extrapolate(time, false);
         }
-        self.interpolate(time)
+        self.interpolate(time, shared)
     }
 
     /// `fcurve_eval_keyframes_extrapolate` from the first key (`before`) or the last.
@@ -245,7 +253,7 @@ impl FCurve {
     }
 
     /// `fcurve_eval_keyframes_interpolate`, for a time strictly inside the keys' range.
-    fn interpolate(&self, time: f32) -> f32 {
+    fn interpolate(&self, time: f32, shared: &mut Option<SharedRoot>) -> f32 {
         let (a, exact) = binary_search(&self.keys, time);
         let Some(bezt) = self.keys.get(a) else {
             return 0.0;
@@ -271,7 +279,7 @@ impl FCurve {
         }
         if prev.interpolation == Interpolation::Bezier {
             return match self.bezier.get(pi).copied().flatten() {
-                Some(seg) if pi < a => seg.eval(time),
+                Some(seg) if pi < a => seg.eval_sharing(time, shared),
                 // a == 0: Blender's segment from a key to itself.
                 _ => BezierSegment::new(prev.co, prev.handle_right, bezt.handle_left, bezt.co)
                     .eval(time),

@@ -22,7 +22,9 @@
 //!   and quaternion sign flips, which Blender plays the long way round and [`Turns::Auto`]
 //!   takes the short way) from the spins the animator typed.
 //! - [`mod@departure`]: per frame, how far a smoothed result's channels are from the playback
-//!   (distance of the origins, rotation angle), for the report.
+//!   (distance of the origins, rotation angle), for the report; [`measure_departure`] gives
+//!   the report's figures at once and compares with the rows [`keys_parameters_played`]
+//!   has played already, so that each frame is played once.
 //! - [`keys_parameters`]: timing "Keys". Within each span, the motion parameter of an output
 //!   frame is the one at which the smoothed motion has travelled the same fraction of the
 //!   span as Blender's playback has at that frame. Travel is the root mean square
@@ -42,14 +44,18 @@ pub mod spans;
 pub mod turns;
 
 #[cfg(test)]
+mod departure_tests;
+#[cfg(test)]
 mod tests;
 #[cfg(test)]
 mod turns_tests;
 
-pub use departure::{departure, Departure};
+pub use departure::{
+    departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
+};
 pub use pace::{
-    keys_parameters, pace_parameters, screw_pace_poses, travel, KeysTiming, DENSE_PACE_SAMPLES,
-    PACE_SAMPLES,
+    keys_parameters, keys_parameters_played, pace_parameters, screw_pace_poses, travel, KeysTiming,
+    DENSE_PACE_SAMPLES, PACE_SAMPLES,
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{

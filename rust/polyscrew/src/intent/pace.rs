@@ -153,6 +153,36 @@ pub fn keys_parameters(
     frames: &[f64],
     smooth: &[Pose],
 ) -> Result<Vec<f64>> {
+    Ok(parameters_and_played(timing, frames, smooth, false)?.0)
+}
+
+/// [`keys_parameters`], and the playback's pose rows it evaluated at the output frames
+/// themselves: `frames.len()` rows of `3 + w` numbers (location, rotation in the playback's
+/// mode; `w` its [`RotationMode::width`](crate::RotationMode::width)), row-major, each the
+/// row [`Playback::channels`] gives at that frame (bit for bit: the same evaluation), and
+/// NaN where the frame was not played at exactly that frame (a span measured on its dense
+/// grid, a frame outside the spans, no playback). A caller that measures the result against
+/// the playback at these frames ([`super::departure::measure_departure`]) then plays each
+/// frame once.
+///
+/// # Errors
+/// As [`keys_parameters`].
+pub fn keys_parameters_played(
+    timing: &KeysTiming<'_>,
+    frames: &[f64],
+    smooth: &[Pose],
+) -> Result<(Vec<f64>, Vec<f64>)> {
+    parameters_and_played(timing, frames, smooth, true)
+}
+
+/// [`keys_parameters`], with the played rows of [`keys_parameters_played`] when `played`
+/// (else an empty vector).
+fn parameters_and_played(
+    timing: &KeysTiming<'_>,
+    frames: &[f64],
+    smooth: &[Pose],
+    played: bool,
+) -> Result<(Vec<f64>, Vec<f64>)> {
     let key_frames = timing.key_frames;
     let k = key_frames.len();
     if k < 2 {
@@ -192,10 +222,18 @@ pub fn keys_parameters(
     let samples = grid_len.saturating_add(t);
     // Per frame: span, fraction, travelled, output; per sample: span, fraction, done, the two
     // interpolation tables; per grid pose: the two tables; one channel row.
+    // (and, asked for, a pose row per frame, the rows at the span ends)
+    let pose_width = timing.playback.map_or(0, |p| 3 + p.mode().width());
+    let rows_len = if played {
+        t.saturating_add(2 * spans).saturating_mul(pose_width)
+    } else {
+        0
+    };
     let bytes = t
         .saturating_mul(4 * 8)
-        .saturating_add(samples.saturating_mul(5 * 8))
-        .saturating_add(grid_len.saturating_mul(2 * 8));
+        .saturating_add(samples.saturating_mul(6 * 8))
+        .saturating_add(grid_len.saturating_mul(2 * 8))
+        .saturating_add(rows_len.saturating_mul(8));
     check_footprint(bytes, "timing Keys", "bake fewer frames")?;
 
     let span_of = |frame: f64| {
@@ -222,30 +260,55 @@ pub fn keys_parameters(
             inside_count[s] += 1;
         }
     }
-    let mut sampled: Vec<(usize, f64)> = try_vec(samples, "pace samples")?;
-    sampled.extend((0..spans).flat_map(|s| (0..per_span).map(move |j| (s, grid(j)))));
+    // (span, fraction of time, the output frame it is, or NOT_OUTPUT)
+    let mut sampled: Vec<Sample> = try_vec(samples, "pace samples")?;
+    sampled.extend((0..spans).flat_map(|s| (0..per_span).map(move |j| (s, grid(j), NOT_OUTPUT))));
     sampled.extend(
         located
             .iter()
-            .copied()
-            .filter(|&(s, tau)| inside(tau) && inside_count[s] <= DENSE_PACE_SAMPLES),
+            .enumerate()
+            .filter(|&(_, &(s, tau))| inside(tau) && inside_count[s] <= DENSE_PACE_SAMPLES)
+            .map(|(i, &(s, tau))| (s, tau, i)),
     );
     for (s, &count) in inside_count.iter().enumerate() {
         if count > DENSE_PACE_SAMPLES {
-            sampled
-                .extend((1..DENSE_PACE_SAMPLES).map(|j| (s, j as f64 / DENSE_PACE_SAMPLES as f64)));
+            sampled.extend(
+                (1..DENSE_PACE_SAMPLES)
+                    .map(|j| (s, j as f64 / DENSE_PACE_SAMPLES as f64, NOT_OUTPUT)),
+            );
         }
     }
     sampled.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    let done = playback_fractions(timing.playback, &ends, &sampled, size)?;
+    let mut rows = if played && pose_width > 0 {
+        let mut rows = try_vec(rows_len, "played rows")?;
+        rows.resize(rows_len, f64::NAN);
+        Some(Played {
+            rows,
+            width: pose_width,
+            frames,
+        })
+    } else {
+        None
+    };
+    let done = playback_fractions(
+        timing.playback,
+        &ends,
+        frames,
+        &sampled,
+        size,
+        rows.as_mut(),
+    )?;
     let xp = collected(
         samples,
-        sampled.iter().map(|&(s, f)| s as f64 + f),
+        sampled.iter().map(|&(s, f, _)| s as f64 + f),
         "pace samples",
     )?;
     let fp = collected(
         samples,
-        sampled.iter().zip(&done).map(|(&(s, _), d)| s as f64 + d),
+        sampled
+            .iter()
+            .zip(&done)
+            .map(|(&(s, _, _), d)| s as f64 + d),
         "pace samples",
     )?;
     drop(sampled);
@@ -291,7 +354,64 @@ pub fn keys_parameters(
                    is not finite",
         });
     }
-    Ok(out)
+    let Some(mut rows) = rows else {
+        return Ok((out, Vec::new()));
+    };
+    // Frames at a key (the start of their span) and at the end of the last span were played
+    // as the span's first and last grid samples: their rows, when played at that very frame.
+    for (i, &(s, tau)) in located.iter().enumerate() {
+        let end = if tau == 0.0 {
+            0
+        } else if tau == 1.0 {
+            1
+        } else {
+            continue;
+        };
+        let at = (rows.frames.len() + 2 * s + end) * rows.width;
+        if rows.rows[at].is_nan() || sample_frame(&ends, s, end as f64) != frames[i] {
+            continue;
+        }
+        rows.rows.copy_within(at..at + rows.width, i * rows.width);
+    }
+    rows.rows.truncate(t * rows.width);
+    Ok((out, rows.rows))
+}
+
+/// A pace sample: (span, fraction of its time, the output frame it is or [`NOT_OUTPUT`]).
+type Sample = (usize, f64, usize);
+
+/// A pace sample that is not an output frame.
+const NOT_OUTPUT: usize = usize::MAX;
+
+/// The playback's pose rows kept for the caller: one per output frame, then the first and
+/// last grid sample of each span (NaN where not played).
+struct Played<'a> {
+    rows: Vec<f64>,
+    width: usize,
+    frames: &'a [f64],
+}
+
+impl Played<'_> {
+    /// Keeps `row` (a channel row) of `sample`: an output frame's, or a span's first or last.
+    fn keep(&mut self, sample: &Sample, row: &[f64]) {
+        let &(s, f, output) = sample;
+        let slot = if output != NOT_OUTPUT {
+            output
+        } else if f == 0.0 {
+            self.frames.len() + 2 * s
+        } else if f == 1.0 {
+            self.frames.len() + 2 * s + 1
+        } else {
+            return;
+        };
+        let at = slot * self.width;
+        self.rows[at..at + self.width].copy_from_slice(&row[..self.width]);
+    }
+}
+
+/// The frame of the fraction `f` of span `s`'s time.
+fn sample_frame(ends: &[f64], s: usize, f: f64) -> f64 {
+    ends[s] + f * (ends[s + 1] - ends[s])
 }
 
 /// The fraction of its span's travel along Blender's playback done at each sample
@@ -300,13 +420,15 @@ pub fn keys_parameters(
 fn playback_fractions(
     playback: Option<&Playback>,
     ends: &[f64],
-    sampled: &[(usize, f64)],
+    frames: &[f64],
+    sampled: &[Sample],
     size: f64,
+    mut rows: Option<&mut Played<'_>>,
 ) -> Result<Vec<f64>> {
     let Some(playback) = playback else {
         return collected(
             sampled.len(),
-            sampled.iter().map(|&(_, f)| f),
+            sampled.iter().map(|&(_, f, _)| f),
             "pace fractions",
         );
     };
@@ -321,14 +443,23 @@ fn playback_fractions(
                 *d /= sum;
             }
         } else {
-            for (d, &(_, f)) in done[start..].iter_mut().zip(&sampled[start..]) {
+            for (d, &(_, f, _)) in done[start..].iter_mut().zip(&sampled[start..]) {
                 *d = f;
             }
         }
     };
-    for (i, &(s, f)) in sampled.iter().enumerate() {
-        let frame = ends[s] + f * (ends[s + 1] - ends[s]);
+    for (i, sample) in sampled.iter().enumerate() {
+        let (s, f, output) = *sample;
+        // an output frame is played at that very frame, a grid sample at its fraction
+        let frame = if output == NOT_OUTPUT {
+            sample_frame(ends, s, f)
+        } else {
+            frames[output]
+        };
         playback.pose_channels_into(&[frame], &mut row)?;
+        if let Some(rows) = rows.as_deref_mut() {
+            rows.keep(sample, &row);
+        }
         let location = DVec3::new(row[0], row[1], row[2]);
         let rotation = playback.rotation(&row);
         match previous {

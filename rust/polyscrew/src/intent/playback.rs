@@ -5,6 +5,8 @@
 //! `rotation_quaternion` `w, x, y, z` or `rotation_axis_angle` `angle, x, y, z`); scale
 //! `x, y, z`: `6 + w` numbers, `w` the mode's [`RotationMode::width`].
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::DMat3;
 
 use super::limits::{check_footprint, collected};
@@ -137,7 +139,10 @@ pub fn rotation_matrices(values: &[f64], mode: RotationMode) -> Result<Vec<DMat3
 /// F-curves (evaluated exactly as Blender's `FCurve.evaluate`), every other channel from the
 /// owner's own value, location zero for an owner Blender does not move by it (a bone
 /// connected to its parent).
-#[derive(Debug, Clone, PartialEq)]
+///
+/// It counts the channel rows it has evaluated ([`Playback::rows_evaluated`]): how often a
+/// caller plays the same curves is observable (the add-on plays each owner's once per frame).
+#[derive(Debug)]
 pub struct Playback {
     curves: Vec<FCurve>,
     /// The channel-row column each curve drives.
@@ -146,6 +151,33 @@ pub struct Playback {
     statics: Vec<f64>,
     mode: RotationMode,
     located: bool,
+    /// Channel rows evaluated so far (every call, every thread).
+    evaluated: AtomicU64,
+}
+
+impl Clone for Playback {
+    /// The same curves and values; its count of rows evaluated starts at 0.
+    fn clone(&self) -> Self {
+        Self {
+            curves: self.curves.clone(),
+            columns: self.columns.clone(),
+            statics: self.statics.clone(),
+            mode: self.mode,
+            located: self.located,
+            evaluated: AtomicU64::new(0),
+        }
+    }
+}
+
+impl PartialEq for Playback {
+    /// The same curves, channels, values, mode and `located` (whatever each has evaluated).
+    fn eq(&self, other: &Self) -> bool {
+        self.curves == other.curves
+            && self.columns == other.columns
+            && self.statics == other.statics
+            && self.mode == other.mode
+            && self.located == other.located
+    }
 }
 
 impl Playback {
@@ -207,7 +239,15 @@ impl Playback {
             statics,
             mode,
             located,
+            evaluated: AtomicU64::new(0),
         })
+    }
+
+    /// How many channel rows (one frame each) this playback has evaluated since it was made,
+    /// by every function that plays it ([`Playback::channels`], [`super::analyse_spans`],
+    /// [`super::keys_parameters`], [`super::departure`], ...).
+    pub fn rows_evaluated(&self) -> u64 {
+        self.evaluated.load(Ordering::Relaxed)
     }
 
     /// The owner's rotation mode.
@@ -270,6 +310,8 @@ impl Playback {
         let width = self.width();
         out.clear();
         try_reserve(out, times.len().saturating_mul(width), "channel values")?;
+        self.evaluated
+            .fetch_add(times.len() as u64, Ordering::Relaxed);
         for (index, &t) in times.iter().enumerate() {
             let t32 = t as f32;
             if !t32.is_finite() {
@@ -280,11 +322,13 @@ impl Playback {
             }
             out.extend_from_slice(&self.statics);
             let row = &mut out[index * width..];
+            // curves keyed together share their Bezier roots at one time
+            let mut shared = None;
             for (c, (curve, &column)) in self.curves.iter().zip(&self.columns).enumerate() {
                 if column >= upto {
                     continue;
                 }
-                let v = curve.evaluate_f32(t32);
+                let v = curve.evaluate_f32_sharing(t32, &mut shared);
                 if !v.is_finite() {
                     return Err(Error::Evaluates {
                         curve: Some(c),

@@ -52,6 +52,7 @@
 //! do not move) are left out.
 
 pub mod body;
+pub mod closed;
 pub mod generator;
 
 use glam::DVec3;
@@ -60,6 +61,7 @@ pub use body::{
     body_footprint, Body, Edge, EdgeKind, FLAT_REL, MAX_VERTEX_COORDINATE, NO_FACE, SWEEP_HINT,
     ZERO_AREA_REL,
 };
+pub use closed::{sweep_closed, sweep_closed_mesh, ClosedMesh, ClosedOptions, DEFAULT_CELL_REL};
 pub use generator::{
     Generator, Scratch, Segment, SegmentKind, Velocity, MOTIONLESS_REL, TANGENT_REL,
 };
@@ -440,6 +442,8 @@ pub fn sweep_mesh(
     sweep(&body, poses, options)
 }
 
+#[cfg(test)]
+mod closed_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

@@ -17,7 +17,7 @@ use super::*;
 use crate::motion::subdivision::{subdivide, Scheme};
 
 /// Signed distance from `p` to the box `[0, s]` (negative inside).
-fn sd_box(p: DVec3, size: DVec3) -> f64 {
+pub(super) fn sd_box(p: DVec3, size: DVec3) -> f64 {
     let c = 0.5 * size;
     let q = (p - c).abs() - c;
     q.max(DVec3::ZERO).length() + q.x.max(q.y).max(q.z).min(0.0)
@@ -27,7 +27,7 @@ fn sd_box(p: DVec3, size: DVec3) -> f64 {
 /// `64 / screws` samples per screw (at least 12), then the best `BEST` samples refined four
 /// times by `FINE` samples over a neighbourhood of one sample spacing (a final spacing of
 /// about `1e-6` of a screw). `Screw::eval` is `s(p_i, t, p_{i+1})`.
-fn min_over_motion(poses: &[Pose], f: &dyn Fn(&Pose) -> f64) -> f64 {
+pub(super) fn min_over_motion(poses: &[Pose], f: &dyn Fn(&Pose) -> f64) -> f64 {
     const FINE: usize = 24;
     const BEST: usize = 4;
     let spans = poses.len() - 1;
@@ -93,7 +93,7 @@ fn probe_points(out: &SweptMesh) -> Vec<DVec3> {
 }
 
 /// Rotation by `angle` about the axis through `point` along `axis`, then a slide along it.
-fn screw_pose(axis: DVec3, point: DVec3, angle: f64, slide: f64) -> Pose {
+pub(super) fn screw_pose(axis: DVec3, point: DVec3, angle: f64, slide: f64) -> Pose {
     let axis = axis.normalize();
     let q = DQuat::from_axis_angle(axis, angle);
     Pose::from_rotation_translation(q, point - q * point + slide * axis)
@@ -101,7 +101,7 @@ fn screw_pose(axis: DVec3, point: DVec3, angle: f64, slide: f64) -> Pose {
 
 /// An L-shaped prism (non-convex): the L `(0,0) (2,0) (2,1) (1,1) (1,2) (0,2)` extruded by
 /// `h` along z (20 triangles, wound either way: `Body::new` turns it outward).
-fn l_prism(h: f64) -> (Vec<DVec3>, Vec<[i64; 3]>) {
+pub(super) fn l_prism(h: f64) -> (Vec<DVec3>, Vec<[i64; 3]>) {
     let l = [
         (0.0, 0.0),
         (2.0, 0.0),
@@ -127,7 +127,7 @@ fn l_prism(h: f64) -> (Vec<DVec3>, Vec<[i64; 3]>) {
 }
 
 /// A smoothed polyscrew: 4 keys, 4-point subdivision, 3 levels (25 poses, 24 screws).
-fn smoothed_motion() -> Vec<Pose> {
+pub(super) fn smoothed_motion() -> Vec<Pose> {
     let keys = [
         Pose::IDENTITY,
         screw_pose(

@@ -1,0 +1,714 @@
+//! The swept region's boundary as one closed, consistently oriented, self-intersection-free
+//! triangle mesh: the zero set of the region's signed distance, contoured by marching
+//! tetrahedra (see `docs/sweep.md` for why this design and not a boolean of the soup).
+//!
+//! The region swept by a closed body `W` along poses `P(t)` is `{x : min_t d(P(t)^-1 x) <= 0}`
+//! with `d` the body's signed distance (negative inside). Here:
+//!
+//! 1. `d` is sampled once, in the body frame, on a grid of spacing `h_b = cell /`
+//!    [`BODY_SUBCELLS`] (exact point-to-triangle distances within a band of
+//!    [`BAND_CELLS`] cells of the surface, signs by ray parity along the grid's columns) and
+//!    read by trilinear interpolation, which is within `sqrt(3) h_b / 2` of `d` (`d` is
+//!    1-Lipschitz, and a trilinear weight `w` puts its corners `sqrt(sum u (1 - u)) h_b` from
+//!    the point on average);
+//! 2. the motion is sampled densely (no body point moves more than a cell between two
+//!    samples, each span on its own screw) and the region's field `g(x) = min_j d(P_j^-1 x)`
+//!    is taken on a world grid of spacing `cell` around the region;
+//! 3. each grid cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the
+//!    main diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where
+//!    `g` changes sign gives one triangle or a quad (two triangles) with its vertices on the
+//!    tetrahedron's edges;
+//! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
+//!    the motion (the body at 8 poses per sample interval on each side of the sample that
+//!    gave the minimum at the edge's ends), kept strictly inside the edge.
+//!
+//! Why it is closed and intersection-free: the surface pieces of a tetrahedron lie inside it
+//! and meet the pieces of its neighbours exactly on their shared faces (a vertex is owned by
+//! its grid edge, shared by every tetrahedron around the edge); every tetrahedron edge
+//! crossed by the zero set holds one vertex, so every surface edge is in exactly two
+//! triangles (two tetrahedra share a face, or two triangles of one quad share its diagonal),
+//! and the orientation is taken from which end of a crossed edge is inside. The outer layer
+//! of the grid is outside every instance, so the surface has no border.
+
+use glam::{DAffine3, DVec3};
+
+use super::{axis_distance, Body};
+use crate::error::{Error, Expected, Result};
+use crate::memory::{try_vec, Footprint};
+use crate::motion::pose::Pose;
+use crate::motion::screw::Screw;
+
+/// The default cell of [`sweep_closed`] as a fraction of the body's extent (the diagonal of
+/// its bounding box): 1.5 %.
+pub const DEFAULT_CELL_REL: f64 = 0.015;
+
+/// The body's distance grid is this many times finer than the world grid.
+pub const BODY_SUBCELLS: f64 = 6.0;
+
+/// Distances are exact within this many world cells of the body's surface (and clamped to
+/// it beyond): enough for the trilinear reads of every grid point whose cube the surface
+/// crosses (`sqrt(3)` cells from the surface at most, plus the body grid's own cube).
+pub const BAND_CELLS: f64 = 2.5;
+
+/// Poses per sample interval at which a vertex's refinement evaluates the body.
+pub const REFINE_POSES: usize = 8;
+
+/// Regula falsi steps of a vertex's refinement along its edge.
+pub const REFINE_ITERATIONS: usize = 5;
+
+/// A vertex is kept at least this fraction of its edge from either end: where the zero set
+/// passes through a grid point, the triangles around it stay far above round-off (and the
+/// float32 copy Blender keeps) instead of shrinking into a fan of slivers that rounding can
+/// fold through each other.
+pub const EDGE_MARGIN: f64 = 0.02;
+
+/// A cell below `extent / MAX_CELLS_PER_EXTENT` (the body's extent) is refused.
+pub const MAX_CELLS_PER_EXTENT: f64 = 1000.0;
+
+/// Most dense poses [`sweep_closed`] takes.
+pub const MAX_POSES: usize = 1 << 20;
+
+/// How to ask [`sweep_closed`] for less.
+const CELL_HINT: &str = "use a larger cell";
+
+/// Bytes per world-grid point: its value (4) and the pose that gave it (4).
+const WORLD_BYTES_PER_POINT: usize = 8;
+
+/// The body grid's origin is shifted by these fractions of its spacing (irrational-looking,
+/// unequal per axis), so that its columns do not run along the edges or diagonals of bodies
+/// made of round numbers.
+const GRID_JITTER: [f64; 3] = [0.313_725_49, 0.271_826_3, 0.141_4];
+
+/// Options of [`sweep_closed`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ClosedOptions {
+    /// The world grid's cell (body units, `> 0`); `None`: [`DEFAULT_CELL_REL`] of the body's
+    /// extent.
+    pub cell: Option<f64>,
+}
+
+/// The closed boundary and what it took.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClosedMesh {
+    /// Vertices, world frame.
+    pub vertices: Vec<DVec3>,
+    /// Triangles, counter-clockwise seen from outside; every edge in exactly two of them.
+    pub triangles: Vec<[u32; 3]>,
+    /// The world grid's cell.
+    pub cell: f64,
+    /// A bound on the distance of every vertex from the exact swept boundary (of the
+    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex
+    /// plus the body grid's interpolation bound `sqrt(3) h_b / 2`.
+    pub error_bound: f64,
+    /// Dense poses sampled.
+    pub poses: usize,
+}
+
+/// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
+struct BodyField {
+    origin: DVec3,
+    h: f64,
+    n: [usize; 3],
+    values: Vec<f32>,
+    band: f64,
+}
+
+impl BodyField {
+    /// Trilinear read at `p` (body frame); `band` outside the grid.
+    #[inline]
+    fn at(&self, p: DVec3) -> f64 {
+        let u = (p - self.origin) / self.h;
+        let [nx, ny, nz] = self.n;
+        if !(u.x >= 0.0 && u.y >= 0.0 && u.z >= 0.0) {
+            return self.band;
+        }
+        let (i, j, k) = (u.x as usize, u.y as usize, u.z as usize);
+        if i + 1 >= nx || j + 1 >= ny || k + 1 >= nz {
+            return self.band;
+        }
+        let (fx, fy, fz) = (u.x - i as f64, u.y - j as f64, u.z - k as f64);
+        let idx = |a: usize, b: usize, c: usize| (c * ny + b) * nx + a;
+        let v = |a, b, c| self.values[idx(a, b, c)] as f64;
+        let c00 = v(i, j, k) * (1.0 - fx) + v(i + 1, j, k) * fx;
+        let c10 = v(i, j + 1, k) * (1.0 - fx) + v(i + 1, j + 1, k) * fx;
+        let c01 = v(i, j, k + 1) * (1.0 - fx) + v(i + 1, j, k + 1) * fx;
+        let c11 = v(i, j + 1, k + 1) * (1.0 - fx) + v(i + 1, j + 1, k + 1) * fx;
+        let c0 = c00 * (1.0 - fy) + c10 * fy;
+        let c1 = c01 * (1.0 - fy) + c11 * fy;
+        c0 * (1.0 - fz) + c1 * fz
+    }
+
+    /// Samples `body`'s signed distance (see the module documentation).
+    fn new(body: &Body, h: f64, band: f64) -> Result<Self> {
+        let verts = body.vertices();
+        let (lo, hi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        // An origin off any round position, so grid columns do not run along the body's
+        // edges (ray parity counts each face crossed once).
+        let jitter = DVec3::from_array(GRID_JITTER) * h;
+        let origin = lo - DVec3::splat(band + 2.0 * h) - jitter;
+        let size = hi + DVec3::splat(band + 2.0 * h) - origin;
+        let n = [
+            (size.x / h).ceil() as usize + 1,
+            (size.y / h).ceil() as usize + 1,
+            (size.z / h).ceil() as usize + 1,
+        ];
+        let count = n[0].saturating_mul(n[1]).saturating_mul(n[2]);
+        Footprint::of::<f32>(count).check("the body's distance grid", CLOSED_HINT)?;
+        let mut values: Vec<f32> = try_vec(count, "the body's distance grid")?;
+        values.resize(count, band as f32);
+        let [nx, ny, nz] = n;
+        let point =
+            |i: usize, j: usize, k: usize| origin + DVec3::new(i as f64, j as f64, k as f64) * h;
+        let range = |lo: f64, hi: f64, o: f64, m: usize| -> (usize, usize) {
+            let a = ((lo - o) / h).floor().max(0.0) as usize;
+            let b = (((hi - o) / h).ceil().max(0.0) as usize).min(m - 1);
+            (a, b)
+        };
+        // Unsigned distances within the band.
+        for t in body.triangles() {
+            let [a, b, c] = t.map(|i| verts[i as usize]);
+            let tlo = a.min(b).min(c) - DVec3::splat(band);
+            let thi = a.max(b).max(c) + DVec3::splat(band);
+            let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
+            let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
+            let (k0, k1) = range(tlo.z, thi.z, origin.z, nz);
+            for k in k0..=k1 {
+                for j in j0..=j1 {
+                    for i in i0..=i1 {
+                        let d = point_triangle_distance(point(i, j, k), a, b, c);
+                        let slot = &mut values[(k * ny + j) * nx + i];
+                        if d < *slot as f64 {
+                            *slot = d as f32;
+                        }
+                    }
+                }
+            }
+        }
+        // Signs: crossings of each column (x_i, y_j) along z.
+        let mut crossings: Vec<(usize, f64)> = Vec::new();
+        for t in body.triangles() {
+            let [a, b, c] = t.map(|i| verts[i as usize]);
+            let tlo = a.min(b).min(c);
+            let thi = a.max(b).max(c);
+            let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
+            let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
+            let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
+            if det == 0.0 {
+                continue;
+            }
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    let p = point(i, j, 0);
+                    let (px, py) = (p.x - a.x, p.y - a.y);
+                    let s = (px * (c.y - a.y) - (c.x - a.x) * py) / det;
+                    let r = ((b.x - a.x) * py - px * (b.y - a.y)) / det;
+                    if s >= 0.0 && r >= 0.0 && s + r < 1.0 && s < 1.0 && r < 1.0 {
+                        let z = a.z + s * (b.z - a.z) + r * (c.z - a.z);
+                        crossings.push((j * nx + i, z));
+                    }
+                }
+            }
+        }
+        crossings.sort_unstable_by(|p, q| p.0.cmp(&q.0).then(p.1.total_cmp(&q.1)));
+        let mut start = 0;
+        while start < crossings.len() {
+            let column = crossings[start].0;
+            let mut end = start;
+            while end < crossings.len() && crossings[end].0 == column {
+                end += 1;
+            }
+            let zs = &crossings[start..end];
+            let (i, j) = (column % nx, column / nx);
+            let mut below = 0;
+            for k in 0..nz {
+                let z = origin.z + k as f64 * h;
+                while below < zs.len() && zs[below].1 <= z {
+                    below += 1;
+                }
+                if below % 2 == 1 {
+                    let slot = &mut values[(k * ny + j) * nx + i];
+                    *slot = -*slot;
+                }
+            }
+            start = end;
+        }
+        Ok(Self {
+            origin,
+            h,
+            n,
+            values,
+            band,
+        })
+    }
+}
+
+/// How to ask the closed sweep for less memory.
+pub const CLOSED_HINT: &str = "use a larger cell, fewer poses or a smaller motion";
+
+/// Distance from `p` to the triangle `(a, b, c)` (Ericson, *Real-Time Collision Detection*,
+/// 5.1.5: the closest point by Voronoi regions).
+pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return ap.length();
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return bp.length();
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (p - (a + v * ab)).length();
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return cp.length();
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (p - (a + w * ac)).length();
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (p - (b + w * (c - b))).length();
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (p - (a + ab * v + ac * w)).length()
+}
+
+/// The dense motion: every pose (body -> world) and, for each interval between two, the
+/// screw that joins them (relative to the first).
+struct DenseMotion {
+    poses: Vec<Pose>,
+    steps: Vec<Screw>,
+}
+
+impl DenseMotion {
+    /// Each span in the fewest steps that move no body vertex more than `step` (the arc of
+    /// the farthest vertex from the axis and the slide).
+    fn new(body: &Body, poses: &[Pose], step: f64) -> Result<Self> {
+        let mut out = Self {
+            poses: vec![poses[0]],
+            steps: Vec::new(),
+        };
+        for pair in poses.windows(2) {
+            let (a, b) = (&pair[0], &pair[1]);
+            let screw = Screw::between(&Pose::IDENTITY, &a.inverse().mul_pose(b));
+            let (axis, point) = (screw.axis(), screw.point());
+            let rho = body
+                .vertices()
+                .iter()
+                .map(|&q| axis_distance(q, point, axis))
+                .fold(0.0, f64::max);
+            let travel = (screw.angle() * rho).hypot(screw.slide());
+            let k = (travel / step).ceil().max(1.0);
+            if out.poses.len() as f64 + k > MAX_POSES as f64 {
+                return Err(Error::Limit {
+                    what: "cell",
+                    counted: "poses",
+                    count: (out.poses.len() as f64 + k).min(usize::MAX as f64) as usize,
+                    limit: MAX_POSES,
+                    hint: CELL_HINT,
+                });
+            }
+            let k = k as u32;
+            let one = Screw::between(&Pose::IDENTITY, &screw.motion(1.0 / k as f64));
+            for j in 1..=k {
+                out.poses
+                    .push(a.mul_pose(&screw.motion(j as f64 / k as f64)));
+                out.steps.push(one);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// The boundary of the region swept by the closed `body` along the polyscrew through `poses`
+/// as a closed, consistently oriented, self-intersection-free triangle mesh (see the module
+/// documentation).
+///
+/// # Errors
+/// - [`Error::TooFew`] for fewer than 2 poses; [`Error::BadPose`] for a pose out of range;
+/// - [`Error::Value`] (`"body"`) for a body that is not closed (no inside);
+/// - [`Error::Value`] (`"cell"`) for a cell that is not finite and positive, below
+///   `extent /` [`MAX_CELLS_PER_EXTENT`], or a motion needing more than [`MAX_POSES`] poses;
+/// - [`Error::Memory`] for grids or a mesh over the memory budget.
+pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedMesh> {
+    if poses.len() < 2 {
+        return Err(Error::TooFew {
+            got: poses.len(),
+            need: 2,
+        });
+    }
+    poses
+        .iter()
+        .enumerate()
+        .try_for_each(|(index, p)| p.check_range(index))?;
+    if !body.is_closed() {
+        return Err(Error::Degenerate {
+            what: "body",
+            at: None,
+            reason: "the mesh is not closed (every edge in two faces): it has no inside to sweep",
+        });
+    }
+    let extent = body.extent();
+    let cell = options.cell.unwrap_or(DEFAULT_CELL_REL * extent);
+    if !(cell.is_finite() && cell > 0.0 && cell * MAX_CELLS_PER_EXTENT >= extent) {
+        return Err(Error::Value {
+            what: "cell",
+            at: None,
+            value: cell,
+            expected: Expected::AtLeast {
+                min: extent / MAX_CELLS_PER_EXTENT,
+                limit: MAX_CELLS_PER_EXTENT as usize,
+                counted: "cells across the body's extent",
+            },
+        });
+    }
+    let band = BAND_CELLS * cell;
+    let field = BodyField::new(body, cell / BODY_SUBCELLS, band)?;
+    let motion = DenseMotion::new(body, poses, cell)?;
+    let to_body: Vec<DAffine3> = motion
+        .poses
+        .iter()
+        .map(|p| p.inverse().to_affine())
+        .collect();
+    // The world grid: the union of the instances' boxes (the body's box grown by the band),
+    // plus two cells, so the outer layer is outside every instance.
+    let verts = body.vertices();
+    let (blo, bhi) = verts
+        .iter()
+        .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let (blo, bhi) = (blo - DVec3::splat(band), bhi + DVec3::splat(band));
+    let boxes: Vec<(DVec3, DVec3)> = motion
+        .poses
+        .iter()
+        .map(|p| {
+            (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| {
+                let q = p.transform_point3(DVec3::new(
+                    if c & 1 == 0 { blo.x } else { bhi.x },
+                    if c & 2 == 0 { blo.y } else { bhi.y },
+                    if c & 4 == 0 { blo.z } else { bhi.z },
+                ));
+                (lo.min(q), hi.max(q))
+            })
+        })
+        .collect();
+    let (wlo, whi) = boxes.iter().fold(
+        (DVec3::INFINITY, DVec3::NEG_INFINITY),
+        |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
+    );
+    let origin = wlo - DVec3::splat(2.0 * cell);
+    let size = whi + DVec3::splat(2.0 * cell) - origin;
+    let dims = [
+        (size.x / cell).ceil() + 1.0,
+        (size.y / cell).ceil() + 1.0,
+        (size.z / cell).ceil() + 1.0,
+    ];
+    let total = dims[0] * dims[1] * dims[2];
+    if total > (usize::MAX / WORLD_BYTES_PER_POINT) as f64 {
+        return Err(Error::Limit {
+            what: "cell",
+            counted: "grid points",
+            count: total.min(usize::MAX as f64) as usize,
+            limit: usize::MAX / WORLD_BYTES_PER_POINT,
+            hint: CELL_HINT,
+        });
+    }
+    let n = dims.map(|d| d as usize);
+    let [nx, ny, nz] = n;
+    let count = nx * ny * nz;
+    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
+        + Footprint::of::<f32>(field.values.len()))
+    .check("the region's distance grid", CLOSED_HINT)?;
+    let mut g: Vec<f32> = try_vec(count, "the region's distance grid")?;
+    g.resize(count, band as f32);
+    let mut arg: Vec<u32> = try_vec(count, "the region's distance grid")?;
+    arg.resize(count, u32::MAX);
+    let deep = -(band as f32);
+    for (j, (inv, (lo, hi))) in to_body.iter().zip(&boxes).enumerate() {
+        let i0 = ((lo.x - origin.x) / cell).floor().max(0.0) as usize;
+        let i1 = (((hi.x - origin.x) / cell).ceil() as usize).min(nx - 1);
+        let j0 = ((lo.y - origin.y) / cell).floor().max(0.0) as usize;
+        let j1 = (((hi.y - origin.y) / cell).ceil() as usize).min(ny - 1);
+        let k0 = ((lo.z - origin.z) / cell).floor().max(0.0) as usize;
+        let k1 = (((hi.z - origin.z) / cell).ceil() as usize).min(nz - 1);
+        let dx = inv.matrix3.x_axis * cell;
+        for k in k0..=k1 {
+            for jj in j0..=j1 {
+                let row = (k * ny + jj) * nx;
+                let mut p = inv
+                    .transform_point3(origin + DVec3::new(i0 as f64, jj as f64, k as f64) * cell);
+                for i in i0..=i1 {
+                    let slot = row + i;
+                    if g[slot] > deep {
+                        let v = field.at(p) as f32;
+                        if v < g[slot] {
+                            g[slot] = v;
+                            arg[slot] = j as u32;
+                        }
+                    }
+                    p += dx;
+                }
+            }
+        }
+    }
+    let refine = Refiner::new(&field, &motion)?;
+    let mut out = ClosedMesh {
+        cell,
+        poses: motion.poses.len(),
+        ..ClosedMesh::default()
+    };
+    contour(&g, &arg, n, origin, cell, &refine, &mut out)?;
+    out.error_bound += 0.5 * 3f64.sqrt() * field.h;
+    Ok(out)
+}
+
+/// Evaluates the region's field between the motion's samples.
+struct Refiner<'a> {
+    field: &'a BodyField,
+    /// World -> body at [`REFINE_POSES`] poses per sample interval (sample `j` at
+    /// `j * REFINE_POSES`).
+    fine: Vec<DAffine3>,
+}
+
+impl<'a> Refiner<'a> {
+    fn new(field: &'a BodyField, motion: &DenseMotion) -> Result<Self> {
+        let count = motion.steps.len() * REFINE_POSES + 1;
+        Footprint::of::<DAffine3>(count).check("the refined motion", CLOSED_HINT)?;
+        let mut fine = try_vec(count, "the refined motion")?;
+        for (pose, screw) in motion.poses.iter().zip(&motion.steps) {
+            for s in 0..REFINE_POSES {
+                let p = pose.mul_pose(&screw.motion(s as f64 / REFINE_POSES as f64));
+                fine.push(p.inverse().to_affine());
+            }
+        }
+        fine.push(motion.poses[motion.poses.len() - 1].inverse().to_affine());
+        Ok(Self { field, fine })
+    }
+
+    /// `min d(P(s)^-1 x)` over the poses `P(s)` within one sample interval of sample `j`.
+    fn at(&self, x: DVec3, j: u32) -> f64 {
+        let j = j as usize;
+        let lo = j.saturating_sub(1) * REFINE_POSES;
+        let hi = ((j + 1) * REFINE_POSES).min(self.fine.len() - 1);
+        self.fine[lo..=hi]
+            .iter()
+            .map(|a| self.field.at(a.transform_point3(x)))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// The region's field at `x` near the samples `js` (`u32::MAX`: none).
+    fn near(&self, x: DVec3, js: [u32; 2]) -> f64 {
+        let a = if js[0] == u32::MAX {
+            f64::INFINITY
+        } else {
+            self.at(x, js[0])
+        };
+        if js[1] == js[0] || js[1] == u32::MAX {
+            return a;
+        }
+        a.min(self.at(x, js[1]))
+    }
+}
+
+/// The six tetrahedra of Kuhn's triangulation of the unit cube, as corner codes
+/// (`x | y << 1 | z << 2`), each positively oriented.
+const KUHN: [[u8; 4]; 6] = [
+    [0, 1, 3, 7],
+    [0, 1, 5, 7],
+    [0, 2, 3, 7],
+    [0, 2, 6, 7],
+    [0, 4, 5, 7],
+    [0, 4, 6, 7],
+];
+
+/// Marching tetrahedra over the world grid (see the module documentation).
+fn contour(
+    g: &[f32],
+    arg: &[u32],
+    n: [usize; 3],
+    origin: DVec3,
+    cell: f64,
+    refine: &Refiner<'_>,
+    out: &mut ClosedMesh,
+) -> Result<()> {
+    use std::collections::HashMap;
+    let [nx, ny, nz] = n;
+    let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
+    let point = |p: usize| {
+        let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
+        origin + DVec3::new(i as f64, j as f64, k as f64) * cell
+    };
+    let offset = |code: u8| {
+        (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
+    };
+    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
+    let mut residual: f64 = 0.0;
+    // The vertex on the grid edge from point `p` to point `q` (`q` above `p` on every axis
+    // it differs in), made once.
+    let mut vertex = |p: usize, q: usize, out: &mut ClosedMesh| -> Result<u32> {
+        let key = (p, q);
+        if let Some(&v) = edges.get(&key) {
+            return Ok(v);
+        }
+        let (a, b) = (point(p), point(q));
+        let (fa, fb) = (g[p] as f64, g[q] as f64);
+        let lerp = |t: f64| a.lerp(b, t.clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN));
+        let mut t = fa / (fa - fb);
+        let js = [arg[p], arg[q]];
+        // Regula falsi on the refined field, when it still brackets the edge.
+        let (mut ta, mut tb) = (0.0, 1.0);
+        let (mut ga, mut gb) = (refine.near(a, js), refine.near(b, js));
+        if (ga < 0.0) != (gb < 0.0) {
+            for _ in 0..REFINE_ITERATIONS {
+                t = (ta + (tb - ta) * ga / (ga - gb)).clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN);
+                let gt = refine.near(lerp(t), js);
+                if gt == 0.0 {
+                    break;
+                }
+                if (gt < 0.0) == (ga < 0.0) {
+                    ta = t;
+                    ga = gt;
+                } else {
+                    tb = t;
+                    gb = gt;
+                }
+            }
+        }
+        let x = lerp(t);
+        residual = residual.max(refine.near(x, js).abs().min(cell));
+        let v = out.vertices.len();
+        if v >= u32::MAX as usize {
+            return Err(Error::Limit {
+                what: "cell",
+                counted: "vertices",
+                count: v + 1,
+                limit: u32::MAX as usize,
+                hint: CELL_HINT,
+            });
+        }
+        out.vertices.push(x);
+        edges.insert(key, v as u32);
+        Ok(v as u32)
+    };
+    let inside = |p: usize| g[p] < 0.0;
+    for k in 0..nz - 1 {
+        for j in 0..ny - 1 {
+            for i in 0..nx - 1 {
+                let base = index(i, j, k);
+                let corner = |c: u8| base + offset(c);
+                let first = inside(base);
+                if (1..8u8).all(|c| inside(corner(c)) == first) {
+                    continue;
+                }
+                for tet in KUHN {
+                    let pts = tet.map(corner);
+                    let ins: Vec<usize> = pts.iter().copied().filter(|&p| inside(p)).collect();
+                    let outs: Vec<usize> = pts.iter().copied().filter(|&p| !inside(p)).collect();
+                    // A grid edge by its ends, lower first.
+                    let edge = |a: usize, b: usize| if a < b { (a, b) } else { (b, a) };
+                    match ins.len() {
+                        1 | 3 => {
+                            // One apex apart from the three others.
+                            let (apex, rest, apex_in) = if ins.len() == 1 {
+                                (ins[0], [outs[0], outs[1], outs[2]], true)
+                            } else {
+                                (outs[0], [ins[0], ins[1], ins[2]], false)
+                            };
+                            let mut tri = [0u32; 3];
+                            for (slot, &r) in tri.iter_mut().zip(&rest) {
+                                let (p, q) = edge(apex, r);
+                                *slot = vertex(p, q, out)?;
+                            }
+                            // Outward: from the inside end of a crossed edge to its outside end.
+                            let (from, to) = if apex_in {
+                                (apex, rest[0])
+                            } else {
+                                (rest[0], apex)
+                            };
+                            push_oriented(out, tri, point(to) - point(from));
+                        }
+                        2 => {
+                            let (a, b, c, d) = (ins[0], ins[1], outs[0], outs[1]);
+                            let ac = {
+                                let (p, q) = edge(a, c);
+                                vertex(p, q, out)?
+                            };
+                            let ad = {
+                                let (p, q) = edge(a, d);
+                                vertex(p, q, out)?
+                            };
+                            let bd = {
+                                let (p, q) = edge(b, d);
+                                vertex(p, q, out)?
+                            };
+                            let bc = {
+                                let (p, q) = edge(b, c);
+                                vertex(p, q, out)?
+                            };
+                            // Both triangles hold the crossing of the edge a -> c.
+                            let outward = point(c) - point(a);
+                            let flip = orientation(out, [ac, ad, bd], outward);
+                            let (t0, t1) = ([ac, ad, bd], [ac, bd, bc]);
+                            if flip {
+                                out.triangles.push([t0[0], t0[2], t0[1]]);
+                                out.triangles.push([t1[0], t1[2], t1[1]]);
+                            } else {
+                                out.triangles.push(t0);
+                                out.triangles.push(t1);
+                            }
+                        }
+                        _ => {}
+                    }
+                }
+            }
+        }
+    }
+    out.error_bound = residual;
+    Ok(())
+}
+
+/// Whether the triangle `t` must be reversed to face along `outward`.
+fn orientation(out: &ClosedMesh, t: [u32; 3], outward: DVec3) -> bool {
+    let [a, b, c] = t.map(|i| out.vertices[i as usize]);
+    (b - a).cross(c - a).dot(outward) < 0.0
+}
+
+/// Adds `t`, reversed if needed to face along `outward`.
+fn push_oriented(out: &mut ClosedMesh, t: [u32; 3], outward: DVec3) {
+    if orientation(out, t, outward) {
+        out.triangles.push([t[0], t[2], t[1]]);
+    } else {
+        out.triangles.push(t);
+    }
+}
+
+/// [`Body::new`] then [`sweep_closed`].
+///
+/// # Errors
+/// Those of [`Body::new`] and [`sweep_closed`].
+pub fn sweep_closed_mesh(
+    vertices: &[DVec3],
+    triangles: &[[i64; 3]],
+    poses: &[Pose],
+    options: &ClosedOptions,
+) -> Result<ClosedMesh> {
+    if poses.len() < 2 {
+        return Err(Error::TooFew {
+            got: poses.len(),
+            need: 2,
+        });
+    }
+    let body = Body::new(vertices, triangles)?;
+    sweep_closed(&body, poses, options)
+}
