@@ -370,7 +370,7 @@ CONVERSIONS = [
     ("Playback.channels, float32 frames", f"playback().channels({f32('(250_000_000,)')})",
      f"Playback.channels: the channel values would need 40.0 GB, over the memory budget of 1.07 GB: pass fewer frames or keys in one call {BUDGET}"),
     ("keys_parameters, float32 frames", f"ps.keys_parameters([0., 1.], {f32('(250_000_000,)')}, size=1.0, poses=K2)",
-     f"keys_parameters: timing Keys would need 24.0 GB, over the memory budget of 1.07 GB: pass fewer frames or keys in one call {BUDGET}"),
+     f"keys_parameters: timing Keys would need 26.0 GB, over the memory budget of 1.07 GB: pass fewer frames or keys in one call {BUDGET}"),
     ("fit_angular_velocity, float32 sample_times", f"ps.fit_angular_velocity([[1., 0, 0, 0]] * 2, [0., 1.], [0., 1.], np.zeros((2, 3)), sample_times={f32('(250_000_000,)')})",
      f"fit_angular_velocity: the fit would need 34.0 GB, over the memory budget of 1.07 GB: use fewer keys, fewer variable frames (max_frames) or a longer fragment_duration {BUDGET}"),
     ("evaluate_fcurves, int32 codes", "ps.evaluate_fcurves([0.], **{**curve(), 'interpolation': np.broadcast_to(np.int32(2), (2**28,))})",
