@@ -76,10 +76,10 @@ def load_addon():
     """The add-on's bake module: the installed extension when enabled, else this checkout's."""
     for name in list(sys.modules):
         if name.startswith("bl_ext.") and name.endswith(".screwbender"):
-            return importlib.import_module(f"{name}.bake")
+            return importlib.import_module(f"{name}.blender.bake")
     sys.path.insert(0, str(ROOT / "addon"))
     try:
-        return importlib.import_module("screwbender.bake")
+        return importlib.import_module("screwbender.blender.bake")
     except ImportError as err:
         raise Failure(
             f"cannot import the add-on ({err}); install the ScrewBender extension or put the polyscrew wheel on PYTHONPATH"

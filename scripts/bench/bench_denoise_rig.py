@@ -114,7 +114,7 @@ def count_reads(bones: int) -> dict:
     """Keyframe reads of one run of ours: per (property): how many curves were read once, twice, ..."""
     from collections import Counter
 
-    bulk = sys.modules["bl_ext.user_default.screwbender.bulk"]
+    bulk = sys.modules["bl_ext.user_default.screwbender.blender.bulk"]
     rig(bones)
     original, reads = bulk.get, Counter()
 

@@ -45,10 +45,10 @@ demo_common.blender_with_addon()
 import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 
-preview = importlib.import_module("bl_ext.user_default.screwbender.preview")
-keys = importlib.import_module("bl_ext.user_default.screwbender.keys")
-bake = importlib.import_module("bl_ext.user_default.screwbender.bake")
-channels = importlib.import_module("bl_ext.user_default.screwbender.channels")
+preview = importlib.import_module("bl_ext.user_default.screwbender.blender.preview")
+keys = importlib.import_module("bl_ext.user_default.screwbender.blender.keys")
+bake = importlib.import_module("bl_ext.user_default.screwbender.blender.bake")
+channels = importlib.import_module("bl_ext.user_default.screwbender.blender.channels")
 
 KEYS = 50
 LEVELS = 5
@@ -88,7 +88,7 @@ def median_ms(run, repeat: int) -> dict[str, float]:
 
 def many_objects(count: int, repeat: int) -> None:
     """The scene refresh of `count` previewed objects (see the module docstring)."""
-    draw = importlib.import_module("bl_ext.user_default.screwbender.preview_draw")
+    draw = importlib.import_module("bl_ext.user_default.screwbender.ops.preview_draw")
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     scene = bpy.context.scene
     objects = []

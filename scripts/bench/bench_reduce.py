@@ -64,8 +64,8 @@ import bpy  # noqa: E402
 import polyscrew  # noqa: E402
 
 ADDON = "bl_ext.user_default.screwbender"
-channels = importlib.import_module(f"{ADDON}.channels")
-curves = importlib.import_module(f"{ADDON}.curves")
+channels = importlib.import_module(f"{ADDON}.blender.channels")
+curves = importlib.import_module(f"{ADDON}.blender.curves")
 
 TOLERANCES = ((0.0005, 0.05), (0.001, 0.5), (0.005, 1.0))  # metres, degrees
 #: Float32 world matrices in Blender's playback: what a check may add to the tolerance.

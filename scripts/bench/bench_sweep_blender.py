@@ -33,7 +33,7 @@ SCREWS = 64
 
 def main() -> None:
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
-    swept = __import__("bl_ext.user_default.screwbender.swept", fromlist=["swept"])
+    swept = __import__("bl_ext.user_default.screwbender.blender.swept", fromlist=["swept"])
     scene = bpy.context.scene
     v, t = bench_shapes.bumpy_torus(250, 200)
     mesh = swept.mesh_from_arrays("Bumpy", v, t)

@@ -36,8 +36,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Matrix, Quaternion, Vector  # noqa: E402
 
-angvel = importlib.import_module("bl_ext.user_default.screwbender.angvel")
-transaction = importlib.import_module("bl_ext.user_default.screwbender.transaction")
+angvel = importlib.import_module("bl_ext.user_default.screwbender.blender.angvel")
+transaction = importlib.import_module("bl_ext.user_default.screwbender.blender.transaction")
 
 FPS = 24
 N_KEYS = 20

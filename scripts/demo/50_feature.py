@@ -76,7 +76,7 @@ def keyed_object(name: str, mesh, frames, poses, offset: Vector) -> bpy.types.Ob
 
 def select_keys(obj, frames) -> None:
     """Selects exactly the keys at `frames` (the keys Approximate Keys works on)."""
-    from bl_ext.user_default.screwbender import channels
+    from bl_ext.user_default.screwbender.blender import channels
 
     for fcurve in channels.object_fcurves(obj):
         for point in fcurve.keyframe_points:

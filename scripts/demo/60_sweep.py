@@ -150,7 +150,7 @@ def render(source_scene, motion: str, obj: bpy.types.Object, region: bpy.types.O
 def demo_common_module_swept():
     import importlib
 
-    return importlib.import_module("bl_ext.user_default.screwbender.swept")
+    return importlib.import_module("bl_ext.user_default.screwbender.blender.swept")
 
 
 def main() -> None:

@@ -30,7 +30,7 @@ import bpy  # noqa: E402
 import numpy as np  # noqa: E402
 from mathutils import Euler  # noqa: E402
 
-pd = importlib.import_module("bl_ext.user_default.screwbender.preview_draw")
+pd = importlib.import_module("bl_ext.user_default.screwbender.ops.preview_draw")
 
 PANEL = (800, 640)
 #: Per panel: (object, scheme, levels, style, show raw, camera rotation in degrees).

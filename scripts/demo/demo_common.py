@@ -79,7 +79,7 @@ def blender_with_addon():
 
     if not Path(polyscrew.__file__).resolve().is_relative_to(wheels.resolve()):
         sys.exit(f"demo: polyscrew comes from {polyscrew.__file__}, not from the extension")
-    return importlib.import_module("bl_ext.user_default.screwbender.bake")
+    return importlib.import_module("bl_ext.user_default.screwbender.blender.bake")
 
 
 def channels():
@@ -90,7 +90,7 @@ def channels():
         import importlib.util
 
         spec = importlib.util.spec_from_file_location(
-            "screwbender_channels", ROOT / "addon" / "screwbender" / "channels.py"
+            "screwbender_channels", ROOT / "addon" / "screwbender" / "blender" / "channels.py"
         )
         module = importlib.util.module_from_spec(spec)
         sys.modules[spec.name] = module

@@ -129,7 +129,7 @@ def key_poses(obj, frames: Sequence[float], poses: np.ndarray, scales: np.ndarra
 
 def fcurves(obj) -> list[bpy.types.FCurve]:
     """The F-curves of `obj`'s active action and slot (the add-on's channels.py, any version)."""
-    return addon_module("channels").object_fcurves(obj)
+    return addon_module("blender.channels").object_fcurves(obj)
 
 
 def curve_points(fcurve) -> np.ndarray:
@@ -174,7 +174,7 @@ def snapshot_action(action, key_selection: bool = True) -> dict:
     `key_selection`, which keys are selected too)."""
     if action is None:
         return {}
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     bags = [(slot, channels.fcurves(bag), channels.groups(bag)) for slot, bag in channels.containers(action)]
     out = {"name": action.name, "library": action.library, "bags": []}
     for identifier, curves, groups in bags:

@@ -58,7 +58,7 @@ if _result != {"FINISHED"} or ADDON not in bpy.context.preferences.addons:
 
 
 def addon_module(name: str = ""):
-    """A module of the installed add-on, e.g. addon_module("bake")."""
+    """A module of the installed add-on, e.g. addon_module("blender.bake")."""
     return importlib.import_module(f"{ADDON}.{name}" if name else ADDON)
 
 
@@ -81,8 +81,8 @@ def factory_scene():
 def sb():
     """The installed add-on's modules: sb.keys, sb.bake, sb.channels."""
     class Modules:
-        keys = addon_module("keys")
-        bake = addon_module("bake")
-        channels = addon_module("channels")
+        keys = addon_module("blender.keys")
+        bake = addon_module("blender.bake")
+        channels = addon_module("blender.channels")
 
     return Modules

@@ -18,7 +18,7 @@ from conftest import addon_module
 def counting_reads():
     """`with counting_reads() as reads:` ... ; `reads` is a Counter of keyframe-property reads
     per F-curve (other collections, vertices for instance, are counted under their RNA type)."""
-    bulk = addon_module("bulk")
+    bulk = addon_module("blender.bulk")
     original = bulk.get
     reads: Counter = Counter()
 

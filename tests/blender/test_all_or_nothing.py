@@ -87,7 +87,7 @@ def test_smooth_motion(sb):
     a, b = keyed("A"), keyed("B", offset=1.0)
     h.select_only(a, b)
     # 10 curves per object (location, Euler, scale): the 14th is B's 4th
-    with fail_on_call("channels", "new_fcurve", 14) as calls:
+    with fail_on_call("blender.channels", "new_fcurve", 14) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.smooth())
     assert calls["n"] == 14  # it failed halfway: A was written, B half
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}  # and works afterwards
@@ -97,7 +97,7 @@ def test_smooth_motion_resmoothing_a_result(sb):
     a = keyed("A")
     h.select_only(a)
     assert bpy.ops.screwbender.smooth(scheme="bspline") == {"FINISHED"}
-    with fail_on_call("channels", "new_fcurve", 5) as calls:
+    with fail_on_call("blender.channels", "new_fcurve", 5) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.smooth(scheme="four_point"))
     assert calls["n"] == 5
 
@@ -106,7 +106,7 @@ def test_revert(sb):
     a, b = keyed("A"), keyed("B", offset=1.0)
     h.select_only(a, b)
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
-    with fail_on_call("channels", "assign", 2) as calls:
+    with fail_on_call("blender.channels", "assign", 2) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.revert())
     assert calls["n"] >= 2  # (the undoing assigns the old actions again)
 
@@ -116,12 +116,12 @@ def test_apply_preview(sb):
     for obj in (a, b):
         obj.screwbender_preview = True
     h.select_only(a, b)
-    with fail_on_call("channels", "new_fcurve", 14) as calls:
+    with fail_on_call("blender.channels", "new_fcurve", 14) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.preview_apply())
     assert calls["n"] == 14
     for obj in (a, b):
         obj.screwbender_preview = False
-    addon_module("preview_draw").sync()
+    addon_module("ops.preview_draw").sync()
 
 
 def test_insert_key_on_motion(sb):
@@ -129,7 +129,7 @@ def test_insert_key_on_motion(sb):
     h.select_only(a, b)
     bpy.context.scene.frame_set(13)
     # 9 keyed channels per object: the 12th insertion is B's 3rd
-    with fail_on_call("channels", "insert_key", 12) as calls:
+    with fail_on_call("blender.channels", "insert_key", 12) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.insert_key())
     assert calls["n"] == 12
 
@@ -142,7 +142,7 @@ def test_insert_key_on_motion_new_curve(sb):
         obj.keyframe_insert("location", frame=frame)
     h.select_only(obj)
     bpy.context.scene.frame_set(5)
-    with fail_on_call("channels", "insert_key", 5) as calls:
+    with fail_on_call("blender.channels", "insert_key", 5) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.insert_key())
     assert calls["n"] == 5
 
@@ -152,19 +152,19 @@ def test_fit_angular_velocity(sb):
     h.select_only(obj)
     assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
     h.select_only(obj)
-    with fail_on_call("angvel", "_set_curve_points", 1) as calls:
+    with fail_on_call("blender.angvel", "_set_curve_points", 1) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.fit_angular_velocity())
     assert calls["n"] == 1
     # a second fit replaces the first fit's curve data: also undone when it fails
     assert bpy.ops.screwbender.fit_angular_velocity() == {"FINISHED"}
-    with fail_on_call("angvel", "_set_curve_points", 1):
+    with fail_on_call("blender.angvel", "_set_curve_points", 1):
         check_unchanged(lambda: bpy.ops.screwbender.fit_angular_velocity())
 
 
 def test_add_angular_velocity_sketch(sb):
     obj = keyed("Top", mode="QUATERNION", scale=False)
     h.select_only(obj)
-    with fail_on_call("angvel", "_set_curve_points", 1) as calls:
+    with fail_on_call("blender.angvel", "_set_curve_points", 1) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.add_angular_velocity_sketch())
     assert calls["n"] == 1
 
@@ -174,28 +174,28 @@ def test_add_angular_velocity_sketch_after_its_last_write(sb):
     record, the sphere, the sketch and its curves all go."""
     obj = keyed("Top", mode="QUATERNION", scale=False)
     h.select_only(obj)
-    with fail_after_call("angvel_ops", "add_sketch", 1) as calls:
+    with fail_after_call("ops.angvel_ops", "add_sketch", 1) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.add_angular_velocity_sketch())
     assert calls["n"] == 1
-    assert addon_module("angvel").SPHERE_KEY not in obj
+    assert addon_module("blender.angvel").SPHERE_KEY not in obj
 
 
 def test_build_swept_region_into_an_unlinked_collection(sb):
     """An existing "Swept Regions" collection that is not in the scene: the sweep links it,
     and a failure unlinks it again."""
-    bpy.data.collections.new(addon_module("swept").COLLECTION)
+    bpy.data.collections.new(addon_module("blender.swept").COLLECTION)
     a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
     h.select_only(a, b)
-    with fail_on_call("swept", "mesh_from_arrays", 2) as calls:
+    with fail_on_call("blender.swept", "mesh_from_arrays", 2) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.sweep())
     assert calls["n"] == 2
-    assert addon_module("swept").COLLECTION not in bpy.context.scene.collection.children
+    assert addon_module("blender.swept").COLLECTION not in bpy.context.scene.collection.children
 
 
 def test_build_swept_region(sb):
     a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
     h.select_only(a, b)
-    with fail_on_call("swept", "mesh_from_arrays", 2) as calls:
+    with fail_on_call("blender.swept", "mesh_from_arrays", 2) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.sweep())
     assert calls["n"] == 2
 
@@ -206,6 +206,6 @@ def test_check_clearance(sb):
     assert bpy.ops.screwbender.sweep() == {"FINISHED"}
     region = bpy.context.view_layer.objects.active
     h.select_only(region, b)
-    with fail_on_call("swept", "select_faces", 2) as calls:
+    with fail_on_call("blender.swept", "select_faces", 2) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.check_clearance())
     assert calls["n"] == 2

@@ -68,7 +68,7 @@ def select_rotation_keys_path(obj, chosen_frames, path):
 def test_sketch_starts_as_the_current_angular_velocity(top):
     obj, frames = top
     assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
-    av = addon_module("angvel")
+    av = addon_module("blender.angvel")
     sphere = av.sphere_of(obj)
     assert sphere is not None and sphere.type == "MESH"
     target_frames, directions, speeds = av.read_sketch(sphere)
@@ -84,7 +84,7 @@ def test_sketch_starts_as_the_current_angular_velocity(top):
 def test_fit_follows_the_sketch_keeps_selected_keys_and_location(top):
     obj, frames = top
     assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
-    av = addon_module("angvel")
+    av = addon_module("blender.angvel")
     sphere = av.sphere_of(obj)
     sketch = sphere[av.SKETCH_KEY]
     # The user's wobble pattern on the direction curve (points stay on the unit sphere).
@@ -135,7 +135,7 @@ def test_fit_follows_the_sketch_keeps_selected_keys_and_location(top):
 def test_infeasible_sketch_is_refused_and_nothing_changes(top):
     obj, frames = top
     assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
-    av = addon_module("angvel")
+    av = addon_module("blender.angvel")
     sphere = av.sphere_of(obj)
     # A sketch spinning the other way round, every key held, no variable frames.
     sketch = sphere[av.SKETCH_KEY]
@@ -163,7 +163,7 @@ def test_fit_needs_a_sketch(top):
 def test_drawn_bezier_stroke_timed_by_length(top):
     obj, frames = top
     assert bpy.ops.screwbender.add_angular_velocity_sketch() == {"FINISHED"}
-    av = addon_module("angvel")
+    av = addon_module("blender.angvel")
     sphere = av.sphere_of(obj)
     sketch = sphere[av.SKETCH_KEY]
     # A hand-drawn stroke: a Bezier spline along the equator, 90 degrees then 180 more.

@@ -59,7 +59,7 @@ def test_linked_action(tmp_path):
     with bpy.data.libraries.load(str(library), link=True) as (source, target):
         target.actions = ["Shared"]
     linked = next(a for a in bpy.data.actions if a.library is not None)
-    channels = h.addon_module("channels")
+    channels = h.addon_module("blender.channels")
     slot = channels.ensure_slot(linked, obj)  # its own slot "OBBody" (None on 4.2)
     channels.assign(obj, linked, slot.identifier if slot is not None else "")
     refuse(r"Body: action 'Shared' is linked from a library and cannot be edited")

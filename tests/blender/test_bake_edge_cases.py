@@ -85,7 +85,7 @@ def test_resmoothing_a_shared_result_that_splits_replaces_it_once(sb, capfd):
 
 
 def test_a_commit_action_that_fails_does_not_stop_the_others_and_is_reported():
-    transaction = addon_module("transaction")
+    transaction = addon_module("blender.transaction")
     ran = []
 
     def broken():
@@ -117,7 +117,7 @@ def test_a_commit_action_that_fails_does_not_stop_the_others_and_is_reported():
 
 
 def test_a_commit_action_registered_once_per_key_runs_once():
-    transaction = addon_module("transaction")
+    transaction = addon_module("blender.transaction")
     ran = []
     with transaction.atomic() as t:
         with transaction.atomic(t) as inner:
@@ -192,7 +192,7 @@ def test_muted_and_keyless_curves_the_bake_does_not_write_survive(sb, capfd):
 
 
 def curve_in(action, obj, path, index):
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     return next(
         fc for fc in channels.action_fcurves(action, channels.slot_identifier(obj))
         if fc.data_path == path and fc.array_index == index

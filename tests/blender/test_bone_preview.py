@@ -31,7 +31,7 @@ CHAIN = ("Upper", "Fore", "Hand")
 @pytest.fixture
 def pd():
     """The overlay module; the overlay is left disabled after each test."""
-    module = addon_module("preview_draw")
+    module = addon_module("ops.preview_draw")
     yield module
     for obj in bpy.data.objects:
         obj.screwbender_preview = False
@@ -69,7 +69,7 @@ def bone_entry(pd, rig, bone):
 
 
 def owner(rig, bone=""):
-    return addon_module("owners").Owner(rig, bone)
+    return addon_module("blender.owners").Owner(rig, bone)
 
 
 def rest_offset(rig, bone) -> np.ndarray:
@@ -207,7 +207,7 @@ def test_hidden_bones_and_the_armatures_option(pd):
 
 
 def test_bone_geometry_is_an_octahedral_bone_of_the_bones_length():
-    preview = addon_module("preview")
+    preview = addon_module("blender.preview")
     g = preview.bone_geometry(2.0)
     assert g.kind == "BONE" and g.points.shape == (6, 3) and g.edges.shape == (12, 2) and g.tris.shape == (8, 3)
     np.testing.assert_allclose(g.points[0], (0, 0, 0))
@@ -411,7 +411,7 @@ def test_insert_key_in_object_mode_keys_the_armatures_bones(pd, capfd):
     scene = bpy.context.scene
     set_smooth(scene, "four_point", 4, armature="BONES")
     rig = keyed_rig()
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     bag = channels.container(rig.animation_data.action, channels.assigned_slot(rig))
     for fc in [fc for fc in h.fcurves(rig) if fc.data_path == 'pose.bones["Upper"].location']:
         channels.remove_fcurve(bag, fc)  # Upper keyed on its rotation only

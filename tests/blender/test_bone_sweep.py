@@ -96,7 +96,7 @@ def swept_objects():
 
 def test_a_prop_deformed_by_a_bone_is_swept_along_the_bones_world_motion():
     rig, prop = rig_with_prop()
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     rest = rest_vertices(prop)
     frames = range(1, LAST + 1)
     poses, misfit = [], 0.0
@@ -149,7 +149,7 @@ def test_a_prop_deformed_by_a_bone_is_swept_along_the_bones_world_motion():
 def test_partial_weights_on_one_bone_follow_it_fully():
     """Blender's Armature modifier divides by the sum of a vertex's weights: a vertex weighted
     0.4 to one bone alone follows it as fully as one weighted 1.0, and the prop sweeps the same."""
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     rig, full = rig_with_prop()
     expected = swept.compute(full, bpy.context, steps=2, caps=True)
     world_full = deformed_world(full, 17)
@@ -164,7 +164,7 @@ def test_partial_weights_on_one_bone_follow_it_fully():
 def test_a_prop_parented_to_a_bone_follows_the_smoothed_bone():
     scene = bpy.context.scene
     rig, prop = rig_with_prop(parent_bone=True)
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     assert swept.bone_driver(prop).deformed is False
     h.select_only(rig)
     assert bpy.ops.screwbender.smooth(armature="BOTH", step=0.5) == {"FINISHED"}

@@ -93,7 +93,7 @@ def test_key_poses_equal_matrix_basis(sb, mode):
 def addon_module_owners():
     from conftest import addon_module
 
-    return addon_module("owners")
+    return addon_module("blender.owners")
 
 
 def helix_poses(t: np.ndarray, radius=0.7, pitch=0.3) -> np.ndarray:

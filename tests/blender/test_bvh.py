@@ -96,7 +96,7 @@ def import_bvh(path) -> bpy.types.Object:
 
 def bone_curves(action, slot: str, bone: str, prop: str, size: int) -> np.ndarray:
     """(frames, values (N, size)) of a bone's curves in `action`."""
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     path = f'pose.bones["{bone}"].{prop}'
     curves = {fc.array_index: fc for fc in channels.action_fcurves(action, slot) if fc.data_path == path}
     assert sorted(curves) == list(range(size)), (bone, prop, sorted(curves))
@@ -115,7 +115,7 @@ def test_a_bvh_clip_is_smoothed_on_all_its_bones_in_one_call(tmp_path, capfd):
     connected = {b.name for b in rig.data.bones if b.use_connect}
     assert connected == {"RightLeg"}
     source = rig.animation_data.action
-    slot = addon_module("channels").slot_identifier(rig)
+    slot = addon_module("blender.channels").slot_identifier(rig)
     before = h.snapshot_action(source)
 
     h.select_only(rig)
@@ -133,7 +133,7 @@ def test_a_bvh_clip_is_smoothed_on_all_its_bones_in_one_call(tmp_path, capfd):
         mode = rig.pose.bones[bone].rotation_mode
         assert mode in h.EULER_ORDERS  # the importer's NATIVE mode: the BVH channel order
         key_frames, key_angles = bone_curves(source, slot, bone, "rotation_euler", 3)
-        has_location = any(fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("channels").action_fcurves(source, slot))
+        has_location = any(fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("blender.channels").action_fcurves(source, slot))
         # A connected bone's location is ignored by Blender: not read, not baked. Any other
         # bone's location is baked where it is keyed; where only its rotation is keyed, the
         # location stays constant (a screw through poses sharing their origin turns about an axis
@@ -162,12 +162,12 @@ def test_a_bvh_clip_is_smoothed_on_all_its_bones_in_one_call(tmp_path, capfd):
         elif bone not in connected:  # location not keyed: constant, so left unkeyed
             assert np.abs(reference[:, :3, 3]).max() < 1e-9
             assert not any(
-                fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("channels").action_fcurves(smoothed, slot)
+                fc.data_path == f'pose.bones["{bone}"].location' for fc in addon_module("blender.channels").action_fcurves(smoothed, slot)
             )
         else:  # no location was baked for a connected bone
             assert not any(
                 fc.data_path == f'pose.bones["{bone}"].location' and len(fc.keyframe_points) > len(key_frames)
-                for fc in addon_module("channels").action_fcurves(smoothed, slot)
+                for fc in addon_module("blender.channels").action_fcurves(smoothed, slot)
             )
     print(f"\nBVH clip, {len(bones)} bones ({len(connected)} connected), {FRAMES - 1} frames, one Smooth Motion call: "
           f"baked locations vs float64 polyscrew.sample {worst['location']:.1e} (largest {largest['location']:.2f}), "

@@ -17,7 +17,7 @@ import pytest
 import bake_helpers as h
 from conftest import addon_module
 
-channels = addon_module("channels")
+channels = addon_module("blender.channels")
 VERSION = bpy.app.version[:2]
 LOCATIONS = np.array([[0.0, 0.0, 0.0], [1.0, 2.0, 0.5], [3.0, 1.0, 1.0]])
 FRAMES = (1.0, 11.0, 21.0)

@@ -34,12 +34,12 @@ UNSUPPORTED = ["GENERATOR", "FNGENERATOR", "ENVELOPE", "NOISE", "LIMITS", "STEPP
 
 @pytest.fixture
 def curves():
-    return addon_module("curves")
+    return addon_module("blender.curves")
 
 
 @pytest.fixture
 def channels():
-    return addon_module("channels")
+    return addon_module("blender.channels")
 
 
 class Builder:

@@ -141,7 +141,7 @@ def test_bones_of_a_rig_in_one_call(sb):
             pb.keyframe_insert("rotation_euler", frame=f)
     h.select_only(rig)
     calls = {"n": 0}
-    module = addon_module("denoise")
+    module = addon_module("blender.denoise")
     original = module.polyscrew.denoise
 
     def counting(*args, **kwargs):
@@ -164,7 +164,7 @@ def test_failure_halfway_changes_nothing(sb):
     a, _, _, _ = keyed_noisy("A", seed=5)
     b, _, _, _ = keyed_noisy("B", seed=6)
     h.select_only(a, b)
-    module = addon_module("denoise")
+    module = addon_module("blender.denoise")
     original = module._edit_keys
     calls = {"n": 0}
 

@@ -20,7 +20,8 @@ def test_installed_from_zip_and_enabled():
     installed = Path(module.__file__).resolve()
     assert installed.is_relative_to(conftest.USER_DIR.resolve()), installed
     source = conftest.ROOT / "addon" / "screwbender"
-    shipped = sorted(p.name for p in source.iterdir() if p.suffix in (".py", ".toml"))
+    # The layer folders (pure/, blender/, ops/) ship as they are in the source.
+    shipped = sorted(p.relative_to(source).as_posix() for p in source.rglob("*") if p.suffix in (".py", ".toml"))
     assert len(shipped) >= 15, shipped
     for name in shipped:
         assert (installed.parent / name).is_file(), name

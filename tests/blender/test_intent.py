@@ -178,7 +178,7 @@ def test_timing_keys_keeps_the_pace_of_blenders_curves(sb, kind):
     frames = np.arange(1.0, 26.0)
     fine = np.arange(1.0, 25.0001, 0.125)
     blender = playback(obj, fine)
-    size = sb.keys.body_size(addon_module("owners").Owner(obj))
+    size = sb.keys.body_size(addon_module("blender.owners").Owner(obj))
     assert bpy.ops.screwbender.smooth(timing="keys", scheme="four_point") == {"FINISHED"}
     ours = playback(obj, fine)
     pick = np.isin(fine, frames)
@@ -293,7 +293,7 @@ def test_preview_and_insert_key_follow_spins_and_holds(sb):
     spins turned the whole way, holds still."""
     from conftest import addon_module
 
-    pd = addon_module("preview_draw")
+    pd = addon_module("ops.preview_draw")
     obj = h.new_object("Wheel", "MESH", "XYZ")  # a spin, a hold (21-31), a spin
     for f, v, x in ((1, 0, 0.0), (21, 360, 1.0), (31, 360, 1.0), (51, 720, 2.0)):
         obj.rotation_euler, obj.location = (0.0, 0.0, math.radians(v)), (x, 0.0, 0.0)

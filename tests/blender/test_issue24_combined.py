@@ -443,12 +443,12 @@ def test_range_modifiers_rerun_failing_midway_changes_nothing(sb):
         noise(curves_of(obj)["location", i], i)
     assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30) == {"FINISHED"}
     move_key(curves_of(obj)["location", 1], 37.0, 1.0)
-    mod = addon_module("modifiers")
+    mod = addon_module("blender.modifiers")
     assert mod is not None
-    with fail_on_call("modifiers", "copy_onto", 2) as calls:
+    with fail_on_call("blender.modifiers", "copy_onto", 2) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30))
     assert calls["n"] == 2
-    with fail_on_call("range_join", "write", 5) as calls:
+    with fail_on_call("blender.range_join", "write", 5) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30))
     assert calls["n"] == 5
     assert bpy.ops.screwbender.smooth(range_mode="CUSTOM", frame_start=10, frame_end=30) == {"FINISHED"}

@@ -316,7 +316,7 @@ def test_modifier_copies_are_all_or_nothing(sb):
         for i in range(3):
             curve(obj, "location", i).modifiers.new("NOISE")
     h.select_only(a, b)
-    with fail_on_call("modifiers", "copy_onto", 5) as calls:  # B's second curve
+    with fail_on_call("blender.modifiers", "copy_onto", 5) as calls:  # B's second curve
         check_unchanged(lambda: bpy.ops.screwbender.smooth())
     assert calls["n"] == 5
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
@@ -427,12 +427,12 @@ def test_an_edited_rerun_is_all_or_nothing(sb):
     obj = keyed("A")
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     move_key(curve(obj, "location", 1), 12.0, 1.0)
-    with fail_on_call("channels", "new_fcurve", 4) as calls:
+    with fail_on_call("blender.channels", "new_fcurve", 4) as calls:
         check_unchanged(lambda: bpy.ops.screwbender.smooth())
     assert calls["n"] == 4
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     assert bpy.ops.screwbender.revert() == {"FINISHED"}
-    with fail_on_call("channels", "assign", 1) as calls:  # the second Revert keeps the edit: fake user
+    with fail_on_call("blender.channels", "assign", 1) as calls:  # the second Revert keeps the edit: fake user
         check_unchanged(lambda: bpy.ops.screwbender.revert())
 
 

@@ -51,7 +51,7 @@ def set_smooth(scene, scheme="jarek", levels=3, timing="smooth") -> None:
 @pytest.fixture
 def pd():
     """The overlay module; the overlay is left disabled after each test."""
-    module = addon_module("preview_draw")
+    module = addon_module("ops.preview_draw")
     yield module
     for obj in bpy.data.objects:
         obj.screwbender_preview = False
@@ -162,7 +162,7 @@ def test_unpreviewable_keys_give_a_message_not_a_crash(pd):
 
 
 def test_instance_geometry_wireframe_and_bounding_box(pd):
-    preview = addon_module("preview")
+    preview = addon_module("blender.preview")
     obj = keyed_object()
     matrices = entry_of_enabled(pd, obj).instances
     mesh_points = np.array([v.co for v in obj.data.vertices])
@@ -738,8 +738,8 @@ def test_insert_key_four_point_hits_the_key_and_reports_the_change(pd, timing, c
     frame = 30.5
     times = np.union1d(np.arange(1.0, 62.0), [frame])  # the frames the operator checks
     before = motion_from_curves(obj, times, "four_point", 4, timing)
-    with addon_module("transaction").atomic() as t:
-        result = addon_module("insert_key").insert_key(obj, frame, pd.smooth_options(scene), t)
+    with addon_module("blender.transaction").atomic() as t:
+        result = addon_module("blender.insert_key").insert_key(obj, frame, pd.smooth_options(scene), t)
     np.testing.assert_array_equal(result.checked_frames, times)
     frames_after, keys_after = baked_matrices(obj)
     new_key = keys_after[list(frames_after).index(frame)]

@@ -94,7 +94,7 @@ def curves_of(obj, action=None) -> dict:
         listed = h.fcurves(obj)
     else:
         slot = action.slots[0].identifier if hasattr(action, "slots") and len(action.slots) else ""
-        listed = addon_module("channels").action_fcurves(action, slot)
+        listed = addon_module("blender.channels").action_fcurves(action, slot)
     return {(fc.data_path, fc.array_index): fc for fc in listed}
 
 
@@ -419,7 +419,7 @@ def test_a_range_bake_failing_halfway_changes_nothing_and_undo_restores():
     a, _ = keyed("A")
     b_obj, _ = keyed("B", seed=4)
     h.select_only(a, b_obj)
-    module = addon_module("range_join")
+    module = addon_module("blender.range_join")
     original = module.write
     calls = {"n": 0}
 

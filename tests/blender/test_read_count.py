@@ -26,8 +26,8 @@ def test_counter_counts_reads_per_curve_and_property():
     for frame in (1, 5, 9):
         ob.location = (frame, 0, 0)
         ob.keyframe_insert("location", frame=frame)
-    bulk = addon_module("bulk")
-    fc = addon_module("channels").object_fcurves(ob)[0]
+    bulk = addon_module("blender.bulk")
+    fc = addon_module("blender.channels").object_fcurves(ob)[0]
     co = np.empty(6, dtype=np.float32)
     with counting_reads() as reads:
         bulk.get(fc.keyframe_points, "co", co)

@@ -33,7 +33,7 @@ def dense_noisy_keys(obj, seed: int, prefix: str = "") -> None:
     path = f'pose.bones["{prefix}"].' if prefix else ""
     co = np.empty(2 * FRAMES, dtype=np.float32)
     co[0::2] = t
-    for fc in addon_module("channels").object_fcurves(obj):
+    for fc in addon_module("blender.channels").object_fcurves(obj):
         if not fc.data_path.startswith(path) or fc.data_path[len(path):] not in ("location", "rotation_euler"):
             continue
         rotation = "rotation" in fc.data_path
@@ -49,7 +49,7 @@ def dense_noisy_keys(obj, seed: int, prefix: str = "") -> None:
 def curve_keys(obj) -> dict:
     """(data path, index) -> key values of the object's action."""
     out = {}
-    for fc in addon_module("channels").object_fcurves(obj):
+    for fc in addon_module("blender.channels").object_fcurves(obj):
         co = np.empty(2 * len(fc.keyframe_points), dtype=np.float32)
         fc.keyframe_points.foreach_get("co", co)
         out[fc.data_path, fc.array_index] = co[1::2].copy()
@@ -123,7 +123,7 @@ def test_remove_noise_on_a_rig_in_pose_mode_with_a_key_selection_reads_each_curv
     rig = armature(bones=(("Upper", None, False), ("Fore", "Upper", False), ("Hand", "Fore", False)), holder=False)
     for i, bone in enumerate(("Upper", "Fore", "Hand")):
         dense_noisy_keys(rig, seed=10 + i, prefix=bone)
-    for fc in addon_module("channels").object_fcurves(rig):
+    for fc in addon_module("blender.channels").object_fcurves(rig):
         flags = np.zeros(FRAMES, dtype=bool)
         flags[10:50] = True
         fc.keyframe_points.foreach_set("select_control_point", flags)
@@ -200,9 +200,9 @@ def test_build_swept_region_reads_each_curve_and_mesh_once():
     assert reads["MeshVertices", "co"] == len(sources)  # each source's evaluated mesh, none read back
     created = bpy.data.collections["Swept Regions"].objects
     assert len(created) == len(sources)
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     for ob in created:  # the area stored is the mesh's own
-        area = addon_module("sweep_report").measures(*swept.mesh_triangles(ob.data)).area
+        area = addon_module("pure.sweep_report").measures(*swept.mesh_triangles(ob.data)).area
         assert math.isclose(ob["screwbender_area"], area, rel_tol=1e-12), (ob.name, ob["screwbender_area"], area)
 
 
@@ -210,7 +210,7 @@ def test_the_preview_refresh_on_many_objects_reads_each_curve_once():
     """Twenty previewed objects, ten of them linked duplicates of the other ten: a first
     refresh computes every preview, a refresh after a key edit recomputes one, a refresh
     with no change recomputes none; each reads each curve's keys once."""
-    pd = addon_module("preview_draw")
+    pd = addon_module("ops.preview_draw")
     scene = bpy.context.scene
     objects = []
     for i in range(10):
@@ -232,7 +232,7 @@ def test_the_preview_refresh_on_many_objects_reads_each_curve_once():
         counts = []
         for step in ("first", "edited", "unchanged"):
             if step == "edited":
-                fc = addon_module("channels").object_fcurves(objects[0])[0]
+                fc = addon_module("blender.channels").object_fcurves(objects[0])[0]
                 fc.keyframe_points[1].co.y += 0.5
                 fc.update()
             before = dict(pd.CACHE.recomputed)

@@ -106,8 +106,8 @@ def test_insert_key_reports_the_motion_blender_plays_after_the_insertion():
     Blender's curves read afresh, and the figures reported equal those measured from a fresh
     read, for plain and cyclic curves, with Auto Handle Smoothing and without (only the new
     key's neighbours read back), a key inserted between keys, on a key and on a subframe."""
-    ik, keys, bake = addon_module("insert_key"), addon_module("keys"), addon_module("bake")
-    transaction, preview_draw = addon_module("transaction"), addon_module("preview_draw")
+    ik, keys, bake = addon_module("blender.insert_key"), addon_module("blender.keys"), addon_module("blender.bake")
+    transaction, preview_draw = addon_module("blender.transaction"), addon_module("ops.preview_draw")
     options = preview_draw.smooth_options(bpy.context.scene)
     for cyclic, smoothing in ((False, "CONT_ACCEL"), (True, "CONT_ACCEL"), (False, "NONE"), (True, "NONE")):
         obj = keyed_object(f"{'Cyclic' if cyclic else 'Plain'} {smoothing}", 0.0, cyclic=cyclic)
@@ -135,8 +135,8 @@ def test_insert_key_reports_the_motion_blender_plays_after_the_insertion():
             for key, packed in spliced.items():  # what the run holds is what Blender has
                 for name, got in zip(("co", "handle_left", "handle_right"), fresh[key]):
                     np.testing.assert_array_equal(getattr(packed, name), got, err_msg=f"{key} {name} at {frame}")
-            owner = addon_module("owners").Owner(obj)
-            slot = addon_module("channels").slot_identifier(obj)
+            owner = addon_module("blender.owners").Owner(obj)
+            slot = addon_module("blender.channels").slot_identifier(obj)
             was = keys.read(owner, options.closed, action=source, slot=slot, turns=options.turns)
             now = keys.read(owner, options.closed, turns=options.turns)
             a, _ = bake.sample_poses(was, result.checked_frames, options, owner)
@@ -152,7 +152,7 @@ def test_insert_key_on_a_rig_does_the_same_work_per_bone_at_any_size():
     """Insert Key on Motion on every bone of rigs of 10 and 40 bones: the add-on lists each
     action's curves once per run (no scan of all curves per bone: what made it grow as
     bones^1.46), so the curves it touches grow linearly with the bones."""
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     listed = []
     original = channels.object_fcurves
 
@@ -187,7 +187,7 @@ def test_the_preview_refresh_reads_every_objects_curves_in_one_pass():
     """Twelve previewed objects and a rig of three previewed bones: a refresh reads all their
     curves in one `curves.read` call (on 6a217ff: one per owner), and the key hashes and
     previews equal those of owners read one by one."""
-    pd, curves = addon_module("preview_draw"), addon_module("curves")
+    pd, curves = addon_module("ops.preview_draw"), addon_module("blender.curves")
     scene = bpy.context.scene
     objects = [keyed_object(f"Previewed{i:02d}", 0.3 * i) for i in range(12)]
     rig = armature("Previewed rig", bones=(("Upper", None, False), ("Fore", "Upper", False), ("Hand", "Fore", False)),
@@ -216,7 +216,7 @@ def test_the_preview_refresh_reads_every_objects_curves_in_one_pass():
         assert calls == [12 * 9 + 3 * 6], calls  # every owner's curves, once, in one call
         assert len(together) == 15 and all(b is not None for _, b in together.values())
         pd.CACHE.forget()
-        preview = addon_module("preview")
+        preview = addon_module("blender.preview")
         alone = preview.read_together
         preview.read_together = lambda pairs, memo: None  # each owner reads its own curves
         try:

@@ -96,7 +96,7 @@ def test_mirrored_object_is_smoothed(sb):
 
 def test_mirrored_object_with_one_scale_axis_keyed(sb):
     obj = keyed(scale=np.array([[-1, 1, 1], [-1, 2, 1], [-1, 1.5, 1], [-1, 1, 1], [-1, 3, 1]], dtype=float))
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     bag = channels.container(obj.animation_data.action, channels.assigned_slot(obj))
     for index in (0, 2):
         channels.remove_fcurve_at(bag, "scale", index)

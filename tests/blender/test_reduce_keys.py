@@ -109,7 +109,7 @@ def check_within(owners, ref, times, distance, angle, label):
 
 @contextlib.contextmanager
 def counting_reduce_calls():
-    module = addon_module("reduce")
+    module = addon_module("blender.reduce")
     original = module.polyscrew.reduce_keys
     calls = {"n": 0, "owners": []}
 
@@ -188,7 +188,7 @@ def test_reduce_keys_on_a_rig_in_pose_mode_holds_in_world_space(sb):
         assert bpy.ops.screwbender.reduce_keys(distance=DISTANCE, angle=ANGLE) == {"FINISHED"}
     # the three bones in one call, chained through their rest matrices (asked again with a
     # smaller tolerance when the add-on's own measure of the result in world space misses it)
-    assert calls["owners"] == [3] * calls["n"] and 1 <= calls["n"] <= 1 + addon_module("reduce").RETRIES
+    assert calls["owners"] == [3] * calls["n"] and 1 <= calls["n"] <= 1 + addon_module("blender.reduce").RETRIES
     bpy.ops.object.mode_set(mode="OBJECT")
     after = sum(transform_keys(rig, b) for b in ("Upper", "Fore", "Hand"))
     print(f"rig: {before} key frames -> {after}")
@@ -265,7 +265,7 @@ def test_undo_restores_the_scene(sb):
 def test_a_failure_halfway_changes_nothing(sb):
     a, b = dense_object("A", seed=1), dense_object("B", seed=2)
     h.select_only(a, b)
-    module = addon_module("reduce")
+    module = addon_module("blender.reduce")
     original = module.write_curve
     calls = {"n": 0}
 

@@ -73,7 +73,7 @@ def test_reduced_keeps_a_noise_modifier_and_unkeyed_channels(sb):
 
 def _remove(obj, fc) -> None:
     """Removes `fc` from the object's action whatever the action API (4.4+ channelbags)."""
-    channels = addon_module("channels")
+    channels = addon_module("blender.channels")
     action = obj.animation_data.action
     bag = channels.ensure_container(action, channels.find_slot(action, channels.slot_identifier(obj)))
     channels.remove_fcurve(bag, fc)

@@ -45,7 +45,7 @@ def transform_curves(action, owner_prefix: str = "") -> list[tuple[str, str, int
 
 
 def addon_channels():
-    return addon_module("channels")
+    return addon_module("blender.channels")
 
 
 def assert_read_once(reads, curves) -> None:
@@ -134,7 +134,7 @@ def test_revert_of_many_objects_scans_the_scene_once(count):
     removes the smoothed copies in one batch (before: a scan of every object and of the file
     per reverted action, quadratic: 0.27 of the smoothing's CPU at 300 objects, 0.4 at 500).
     Counted, not timed (the times are printed; speed is measured in scripts/bench/bench_floor.py)."""
-    bake = addon_module("bake")
+    bake = addon_module("blender.bake")
     objects = many(count)
     sources = [o.animation_data.action for o in objects]
     h.select_only(*objects)
@@ -184,8 +184,8 @@ def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
     """A span baked at more than intent.DEPARTURE_SPAN_FRAMES frames is measured at that many
     frames: the largest departure and the frames over the thresholds agree with measuring
     every frame (a screw between two keys against Blender's independent channel curves)."""
-    intent = addon_module("intent")
-    bake = addon_module("bake")
+    intent = addon_module("pure.intent")
+    bake = addon_module("blender.bake")
     obj = long_object("Long")
     actions, skipped, _ = bake.prepare([obj], bake.Options())
     part = actions[0].parts[0]
@@ -234,7 +234,7 @@ def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
     comparison). Counted with the playback's own counter of rows played, for objects, a rig in
     Pose Mode, and a long bake whose spans are measured on a grid (there the departure plays
     at most DEPARTURE_SPAN_FRAMES frames a span). Before: it played every measured frame again."""
-    intent = addon_module("intent")
+    intent = addon_module("pure.intent")
     objects = [keyed(f"Once{n}", 40 + n, mode=mode) for n, mode in enumerate(("XYZ", "QUATERNION", "ZXY"))]
     seen, original = departure_plays(intent)
     try:
@@ -269,7 +269,7 @@ def test_the_written_digest_notices_every_kind_of_edit():
     # the result's digest (a CRC per curve, issue 24 item 6 made cheaper) as written equals the
     # one read back, and changes for a moved key (frame or value), a changed interpolation,
     # an added and a deleted key; put back, it is the written one again
-    bake = addon_module("bake")
+    bake = addon_module("blender.bake")
     obj = keyed("Edited", 7)
     h.select_only(obj)
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}

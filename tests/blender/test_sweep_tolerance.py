@@ -180,7 +180,7 @@ def smoothed(obj):
         key(obj, f, Matrix(m.tolist()))
     h.select_only(obj)
     assert bpy.ops.screwbender.smooth() == {"FINISHED"}
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     return list(swept.motion_frames(obj, scene))
 
 

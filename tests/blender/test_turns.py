@@ -341,7 +341,7 @@ def test_no_departure_reported_where_the_result_plays_as_blender(sb, capfd):
 def addon_size(obj) -> float:
     from conftest import addon_module
 
-    return addon_module("keys").body_size(addon_module("owners").as_owner(obj))
+    return addon_module("blender.keys").body_size(addon_module("blender.owners").as_owner(obj))
 
 
 def test_smooth_blend_script_takes_turns(sb, tmp_path):
@@ -374,7 +374,7 @@ def test_panel_setting_preview_and_bake_agree(sb, turns):
     states the rule); the live preview draws what Smooth Motion then bakes with it."""
     from conftest import addon_module
 
-    pd = addon_module("preview_draw")
+    pd = addon_module("ops.preview_draw")
     prop = bpy.ops.screwbender.smooth.get_rna_type().properties["turns"]
     setting = bpy.types.Scene.bl_rna.properties["screwbender"].fixed_type.properties["turns"]
     assert [i.identifier for i in prop.enum_items] == [i.identifier for i in setting.enum_items] == ["AUTO", "BLENDER", "SHORTEST"]

@@ -56,7 +56,7 @@ def posed_counting_frame_sets(items) -> tuple[list, list]:
     handler = lambda scene, *args: sets.append(scene.frame_current)  # noqa: E731
     bpy.app.handlers.frame_change_post.append(handler)
     try:
-        posed = addon_module("swept").world_poses_all(items, bpy.context.scene)
+        posed = addon_module("blender.swept").world_poses_all(items, bpy.context.scene)
     finally:
         bpy.app.handlers.frame_change_post.remove(handler)
     return posed, sets
@@ -93,7 +93,7 @@ def scene_with_every_chain():
 
 
 def test_world_poses_from_the_curves_equal_blenders_matrix_world_at_every_frame():
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     scene = bpy.context.scene
     cases = scene_with_every_chain()
     items, expected = [], {}
@@ -118,7 +118,7 @@ def test_world_poses_from_the_curves_equal_blenders_matrix_world_at_every_frame(
 def test_an_object_with_a_constraint_is_played_once_per_frame_for_all():
     """Two objects with a constraint (and one without): those two take the frame_set path,
     which sets each frame once for both; their poses equal matrix_world there too."""
-    swept = addon_module("swept")
+    swept = addon_module("blender.swept")
     scene = bpy.context.scene
     scene.frame_start, scene.frame_end = 1, 24
     leader = mesh("Leader")

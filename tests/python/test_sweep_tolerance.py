@@ -11,8 +11,6 @@
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import numpy as np
 import polyscrew
@@ -21,10 +19,10 @@ import scipy.linalg
 from scipy.spatial import ConvexHull
 from scipy.spatial.transform import Rotation
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "addon" / "screwbender"))
-import sweep_report  # noqa: E402  (pure: no bpy)
+from pure_layer import module
+from screws import screw_matrix  # (tests/fixtures)
 
-from screws import screw_matrix  # noqa: E402  (tests/fixtures)
+sweep_report = module("sweep_report")  # the add-on's pure layer: no bpy
 
 CUBE_V = np.array([(x, y, z) for z in (0, 1) for y in (0, 1) for x in (0, 1)], float)
 CUBE_T = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7],

@@ -17,49 +17,21 @@ approximated.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import bpy
 import numpy as np
 import polyscrew
 
+from ..pure.feature_points import (  # noqa: F401  (re-exported: feature.METHODS, ...)
+    BONE_BOX_WIDTH,
+    METHODS,
+    PARAMETRIZATIONS,
+    bone_points,
+    key_stiffness,
+    nearest_rows,
+)
 from . import bulk, channels, keys, owners
-
-#: Smoothing methods: (identifier, label, description).
-METHODS = (
-    (
-        "SCREW",
-        "Screw Subdivision",
-        "Subdivide the key poses as screws (ScrewBender): coordinate-free, reproduces screw motions exactly",
-    ),
-    (
-        "FEATURE",
-        "Feature Points",
-        "Run C2 variational curves through the key positions of the mesh's inertia points and fit the rigid "
-        "object to them at every frame (Hofer-Pottmann-Ravani); can approximate noisy keys. Scheme then "
-        "smooths only scale",
-    ),
-)
-#: Parameter spacing of the variational curves.
-PARAMETRIZATIONS = (
-    ("uniform", "Uniform", "Keys equally spaced along the curves (the paper's uniform scheme)"),
-    (
-        "centripetal",
-        "Centripetal",
-        "Spacing by the square root of how far the object moves between keys: less change of "
-        "speed where keys are unevenly far apart",
-    ),
-)
-
-
-def nearest_rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Per frame of `at`: the index of the nearest frame of `frames` (sorted, not empty), and
-    whether it is the same frame (within :data:`keys.FRAME_TOLERANCE`). Both neighbours are
-    looked at (a key a hair before or after a frame is that frame's key)."""
-    at = np.asarray(at, dtype=np.float64)
-    last = len(frames) - 1
-    right = np.clip(np.searchsorted(frames, at), 0, last)
-    left = np.clip(right - 1, 0, last)
-    index = np.where(np.abs(frames[left] - at) < np.abs(frames[right] - at), left, right)
-    return index, np.abs(frames[index] - at) < keys.FRAME_TOLERANCE
 
 
 def selected_frames(
@@ -104,17 +76,6 @@ def selected_keys(owner: owners.Owner | bpy.types.Object, frames: np.ndarray) ->
     return selected_frames(owner, channels.object_fcurves(owner.obj), frames, skip_muted=True)
 
 
-#: A bone's feature points are those of a box around it, this wide per unit of bone length.
-BONE_BOX_WIDTH = 0.1
-
-
-def bone_points(length: float) -> np.ndarray:
-    """The eight corners of a box around a bone of `length` in its own space (head at the
-    origin, the bone along +Y): the bone's body for the Feature Points method."""
-    w = BONE_BOX_WIDTH * length
-    return np.array([(x, y, z) for x in (-w, w) for y in (0.0, length) for z in (-w, w)])
-
-
 def feature_points(owner: owners.Owner | bpy.types.Object, scale: np.ndarray) -> np.ndarray | None:
     """The six inertia points of the owner's body in the frame of its rigid pose: an object's
     mesh (vertices times `scale`), a bone's box of its length (:func:`bone_points`); None (a
@@ -134,17 +95,6 @@ def feature_points(owner: owners.Owner | bpy.types.Object, scale: np.ndarray) ->
         return polyscrew.inertia_points(co.reshape(-1, 3) * scale)
     except ValueError:  # all vertices on a line: no rotation about it is defined by them
         return None
-
-
-def key_stiffness(motion: keys.KeyedMotion, selected: np.ndarray, approximate: bool, stiffness: float):
-    """Spring lambda per key: None (hit every key) unless `approximate`; then selected keys get
-    `stiffness`, unselected keys and the ends of an open motion are hit (inf)."""
-    if not approximate:
-        return None
-    lam = np.where(selected, float(stiffness), np.inf)
-    if not motion.closed:
-        lam[0] = lam[-1] = np.inf
-    return lam
 
 
 def check_approximate(owner: owners.Owner | bpy.types.Object, motion: keys.KeyedMotion, stiffness: float) -> None:
@@ -201,3 +151,17 @@ def sample_poses(
     """The feature-point motion of `owner` at `frames`, keys at their own frames with the
     options' timing: (len(frames), 4, 4) rigid poses (see :func:`sample_poses_at`)."""
     return sample_poses_at(owner, motion, motion.frames, frames, options, motion.period, options.timing)
+
+
+def sampler(owner: owners.Owner | bpy.types.Object, options) -> Callable | None:
+    """The Feature Points sampler that :func:`sampling.sample` (pure) calls per piece of `owner`'s
+    motion: `(piece, key_times, times, period=None, timing="linear") -> poses`, reading the
+    body's points and the key selection here; None with the Screw method or without an owner."""
+    if options.method != "FEATURE" or owner is None:
+        return None
+    owner = owners.as_owner(owner)
+
+    def sample(piece, key_times: np.ndarray, times: np.ndarray, period: float | None = None, timing: str = "linear"):
+        return sample_poses_at(owner, piece, key_times, times, options, period, timing)
+
+    return sample

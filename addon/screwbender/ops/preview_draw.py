@@ -31,7 +31,7 @@ from bpy.app.handlers import persistent
 from gpu_extras.batch import batch_for_shader
 from mathutils import Matrix
 
-from . import bake, bulk, channels, owners, preview
+from ..blender import bake, bulk, channels, owners, preview
 
 #: The object property that turns an object's preview on.
 OBJECT_PROP = "screwbender_preview"

@@ -18,60 +18,19 @@ leaves the scene as it was.
 
 from __future__ import annotations
 
-import contextlib
 import zlib
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import bpy
 import numpy as np
 
-from . import bulk, channels, feature, intent, keys, modifiers, owners, range_join, sampling, transaction
+from ..pure import intent, sampling
+from ..pure.grids import MAX_KEYS, bake_frames, with_key_frames  # noqa: F401  (re-exported: bake.bake_frames)
+from ..pure.reports import Outcome, _names, summary  # noqa: F401  (re-exported: bake.summary)
+from ..pure.smooth_options import CLOSED_MODES, RANGE_MODES, SCHEMES, TIMINGS, Options  # noqa: F401  (re-exported: bake.Options)
+from . import action_groups, bulk, channels, feature, keys, modifiers, owners, range_join, transaction
 from .keys import SmoothError
-
-#: Subdivision schemes: (identifier, label, description).
-#: (The strays are measured by scripts/bench/measure_schemes.py: the demo scene and 20 random keyed
-#: motions spanning about 6 units, at 4 levels.)
-SCHEMES = (
-    ("four_point", "4-Point", "Interpolating (the default): the motion passes through every key pose exactly (C1)"),
-    (
-        "bspline",
-        "B-Spline",
-        "Approximating: the smoothest motion (C2); it cuts inside the key poses and misses them, "
-        "measured up to 2.1 units and 33 degrees on keys 6 units apart",
-    ),
-    (
-        "jarek",
-        "Jarek",
-        "Between the two: smoother than 4-point (C2 in the limit), it misses the keys by about half "
-        "as much as B-Spline (measured up to 1.2 units and 19 degrees on keys 6 units apart)",
-    ),
-)
-#: Timing of the motion between keys.
-TIMINGS = (
-    ("smooth", "Smooth", "Velocity continuous across keys at uneven frames (monotone C1 time map)"),
-    ("linear", "Linear", "Constant pace between two keys, pace changes at each key"),
-    (
-        "keys",
-        "Keys",
-        "The pace of Blender's own interpolation of the keys: within each span the motion has gone "
-        "the same fraction of the way as Blender's curves (ease in/out, Expo, Back, custom handles "
-        "keep their feel). Overshoot (Back, Elastic) is kept as pace, not as a path beyond the keys",
-    ),
-)
-#: Whether the motion is a cycle.
-CLOSED_MODES = (
-    ("AUTO", "Auto", "Closed when a Cycles modifier is on the transform F-curves"),
-    ("ON", "Closed", "Treat the keys as a cycle (a last key repeating the first one closes it)"),
-    ("OFF", "Open", "Treat the keys as an open sequence, ignoring Cycles modifiers"),
-)
-
-#: Which frames get baked keys.
-RANGE_MODES = (
-    ("KEYS", "Keys", "Bake each object from its first to its last key (a cycle: over one period)"),
-    ("SCENE", "Scene", "Bake the scene's frame range"),
-    ("CUSTOM", "Custom", "Bake the frame range given by Start and End"),
-)
 
 #: Custom properties recorded on a smoothed action.
 SOURCE_KEY = "screwbender_source"
@@ -84,39 +43,6 @@ WRITTEN_KEY = "screwbender_written"
 
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
-
-
-@dataclass
-class Options:
-    """Everything the smoothing needs besides the objects."""
-
-    scheme: str = "four_point"
-    levels: int = 4
-    timing: str = "keys"
-    closed: str = "AUTO"
-    #: Baked frame range; None bakes each object over its keys' range.
-    frame_range: tuple[float, float] | None = None
-    #: Frames between baked keys (1 frame, or less for subframes).
-    step: float = 1.0
-    #: "SCREW" (screw subdivision) or "FEATURE" (feature points, see :mod:`feature`).
-    method: str = "SCREW"
-    #: Feature points: "uniform" or "centripetal" spacing of the variational curves.
-    parametrization: str = "uniform"
-    #: Feature points: approximate the unselected keys (else every key is hit).
-    approximate: bool = False
-    #: Feature points: spring stiffness of the approximated keys (smaller is smoother).
-    stiffness: float = 1.0
-    #: Smooth the current action even when it is a result of Smooth Motion (else such an
-    #: object's original keys are smoothed again, replacing the earlier result).
-    smooth_result: bool = False
-    #: Turns (:data:`intent.TURNS`): "AUTO" (typed spins as Blender plays them, flips the
-    #: short way), "BLENDER" (every span as Blender plays it) or "SHORTEST".
-    turns: str = "AUTO"
-    #: "EVERY_STEP" (one key per baked frame) or "REDUCED" (the fewest keys within the
-    #: tolerance `key_distance` (Blender units) and `key_angle` (radians): :mod:`reduce`).
-    key_mode: str = "EVERY_STEP"
-    key_distance: float = 0.001
-    key_angle: float = 0.008726646259971648
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -238,66 +164,8 @@ def sample_poses(
     (:mod:`sampling`: pieces between holds, timing "keys").
     """
     owner = owners.as_owner(owner) if owner is not None else None
-    sampled = sampling.sample(motion, frames, options, owner)
+    sampled = sampling.sample(motion, frames, options, feature.sampler(owner, options))
     return sampled.poses, sampled.scales
-
-
-#: Most keys one Smooth Motion may write (all objects together). Blender keeps about 60 bytes
-#: per key (a BezTriple) plus the undo copy of the action: 20 million keys are about 2.5 GB.
-MAX_KEYS = 20_000_000
-
-
-def bake_frames(start: float, end: float, step: float) -> np.ndarray:
-    """The baked frames: `start`, every multiple of `step` strictly between, and `end`.
-
-    Keys sit on the scene's frame grid (whole frames for a step of 1, multiples of the step
-    otherwise) and the range's ends, usually the first and last key, are always baked exactly,
-    also when they are subframes (1.5 ... 20.6) or when the step does not divide the range
-    (0.1 over 1..30: 10 * 0.1 is not 1.0 in floating point, so grid frames are `k / 10`).
-    A grid frame closer than :data:`keys.FRAME_TOLERANCE` to an end is that end.
-    """
-    if not step > 0.0:
-        raise SmoothError(f"step must be positive, got {step:g}")
-    if not end > start:
-        raise SmoothError(f"frame range {start:g} to {end:g} is empty")
-    count = (end - start) / step + 2
-    if count > MAX_KEYS:
-        raise SmoothError(
-            f"frame range {start:g} to {end:g} at step {step:g} is {count:,.0f} frames; the most "
-            f"Smooth Motion bakes is {MAX_KEYS:,} keys: raise Step or shorten the Frame Range"
-        )
-    tol = keys.FRAME_TOLERANCE
-    first, last = int(np.ceil((start + tol) / step)), int(np.floor((end - tol) / step))
-    k = np.arange(first, last + 1, dtype=np.float64)
-    per_frame = 1.0 / step
-    if abs(per_frame - round(per_frame)) < 1e-9:  # 0.1, 0.2, 0.5, 1: grid frames k / n exactly
-        grid = k / round(per_frame)
-    else:
-        grid = k * step
-    grid = grid[(grid > start + tol) & (grid < end - tol)]
-    return np.concatenate(([start], grid, [end]))
-
-
-def with_key_frames(grid: np.ndarray, key_frames: np.ndarray) -> np.ndarray:
-    """The baked frames `grid` (sorted, from :func:`bake_frames`) with every key frame of
-    `key_frames` inside their range added: every key pose is a baked key, also at a subframe
-    (a key at 12.5, keys every half frame of a 60 fps capture in a 30 fps scene). A grid frame
-    closer than :data:`keys.FRAME_TOLERANCE` to a key frame gives way to the key frame."""
-    tol = keys.FRAME_TOLERANCE
-    key_frames = np.asarray(key_frames, dtype=np.float64)
-    inside = key_frames[(key_frames > grid[0] + tol) & (key_frames < grid[-1] - tol)]
-    if not len(inside):
-        return grid
-    at = np.minimum(np.searchsorted(grid, inside), len(grid) - 1)
-    if np.array_equal(grid[at], inside):  # every key frame is a grid frame already
-        return grid
-    inside = np.unique(inside)
-    # grid frames near a key frame are that key frame
-    at = np.clip(np.searchsorted(inside, grid), 1, len(inside)) - 1
-    near = np.minimum(np.abs(grid - inside[at]), np.abs(grid - inside[np.minimum(at + 1, len(inside) - 1)]))
-    keep = near > tol
-    keep[0] = keep[-1] = True  # the range's ends stay exact
-    return np.unique(np.concatenate((grid[keep], inside)))
 
 
 def channel_count(motion: keys.KeyedMotion) -> int:
@@ -357,7 +225,9 @@ def sample_channels(
         mode = motion.rotation_mode
         previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        sampled = sampling.sample(motion, frames, options, owner, channels=True, previous=previous, played=True)
+        sampled = sampling.sample(
+            motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous, played=True
+        )
         location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
         values = {"location": location, keys.rotation_path(mode): rotation}
         if not motion.located:
@@ -580,6 +450,22 @@ def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Actio
     return None
 
 
+def source_action(
+    current: bpy.types.Action, identifier: str, made_by: str, again: bool, keep_edits: bool = True
+) -> tuple[bpy.types.Action, str, bool]:
+    """The action (and slot) a run of the operator `made_by` reads for owners animated by
+    `current`: `current` itself, or, when `current` is that operator's result and `again` (run on
+    the result) is off, the original it was made from, read again with the new options; with
+    `keep_edits`, a result the animator edited since is read as it is (never thrown away). The
+    third value says whether that happened (for the report)."""
+    found = original_of(current, made_by)
+    if found is None or again:
+        return current, identifier, False
+    if keep_edits and was_edited(current, identifier):
+        return current, identifier, True
+    return found[0], found[1], False
+
+
 def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
     """Gives the objects of `bake` a copy of their current action whose transform curves of
     the smoothed owners are the baked ones (every other curve as it was); see
@@ -695,21 +581,15 @@ class _Group:
 def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
     """The owners grouped by the action and slot that animates them (linked duplicates share
     one), in the order given; owners without an action are refused here."""
+    found, skipped = action_groups.by_action(selection)
     groups: dict[tuple, _Group] = {}
-    skipped = []
-    for item in selection:
-        owner = owners.as_owner(item)
-        adt = owner.obj.animation_data
-        if adt is None or adt.action is None:
-            skipped.append((owner, keys.no_action(owner.name, adt)))
-            continue
-        group = groups.setdefault(
-            (adt.action.as_pointer(), channels.slot_identifier(owner.obj)), _Group([], [])
-        )
-        if owner.obj not in group.objects:
-            group.objects.append(owner.obj)
-        if owner.bone not in group.bones:
-            group.bones.append(owner.bone)
+    for by_action in found:
+        group = groups[by_action.action.as_pointer(), by_action.identifier] = _Group([], [])
+        for owner in by_action.members:
+            if owner.obj not in group.objects:
+                group.objects.append(owner.obj)
+            if owner.bone not in group.bones:
+                group.bones.append(owner.bone)
     # Every object the action animates through that slot keeps sharing it, selected or not
     # (one pass over the scene's objects for all the actions).
     users = users_by_slot({pointer for pointer, _ in groups})
@@ -748,20 +628,14 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
     first = group.objects[0]
     current = first.animation_data.action
     identifier = channels.slot_identifier(first)
-    source, source_slot = current, identifier
-    found = original_of(current, "smooth")
+    source, source_slot, edited = source_action(current, identifier, "smooth", options.smooth_result)
     notes = []
-    if found is not None and not options.smooth_result:
-        if was_edited(current, identifier):
-            # The animator changed the result: the edit is the new source, never thrown away.
-            notes.append(
-                f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
-                "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
-                "them, a second Revert to the original)"
-            )
-        else:
-            # A result of Smooth Motion: smooth the original keys again with the new options.
-            source, source_slot = found
+    if edited:
+        notes.append(
+            f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
+            "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
+            "them, a second Revert to the original)"
+        )
     read_from = None if source is current else source
     # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
@@ -854,22 +728,14 @@ def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, 
 
 
 @dataclass
-class Smoothed:
-    """What Smooth Motion did."""
+class Smoothed(Outcome):
+    """What Smooth Motion did: every object given a new action is among `owners`, selected or
+    not (a linked duplicate sharing the action changes too)."""
 
-    #: The new actions.
-    actions: list[bpy.types.Action]
     #: The objects given a new action.
-    objects: list[bpy.types.Object]
-    #: The owners whose motion changed (objects and bones), by name: every object given a new
-    #: action, selected or not (a linked duplicate sharing the action changes too).
-    owners: list[str]
-    #: How many of them are bones.
-    bones: int
-    #: Messages of what was skipped (nothing changed there).
-    skipped: list[str]
-    #: Other things worth telling (shared actions split, results re-smoothed).
-    notes: list[str]
+    objects: list[bpy.types.Object] = field(default_factory=list)
+    #: How many of the owners are bones.
+    bones: int = 0
 
 
 def _in_order(selection: list, skipped: list) -> list[str]:
@@ -950,14 +816,7 @@ def smooth(
         from . import reduce
 
         notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
-    with contextlib.ExitStack() as stack:
-        if t is None:
-            t = stack.enter_context(transaction.atomic())
-        actions = []
-        for i, bake in enumerate(bakes):
-            actions.append(write(bake, t))
-            if progress is not None:
-                progress(len(groups) + i + 1, total)
+    actions = action_groups.write_all(bakes, write, t, progress, len(groups), total)
     return Smoothed(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],
@@ -966,18 +825,6 @@ def smooth(
         skipped=skipped,
         notes=notes,
     )
-
-
-def _names(names: list[str], limit: int = 3) -> str:
-    """"A, B, C and 297 more": a readable list of many names."""
-    if len(names) <= limit:
-        return ", ".join(names)
-    return f"{', '.join(names[:limit])} and {len(names) - limit} more"
-
-
-def summary(names: list[str], limit: int = 3) -> str:
-    """The report's list of names: the first `limit` and how many more."""
-    return _names(sorted(names), limit)
 
 
 def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:

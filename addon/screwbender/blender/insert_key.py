@@ -35,11 +35,11 @@ import bpy
 import numpy as np
 import polyscrew
 
+from ..pure.packed_parts import PER_KEY as _PER_KEY
+from ..pure.packed_parts import joined as _joined
+from ..pure.packed_parts import one as _one
 from . import bake, bulk, channels, curves, keys, owners, transaction
 from .keys import SmoothError
-from .packed_parts import PER_KEY as _PER_KEY
-from .packed_parts import joined as _joined
-from .packed_parts import one as _one
 
 
 @dataclass

@@ -57,7 +57,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import polyscrew
 
-from . import curves
+from .packed import Packed
 
 #: A span whose channels turn further than this (radians, 150 degrees) along Blender's
 #: playback gets poses from that playback added inside it: the screw between its keys alone,
@@ -140,7 +140,7 @@ class Source:
     `polyscrew.evaluate_fcurves`, and the values of the channels without a curve; and the
     same as a `polyscrew.Playback`, built once, that evaluates them."""
 
-    packed: curves.Packed
+    packed: Packed
     #: (property, array index) of each packed curve.
     columns: list[tuple[str, int]]
     #: property -> its values on the owner (used where a channel has no curve).

@@ -9,8 +9,8 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
-from . import bake, bake_ops, channels, owners, reduce, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, owners, reduce
+from . import pipeline
 
 
 def distance_property(name: str = "Distance") -> FloatProperty:
@@ -101,31 +101,19 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
         options = reduce.Options(
             distance=self.distance, angle=self.angle, reduce_result=self.reduce_result, per_channel=self.per_channel
         )
-        wm = context.window_manager
-        wm.progress_begin(0.0, 1.0)
-        try:
-            result = reduce.reduce_keys(selection, options, lambda done, total: wm.progress_update(done / total))
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:  # reduce_keys has undone its changes
-            return transaction.report_failure(self, err, "Reduce Keys")
-        finally:
-            wm.progress_end()
-        if not result.actions:
-            bake_ops.report_skipped(self, result.skipped, "ERROR")
-            return {"CANCELLED"}
-        bake_ops.report_skipped(self, result.skipped, "WARNING")
-        bake_ops.report_notes(self, result.notes)
+        return pipeline.run(
+            self, "Reduce Keys", lambda progress: reduce.reduce_keys(selection, options, progress),
+            lambda result: pipeline.report_outcome(self, result, lambda: self.summary_line(result)), context,
+        )
+
+    def summary_line(self, result: reduce.Result) -> str:
         share = 100.0 * result.keys_after / max(result.frames, 1)
-        self.report(
-            {"INFO"},
+        return (
             f"Reduced the keys of {len(result.owners)}: {bake.summary(result.owners)}: {result.keys_before:,} key frames "
             f"-> {result.keys_after:,} ({share:.1f} % of the frames); largest error "
             f"{result.distance_error:.3g} (tolerance {self.distance:.3g}) and "
-            f"{math.degrees(result.angle_error):.3g} degrees (tolerance {math.degrees(self.angle):.3g})",
+            f"{math.degrees(result.angle_error):.3g} degrees (tolerance {math.degrees(self.angle):.3g})"
         )
-        return {"FINISHED"}
 
 
 class VIEW3D_PT_screwbender_reduce(bpy.types.Panel):

@@ -6,53 +6,28 @@ entries. Operators collect options, call :mod:`bake` and report; panels only dra
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty
 
-from . import bake, channels, feature, intent, owners, reduce, reduce_ops, transaction
-from .keys import SmoothError
-
-
-def report_skipped(operator: bpy.types.Operator, skipped: list[str], level: str) -> None:
-    """One line per skipped object for a few, else one line: how many, and the first reasons."""
-    if len(skipped) <= 3:
-        for message in skipped:
-            operator.report({level}, message)
-        return
-    for message in skipped:  # the whole list for the console (a pipeline's log)
-        print(f"ScrewBender: {message}")
-    operator.report(
-        {level}, f"{len(skipped)} objects skipped (the list is in the console): {'; '.join(skipped[:2])}; ..."
-    )
-
-
-def report_notes(operator: bpy.types.Operator, notes: list[str]) -> None:
-    """The notes of a run (what was kept, a rerun from the original keys): one line each for
-    a few, else two and how many more (the whole list in the console)."""
-    if len(notes) <= 3:
-        for note in notes:
-            operator.report({"INFO"}, note)
-        return
-    for note in notes:  # many owners: one line, the list in the console
-        print(f"ScrewBender: {note}")
-    operator.report({"INFO"}, f"{'; '.join(notes[:2])}; and {len(notes) - 2} more notes (in the console)")
+from ..blender import bake, channels, feature, owners, reduce, transaction
+from ..pure import intent
+from . import pipeline, reduce_ops
+from .pipeline import report_notes, report_skipped  # noqa: F401  (bake_ops.report_*: the pipeline's)
 
 
 def report_smoothed(operator: bpy.types.Operator, result: bake.Smoothed, verb: str) -> set[str]:
     """Reports what Smooth Motion did in one readable line (plus skipped objects and notes)."""
-    if not result.actions:
-        report_skipped(operator, result.skipped, "ERROR")
-        return {"CANCELLED"}
-    report_skipped(operator, result.skipped, "WARNING")
-    report_notes(operator, result.notes)
-    names = result.owners
-    if result.bones == len(names):
-        what = "bone(s)"
-    elif result.bones:
-        what = "bone(s) and object(s)"
-    else:
-        what = "object(s)"
-    count = len(result.actions)
-    shared = f" ({count} new action{'s' if count != 1 else ''})" if count != len(names) else ""
-    operator.report({"INFO"}, f"{verb} {len(names)} {what}: {bake.summary(names)}{shared}")
-    return {"FINISHED"}
+
+    def line() -> str:
+        names = result.owners
+        if result.bones == len(names):
+            what = "bone(s)"
+        elif result.bones:
+            what = "bone(s) and object(s)"
+        else:
+            what = "object(s)"
+        count = len(result.actions)
+        shared = f" ({count} new action{'s' if count != 1 else ''})" if count != len(names) else ""
+        return f"{verb} {len(names)} {what}: {bake.summary(names)}{shared}"
+
+    return pipeline.report_outcome(operator, result, line)
 
 
 def draw_method(layout: bpy.types.UILayout, settings) -> None:
@@ -220,21 +195,12 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         selection = owners.selection(context, self.armature, channels.object_fcurves)
-        wm = context.window_manager
+        options = self.smooth_options(context)
         # bake.smooth counts its own steps (two per action): the bar shows their fraction
-        wm.progress_begin(0.0, 1.0)
-        try:
-            result = bake.smooth(
-                selection, self.smooth_options(context), lambda done, total: wm.progress_update(done / total)
-            )
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:  # anything else: bake.smooth has undone its changes
-            return transaction.report_failure(self, err, "Smooth Motion")
-        finally:
-            wm.progress_end()
-        return report_smoothed(self, result, "Smoothed")
+        return pipeline.run(
+            self, "Smooth Motion", lambda progress: bake.smooth(selection, options, progress),
+            lambda result: report_smoothed(self, result, "Smoothed"), context,
+        )
 
 
 class SCREWBENDER_OT_revert(bpy.types.Operator):
@@ -254,7 +220,8 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         reverted: dict[str, bpy.types.Object] = {}
         kept: list[str] = []
-        try:
+
+        def work(progress: pipeline.Progress) -> None:
             with transaction.atomic() as t:
                 chosen = [o for o in sorted(context.selected_objects, key=lambda o: o.name) if bake.source_of(o) is not None]
                 # who uses each smoothed action: one pass over the scene's objects for all of them
@@ -264,8 +231,10 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
                     if obj.name not in reverted:
                         reverted.update((o.name, o) for o in bake.revert(obj, t, kept, users, removals))
                 t.on_commit(lambda: bake.remove_unused(removals))
-        except Exception as err:
-            return transaction.report_failure(self, err, "Revert Smoothing")
+
+        return pipeline.run(self, "Revert Smoothing", work, lambda _: self.report_reverted(context, reverted, kept))
+
+    def report_reverted(self, context: bpy.types.Context, reverted: dict, kept: list[str]) -> set[str]:
         selected = {o.name for o in context.selected_objects}
         others = sorted(set(reverted) - selected)
         also = f" (and {bake.summary(others)}, which shared its action)" if others else ""

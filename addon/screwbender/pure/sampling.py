@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 import polyscrew
 
-from . import feature, keys
+from . import keyed as keys
 
 #: Steps per key span along which the travel of Blender's playback and of the smoothed motion
 #: is measured (timing "keys"; the output frames inside a span are measured too): the core's
@@ -108,7 +108,7 @@ def _parameter_motion(motion: keys.KeyedMotion) -> tuple[np.ndarray, float | Non
     return np.arange(k, dtype=np.float64), (float(k) if motion.closed else None)
 
 
-def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner, played: bool = False):
+def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, features=None, played: bool = False):
     """Timing "keys": the motion parameter of each frame of `frames`.
 
     Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
@@ -129,11 +129,11 @@ def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, owner
     common = dict(size=motion.size, closed=motion.closed, period=motion.period, playback=playback)
     if played:
         common["played"] = True
-    if options.method == "FEATURE" and owner is not None:
+    if options.method == "FEATURE" and features is not None:
         k = len(motion.frames)
         u = polyscrew.pace_parameters(k if motion.closed else k - 1)
         times = np.arange(k, dtype=np.float64)
-        smooth = feature.sample_poses_at(owner, motion, times, u, options, float(k) if motion.closed else None)
+        smooth = features(motion, times, u, float(k) if motion.closed else None)
         return polyscrew.keys_parameters(motion.frames, frames, smooth=smooth, **common)
     return polyscrew.keys_parameters(
         motion.frames, frames, poses=motion.poses, scheme=options.scheme, levels=options.levels, **common
@@ -162,7 +162,7 @@ def sample(
     motion: keys.KeyedMotion,
     frames: np.ndarray,
     options,
-    owner=None,
+    features=None,
     channels: bool = False,
     previous=None,
     played: bool = False,
@@ -173,12 +173,13 @@ def sample(
     the playback's rows timing "keys" played at these frames (:attr:`Sampled.played`).
 
     One polyscrew call per piece for the motion (and per hold for channels), one for scale;
-    timing "keys" computes each piece's parameters once for both.
+    timing "keys" computes each piece's parameters once for both. `features`: the Feature
+    Points method's sampler (the Blender layer's `feature.sampler`), None for screw subdivision.
     """
     frames = np.asarray(frames, dtype=np.float64)
     if len(frames) > 1 and np.any(np.diff(frames) < 0.0):
         order = np.argsort(frames, kind="stable")
-        done = sample(motion, frames[order], options, owner, channels, previous, played)
+        done = sample(motion, frames[order], options, features, channels, previous, played)
         back = np.empty_like(order)
         back[order] = np.arange(len(order))
         return Sampled(
@@ -224,7 +225,7 @@ def sample(
             if options.timing == "keys":
                 key_times, period = _parameter_motion(piece)
                 if keep_played:
-                    at, rows_played = keys_parameters(piece, t, options, owner, played=True)
+                    at, rows_played = keys_parameters(piece, t, options, features, played=True)
                     if len(seg.rows) == n:
                         played_rows = rows_played
                     else:
@@ -232,13 +233,13 @@ def sample(
                             played_rows = np.full((n, rows_played.shape[1]), np.nan)
                         played_rows[rows] = rows_played
                 else:
-                    at = keys_parameters(piece, t, options, owner)
+                    at = keys_parameters(piece, t, options, features)
                 spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")
             else:
                 spec = _spec(piece, options)
                 key_times, at = piece.frames, t
-            if options.method == "FEATURE" and owner is not None:
-                piece_poses = feature.sample_poses_at(owner, piece, key_times, at, options, spec["period"], spec["timing"])
+            if options.method == "FEATURE" and features is not None:
+                piece_poses = features(piece, key_times, at, spec["period"], spec["timing"])
                 if channels:
                     location[rows] = piece_poses[:, :3, 3]
                     values = polyscrew.rotation_channels(piece_poses, mode, previous=last_rotation)

@@ -23,7 +23,6 @@ than the noise estimated) and how pops are kept: :mod:`denoise_data`.
 
 from __future__ import annotations
 
-import contextlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 
@@ -31,7 +30,9 @@ import bpy
 import numpy as np
 import polyscrew
 
-from . import bake, bulk, channels, denoise_data, feature, keys, owners, transaction
+from ..pure import denoise_data
+from ..pure.reports import Outcome
+from . import action_groups, bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).
@@ -91,13 +92,9 @@ class Cleaned:
 
 
 @dataclass
-class Denoised:
+class Denoised(Outcome):
     """What Remove Noise did."""
 
-    actions: list[bpy.types.Action]
-    owners: list[str]
-    skipped: list[str]
-    notes: list[str] = field(default_factory=list)
     #: The strengths used (frames), per owner: (rotation, translation).
     strengths: list[tuple[float, float]] = field(default_factory=list)
 
@@ -382,25 +379,16 @@ def remove_noise(
     """Removes the noise of the owners in `selection` (objects or :class:`owners.Owner`s);
     owners animated by one action get one new action. Everything is read and denoised before
     anything is written, and the writing is all or nothing."""
-    selection = [owners.as_owner(item) for item in selection]
-    groups: dict[tuple, list[owners.Owner]] = {}
-    skipped = []
-    for owner in selection:
-        adt = owner.obj.animation_data
-        if adt is None or adt.action is None:
-            skipped.append(f"{owner.name}: no animation (no active action): skipped")
-            continue
-        groups.setdefault((adt.action.as_pointer(), channels.slot_identifier(owner.obj)), []).append(owner)
+    groups, refused = action_groups.by_action(selection)
+    skipped = [message for _, message in refused]
     prepared, plans, notes, rerun = [], [], [], []
     sharers: dict[tuple[int, str], list[str]] = {}
-    for i, members in enumerate(groups.values()):
+    for i, group in enumerate(groups):
+        members = group.members
         first = members[0].obj
-        current = first.animation_data.action
-        identifier = channels.slot_identifier(first)
-        source, slot = current, identifier
-        found = bake.original_of(current, "denoise")
-        if found is not None and not options.smooth_result:
-            source, slot = found
+        current, identifier = group.action, group.identifier
+        # (an edited result is denoised from the original keys again, as before)
+        source, slot, _ = bake.source_action(current, identifier, "denoise", options.smooth_result, keep_edits=False)
         listed = channels.action_fcurves(source, slot)
         by_owner = owners.curves_by_owner(listed)
         # The keys the user sees and selects: those of the action shown (an earlier result).
@@ -446,26 +434,24 @@ def remove_noise(
         for objects, source, current, identifier, done in plans
         if (kept := [o for o in done if (o.obj.as_pointer(), o.bone) in cleaned])
     ]
-    actions = []
-    with contextlib.ExitStack() as stack:
-        if t is None:
-            t = stack.enter_context(transaction.atomic())
-        for i, (objects, source, current, identifier, done) in enumerate(plans):
-            parts = [cleaned[(o.obj.as_pointer(), o.bone)] for o in done]
 
-            def edit(bag, parts=parts) -> None:
-                by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
-                for part in parts:
-                    _edit_keys(by_owner.get(part.owner.bone, []), part)
-                if options.key_mode == "REDUCED":
-                    from . import reduce
+    def write(plan, t: transaction.Transaction) -> bpy.types.Action:
+        objects, source, current, identifier, done = plan
+        parts = [cleaned[(o.obj.as_pointer(), o.bone)] for o in done]
 
-                    results = reduce.reduce_bag(bag, [p.owner for p in parts], options.key_distance, options.key_angle)
-                    notes.append(reduce.summary(results))
+        def edit(bag, parts=parts) -> None:
+            by_owner = owners.curves_by_owner(channels.fcurves(bag))  # one pass, not one per bone
+            for part in parts:
+                _edit_keys(by_owner.get(part.owner.bone, []), part)
+            if options.key_mode == "REDUCED":
+                from . import reduce
 
-            actions.append(bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise"))
-            if progress is not None:
-                progress(len(groups) + i + 1, 2 * len(groups))
+                results = reduce.reduce_bag(bag, [p.owner for p in parts], options.key_distance, options.key_angle)
+                notes.append(reduce.summary(results))
+
+        return bake.new_result(objects, source, current, identifier, t, edit, made_by="denoise")
+
+    actions = action_groups.write_all(plans, write, t, progress, len(groups), 2 * len(groups))
     parts = list(cleaned.values())
     for c in parts:
         notes.extend(data_notes(c))

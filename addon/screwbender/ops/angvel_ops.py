@@ -7,9 +7,10 @@ from __future__ import annotations
 import bpy
 from bpy.props import EnumProperty, FloatProperty, IntProperty
 
-from . import transaction
-from .angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
-from .keys import SmoothError
+from ..blender import transaction
+from ..blender.angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
+from ..blender.keys import SmoothError
+from . import pipeline
 
 
 class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):
@@ -31,16 +32,16 @@ class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
-        try:
+
+        def work(progress: pipeline.Progress) -> bpy.types.Object:
             with transaction.atomic() as t:
-                sphere = add_sketch(context, obj, t)
-        except (SmoothError, ValueError) as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Add Angular Velocity Sketch")
-        self.report({"INFO"}, f"{obj.name}: edit the blue curve on {sphere.name} and its '{SPEED_PROP}' curve")
-        return {"FINISHED"}
+                return add_sketch(context, obj, t)
+
+        def report(sphere: bpy.types.Object) -> set[str]:
+            self.report({"INFO"}, f"{obj.name}: edit the blue curve on {sphere.name} and its '{SPEED_PROP}' curve")
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Add Angular Velocity Sketch", work, report, refusals=(SmoothError, ValueError))
 
 
 class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
@@ -93,20 +94,20 @@ class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         obj = context.active_object
-        try:
+
+        def work(progress: pipeline.Progress):
             with transaction.atomic() as t:
-                result = fit(context, obj, t, self.alpha, self.delta, self.max_frames, self.stroke_timing)
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Fit Angular Velocity")
-        self.report(
-            {"INFO"},
-            f"{obj.name}: fit error {result.fit_error:.4f} (delta {self.delta:g}), "
-            f"{len(result.frame_times)} variable frames, {result.iterations} iterations",
-        )
-        return {"FINISHED"}
+                return fit(context, obj, t, self.alpha, self.delta, self.max_frames, self.stroke_timing)
+
+        def report(result) -> set[str]:
+            self.report(
+                {"INFO"},
+                f"{obj.name}: fit error {result.fit_error:.4f} (delta {self.delta:g}), "
+                f"{len(result.frame_times)} variable frames, {result.iterations} iterations",
+            )
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Fit Angular Velocity", work, report)
 
 
 class VIEW3D_PT_screwbender_angular_velocity(bpy.types.Panel):

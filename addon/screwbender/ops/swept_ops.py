@@ -8,7 +8,9 @@ import time
 import bpy
 from bpy.props import BoolProperty, FloatProperty, IntProperty
 
-from . import sweep_report, swept, transaction
+from ..blender import swept, transaction
+from ..pure import sweep_report
+from . import pipeline
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):
@@ -90,7 +92,8 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     def execute(self, context: bpy.types.Context) -> set[str]:
         objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
         start = time.perf_counter()
-        try:
+
+        def work(progress: pipeline.Progress) -> tuple[list, list, list]:
             tolerance = self.tolerance if self.tolerance > 0.0 else None
             cell = self.cell if self.cell > 0.0 else (self.voxel_size if self.properties.is_property_set("voxel_size") else None)
             read: dict = {}  # each key curve read once, also when meshes share an action or a rig
@@ -113,25 +116,26 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                 for obj in created:
                     obj.select_set(True)
                 context.view_layer.objects.active = created[-1]
-        except swept.SweepError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Build Swept Region")
-        seconds = time.perf_counter() - start
-        tris = sum(swept.triangle_count(o.data) for o in created)
-        sweep_ms = 1e3 * sum(s.seconds for s in computed)
-        volumes = [m.volume for m in found]
-        self.report(
-            {"INFO"},
-            sweep_report.summary(
-                len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
-                max(s.error_bound for s in computed), sum(m.area for m in found),
-                None if any(v is None for v in volumes) else sum(volumes),
-                cell=max(s.cell for s in computed),
-            ),
-        )
-        return {"FINISHED"}
+            return computed, created, found
+
+        def report(done: tuple[list, list, list]) -> set[str]:
+            computed, created, found = done
+            seconds = time.perf_counter() - start
+            tris = sum(swept.triangle_count(o.data) for o in created)
+            sweep_ms = 1e3 * sum(s.seconds for s in computed)
+            volumes = [m.volume for m in found]
+            self.report(
+                {"INFO"},
+                sweep_report.summary(
+                    len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
+                    max(s.error_bound for s in computed), sum(m.area for m in found),
+                    None if any(v is None for v in volumes) else sum(volumes),
+                    cell=max(s.cell for s in computed),
+                ),
+            )
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Build Swept Region", work, report, refusals=(swept.SweepError,))
 
 
 class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
@@ -156,12 +160,9 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
         region = context.active_object
         others = sorted((o for o in context.selected_objects if o is not region and o.type == "MESH"), key=lambda o: o.name)
         depsgraph = context.evaluated_depsgraph_get()
-        try:
+
+        def work(progress: pipeline.Progress) -> dict:
             results = {o.name: swept.clearance(region, o, depsgraph) for o in others}
-        except swept.SweepError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        try:
             with transaction.atomic() as t:
                 for o in [region, *others]:
                     t.keep_face_selection(o.data)
@@ -170,14 +171,17 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
                     swept.select_faces(o, results[o.name].faces_b)
                 t.set_item(region, "screwbender_clearance", {name: r.distance for name, r in results.items()})
                 t.set_item(region, "screwbender_intersects", [name for name, r in results.items() if r.intersects])
-        except Exception as err:
-            return transaction.report_failure(self, err, "Check Clearance")
-        for name, r in results.items():
-            if r.intersects:
-                self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")
-            else:
-                self.report({"INFO"}, f"{region.name} clears {name} by {r.distance:.6g}")
-        return {"FINISHED"}
+            return results
+
+        def report(results: dict) -> set[str]:
+            for name, r in results.items():
+                if r.intersects:
+                    self.report({"WARNING"}, f"{region.name} intersects {name} ({len(r.faces_a)} faces selected)")
+                else:
+                    self.report({"INFO"}, f"{region.name} clears {name} by {r.distance:.6g}")
+            return {"FINISHED"}
+
+        return pipeline.run(self, "Check Clearance", work, report, refusals=(swept.SweepError,))
 
 
 class VIEW3D_PT_screwbender_sweep(bpy.types.Panel):

@@ -7,8 +7,8 @@ from __future__ import annotations
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
-from . import bake, bake_ops, channels, denoise, owners, reduce, reduce_ops, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, denoise, owners, reduce
+from . import pipeline, reduce_ops
 
 
 class SCREWBENDER_OT_denoise(bpy.types.Operator):
@@ -123,36 +123,25 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         selection = owners.selection(context, self.armature, channels.object_fcurves)
-        wm = context.window_manager
-        wm.progress_begin(0.0, 1.0)  # remove_noise counts its own steps (two per action)
-        try:
-            result = denoise.remove_noise(
-                selection, self.denoise_options(context), lambda done, total: wm.progress_update(done / total)
-            )
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:  # remove_noise has undone its changes
-            return transaction.report_failure(self, err, "Remove Noise")
-        finally:
-            wm.progress_end()
-        if not result.actions:
-            bake_ops.report_skipped(self, result.skipped, "ERROR")
-            return {"CANCELLED"}
-        bake_ops.report_skipped(self, result.skipped, "WARNING")
-        bake_ops.report_notes(self, result.notes)
+        options = self.denoise_options(context)
+        # remove_noise counts its own steps (two per action)
+        return pipeline.run(
+            self, "Remove Noise", lambda progress: denoise.remove_noise(selection, options, progress),
+            lambda result: pipeline.report_outcome(self, result, lambda: self.strength_line(result)), context,
+        )
+
+    def strength_line(self, result: denoise.Denoised) -> str:
+        """The run's summary line; the strengths used are set on the operator (Redo panel)."""
         rotation = sorted(s[0] for s in result.strengths)
         translation = sorted(s[1] for s in result.strengths)
         self.rotation_strength = rotation[len(rotation) // 2]
         self.translation_strength = translation[len(translation) // 2]
         spread = "" if len(rotation) == 1 else " (median over them)"
         how = "chosen from the data" if self.auto_strength else "given"
-        self.report(
-            {"INFO"},
+        return (
             f"Removed noise from {len(result.owners)}: {bake.summary(result.owners)}; strength {how}: rotation "
-            f"{self.rotation_strength:.3g}, translation {self.translation_strength:.3g} frames{spread}",
+            f"{self.rotation_strength:.3g}, translation {self.translation_strength:.3g} frames{spread}"
         )
-        return {"FINISHED"}
 
 
 class VIEW3D_PT_screwbender_denoise(bpy.types.Panel):

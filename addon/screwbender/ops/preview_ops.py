@@ -17,8 +17,9 @@ import math
 import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProperty, IntProperty, PointerProperty
 
-from . import bake, bake_ops, channels, insert_key, owners, preview, preview_draw, transaction
-from .keys import SmoothError
+from ..blender import bake, channels, insert_key, owners, preview, transaction
+from ..blender.keys import SmoothError
+from . import bake_ops, pipeline, preview_draw
 
 STYLES = (
     ("WIRE", "Wireframe", "Each instance drawn as the wireframe of its mesh"),
@@ -112,20 +113,21 @@ class SCREWBENDER_OT_preview_apply(bpy.types.Operator):
                 "the keys do not: key it (or undo the move) before applying",
             )
             return {"CANCELLED"}
-        try:
-            with transaction.atomic() as t:
-                selection = preview_draw.previewed_owners(context.scene, objects)
-                result = bake.smooth(selection, preview_draw.smooth_options(context.scene), t=t)
-                for obj in result.objects:
-                    t.set(obj, preview_draw.OBJECT_PROP, False)
-        except SmoothError as err:
-            self.report({"ERROR"}, str(err))
-            return {"CANCELLED"}
-        except Exception as err:
-            return transaction.report_failure(self, err, "Apply Preview")
-        finally:
-            preview_draw.sync()
-        return bake_ops.report_smoothed(self, result, "Applied the preview of")
+
+        def work(progress: pipeline.Progress) -> bake.Smoothed:
+            try:
+                with transaction.atomic() as t:
+                    selection = preview_draw.previewed_owners(context.scene, objects)
+                    result = bake.smooth(selection, preview_draw.smooth_options(context.scene), t=t)
+                    for obj in result.objects:
+                        t.set(obj, preview_draw.OBJECT_PROP, False)
+            finally:
+                preview_draw.sync()
+            return result
+
+        return pipeline.run(
+            self, "Apply Preview", work, lambda result: bake_ops.report_smoothed(self, result, "Applied the preview of")
+        )
 
 
 class SCREWBENDER_OT_insert_key(bpy.types.Operator):
@@ -163,8 +165,9 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         errors = []
         grouped: dict = {}  # object -> its transform curves by owner: one pass over each action
         known: dict = {}  # the keys read (and keyed) so far: each curve read once per run
-        try:
-            with transaction.atomic() as t:
+
+        def work(progress: pipeline.Progress) -> None:
+            with transaction.atomic() as t:  # a failure takes back every key inserted so far
                 for owner in selection:  # an owner that cannot be smoothed is skipped unchanged
                     by_owner = grouped.get(owner.obj.as_pointer())
                     if by_owner is None:
@@ -176,8 +179,10 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
                                 owner, frame, options, one, by_owner.get(owner.bone, []), known)))
                     except SmoothError as err:
                         errors.append(str(err))
-        except Exception as err:  # every key inserted so far is taken back
-            return transaction.report_failure(self, err, "Insert Key on Motion")
+
+        return pipeline.run(self, "Insert Key on Motion", work, lambda _: self.report_inserted(scene, frame, results, errors))
+
+    def report_inserted(self, scene: bpy.types.Scene, frame: float, results: list, errors: list[str]) -> set[str]:
         for message in errors:
             self.report({"WARNING" if results else "ERROR"}, message)
         if not results:
