@@ -245,7 +245,7 @@ impl Playback {
 
     /// How many channel rows (one frame each) this playback has evaluated since it was made,
     /// by every function that plays it ([`Playback::channels`], [`super::analyse_spans`],
-    /// [`super::keys_parameters`], [`super::departure`], ...).
+    /// [`super::keys_parameters`], [`fn@super::departure`], ...).
     pub fn rows_evaluated(&self) -> u64 {
         self.evaluated.load(Ordering::Relaxed)
     }
