@@ -14,8 +14,8 @@ use polyscrew::sweep::{
 };
 use polyscrew::{Error, Pose};
 
-use crate::args::float_array;
 use crate::args::{self, Function, Sweep};
+use crate::args::{float_array, FloatArg, IntArg};
 use crate::arrays::{pose_count, read_poses, read_rows3};
 use crate::errors::{check_budget, shape_err, to_py_err};
 
@@ -118,28 +118,8 @@ fn sweep<'py>(
             )))
         }
     };
-    let vertices = float_array(F, "vertices", vertices)?;
-    let triangles = args::int_array(F, "triangles", triangles)?;
-    let poses = float_array(F, "poses", poses)?;
-    let (n, single) = pose_count(F, "poses", poses.shape())?;
-    if single {
-        return Err(to_py_err(F, Error::TooFew { got: 1, need: 2 }));
-    }
-    let (nv, nt) = (
-        vertices.shape().first().copied().unwrap_or(0),
-        triangles.shape().first().copied().unwrap_or(0),
-    );
     // The inputs read and the body built; the core checks the output span by span.
-    check_budget(
-        F,
-        vertices.copy()
-            + triangles.copy()
-            + poses.copy()
-            + Footprint::of::<Pose>(n)
-            + body_footprint(nv, nt),
-        "the swept body",
-        SWEEP_HINT,
-    )?;
+    let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, SWEEP_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let options = SweepOptions {
         steps,
@@ -155,16 +135,7 @@ fn sweep<'py>(
         let p = read_poses(F, "poses", pa)?;
         let out = sweep_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))?;
         drop((v, t, p));
-        let mut flat =
-            try_vec(out.vertices.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
-        flat.extend(out.vertices.iter().flat_map(|q| q.to_array()));
-        let vo = Array2::from_shape_vec((out.vertices.len(), 3), flat)
-            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
-        let mut flat =
-            try_vec(out.triangles.len() * 3, "the swept mesh").map_err(|e| to_py_err(F, e))?;
-        flat.extend(out.triangles.iter().flat_map(|t| t.map(i64::from)));
-        let to = Array2::from_shape_vec((out.triangles.len(), 3), flat)
-            .map_err(|e| crate::errors::invalid(format!("{F}: {e}")))?;
+        let (vo, to) = mesh_arrays(F, &out.vertices, &out.triangles)?;
         Ok((
             vo,
             to,
@@ -239,27 +210,7 @@ fn sweep_closed<'py>(
 ) -> PyResult<Bound<'py, PyTuple>> {
     const F: &str = "sweep_closed";
     let cell = args::optional_float(F, "cell", cell)?;
-    let vertices = float_array(F, "vertices", vertices)?;
-    let triangles = args::int_array(F, "triangles", triangles)?;
-    let poses = float_array(F, "poses", poses)?;
-    let (n, single) = pose_count(F, "poses", poses.shape())?;
-    if single {
-        return Err(to_py_err(F, Error::TooFew { got: 1, need: 2 }));
-    }
-    let (nv, nt) = (
-        vertices.shape().first().copied().unwrap_or(0),
-        triangles.shape().first().copied().unwrap_or(0),
-    );
-    check_budget(
-        F,
-        vertices.copy()
-            + triangles.copy()
-            + poses.copy()
-            + Footprint::of::<Pose>(n)
-            + body_footprint(nv, nt),
-        "the swept body",
-        CLOSED_HINT,
-    )?;
+    let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let options = ClosedOptions { cell };
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
@@ -283,6 +234,39 @@ fn sweep_closed<'py>(
     dict.set_item("error_bound", figures[1])?;
     dict.set_item("poses", count)?;
     PyTuple::new(py, [vo.into_any(), to.into_any(), dict.into_any()])
+}
+
+/// The `vertices`, `triangles` and `poses` (two or more) of a sweep, their copies, the poses
+/// and the body checked against the memory budget (`hint`: how to ask for less).
+fn body_and_poses<'py>(
+    function: &'static str,
+    vertices: &Bound<'py, PyAny>,
+    triangles: &Bound<'py, PyAny>,
+    poses: &Bound<'py, PyAny>,
+    hint: &'static str,
+) -> PyResult<(FloatArg<'py>, IntArg<'py>, FloatArg<'py>)> {
+    let vertices = float_array(function, "vertices", vertices)?;
+    let triangles = args::int_array(function, "triangles", triangles)?;
+    let poses = float_array(function, "poses", poses)?;
+    let (n, single) = pose_count(function, "poses", poses.shape())?;
+    if single {
+        return Err(to_py_err(function, Error::TooFew { got: 1, need: 2 }));
+    }
+    let (nv, nt) = (
+        vertices.shape().first().copied().unwrap_or(0),
+        triangles.shape().first().copied().unwrap_or(0),
+    );
+    check_budget(
+        function,
+        vertices.copy()
+            + triangles.copy()
+            + poses.copy()
+            + Footprint::of::<Pose>(n)
+            + body_footprint(nv, nt),
+        "the swept body",
+        hint,
+    )?;
+    Ok((vertices, triangles, poses))
 }
 
 /// The `(V, 3)` float64 and `(T, 3)` int64 arrays of a mesh (no GIL needed).
