@@ -119,7 +119,7 @@ def region_sd(points, inv, sd, poses_per_chunk=16, points_per_chunk=1 << 16):
         part = points[start:start + points_per_chunk]
         for lo in range(0, len(inv), poses_per_chunk):
             m = inv[lo:lo + poses_per_chunk]
-            local = np.einsum("pij,nj->pni", m[:, :3, :3], part) + m[:, None, :3, 3]
+            local = np.swapaxes(m[:, :3, :3] @ part.T, 1, 2) + m[:, None, :3, 3]
             best[start:start + len(part)] = np.minimum(best[start:start + len(part)], sd(local).min(axis=0))
     return best
 
@@ -136,11 +136,38 @@ def mesh_volume(v, t):
     return float(np.einsum("ij,ij->i", a, np.cross(b, c)).sum() / 6.0)
 
 
+def crossings(points, inv, sd, poses_per_chunk=16, points_per_chunk=1 << 15):
+    """Where the motion sampled at `inv` (world -> body) may take `points` inside the body.
+
+    Returns (inside, undecided): inside when the body's signed distance is negative at a
+    sampled pose; undecided when it is not, but some interval between two consecutive poses
+    may still reach inside: a body-frame point moves along its screw by no more than the chord
+    between the interval's ends, and `sd` is 1-Lipschitz, so along the interval `sd` stays above
+    the larger of its two end values less that chord."""
+    inside = np.zeros(len(points), dtype=bool)
+    undecided = np.zeros(len(points), dtype=bool)
+    for start in range(0, len(points), points_per_chunk):
+        part = points[start:start + points_per_chunk]
+        seen = np.zeros(len(part), dtype=bool)
+        near = np.zeros(len(part), dtype=bool)
+        for lo in range(0, max(len(inv) - 1, 1), poses_per_chunk):
+            m = inv[lo:lo + poses_per_chunk + 1]  # one pose shared with the next chunk
+            local = np.swapaxes(m[:, :3, :3] @ part.T, 1, 2) + m[:, None, :3, 3]
+            d = sd(local)
+            seen |= (d < 0).any(axis=0)
+            chord = np.linalg.norm(np.diff(local, axis=0), axis=-1)
+            near |= (np.maximum(d[:-1], d[1:]) <= chord).any(axis=0)
+        inside[start:start + len(part)] = seen
+        undecided[start:start + len(part)] = near & ~seen
+    return inside, undecided
+
+
 def reference_volume(v_body, poses, sd, cell, per_span=(8, 64, 1024)):
     """The region's volume: one jittered sample per grid cell of the region's box, inside when
-    the minimum over the motion of `sd` is negative; the motion sampled coarsely first, and the
-    samples whose coarse minimum is within the largest move between coarse poses (of a body-
-    frame point from the box) of zero decided again on a finer motion."""
+    the body's signed distance `sd` is negative at a pose of the motion; the motion sampled
+    coarsely first, and only the samples that an interval between coarse poses may still take
+    inside (`crossings`) decided again on a finer motion, `per_span` intervals per screw at the
+    last level."""
     corners = np.array([(x, y, z) for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
     lo_b, hi_b = v_body.min(axis=0), v_body.max(axis=0)
     body_box = lo_b + corners * (hi_b - lo_b)
@@ -150,18 +177,14 @@ def reference_volume(v_body, poses, sd, cell, per_span=(8, 64, 1024)):
     shape = np.ceil((hi - lo) / cell).astype(int)
     grid = np.stack(np.meshgrid(*[np.arange(n) for n in shape], indexing="ij"), axis=-1).reshape(-1, 3)
     pts = lo + (grid + np.random.default_rng(3).random(grid.shape)) * cell
-    box = lo + corners * (hi - lo)
     undecided = np.arange(len(pts))
     inside = np.zeros(len(pts), dtype=bool)
     for level, k in enumerate(per_span):
-        inv = np.linalg.inv(dense(poses, k))
-        # The most a world point of the box moves in the body frame between two poses.
-        moved = np.einsum("pij,nj->pni", inv[:, :3, :3], box) + inv[:, None, :3, 3]
-        step = np.linalg.norm(np.diff(moved, axis=0), axis=-1).max()
-        d = region_sd(pts[undecided], inv, sd)
-        inside[undecided[d < 0]] = True
-        if level + 1 < len(per_span):
-            undecided = undecided[(d >= 0) & (d <= step)]
+        inv = fine if level + 1 == len(per_span) else dense(poses, k)
+        inv = np.linalg.inv(inv)
+        hit, maybe = crossings(pts[undecided], inv, sd)
+        inside[undecided[hit]] = True
+        undecided = undecided[maybe]
     return inside.sum() * cell**3
 
 
