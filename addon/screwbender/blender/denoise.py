@@ -157,14 +157,15 @@ def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.
 
 def prepare(
     owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None,
-    read: dict | None = None,
+    read: dict | None = None, cache: dict | None = None,
 ) -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
     """The owner's key poses (no analysis), the rows to smooth and which of them are held.
     `fcurves` hold the keys read; `shown` (default `fcurves`) the keys the user sees and
     selects (the earlier result, on a rerun from the original keys); `read`: the keys of many
-    owners read together (:func:`read_together`), used when they hold this owner's."""
+    owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
+    `keys.read`'s, kept for one run (an object's checks made once for all its bones)."""
     motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
-                       packed=None if read is None else _part(owner, fcurves, read))
+                       packed=None if read is None else _part(owner, fcurves, read), cache=cache)
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
@@ -438,7 +439,7 @@ def remove_noise(
         shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         listed_groups.append((source, slot, by_owner, shown))
         pairs.extend((owner, by_owner.get(owner.bone, [])) for owner in group.members)
-    read = read_together(pairs)
+    read, cache = read_together(pairs), {}
     for i, group in enumerate(groups):
         members = group.members
         first = members[0].obj
@@ -457,7 +458,8 @@ def remove_noise(
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
                                              action=None if source is current else source, slot=slot,
-                                             shown=shown.get(owner.bone, []), read=read)
+                                             shown=shown.get(owner.bone, []), read=read,
+                                             cache=cache)
             except SmoothError as err:
                 skipped.append(str(err))
                 continue
