@@ -438,7 +438,7 @@ def remove_noise(
         # The keys the user sees and selects: those of the action shown (an earlier result).
         shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         listed_groups.append((source, slot, by_owner, shown))
-        pairs.extend((owner, by_owner.get(owner.bone, [])) for owner in group.members)
+        pairs.extend((owner, by_owner.get(owner.bone, [])) for owner in group.members if owner.exists())
     read, cache = read_together(pairs), {}
     for i, group in enumerate(groups):
         members = group.members
