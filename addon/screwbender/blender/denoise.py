@@ -32,7 +32,7 @@ import polyscrew
 
 from ..pure import denoise_data
 from ..pure.reports import Outcome
-from . import action_groups, bake, bulk, channels, feature, keys, owners, transaction
+from . import action_groups, bake, bulk, channels, feature, keys, owners, preview, transaction
 from .keys import SmoothError
 
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).
@@ -89,6 +89,9 @@ class Cleaned:
     limited: int = 0
     #: Why the owner is refused after all (sparse keys that are blocked poses), else None.
     refused: str | None = None
+    #: The rotation channels written at the keys `rows` (len(rows), k), like the original key
+    #: values (:func:`near_rotations`, one `polyscrew` call for all owners of a mode).
+    near: np.ndarray | None = None
 
 
 @dataclass
@@ -153,12 +156,16 @@ def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.
 
 
 def prepare(
-    owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None
+    owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None,
+    read: dict | None = None, cache: dict | None = None,
 ) -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
     """The owner's key poses (no analysis), the rows to smooth and which of them are held.
     `fcurves` hold the keys read; `shown` (default `fcurves`) the keys the user sees and
-    selects (the earlier result, on a rerun from the original keys)."""
-    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False)
+    selects (the earlier result, on a rerun from the original keys); `read`: the keys of many
+    owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
+    `keys.read`'s, kept for one run (an object's checks made once for all its bones)."""
+    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
+                       packed=None if read is None else _part(owner, fcurves, read), cache=cache)
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
@@ -174,6 +181,42 @@ def prepare(
     if held.all():
         raise SmoothError(f"{owner.name}: every key in the frame range is unselected (held): nothing to smooth: skipped")
     return motion, rows, held
+
+
+def read_together(pairs: list[tuple[owners.Owner, list]]) -> dict:
+    """The transform curves of every owner of `pairs` ((owner, its curves)) read in one
+    `curves.read` call, each curve once (:func:`preview.read_together`): per owner's played
+    curves, their part of the packed keys (empty when some curve cannot be packed: each owner
+    then reads its own, which says why)."""
+    read: dict = {}
+    preview.read_together(pairs, read)
+    return read
+
+
+def _part(owner: owners.Owner, fcurves: list, read: dict) -> tuple[list, object] | None:
+    """(the owner's played transform curves, their packed keys) from :func:`read_together`'s
+    `read`, for `keys.read(packed=...)`; None when they were not read there."""
+    played = preview.played_curves(owner, fcurves)
+    part = read.get(tuple(fc.as_pointer() for fc in played))
+    return None if part is None else (played, part)
+
+
+def near_rotations(parts: list[Cleaned]) -> None:
+    """Sets each part's `near`: its smoothed rotations as channels of its mode, each written
+    like the original key value at its frame (its quaternion sign, its Euler twin and whole
+    turns: spins and deliberate sign flips of the keys are kept). One
+    `polyscrew.rotation_channels_near` call per rotation mode for all parts (row by row: the
+    same values as one call per part)."""
+    by_mode: dict[str, list[Cleaned]] = {}
+    for c in parts:
+        by_mode.setdefault(c.motion.rotation_mode, []).append(c)
+    for mode, chosen in by_mode.items():
+        poses = np.concatenate([c.poses for c in chosen])
+        reference = np.concatenate([_original_rotation(c.motion)[c.rows] for c in chosen])
+        near = polyscrew.rotation_channels_near(poses, mode, reference)
+        bounds = np.cumsum([0] + [len(c.rows) for c in chosen]).tolist()
+        for c, lo, hi in zip(chosen, bounds[:-1], bounds[1:]):
+            c.near = near[lo:hi]
 
 
 def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.ndarray, list]], options: Options) -> list[Cleaned]:
@@ -292,11 +335,11 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
     smoothed[smoothed_rows] = True
     in_range = np.zeros(len(motion.frames), dtype=bool)
     in_range[cleaned.rows] = True
-    original = _original_rotation(motion)
-    rotation = np.zeros((len(motion.frames), original.shape[1]))
-    # Each smoothed key written like the original key value (its quaternion sign, its Euler
-    # twin and whole turns), so spins and deliberate sign flips of the keys are kept.
-    rotation[cleaned.rows] = polyscrew.rotation_channels_near(cleaned.poses, mode, original[cleaned.rows])
+    if cleaned.near is None:
+        near_rotations([cleaned])
+    rotation = np.zeros((len(motion.frames), cleaned.near.shape[1]))
+    # Each smoothed key written like the original key value (:func:`near_rotations`).
+    rotation[cleaned.rows] = cleaned.near
     values = {path: rotation}
     if motion.located:
         location = np.zeros((len(motion.frames), 3))
@@ -383,17 +426,26 @@ def remove_noise(
     skipped = [message for _, message in refused]
     prepared, plans, notes, rerun = [], [], [], []
     sharers: dict[tuple[int, str], list[str]] = {}
+    # Every group's users in one pass over the scene's objects (one pass per group grew as
+    # groups x objects), and every owner's transform curves read in one pass.
+    users_all = bake.users_by_slot({group.action.as_pointer() for group in groups})
+    listed_groups, pairs = [], []
+    for group in groups:
+        current, identifier = group.action, group.identifier
+        # (an edited result is denoised from the original keys again, as before)
+        source, slot, _ = bake.source_action(current, identifier, "denoise", options.smooth_result, keep_edits=False)
+        by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
+        # The keys the user sees and selects: those of the action shown (an earlier result).
+        shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
+        listed_groups.append((source, slot, by_owner, shown))
+        pairs.extend((owner, by_owner.get(owner.bone, [])) for owner in group.members if owner.exists())
+    read, cache = read_together(pairs), {}
     for i, group in enumerate(groups):
         members = group.members
         first = members[0].obj
         current, identifier = group.action, group.identifier
-        # (an edited result is denoised from the original keys again, as before)
-        source, slot, _ = bake.source_action(current, identifier, "denoise", options.smooth_result, keep_edits=False)
-        listed = channels.action_fcurves(source, slot)
-        by_owner = owners.curves_by_owner(listed)
-        # The keys the user sees and selects: those of the action shown (an earlier result).
-        shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
-        users = bake.users_of(current, identifier)
+        source, slot, by_owner, shown = listed_groups[i]
+        users = users_all.get((current.as_pointer(), identifier), [])
         done = []
         # Owners of the same curves (linked duplicates sharing the action): read and smoothed
         # once, their names reported with the first's (they get the result action too).
@@ -406,7 +458,8 @@ def remove_noise(
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
                                              action=None if source is current else source, slot=slot,
-                                             shown=shown.get(owner.bone, []))
+                                             shown=shown.get(owner.bone, []), read=read,
+                                             cache=cache)
             except SmoothError as err:
                 skipped.append(str(err))
                 continue
@@ -429,6 +482,7 @@ def remove_noise(
         if c.refused is not None:
             skipped.append(c.refused)
             del cleaned[key]
+    near_rotations(list(cleaned.values()))
     plans = [
         (objects, source, current, identifier, kept)
         for objects, source, current, identifier, done in plans

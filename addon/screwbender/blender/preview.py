@@ -203,6 +203,12 @@ def _played(listed: list) -> list:
     return [fc for fc in listed if not fc.mute and len(fc.keyframe_points)]
 
 
+def played_curves(owner: owners.Owner, fcurves: list) -> list:
+    """The owner's transform curves among `fcurves` that :func:`keys.read` reads (keyed, not
+    muted): the curves of its part in :func:`read_together`'s `memo`."""
+    return _played(_transform_curves(owner, fcurves))
+
+
 def read_together(pairs: list[tuple[owners.Owner, list]], memo: dict) -> None:
     """Reads the played transform curves of every owner of `pairs` ((owner, its curves) each,
     see :func:`key_hash`) in one `curves.read` call, each curve once, and gives each owner its
