@@ -34,6 +34,14 @@ def test_nested_transaction_shares_the_snapshot_and_still_undoes_only_its_own():
         with transaction.atomic() as t:
             with transaction.atomic(t) as quiet:
                 assert quiet._existing is t._existing  # shared: nothing was created
+            try:
+                with transaction.atomic(t) as sharing:
+                    assert sharing._existing is t._existing
+                    bpy.data.actions.new("MadeBySharing")
+                    raise KeyError("sharing fails")
+            except KeyError:
+                pass
+            assert _ids() == before, "a nested rollback on the shared snapshot removes what it made"
             outer = bpy.data.actions.new("MadeByOuter")
             try:
                 with transaction.atomic(t) as nested:
@@ -45,9 +53,9 @@ def test_nested_transaction_shares_the_snapshot_and_still_undoes_only_its_own():
                 pass
             names = {a.name for a in bpy.data.actions}
             assert "MadeByOuter" in names and "MadeByNested" not in names
-            with transaction.atomic(t) as shared_again:
+            with transaction.atomic(t) as later:
                 # one created since the outer began: a scan (not the outer's snapshot, which lacks it)
-                assert shared_again._existing is not t._existing
+                assert later._existing is not t._existing
             bpy.data.objects.new("MadeByOuterToo", None)
             with transaction.atomic(t) as inner:
                 made = bpy.data.actions.new("MadeByInner")
