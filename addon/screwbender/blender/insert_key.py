@@ -22,7 +22,7 @@ Each source curve is read once per run (issue 27): its keys are packed once
 the keys, handles and count of every curve it keyed), and the motion after the insertion is
 that read with the new key spliced in: Blender recomputes the handles of the new key and of
 its two neighbours only (and, on a cyclic curve, of the first and last two keys), which are
-read back one by one, not the whole curve. A curve with Auto Handle Smoothing
+read back one by one, not the whole curve (the new key whole, the others their handles). A curve with Auto Handle Smoothing
 (`auto_smoothing`: every handle may move) has its handles read again in full. Many owners of
 one action (a rig's bones) share one pass over its curves (:func:`owners.curves_by_owner`).
 """
@@ -124,11 +124,12 @@ def _spliced(fcurve: bpy.types.FCurve, before: curves.Packed, frame: float) -> c
         window |= {j for j in (0, 1, m - 2, m - 1) if 0 <= j < m}  # cycle-aware handles wrap
     for j in sorted(window):
         point = points[j]
-        after.co[j] = point.co
         after.handle_left[j] = point.handle_left
         after.handle_right[j] = point.handle_right
-        after.interpolation[j], after.easing[j] = _key_codes(point)
-        after.back[j], after.amplitude[j], after.period[j] = point.back, point.amplitude, point.period
+        if j == i:  # the new (or replaced) key: all of it; the others only had their handles recomputed
+            after.co[j] = point.co
+            after.interpolation[j], after.easing[j] = _key_codes(point)
+            after.back[j], after.amplitude[j], after.period[j] = point.back, point.amplitude, point.period
     if getattr(fcurve, "auto_smoothing", "NONE") != "NONE":  # every handle may have moved
         for name in ("handle_left", "handle_right"):
             flat = np.empty(2 * m, dtype=np.float32)
