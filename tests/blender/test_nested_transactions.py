@@ -1,5 +1,5 @@
-"""Issue 27 (speed27a): Insert Key on Motion, Revert and Smooth Motion without per-owner work
-that grows with the scene.
+"""Nested transactions (Insert Key on Motion runs one per owner) without per-owner work that
+grows with the scene (issue 27).
 
 - A nested transaction (Insert Key runs one per owner, so that an owner it cannot key is
   skipped unchanged) takes its outer transaction's snapshot of the file's data-blocks when
