@@ -90,14 +90,15 @@ pub use feature::variational::{
     variational_curve, variational_subdivide, Parametrization, Stiffness,
 };
 pub use intent::{
-    analyse_spans, keys_parameters, rotation_matrices, rotation_matrix, Channel, KeysTiming,
-    Playback, Spans,
+    analyse_spans, keys_parameters, rotation_matrices, rotation_matrix, timed_frames, Channel,
+    KeysTiming, PaceSource, Playback, Spans, Timed,
 };
 pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{
-    channels_near, rotation_channels, EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
+    angles_near, channels_near, rotation_channels, same_rotation_map, EulerOrder, RotationMode,
+    MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
 };
-pub use motion::moves::{partial_moves, turn_vectors, MoveBounds};
+pub use motion::moves::{direction_steps, partial_moves, turn_vectors, MoveBounds};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};
 pub use motion::sample::{sample, Motion, MotionSpec};
 pub use motion::screw::{midpoint, s, s_many, Screw};
