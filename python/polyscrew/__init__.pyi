@@ -70,6 +70,7 @@ ArrayLike = npt.ArrayLike
 FloatArray = npt.NDArray[np.float64]
 SchemeName = Literal["four_point", "bspline", "jarek"]
 TimingName = Literal["smooth", "linear", "keys"]
+TimeMapName = Literal["smooth", "linear"]
 RotationModeName = Literal["QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"]
 
 # --- The exception family: every error polyscrew raises about its arguments or its work ---
@@ -154,7 +155,7 @@ def sample(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """The subdivided motion of ``poses`` keyed at ``key_times``, at ``times``: (len(times), 4, 4).
 
@@ -162,7 +163,9 @@ def sample(
     ``times`` within +-1e300. ``closed`` makes a cycle of length
     ``period`` (default: closed after the mean key spacing). ``timing="smooth"`` is the
     monotone C1 map from time to the motion parameter, ``"linear"`` maps each key span
-    linearly. Open motions hold their end poses outside the keys' range.
+    linearly (the timings that map time, ``TimeMapName``: timing ``"keys"`` follows Blender's
+    playback, ``timed_frames`` turns it into times to sample at). Open motions hold their end
+    poses outside the keys' range.
     """
 
 def sample_channels(
@@ -175,7 +178,7 @@ def sample_channels(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> tuple[FloatArray, FloatArray]:
     """``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
     ``rotation_channels(sample(...), mode, previous)``, without the (len(times), 4, 4)
@@ -195,7 +198,7 @@ def sample_vectors(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """``sample`` for plain vectors ``values`` (N, 3) (for example log-scale): (len(times), 3)."""
 
@@ -320,6 +323,11 @@ CONTINUED_ROTATION_MODES: tuple[str, ...]
 ``rotation_channels`` and ``sample_channels``: a bake from its first key's values, a piece
 from the piece before): quaternion and the Euler orders. Axis-angle channels start from
 their own first rotation."""
+
+NORMALISED_CHANNELS: dict[str, tuple[int, int]]
+"""The channels ``start:stop`` of a rotation mode that Blender normalises before it uses them
+(scaling them together keeps the rotation): ``"QUATERNION"`` -> ``(0, 4)``, ``"AXIS_ANGLE"``
+-> ``(1, 4)`` (the axis); Euler orders have none."""
 
 TIMINGS: tuple[str, ...]
 """Every timing, the core's: ``("smooth", "linear", "keys")``."""
@@ -650,7 +658,7 @@ def sample_feature(
     stiffness: float | ArrayLike | None = None,
     inserted_stiffness: float | None = None,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).
 
@@ -911,7 +919,7 @@ def timed_frames(
     levels: int = 4,
     smooth: ArrayLike | None = None,
     played: bool = False,
-) -> tuple[Any, Any, Any, TimingName, FloatArray | None]:
+) -> tuple[Any, Any, Any, TimeMapName, FloatArray | None]:
     """Where the motion of keys at ``key_frames`` is sampled for ``frames`` with ``timing``, in
     one call for every timing: ``(key_times, times, period, timing, rows)`` to pass to
     ``sample``, ``sample_channels``, ``sample_vectors`` or a feature-point sampler (with the

@@ -206,6 +206,13 @@ def test_same_rotation_map_is_the_former_join_map_and_keeps_every_rotation(mode,
 
 def test_continued_rotation_modes_are_the_cores():
     assert polyscrew.CONTINUED_ROTATION_MODES == ("QUATERNION", *EULER)
+    assert polyscrew.NORMALISED_CHANNELS == {"QUATERNION": (0, 4), "AXIS_ANGLE": (1, 4)}
+    rng = np.random.default_rng(3)
+    for mode, (start, stop) in polyscrew.NORMALISED_CHANNELS.items():  # scaling them keeps the rotation (scipy)
+        values = polyscrew.rotation_channels(Rotation.random(random_state=rng).as_matrix()[None], mode)[0]
+        scaled = values.copy()
+        scaled[start:stop] *= 2.7
+        np.testing.assert_allclose(scipy_matrix(scaled, mode), scipy_matrix(values, mode), atol=1e-14)
     previous = np.array([0.1, 0.2, 0.3])
     for mode in polyscrew.ROTATION_MODES:
         want = None if mode == "AXIS_ANGLE" else previous

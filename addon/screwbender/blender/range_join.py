@@ -369,8 +369,9 @@ def end_maps(join: Join, motion: keys.KeyedMotion, played: dict, values: dict, f
     ends, by a factor that changes geometrically along the range."""
     mode = motion.rotation_mode
     path = keys.rotation_path(mode)
-    if keys.rotation_width(mode) == 4 and path in values:
-        part = slice(0, 4) if mode == "QUATERNION" else slice(1, 4)
+    normalised = polyscrew.NORMALISED_CHANNELS.get(mode)  # (the core's: a quaternion, an axis-angle's axis)
+    if normalised is not None and path in values:
+        part = slice(*normalised)
         baked = values[path]
         logs = []
         for row, src_row, cut_here in ((0, 0, join.before), (-1, 1, join.after)):

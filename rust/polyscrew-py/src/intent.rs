@@ -641,18 +641,19 @@ fn keys_parameters<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     const F: &str = KeysParameters::NAME;
     let size = args::float_scalar(F, "size", size)?;
-    let pace = PaceArgs {
+    let (out, rows, _) = paced(
+        py,
+        F,
+        key_frames,
+        frames,
         size,
         closed,
         period,
         playback,
-        poses,
-        scheme: scheme.0,
-        levels,
-        smooth,
+        (poses, smooth),
+        (scheme.0, levels),
         played,
-    };
-    let (out, rows, _) = paced(py, F, key_frames, frames, &pace)?;
+    )?;
     let out = out.into_any();
     match rows {
         Some(rows) => Ok((out, rows).into_pyobject(py)?.into_any()),
@@ -667,31 +668,24 @@ type Paced<'py> = (
     usize,
 );
 
-/// The arguments of a paced timing (`keys_parameters`, `timed_frames`) besides the frames.
-struct PaceArgs<'a, 'py> {
-    size: f64,
-    closed: bool,
-    period: Option<&'a Bound<'py, PyAny>>,
-    playback: Option<&'a Bound<'py, PyAny>>,
-    poses: Option<&'a Bound<'py, PyAny>>,
-    scheme: Scheme,
-    levels: u32,
-    smooth: Option<&'a Bound<'py, PyAny>>,
-    played: bool,
-}
-
-/// Timing Keys' parameters of `frames` (the core's `timed_frames`), with `played` the
-/// playback's rows at them ((T, 0) without a playback), and the number of keys.
+/// Timing Keys' parameters of `frames` (the core's `timed_frames`; the arguments as
+/// `keys_parameters` takes them), with `played` the playback's rows at them ((T, 0) without
+/// a playback), and the number of keys.
+#[allow(clippy::too_many_arguments)]
 fn paced<'py>(
     py: Python<'py>,
-    function: &'static str,
+    f: &'static str,
     key_frames: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
-    pace: &PaceArgs<'_, 'py>,
+    size: f64,
+    closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    playback: Option<&Bound<'py, PyAny>>,
+    (poses, smooth): (Option<&Bound<'py, PyAny>>, Option<&Bound<'py, PyAny>>),
+    (scheme, levels): (Scheme, u32),
+    played: bool,
 ) -> PyResult<Paced<'py>> {
-    let f = function;
-    let (size, closed, played) = (pace.size, pace.closed, pace.played);
-    let period = args::optional_float(f, "period", pace.period)?;
+    let period = args::optional_float(f, "period", period)?;
     let period = match (closed, period) {
         (true, Some(p)) => Some(p),
         (true, None) => {
@@ -701,8 +695,7 @@ fn paced<'py>(
         }
         (false, _) => None,
     };
-    let playback = pace
-        .playback
+    let playback = playback
         .filter(|p| !p.is_none())
         .map(|p| playback_arg(f, "playback", p))
         .transpose()?;
@@ -711,8 +704,8 @@ fn paced<'py>(
     let k = vector_len(f, "key_frames", &key_frames)?;
     let t = vector_len(f, "frames", &frames)?;
     let (poses, smooth) = (
-        pace.poses.filter(|p| !p.is_none()),
-        pace.smooth.filter(|p| !p.is_none()),
+        poses.filter(|p| !p.is_none()),
+        smooth.filter(|p| !p.is_none()),
     );
     let (array, is_keys) = match (poses, smooth) {
         (Some(p), None) => (float_array(f, "poses", p)?, true),
@@ -758,8 +751,8 @@ fn paced<'py>(
     let inner = playback.map(|p| &p.get().inner);
     let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
     let spec = MotionSpec {
-        scheme: pace.scheme,
-        levels: pace.levels,
+        scheme,
+        levels,
         closed,
         period,
         timing: Timing::Keys,
@@ -819,7 +812,7 @@ fn paced<'py>(
 ///     levels: int = 4,
 ///     smooth: ArrayLike | None = None,
 ///     played: bool = False,
-/// ) -> tuple[Any, Any, Any, TimingName, FloatArray | None]
+/// ) -> tuple[Any, Any, Any, TimeMapName, FloatArray | None]
 ///
 /// Where the motion of keys at ``key_frames`` is sampled for ``frames`` with ``timing``, in
 /// one call for every timing: ``(key_times, times, period, timing, rows)`` to pass to
@@ -873,18 +866,19 @@ fn timed_frames<'py>(
             )))
         }
     };
-    let pace = PaceArgs {
+    let (parameters, rows, k) = paced(
+        py,
+        F,
+        key_frames,
+        frames,
         size,
         closed,
         period,
         playback,
-        poses,
-        scheme: scheme.0,
-        levels,
-        smooth,
+        (poses, smooth),
+        (scheme.0, levels),
         played,
-    };
-    let (parameters, rows, k) = paced(py, F, key_frames, frames, &pace)?;
+    )?;
     let key_times = (0..k)
         .map(|i| i as f64)
         .collect::<Vec<f64>>()

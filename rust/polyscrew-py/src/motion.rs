@@ -335,7 +335,7 @@ impl<'py> TimedInput<'py> {
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> FloatArray
 ///
 /// The subdivided motion of ``poses`` keyed at ``key_times``, at ``times``: (len(times), 4, 4).
@@ -344,7 +344,9 @@ impl<'py> TimedInput<'py> {
 /// ``times`` within +-1e300. ``closed`` makes a cycle of length
 /// ``period`` (default: closed after the mean key spacing). ``timing="smooth"`` is the
 /// monotone C1 map from time to the motion parameter, ``"linear"`` maps each key span
-/// linearly. Open motions hold their end poses outside the keys' range.
+/// linearly (the timings that map time, ``TimeMapName``: timing ``"keys"`` follows Blender's
+/// playback, ``timed_frames`` turns it into times to sample at). Open motions hold their end
+/// poses outside the keys' range.
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
 #[pyo3(
@@ -403,7 +405,7 @@ fn sample<'py>(
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> tuple[FloatArray, FloatArray]
 ///
 /// ``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
@@ -538,7 +540,7 @@ fn subdivide_vectors<'py>(
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> FloatArray
 ///
 /// ``sample`` for plain vectors ``values`` (N, 3) (for example log-scale): (len(times), 3).
@@ -815,6 +817,9 @@ fn angles_near<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// The `(a, c)` arrays of [`same_rotation_map`].
+type ChannelMap<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
 /// same_rotation_map(
 ///     source: ArrayLike, target: ArrayLike, mode: RotationModeName
 /// ) -> tuple[FloatArray, FloatArray] | None
@@ -833,7 +838,7 @@ fn same_rotation_map<'py>(
     source: &Bound<'py, PyAny>,
     target: &Bound<'py, PyAny>,
     mode: Choice<SameRotationMap, RotationMode>,
-) -> PyResult<Option<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>)>> {
+) -> PyResult<Option<ChannelMap<'py>>> {
     const F: &str = SameRotationMap::NAME;
     let mode = mode.0;
     let width = mode.width();
@@ -1048,6 +1053,18 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "CONTINUED_ROTATION_MODES",
         pyo3::types::PyTuple::new(m.py(), continued)?,
     )?;
+    // stub:
+    // stub: NORMALISED_CHANNELS: dict[str, tuple[int, int]]
+    // stub: """The channels ``start:stop`` of a rotation mode that Blender normalises before it uses them
+    // stub: (scaling them together keeps the rotation): ``"QUATERNION"`` -> ``(0, 4)``, ``"AXIS_ANGLE"``
+    // stub: -> ``(1, 4)`` (the axis); Euler orders have none."""
+    let normalised = pyo3::types::PyDict::new(m.py());
+    for mode in RotationMode::ALL {
+        if let Some(channels) = mode.normalised() {
+            normalised.set_item(mode.name(), channels)?;
+        }
+    }
+    m.add("NORMALISED_CHANNELS", normalised)?;
     // stub:
     // stub: TIMINGS: tuple[str, ...]
     // stub: """Every timing, the core's: ``("smooth", "linear", "keys")``."""

@@ -503,6 +503,15 @@ impl Error {
     }
 }
 
+/// `": {hint}"`, or nothing for an empty hint (the end of a limit's message).
+fn write_hint(f: &mut fmt::Formatter<'_>, hint: &str) -> fmt::Result {
+    if hint.is_empty() {
+        Ok(())
+    } else {
+        write!(f, ": {hint}")
+    }
+}
+
 /// A list of names as messages show them: Blender's identifiers bare (`QUATERNION, XYZ`),
 /// lowercase option names quoted (`"smooth", "linear"`).
 fn names(expected: &[&str]) -> String {
@@ -667,11 +676,7 @@ impl fmt::Display for Error {
                     f,
                     "{what}: {count} {counted} exceed the limit of {limit} in one call"
                 )?;
-                if hint.is_empty() {
-                    Ok(())
-                } else {
-                    write!(f, ": {hint}")
-                }
+                write_hint(f, hint)
             }
             Self::LimitOver {
                 what,
@@ -687,11 +692,7 @@ impl fmt::Display for Error {
                     "{what}: the {parts} {of} would take {count} {counted}, over the limit of \
                      {limit} in one call"
                 )?;
-                if hint.is_empty() {
-                    Ok(())
-                } else {
-                    write!(f, ": {hint}")
-                }
+                write_hint(f, hint)
             }
             Self::Degenerate { what, at, reason } => {
                 write!(f, "{what}: {}{reason}", prefix(at))

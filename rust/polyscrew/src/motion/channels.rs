@@ -220,6 +220,17 @@ impl RotationMode {
         !matches!(self, Self::AxisAngle)
     }
 
+    /// The channels `start..end` Blender normalises before it uses them, so that scaling
+    /// them together keeps the rotation: a quaternion's four, an axis-angle's axis (`1..4`);
+    /// `None` for Euler angles.
+    pub const fn normalised(self) -> Option<(usize, usize)> {
+        match self {
+            Self::Quaternion => Some((0, 4)),
+            Self::AxisAngle => Some((1, 4)),
+            Self::Euler(_) => None,
+        }
+    }
+
     /// Whether channel `channel` is an angle, radians that wrap by whole turns: the three
     /// Euler angles, the axis-angle angle (channel 0); no quaternion channel.
     pub fn is_angle(self, channel: usize) -> bool {
@@ -1174,6 +1185,8 @@ mod tests {
             Err(Error::LengthMismatch { .. })
         ));
         assert!(RotationMode::Quaternion.continued() && !RotationMode::AxisAngle.continued());
+        assert_eq!(RotationMode::AxisAngle.normalised(), Some((1, 4)));
+        assert_eq!(RotationMode::Euler(EulerOrder::Xyz).normalised(), None);
         assert!(RotationMode::Euler(EulerOrder::Yzx).continued());
     }
 }

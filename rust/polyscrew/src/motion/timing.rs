@@ -47,24 +47,13 @@ impl Timing {
     /// Every timing, in the order the add-on lists them.
     pub const ALL: [Self; 3] = [Self::Smooth, Self::Linear, Self::Keys];
 
-    /// [`name`](Self::name) of every timing of [`ALL`](Self::ALL), in its order.
-    pub const NAMES: [&'static str; 3] = {
-        let mut names = [""; 3];
-        let mut i = 0;
-        while i < names.len() {
-            names[i] = Self::ALL[i].name();
-            i += 1;
-        }
-        names
-    };
+    /// [`name`](Self::name) of every timing of [`ALL`](Self::ALL), in its order (the
+    /// variants' order).
+    pub const NAMES: [&'static str; 3] = ["smooth", "linear", "keys"];
 
     /// The timing's name: `"smooth"`, `"linear"`, `"keys"`.
     pub const fn name(self) -> &'static str {
-        match self {
-            Self::Smooth => "smooth",
-            Self::Linear => "linear",
-            Self::Keys => "keys",
-        }
+        Self::NAMES[self as usize]
     }
 
     /// Whether the timing follows the pace of a playback (it needs the body's size and the
@@ -344,7 +333,8 @@ mod tests {
     #[test]
     fn every_timing_parses_its_own_name_and_only_keys_is_paced() {
         assert_eq!(Timing::NAMES, ["smooth", "linear", "keys"]);
-        for timing in Timing::ALL {
+        for (i, timing) in Timing::ALL.into_iter().enumerate() {
+            assert_eq!(timing as usize, i);
             assert_eq!(Timing::from_name(timing.name()), Ok(timing));
             assert_eq!(timing.paced(), timing == Timing::Keys, "{timing:?}");
         }
