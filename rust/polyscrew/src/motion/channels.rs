@@ -192,6 +192,16 @@ impl RotationMode {
         }
     }
 
+    /// The transform properties of an owner in this mode: `"location"`, its
+    /// [`property`](Self::property), `"scale"`.
+    pub const fn transform_properties(self) -> &'static [&'static str] {
+        match self {
+            Self::Quaternion => &["location", "rotation_quaternion", "scale"],
+            Self::AxisAngle => &["location", "rotation_axis_angle", "scale"],
+            Self::Euler(_) => &["location", "rotation_euler", "scale"],
+        }
+    }
+
     /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
     /// quaternions, the angle of axis-angle, the three Euler angles.
     fn angles(self) -> usize {
@@ -721,6 +731,36 @@ pub fn same_rotation_map(
         .find(|(a, c)| (0..width).all(|i| (a[i] * source[i] + c[i] - target[i]).abs() <= tol))
 }
 
+/// The rotation of `values` in `mode` as a quaternion of any non-zero length, as
+/// [`rotation_matrix`] reads them (the departure's angle): a quaternion scaled by its largest component (the
+/// identity for zero), Euler angles as the product of their axes' half-angle quaternions
+/// (`q = q(a3) q(a2) q(a1)`, `R = R(a3) R(a2) R(a1)`); `None` for axis-angle.
+pub(crate) fn rotation_quat(mode: RotationMode, values: &[f64]) -> Option<DQuat> {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            Some(if largest > 0.0 {
+                q / largest
+            } else {
+                DQuat::IDENTITY
+            })
+        }
+        RotationMode::AxisAngle => None,
+        RotationMode::Euler(order) => {
+            let about = |axis: usize| match axis {
+                0 => DQuat::from_rotation_x(v(0)),
+                1 => DQuat::from_rotation_y(v(1)),
+                _ => DQuat::from_rotation_z(v(2)),
+            };
+            // (the axes in the order they apply, as `EulerOrder::to_mat3`)
+            let [first, second, third] = order.axes().0;
+            Some(about(third) * about(second) * about(first))
+        }
+    }
+}
+
 /// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
 /// it:
 ///
@@ -1187,6 +1227,9 @@ mod tests {
         assert!(RotationMode::Quaternion.continued() && !RotationMode::AxisAngle.continued());
         assert_eq!(RotationMode::AxisAngle.normalised(), Some((1, 4)));
         assert_eq!(RotationMode::Euler(EulerOrder::Xyz).normalised(), None);
+        for mode in RotationMode::ALL {
+            assert_eq!(mode.transform_properties()[1], mode.property());
+        }
         assert!(RotationMode::Euler(EulerOrder::Yzx).continued());
     }
 }
