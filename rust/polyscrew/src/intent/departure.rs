@@ -395,7 +395,6 @@ pub fn measured_frames(
 mod angle_tests {
     use super::*;
     use crate::{EulerOrder, RotationMode};
-    use glam::DQuat;
 
     /// The angle between two rotations as [`compare`] takes it from quaternions equals
     /// [`rotation_angle`] of their matrices, in every quaternion and Euler mode (unnormalised,
