@@ -69,7 +69,8 @@ import numpy.typing as npt
 ArrayLike = npt.ArrayLike
 FloatArray = npt.NDArray[np.float64]
 SchemeName = Literal["four_point", "bspline", "jarek"]
-TimingName = Literal["smooth", "linear"]
+TimingName = Literal["smooth", "linear", "keys"]
+TimeMapName = Literal["smooth", "linear"]
 RotationModeName = Literal["QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"]
 
 # --- The exception family: every error polyscrew raises about its arguments or its work ---
@@ -154,7 +155,7 @@ def sample(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """The subdivided motion of ``poses`` keyed at ``key_times``, at ``times``: (len(times), 4, 4).
 
@@ -162,7 +163,9 @@ def sample(
     ``times`` within +-1e300. ``closed`` makes a cycle of length
     ``period`` (default: closed after the mean key spacing). ``timing="smooth"`` is the
     monotone C1 map from time to the motion parameter, ``"linear"`` maps each key span
-    linearly. Open motions hold their end poses outside the keys' range.
+    linearly (the timings that map time, ``TimeMapName``: timing ``"keys"`` follows Blender's
+    playback, ``timed_frames`` turns it into times to sample at). Open motions hold their end
+    poses outside the keys' range.
     """
 
 def sample_channels(
@@ -175,7 +178,7 @@ def sample_channels(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> tuple[FloatArray, FloatArray]:
     """``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
     ``rotation_channels(sample(...), mode, previous)``, without the (len(times), 4, 4)
@@ -195,7 +198,7 @@ def sample_vectors(
     levels: int = 4,
     closed: bool = False,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """``sample`` for plain vectors ``values`` (N, 3) (for example log-scale): (len(times), 3)."""
 
@@ -228,6 +231,34 @@ def turn_vectors(a: ArrayLike, b: ArrayLike) -> FloatArray:
     each), in the world frame: (N, 3) rotation vectors ``log(R_b R_a^T)``, axis times angle,
     the angle (their length) in [0, pi], exact near 0 and near pi (``atan2`` of the relative
     quaternion, not ``arccos`` of a trace). At most ``MAX_ROTATIONS`` rows.
+    """
+
+def angles_near(
+    values: ArrayLike, reference: ArrayLike, mode: RotationModeName, channel: int
+) -> FloatArray:
+    """Each of ``values`` (N,) of rotation channel ``channel`` in ``mode`` moved by whole turns to
+    within half a turn of the same entry of ``reference`` (N,) when that channel is an angle
+    (the three Euler angles, the axis-angle angle: channel 0), unchanged otherwise: the same
+    rotations, written like the reference (ties of half a turn rounded away from zero).
+    """
+
+def same_rotation_map(
+    source: ArrayLike, target: ArrayLike, mode: RotationModeName
+) -> tuple[FloatArray, FloatArray] | None:
+    """The per-channel map ``(a, c)`` with ``a * source + c == target`` (within 1e-5 of the
+    largest of 1 and ``|target|``) that keeps every rotation channel values in ``mode`` can
+    hold, so that mapping a curve's keys and handles by it keeps every pose Blender plays;
+    None when no such map takes ``source`` to ``target`` (one row of channel values each):
+    quaternions a common scale (the sign, and a length Blender normalises away); axis-angle
+    the angle's sign and whole turns, the axis scaled by a length of that sign; Euler whole
+    turns, or the twin triple ``(x + pi, pi - y, z + pi)`` (the order's middle axis negated)
+    and whole turns.
+    """
+
+def direction_steps(directions: ArrayLike) -> FloatArray:
+    """The angle between each two consecutive rows of ``directions`` (N, 3) (any nonzero
+    lengths): (N - 1,) angles in [0, pi], ``atan2(|a x b|, a . b)``, exact near 0 and near
+    pi where ``arccos`` of a dot product loses digits; 0 where a row is zero.
     """
 
 def partial_moves(
@@ -286,6 +317,25 @@ ROTATION_MODES: dict[str, tuple[str, int]]
 number of its channels), in Blender's order: ``"QUATERNION"`` -> ``("rotation_quaternion",
 4)``, ``"AXIS_ANGLE"`` -> ``("rotation_axis_angle", 4)``, each Euler order (``"XYZ"``, ...)
 -> ``("rotation_euler", 3)``."""
+
+CONTINUED_ROTATION_MODES: tuple[str, ...]
+"""The rotation modes whose channels continue the values before them (``previous`` of
+``rotation_channels`` and ``sample_channels``: a bake from its first key's values, a piece
+from the piece before): quaternion and the Euler orders. Axis-angle channels start from
+their own first rotation."""
+
+NORMALISED_CHANNELS: dict[str, tuple[int, int]]
+"""The channels ``start:stop`` of a rotation mode that Blender normalises before it uses them
+(scaling them together keeps the rotation): ``"QUATERNION"`` -> ``(0, 4)``, ``"AXIS_ANGLE"``
+-> ``(1, 4)`` (the axis); Euler orders have none."""
+
+TIMINGS: tuple[str, ...]
+"""Every timing, the core's: ``("smooth", "linear", "keys")``."""
+
+PACED_TIMINGS: tuple[str, ...]
+"""The timings that follow the pace of Blender's playback (``("keys",)``): not a map of time
+alone, they need the body's size and the playback (``timed_frames``); ``sample`` and its
+kin refuse them."""
 
 FitStatusName = Literal["converged", "iteration_limit", "above_delta"]
 
@@ -608,7 +658,7 @@ def sample_feature(
     stiffness: float | ArrayLike | None = None,
     inserted_stiffness: float | None = None,
     period: float | None = None,
-    timing: TimingName = "smooth",
+    timing: TimeMapName = "smooth",
 ) -> FloatArray:
     """``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).
 
@@ -853,6 +903,36 @@ def keys_parameters(
     Raises ValueError naming the argument: key frames that do not increase, a period not
     beyond the keys, a size that is not positive, frames not finite, neither or both of
     ``poses`` and ``smooth``, or ``smooth`` of the wrong length.
+    """
+
+def timed_frames(
+    key_frames: ArrayLike,
+    frames: ArrayLike,
+    timing: TimingName = "smooth",
+    *,
+    size: float | None = None,
+    closed: bool = False,
+    period: float | None = None,
+    playback: Playback | None = None,
+    poses: ArrayLike | None = None,
+    scheme: SchemeName = "four_point",
+    levels: int = 4,
+    smooth: ArrayLike | None = None,
+    played: bool = False,
+) -> tuple[Any, Any, Any, TimeMapName, FloatArray | None]:
+    """Where the motion of keys at ``key_frames`` is sampled for ``frames`` with ``timing``, in
+    one call for every timing: ``(key_times, times, period, timing, rows)`` to pass to
+    ``sample``, ``sample_channels``, ``sample_vectors`` or a feature-point sampler (with the
+    same ``closed``, ``scheme`` and ``levels``).
+
+    A map of time (``"smooth"``, ``"linear"``): ``key_frames``, ``frames``, ``period`` and
+    ``timing`` as given (the same objects), ``rows`` None. A timing that follows Blender's
+    pace (``PACED_TIMINGS``: ``"keys"``): key times ``0..K-1`` (float64), the parameters of
+    ``keys_parameters`` (which takes the same keyword arguments: ``size`` required, ``poses``
+    or ``smooth``, the ``playback``), period ``K`` for a closed motion (else None),
+    ``"linear"``, and with ``played`` the playback's rows of ``keys_parameters(...,
+    played=True)`` (else None). GIL released. Raises ValueError as ``keys_parameters``, and
+    for a paced timing without ``size``.
     """
 
 def pace_parameters(spans: int) -> FloatArray:

@@ -73,7 +73,7 @@ REPRODUCERS = [
         "fit, fragment_duration=1e-15 (asked for 32 PB)",
         "report(lambda: ps.fit_angular_velocity([[1.,0,0,0]]*2, [0.,1], [0.,1], np.zeros((2,3)), fragment_duration=1e-15))",
         "ValueError",
-        r"fit_angular_velocity: fragment_duration: 1e-15 is not at least 1e-6 \(at most 1000000 fragments of the key range\)",
+        r"fit_angular_velocity: fragment_duration: 1e-15 is not at least 1e-6 \(at most 1000000 fragments of the key range, 1 long\)",
     ),
     (
         "subdivide 100,000 keys x 12 levels (22.9 GB)",
@@ -478,8 +478,8 @@ print(json.dumps({"turn": float(out[2].min()), "inserted": len(out[3])}))
           f"512 spans (2,097,152 samples) computed in {at_cap_peak['cpu']:.2f} s of CPU, "
           f"peak growth {at_cap_peak['growth'] / MB:.0f} MB, {result['inserted']} frames inserted")
     hint = "analyse fewer key frames at once (a span takes one sample per few degrees its rotation channels turn)"
-    assert many == {"error": "ValueError", "message": f"analyse_spans: frames: 65536000 samples of the playback (for the key spans) exceed the limit of 2097152 in one call: {hint}"}
-    assert over == {"error": "ValueError", "message": f"analyse_spans: frames: 2101248 samples of the playback (for the key spans) exceed the limit of 2097152 in one call: {hint}"}
+    assert many == {"error": "ValueError", "message": f"analyse_spans: frames: the 16000 key spans would take 65536000 samples of the playback, over the limit of 2097152 in one call: {hint}"}
+    assert over == {"error": "ValueError", "message": f"analyse_spans: frames: the 513 key spans would take 2101248 samples of the playback, over the limit of 2097152 in one call: {hint}"}
     assert many_peak["cpu"] < 1.0 and over_peak["cpu"] < 1.0
     assert at_cap == {"finite": True}
     assert result["turn"] > 1000  # every span a spin (its samples alias: under 4096 pi)

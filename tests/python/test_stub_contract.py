@@ -163,7 +163,8 @@ KEYS[:, 1, 3] = [0.0, 1.0, 1.0, 0.0]
     "alias, call",
     [
         ("SchemeName", lambda v: polyscrew.subdivide(KEYS, scheme=v, levels=1)),
-        ("TimingName", lambda v: polyscrew.sample(KEYS, [0.0, 1.0, 2.0, 3.0], [0.5], timing=v)),
+        ("TimeMapName", lambda v: polyscrew.sample(KEYS, [0.0, 1.0, 2.0, 3.0], [0.5], timing=v)),
+        ("TimingName", lambda v: polyscrew.timed_frames([0.0, 1.0, 2.0, 3.0], [0.5], v, size=1.0, poses=KEYS)[1]),
         ("RotationModeName", lambda v: polyscrew.rotation_channels(np.eye(3)[None], v)),
         ("CurveSchemeName", lambda v: polyscrew.feature_motion(KEYS, scheme=v, levels=1)),
         ("ParametrizationName", lambda v: polyscrew.feature_motion(KEYS, levels=1, parametrization=v)),

@@ -201,7 +201,7 @@ def read_sketch(sphere: bpy.types.Object, timing: str = "POINTS") -> tuple[np.nd
     start, end = (float(v) for v in sphere[RANGE_KEY])
     if timing == "LENGTH":
         unit = _unit_rows(directions)
-        step = np.arccos(np.clip(np.sum(unit[1:] * unit[:-1], axis=1), -1.0, 1.0))
+        step = polyscrew.direction_steps(unit)
         keep = np.concatenate(([True], step > 1e-9))  # repeated points would share a time
         directions, unit = directions[keep], unit[keep]
         travelled = np.concatenate(([0.0], np.cumsum(step[keep[1:]])))
@@ -272,7 +272,7 @@ def fit(
             target_speed=speeds,
         )
         mode = motion.rotation_mode
-        previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
+        previous = keys.continued(mode, motion.first_rotation)
         matrices = polyscrew.rotation_matrices(result.quaternions, "QUATERNION")
         rotation = polyscrew.rotation_channels(matrices, mode, previous=previous)
     except ValueError as err:

@@ -223,7 +223,7 @@ def sample_channels(
             key_frames = (key_frames[None] + motion.period * np.arange(first, last + 1)[:, None]).ravel()
         frames = with_key_frames(frames, key_frames)
         mode = motion.rotation_mode
-        previous = None if mode == "AXIS_ANGLE" else motion.first_rotation
+        previous = keys.continued(mode, motion.first_rotation)
         # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
         sampled = sampling.sample(
             motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous, played=True

@@ -290,8 +290,6 @@ def data_notes(c: Cleaned) -> list[str]:
     return notes
 
 
-TAU = 2.0 * np.pi
-
 
 def _rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`nearest_rows`, at once when the keys `at` are the key frames `frames` themselves
@@ -319,7 +317,7 @@ def _original_rotation(motion: keys.KeyedMotion) -> np.ndarray:
                 return np.asarray(motion.source.channels(motion.frames)[path], dtype=np.float64)
         return out
     # Curves the add-on cannot evaluate: continuity from the first key's values.
-    return polyscrew.rotation_channels(motion.poses, mode, previous=None if mode == "AXIS_ANGLE" else motion.first_rotation)
+    return polyscrew.rotation_channels(motion.poses, mode, previous=keys.continued(mode, motion.first_rotation))
 
 
 def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
@@ -345,7 +343,6 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         location = np.zeros((len(motion.frames), 3))
         location[cleaned.rows] = cleaned.poses[:, :3, 3]
         values["location"] = location
-    euler = mode not in ("QUATERNION", "AXIS_ANGLE")
     originals = {(fc.data_path, fc.array_index): fc for fc in cleaned.originals}
     # What keys.read read (one foreach_get per property and curve): the original keys, and on
     # a first run also those of the result's curves (a copy of them): nothing is read again.
@@ -376,8 +373,8 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         row, near = _rows(motion.frames, co[:, 0])
         edit = near & smoothed[row]
         target = values[prop][row[edit], fc.array_index]
-        if euler and prop == path:  # within half a turn of the key's own original value
-            target = target + TAU * np.round((co[edit, 1] - target) / TAU)
+        if prop == path:  # an angle within half a turn of the key's own original value
+            target = polyscrew.angles_near(target, co[edit, 1], mode, fc.array_index)
         delta = (target - co[edit, 1]).astype(np.float32)
         left[edit, 1] += delta
         right[edit, 1] += delta

@@ -28,6 +28,7 @@ from ..pure.keyed import (  # noqa: F401  (re-exported: the pure layer's key pos
     _union,
     baked_channels,
     compose,
+    continued,
     key_motion,
     rotation_matrices,
     rotation_path,

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import bpy
 import numpy as np
+import polyscrew
 
 from ..pure.bezier import _bezier, split_bezier  # noqa: F401  (re-exported: range_join.split_bezier)
 from . import bulk, keys
@@ -56,7 +57,6 @@ _FIELDS = (
     ("period", np.float32, 1),
 )
 
-TAU = 2.0 * np.pi
 #: Blender's defaults of the easing parameters of a new key.
 _DEFAULTS = {"back": 1.70158, "amplitude": 0.8, "period": 4.1}
 
@@ -231,38 +231,13 @@ def _concat(tables: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
 def equivalence(source: np.ndarray, baked: np.ndarray, mode: str, prop: str) -> tuple[np.ndarray, np.ndarray] | None:
     """`(a, c)` with `a * source + c == baked` (per channel) for a map that keeps every rotation
     the channels of `prop` can play (identity for location and scale); None when no such map
-    matches (the caller then writes the source value)."""
-    source, baked = np.asarray(source, dtype=np.float64), np.asarray(baked, dtype=np.float64)
-    ones, zeros = np.ones_like(source), np.zeros_like(source)
-    tol = 1e-5 * max(1.0, float(np.max(np.abs(baked))))
+    matches (the caller then writes the source value). The rotation maps are the core's
+    (`polyscrew.same_rotation_map`: quaternion sign and length, axis-angle sign and whole turns,
+    Euler whole turns and the twin triple)."""
     if prop != keys.rotation_path(mode):
-        return ones, zeros
-    candidates = []
-    if mode == "QUATERNION":
-        norm = float(source @ source)
-        if norm > 0.0:
-            candidates.append((ones * (float(baked @ source) / norm), zeros))
-    elif mode == "AXIS_ANGLE":
-        axis = float(source[1:] @ source[1:])
-        for sign in (1.0, -1.0):
-            if axis > 0.0:
-                scale = float(baked[1:] @ source[1:]) / axis  # the axis: sign times a positive length
-                if scale * sign > 0.0:
-                    a = np.array([sign, scale, scale, scale])
-                    c = np.array([TAU * np.round((baked[0] - sign * source[0]) / TAU), 0.0, 0.0, 0.0])
-                    candidates.append((a, c))
-    else:
-        candidates.append((ones, TAU * np.round((baked - source) / TAU)))
-        first, middle, last = ("XYZ".index(axis) for axis in mode)
-        a = ones.copy()
-        a[middle] = -1.0
-        twin = np.full(3, np.pi)
-        c = twin + TAU * np.round((baked - (a * source + twin)) / TAU)
-        candidates.append((a, c))
-    for a, c in candidates:
-        if np.all(np.abs(a * source + c - baked) <= tol):
-            return a, c
-    return None
+        ones = np.ones(len(source))
+        return ones, np.zeros_like(ones)
+    return polyscrew.same_rotation_map(source, baked, mode)
 
 
 def _map(table: dict[str, np.ndarray], a: float, c: float) -> None:
@@ -394,8 +369,9 @@ def end_maps(join: Join, motion: keys.KeyedMotion, played: dict, values: dict, f
     ends, by a factor that changes geometrically along the range."""
     mode = motion.rotation_mode
     path = keys.rotation_path(mode)
-    if keys.rotation_width(mode) == 4 and path in values:
-        part = slice(0, 4) if mode == "QUATERNION" else slice(1, 4)
+    normalised = polyscrew.NORMALISED_CHANNELS.get(mode)  # (the core's: a quaternion, an axis-angle's axis)
+    if normalised is not None and path in values:
+        part = slice(*normalised)
         baked = values[path]
         logs = []
         for row, src_row, cut_here in ((0, 0, join.before), (-1, 1, join.after)):

@@ -113,6 +113,14 @@ def rotation_width(mode: str) -> int:
     return polyscrew.ROTATION_MODES[mode][1]
 
 
+def continued(mode: str, values: np.ndarray | None) -> np.ndarray | None:
+    """What rotation channels in mode `mode` continue from (`previous` of
+    `polyscrew.rotation_channels` and `sample_channels`): `values`, or None for a mode whose
+    channels start from their own first rotation (the core's rule,
+    `polyscrew.CONTINUED_ROTATION_MODES`: axis-angle)."""
+    return values if mode in polyscrew.CONTINUED_ROTATION_MODES else None
+
+
 def transform_paths(mode: str) -> tuple[str, str, str]:
     """Location, rotation (for `mode`) and scale property names."""
     return ("location", rotation_path(mode), "scale")

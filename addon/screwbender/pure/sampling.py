@@ -6,8 +6,8 @@ The key poses (:func:`keys.read`) are cut at held spans (:mod:`intent`) into pie
 piece is one `polyscrew` call (screw subdivision or feature points) for all its frames, held
 frames keep their key pose. Timing "smooth" and "linear" map frames to the motion with
 polyscrew's own time maps; timing "keys" gives each frame the parameter at which the smoothed
-piece has travelled the same fraction of the span as Blender's playback has
-(:func:`keys_parameters`).
+piece has travelled the same fraction of the span as Blender's playback has. The core chooses
+between them (:func:`timed`: one `polyscrew.timed_frames` call for every timing).
 """
 
 from __future__ import annotations
@@ -91,52 +91,31 @@ def _sub(motion: keys.KeyedMotion, lo: int, hi: int) -> keys.KeyedMotion:
     )
 
 
-def _spec(motion: keys.KeyedMotion, options, timing: str | None = None) -> dict:
-    return dict(
-        scheme=options.scheme,
-        levels=options.levels,
-        closed=motion.closed,
-        period=motion.period,
-        timing=timing or options.timing,
-    )
+def timed(motion: keys.KeyedMotion, frames: np.ndarray, options, features=None, played: bool = False):
+    """Where `motion` (one piece) is sampled for `frames` with the options' timing, chosen by
+    the core for every timing: one `polyscrew.timed_frames` call, which returns
+    `(key_times, times, period, timing, rows)` to sample the motion with.
 
-
-def _parameter_motion(motion: keys.KeyedMotion) -> tuple[np.ndarray, float | None]:
-    """Key times `0, 1, ..., K-1` (and period K for a cycle): with linear timing, the motion
-    of these keys at time u is the motion at parameter u."""
-    k = len(motion.frames)
-    return np.arange(k, dtype=np.float64), (float(k) if motion.closed else None)
-
-
-def keys_parameters(motion: keys.KeyedMotion, frames: np.ndarray, options, features=None, played: bool = False):
-    """Timing "keys": the motion parameter of each frame of `frames`.
-
-    Within a span (keys i, i+1), a frame gets the parameter at which the smoothed motion has
-    travelled the same fraction of the span's travel as Blender's own playback of the curves
-    has at that frame (travel: `sqrt(|dt|^2 + size^2/3 |dR|_F^2)`, summed along
-    :data:`PACE_SAMPLES` steps per span). Without Blender's curves (a motion read from key
-    values only), or over a span where Blender's playback does not move (the span closing a
-    cycle that has no Cycles modifier), the fraction is the fraction of time.
-
-    One `polyscrew.keys_parameters` call: it samples Blender's playback (the motion's
-    `polyscrew.Playback`) and the smoothed screw motion itself; for the Feature Points
-    method the smoothed motion's poses at `polyscrew.pace_parameters` are sampled here first.
-    With `played`, returns `(parameters, rows)`: also the playback's location and rotation at
-    the frames it played (NaN elsewhere), which the departure measure then need not play again.
+    Smooth and Linear are maps of time: the keys at their frames, the frames themselves.
+    Timing "keys" (`polyscrew.PACED_TIMINGS`) gives each frame the parameter at which the
+    smoothed motion has travelled the same fraction of its span as Blender's own playback of
+    the curves has there (`polyscrew.keys_parameters`; the fraction of time without Blender's
+    curves); the motion is then sampled at those parameters, keys at 0..K-1, with linear
+    timing. For the Feature Points method the smoothed motion's poses at
+    `polyscrew.pace_parameters` are sampled here first. With `played` (and Blender's curves),
+    `rows` are the playback's location and rotation at the frames it played (NaN elsewhere),
+    which the departure measure then need not play again; else None.
     """
-    frames = np.asarray(frames, dtype=np.float64)
     playback = motion.source.playback if motion.source is not None else None
-    common = dict(size=motion.size, closed=motion.closed, period=motion.period, playback=playback)
-    if played:
-        common["played"] = True
-    if options.method == "FEATURE" and features is not None:
+    poses, smooth = motion.poses, None
+    if options.method == "FEATURE" and features is not None and options.timing in polyscrew.PACED_TIMINGS:
         k = len(motion.frames)
         u = polyscrew.pace_parameters(k if motion.closed else k - 1)
-        times = np.arange(k, dtype=np.float64)
-        smooth = features(motion, times, u, float(k) if motion.closed else None)
-        return polyscrew.keys_parameters(motion.frames, frames, smooth=smooth, **common)
-    return polyscrew.keys_parameters(
-        motion.frames, frames, poses=motion.poses, scheme=options.scheme, levels=options.levels, **common
+        poses, smooth = None, features(motion, np.arange(k, dtype=np.float64), u, float(k) if motion.closed else None)
+    return polyscrew.timed_frames(
+        motion.frames, frames, options.timing, size=motion.size, closed=motion.closed, period=motion.period,
+        playback=playback, poses=poses, scheme=options.scheme, levels=options.levels, smooth=smooth,
+        played=played and playback is not None,
     )
 
 
@@ -202,7 +181,6 @@ def sample(
     logs = np.log(np.where(motion.scale_axes, motion.scales, 1.0)) if scaled else None
     log_scales = np.empty((n, 3)) if scaled else None
     last_rotation = previous
-    keep_played = played and options.timing == "keys" and motion.source is not None
     played_rows = None
     for seg in segments(motion, frames):
         # (every frame in one piece, the usual case: a slice, no index arrays to scatter through)
@@ -221,23 +199,15 @@ def sample(
         else:
             whole = seg.lo == 0 and seg.hi == len(motion.frames) - 1
             piece = motion if whole else _sub(motion, seg.lo, seg.hi)
-            t = frames[rows]
-            if options.timing == "keys":
-                key_times, period = _parameter_motion(piece)
-                if keep_played:
-                    at, rows_played = keys_parameters(piece, t, options, features, played=True)
-                    if len(seg.rows) == n:
-                        played_rows = rows_played
-                    else:
-                        if played_rows is None:
-                            played_rows = np.full((n, rows_played.shape[1]), np.nan)
-                        played_rows[rows] = rows_played
+            key_times, at, period, timing, rows_played = timed(piece, frames[rows], options, features, played)
+            if rows_played is not None:
+                if len(seg.rows) == n:
+                    played_rows = rows_played
                 else:
-                    at = keys_parameters(piece, t, options, features)
-                spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing="linear")
-            else:
-                spec = _spec(piece, options)
-                key_times, at = piece.frames, t
+                    if played_rows is None:
+                        played_rows = np.full((n, rows_played.shape[1]), np.nan)
+                    played_rows[rows] = rows_played
+            spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing=timing)
             if options.method == "FEATURE" and features is not None:
                 piece_poses = features(piece, key_times, at, spec["period"], spec["timing"])
                 if channels:
@@ -256,8 +226,7 @@ def sample(
             if rotation is None:
                 rotation = np.empty((n, values.shape[1]))
             rotation[rows] = values
-            if mode != "AXIS_ANGLE":
-                last_rotation = values[-1]
+            last_rotation = keys.continued(mode, values[-1])
     scales = None
     if scaled:
         scales = np.empty((n, 3))

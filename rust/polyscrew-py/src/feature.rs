@@ -331,7 +331,7 @@ fn feature_motion<'py>(
 ///     stiffness: float | ArrayLike | None = None,
 ///     inserted_stiffness: float | None = None,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> FloatArray
 ///
 /// ``feature_motion`` as a function of time, at ``times``: (len(times), 4, 4).

@@ -10,18 +10,18 @@ use pyo3::prelude::*;
 
 use polyscrew::intent::{
     analyse_turns as core_analyse_turns, departure as core_departure,
-    keys_parameters as core_keys_parameters, keys_parameters_played as core_keys_parameters_played,
     measure_departure as core_measure_departure, pace_parameters as core_pace_parameters,
-    rotation_matrices as core_rotation_matrices, screw_pace_poses, Channel, DepartureLimits,
-    KeysTiming, Playback, Spans, Turns, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES,
-    PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
+    rotation_matrices as core_rotation_matrices, timed_frames as core_timed_frames, Channel,
+    DepartureLimits, PaceSource, Playback, Spans, Timed, Turns, HOLD_TOLERANCE,
+    MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES, PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES,
+    WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
-use polyscrew::{Error, Pose, RotationMode, Scheme};
+use polyscrew::{Error, MotionSpec, Pose, RotationMode, Scheme, Timing};
 
 use crate::args::{
     self, float_array, AnalyseSpans, AnalyseTurns, Choice, Function, KeysParameters, Most,
-    PlaybackNew, RotationMatrices,
+    PlaybackNew, RotationMatrices, TimedFrames,
 };
 use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
 use crate::errors::{check_budget, shape_err, to_py_err};
@@ -580,14 +580,6 @@ fn analyse_turns<'py>(
     Ok((held, pops, turn, inserted, flips))
 }
 
-/// Where `keys_parameters` gets the smoothed motion from.
-enum Smoothed {
-    /// The key poses, smoothed by the scheme and levels.
-    Keys(Vec<Pose>),
-    /// The caller's poses at `pace_parameters(spans)`.
-    Given(Vec<Pose>),
-}
-
 /// keys_parameters(
 ///     key_frames: ArrayLike,
 ///     frames: ArrayLike,
@@ -649,42 +641,85 @@ fn keys_parameters<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     const F: &str = KeysParameters::NAME;
     let size = args::float_scalar(F, "size", size)?;
-    let period = args::optional_float(F, "period", period)?;
+    let (out, rows, _) = paced(
+        py,
+        F,
+        key_frames,
+        frames,
+        size,
+        closed,
+        period,
+        playback,
+        (poses, smooth),
+        (scheme.0, levels),
+        played,
+    )?;
+    let out = out.into_any();
+    match rows {
+        Some(rows) => Ok((out, rows).into_pyobject(py)?.into_any()),
+        None => Ok(out),
+    }
+}
+
+/// What [`paced`] returns: the parameters, the played rows, the number of keys.
+type Paced<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    usize,
+);
+
+/// Timing Keys' parameters of `frames` (the core's `timed_frames`; the arguments as
+/// `keys_parameters` takes them), with `played` the playback's rows at them ((T, 0) without
+/// a playback), and the number of keys.
+#[allow(clippy::too_many_arguments)]
+fn paced<'py>(
+    py: Python<'py>,
+    f: &'static str,
+    key_frames: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
+    size: f64,
+    closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    playback: Option<&Bound<'py, PyAny>>,
+    (poses, smooth): (Option<&Bound<'py, PyAny>>, Option<&Bound<'py, PyAny>>),
+    (scheme, levels): (Scheme, u32),
+    played: bool,
+) -> PyResult<Paced<'py>> {
+    let period = args::optional_float(f, "period", period)?;
     let period = match (closed, period) {
         (true, Some(p)) => Some(p),
         (true, None) => {
             return Err(crate::errors::invalid(format!(
-                "{F}: period: a closed motion needs its period"
+                "{f}: period: a closed motion needs its period"
             )))
         }
         (false, _) => None,
     };
-    let scheme = scheme.0;
     let playback = playback
         .filter(|p| !p.is_none())
-        .map(|p| playback_arg(F, "playback", p))
+        .map(|p| playback_arg(f, "playback", p))
         .transpose()?;
-    let key_frames = float_array(F, "key_frames", key_frames)?;
-    let frames = float_array(F, "frames", frames)?;
-    let k = vector_len(F, "key_frames", &key_frames)?;
-    let t = vector_len(F, "frames", &frames)?;
+    let key_frames = float_array(f, "key_frames", key_frames)?;
+    let frames = float_array(f, "frames", frames)?;
+    let k = vector_len(f, "key_frames", &key_frames)?;
+    let t = vector_len(f, "frames", &frames)?;
     let (poses, smooth) = (
         poses.filter(|p| !p.is_none()),
         smooth.filter(|p| !p.is_none()),
     );
     let (array, is_keys) = match (poses, smooth) {
-        (Some(p), None) => (float_array(F, "poses", p)?, true),
-        (None, Some(s)) => (float_array(F, "smooth", s)?, false),
+        (Some(p), None) => (float_array(f, "poses", p)?, true),
+        (None, Some(s)) => (float_array(f, "smooth", s)?, false),
         _ => {
             return Err(crate::errors::invalid(format!(
-                "{F}: give either poses (the key poses) or smooth (the smoothed motion's poses)"
+                "{f}: give either poses (the key poses) or smooth (the smoothed motion's poses)"
             )))
         }
     };
     let n = if is_keys {
-        key_count(F, &array)?
+        key_count(f, &array)?
     } else {
-        pose_count(F, "smooth", array.shape())?.0
+        pose_count(f, "smooth", array.shape())?.0
     };
     // the copies of the input and the output, and the core's working memory (which it
     // checks again on its own): per frame four values, per pace sample five, per pose of
@@ -703,7 +738,7 @@ fn keys_parameters<'py>(
         + Footprint::of::<f64>(rows)
         + Footprint::of::<Pose>(if is_keys { grid } else { 0 });
     check_budget(
-        F,
+        f,
         key_frames.copy()
             + frames.copy()
             + array.copy()
@@ -715,46 +750,143 @@ fn keys_parameters<'py>(
     let (key_frames, frames, array) = (key_frames.read()?, frames.read()?, array.read()?);
     let inner = playback.map(|p| &p.get().inner);
     let (kv, fv, pv) = (key_frames.as_array(), frames.as_array(), array.as_array());
+    let spec = MotionSpec {
+        scheme,
+        levels,
+        closed,
+        period,
+        timing: Timing::Keys,
+    };
     let (out, rows) = py.detach(|| -> PyResult<(Vec<f64>, Vec<f64>)> {
-        let key_frames = read_vector(F, "key_frames", &kv)?;
-        let frames = read_vector(F, "frames", &fv)?;
-        let smoothed = if is_keys {
-            Smoothed::Keys(read_keys(F, &pv)?)
+        let key_frames = read_vector(f, "key_frames", &kv)?;
+        let frames = read_vector(f, "frames", &fv)?;
+        let poses = if is_keys {
+            read_keys(f, &pv)?
         } else {
-            Smoothed::Given(read_poses(F, "smooth", &pv)?)
+            read_poses(f, "smooth", &pv)?
         };
-        let timing = KeysTiming {
-            key_frames: &key_frames,
-            period,
-            size,
-            playback: inner,
+        let source = if is_keys {
+            PaceSource::Keys(&poses)
+        } else {
+            PaceSource::Given(&poses)
         };
-        let run = |smooth: &[Pose]| {
-            if played {
-                core_keys_parameters_played(&timing, &frames, smooth)
-            } else {
-                core_keys_parameters(&timing, &frames, smooth).map(|u| (u, Vec::new()))
-            }
-        };
-        match &smoothed {
-            Smoothed::Keys(keys) => {
-                screw_pace_poses(keys, scheme, levels, closed).and_then(|smooth| run(&smooth))
-            }
-            Smoothed::Given(smooth) => run(smooth),
+        match core_timed_frames(
+            &key_frames,
+            &frames,
+            &spec,
+            Some(size),
+            inner,
+            source,
+            played,
+        ) {
+            Ok(Timed::Parameters {
+                parameters, played, ..
+            }) => Ok((parameters, played)),
+            Ok(Timed::Frames) => unreachable!("timing Keys is paced"),
+            Err(e) => Err(to_py_err(f, e)),
         }
-        .map_err(|e| to_py_err(F, e))
     })?;
-    let out = out.into_pyarray(py).into_any();
+    let out = out.into_pyarray(py);
     if !played {
-        return Ok(out);
+        return Ok((out, None, k));
     }
     // (T, 0) without a playback: nothing played
     let width = inner.map_or(0, |p| 3 + p.mode().width());
     let rows = Array2::from_shape_vec((t, width), rows)
         .expect("a row per frame")
-        .into_pyarray(py)
-        .into_any();
-    Ok((out, rows).into_pyobject(py)?.into_any())
+        .into_pyarray(py);
+    Ok((out, Some(rows), k))
+}
+
+/// timed_frames(
+///     key_frames: ArrayLike,
+///     frames: ArrayLike,
+///     timing: TimingName = "smooth",
+///     *,
+///     size: float | None = None,
+///     closed: bool = False,
+///     period: float | None = None,
+///     playback: Playback | None = None,
+///     poses: ArrayLike | None = None,
+///     scheme: SchemeName = "four_point",
+///     levels: int = 4,
+///     smooth: ArrayLike | None = None,
+///     played: bool = False,
+/// ) -> tuple[Any, Any, Any, TimeMapName, FloatArray | None]
+///
+/// Where the motion of keys at ``key_frames`` is sampled for ``frames`` with ``timing``, in
+/// one call for every timing: ``(key_times, times, period, timing, rows)`` to pass to
+/// ``sample``, ``sample_channels``, ``sample_vectors`` or a feature-point sampler (with the
+/// same ``closed``, ``scheme`` and ``levels``).
+///
+/// A map of time (``"smooth"``, ``"linear"``): ``key_frames``, ``frames``, ``period`` and
+/// ``timing`` as given (the same objects), ``rows`` None. A timing that follows Blender's
+/// pace (``PACED_TIMINGS``: ``"keys"``): key times ``0..K-1`` (float64), the parameters of
+/// ``keys_parameters`` (which takes the same keyword arguments: ``size`` required, ``poses``
+/// or ``smooth``, the ``playback``), period ``K`` for a closed motion (else None),
+/// ``"linear"``, and with ``played`` the playback's rows of ``keys_parameters(...,
+/// played=True)`` (else None). GIL released. Raises ValueError as ``keys_parameters``, and
+/// for a paced timing without ``size``.
+#[pyfunction]
+#[pyo3(signature = (key_frames, frames, timing=Choice::of(Timing::Smooth), *, size=None, closed=false, period=None, playback=None, poses=None, scheme=Choice::of(Scheme::FourPoint), levels=4, smooth=None, played=false))]
+#[pyo3(
+    text_signature = "(key_frames, frames, timing='smooth', *, size=None, closed=False, period=None, playback=None, poses=None, scheme='four_point', levels=4, smooth=None, played=False)"
+)]
+#[allow(clippy::too_many_arguments)]
+fn timed_frames<'py>(
+    py: Python<'py>,
+    key_frames: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
+    timing: Choice<TimedFrames, Timing>,
+    size: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = args::closed::<TimedFrames>)] closed: bool,
+    period: Option<&Bound<'py, PyAny>>,
+    playback: Option<&Bound<'py, PyAny>>,
+    poses: Option<&Bound<'py, PyAny>>,
+    scheme: Choice<TimedFrames, Scheme>,
+    #[pyo3(from_py_with = args::levels::<TimedFrames>)] levels: u32,
+    smooth: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = played_arg)] played: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    const F: &str = TimedFrames::NAME;
+    let timing = timing.0;
+    if !timing.paced() {
+        let none = py.None().into_bound(py);
+        let period = period.cloned().unwrap_or_else(|| none.clone());
+        return Ok((key_frames, frames, period, timing.name(), none)
+            .into_pyobject(py)?
+            .into_any());
+    }
+    let size = match size.filter(|s| !s.is_none()) {
+        Some(size) => args::float_scalar(F, "size", size)?,
+        None => {
+            return Err(crate::errors::invalid(format!(
+                "{F}: size: timing {} needs the body's size",
+                timing.name()
+            )))
+        }
+    };
+    let (parameters, rows, k) = paced(
+        py,
+        F,
+        key_frames,
+        frames,
+        size,
+        closed,
+        period,
+        playback,
+        (poses, smooth),
+        (scheme.0, levels),
+        played,
+    )?;
+    let key_times = (0..k)
+        .map(|i| i as f64)
+        .collect::<Vec<f64>>()
+        .into_pyarray(py);
+    let period = closed.then_some(k as f64);
+    Ok((key_times, parameters, period, Timing::Linear.name(), rows)
+        .into_pyobject(py)?
+        .into_any())
 }
 
 /// pace_parameters(spans: int) -> FloatArray
@@ -831,6 +963,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(analyse_spans, m)?)?;
     m.add_function(wrap_pyfunction!(analyse_turns, m)?)?;
     m.add_function(wrap_pyfunction!(keys_parameters, m)?)?;
+    m.add_function(wrap_pyfunction!(timed_frames, m)?)?;
     m.add_function(wrap_pyfunction!(pace_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_matrices, m)?)?;
     // stub:

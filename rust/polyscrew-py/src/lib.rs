@@ -47,7 +47,8 @@ where
 // stub: ArrayLike = npt.ArrayLike
 // stub: FloatArray = npt.NDArray[np.float64]
 // stub: SchemeName = Literal["four_point", "bspline", "jarek"]
-// stub: TimingName = Literal["smooth", "linear"]
+// stub: TimingName = Literal["smooth", "linear", "keys"]
+// stub: TimeMapName = Literal["smooth", "linear"]
 // stub: RotationModeName = Literal["QUATERNION", "AXIS_ANGLE", "XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"]
 
 // The extension module `polyscrew._polyscrew`; `polyscrew/__init__.py` re-exports it.

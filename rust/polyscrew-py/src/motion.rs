@@ -9,17 +9,19 @@ use polyscrew::motion::sample::sample_footprint;
 use polyscrew::motion::screw::MAX_T;
 use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
-    channels_near as core_channels_near, partial_moves as core_partial_moves,
-    rotation_channels as core_rotation_channels, sample as core_sample,
-    subdivide as core_subdivide, subdivided_len, turn_vectors as core_turn_vectors, Error,
-    MoveBounds, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
+    angles_near as core_angles_near, channels_near as core_channels_near,
+    direction_steps as core_direction_steps, partial_moves as core_partial_moves,
+    rotation_channels as core_rotation_channels, same_rotation_map as core_same_rotation_map,
+    sample as core_sample, subdivide as core_subdivide, subdivided_len,
+    turn_vectors as core_turn_vectors, Error, MoveBounds, Pose, RotationMode, Scheme, Screw,
+    Timing, MAX_LEVELS,
 };
 use pyo3::prelude::*;
 
 use crate::args::{
-    self, copy_of, float_array, Choice, FloatArg, FloatArray, Function, PartialMoves,
-    RotationChannels, RotationChannelsNear, Sample, SampleChannels, SampleVectors, Subdivide,
-    SubdivideVectors, TurnVectors,
+    self, copy_of, float_array, AnglesNear, Choice, DirectionSteps, FloatArg, FloatArray, Function,
+    PartialMoves, RotationChannels, RotationChannelsNear, SameRotationMap, Sample, SampleChannels,
+    SampleVectors, Subdivide, SubdivideVectors, TurnVectors,
 };
 use crate::arrays::{
     fill, key_count, pose_count, poses_to_array, read_keys, read_one_pose, read_poses, read_spec,
@@ -333,7 +335,7 @@ impl<'py> TimedInput<'py> {
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> FloatArray
 ///
 /// The subdivided motion of ``poses`` keyed at ``key_times``, at ``times``: (len(times), 4, 4).
@@ -342,7 +344,9 @@ impl<'py> TimedInput<'py> {
 /// ``times`` within +-1e300. ``closed`` makes a cycle of length
 /// ``period`` (default: closed after the mean key spacing). ``timing="smooth"`` is the
 /// monotone C1 map from time to the motion parameter, ``"linear"`` maps each key span
-/// linearly. Open motions hold their end poses outside the keys' range.
+/// linearly (the timings that map time, ``TimeMapName``: timing ``"keys"`` follows Blender's
+/// playback, ``timed_frames`` turns it into times to sample at). Open motions hold their end
+/// poses outside the keys' range.
 #[pyfunction]
 #[pyo3(signature = (poses, key_times, times, scheme=Choice::of(Scheme::Jarek), levels=4, closed=false, period=None, timing=Choice::of(Timing::Smooth)))]
 #[pyo3(
@@ -401,7 +405,7 @@ fn sample<'py>(
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> tuple[FloatArray, FloatArray]
 ///
 /// ``sample`` as Blender channels: locations (len(times), 3) and the rotation channels
@@ -536,7 +540,7 @@ fn subdivide_vectors<'py>(
 ///     levels: int = 4,
 ///     closed: bool = False,
 ///     period: float | None = None,
-///     timing: TimingName = "smooth",
+///     timing: TimeMapName = "smooth",
 /// ) -> FloatArray
 ///
 /// ``sample`` for plain vectors ``values`` (N, 3) (for example log-scale): (len(times), 3).
@@ -775,6 +779,117 @@ fn turn_vectors<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// angles_near(
+///     values: ArrayLike, reference: ArrayLike, mode: RotationModeName, channel: int
+/// ) -> FloatArray
+///
+/// Each of ``values`` (N,) of rotation channel ``channel`` in ``mode`` moved by whole turns to
+/// within half a turn of the same entry of ``reference`` (N,) when that channel is an angle
+/// (the three Euler angles, the axis-angle angle: channel 0), unchanged otherwise: the same
+/// rotations, written like the reference (ties of half a turn rounded away from zero).
+#[pyfunction]
+fn angles_near<'py>(
+    py: Python<'py>,
+    values: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    mode: Choice<AnglesNear, RotationMode>,
+    channel: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    const F: &str = AnglesNear::NAME;
+    let (mode, channel) = (mode.0, args::int_in(F, "channel", channel, 0, 3)?);
+    let values = float_array(F, "values", values)?;
+    let reference = float_array(F, "reference", reference)?;
+    let n = vector_len(F, "values", &values)?;
+    vector_len(F, "reference", &reference)?;
+    check_budget(
+        F,
+        values.copy() + reference.copy() + Footprint::of::<f64>(n).times(3),
+        "the angles",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    let (values, reference) = (values.read()?, reference.read()?);
+    let (vv, rv) = (values.as_array(), reference.as_array());
+    let out = py.detach(|| -> PyResult<Vec<f64>> {
+        let values = read_vector(F, "values", &vv)?;
+        let reference = read_vector(F, "reference", &rv)?;
+        core_angles_near(&values, &reference, mode, channel as usize).map_err(|e| to_py_err(F, e))
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
+/// The `(a, c)` arrays of [`same_rotation_map`].
+type ChannelMap<'py> = (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>);
+
+/// same_rotation_map(
+///     source: ArrayLike, target: ArrayLike, mode: RotationModeName
+/// ) -> tuple[FloatArray, FloatArray] | None
+///
+/// The per-channel map ``(a, c)`` with ``a * source + c == target`` (within 1e-5 of the
+/// largest of 1 and ``|target|``) that keeps every rotation channel values in ``mode`` can
+/// hold, so that mapping a curve's keys and handles by it keeps every pose Blender plays;
+/// None when no such map takes ``source`` to ``target`` (one row of channel values each):
+/// quaternions a common scale (the sign, and a length Blender normalises away); axis-angle
+/// the angle's sign and whole turns, the axis scaled by a length of that sign; Euler whole
+/// turns, or the twin triple ``(x + pi, pi - y, z + pi)`` (the order's middle axis negated)
+/// and whole turns.
+#[pyfunction]
+fn same_rotation_map<'py>(
+    py: Python<'py>,
+    source: &Bound<'py, PyAny>,
+    target: &Bound<'py, PyAny>,
+    mode: Choice<SameRotationMap, RotationMode>,
+) -> PyResult<Option<ChannelMap<'py>>> {
+    const F: &str = SameRotationMap::NAME;
+    let mode = mode.0;
+    let width = mode.width();
+    let (source, target) = (
+        float_array(F, "source", source)?,
+        float_array(F, "target", target)?,
+    );
+    for (what, array) in [("source", &source), ("target", &target)] {
+        if array.shape() != [width] {
+            return Err(shape_err(F, what, &format!("({width},)"), array.shape()));
+        }
+    }
+    let (source, target) = (source.read()?, target.read()?);
+    let (sv, tv) = (source.as_array(), target.as_array());
+    let (source, target) = (
+        read_vector(F, "source", &sv)?,
+        read_vector(F, "target", &tv)?,
+    );
+    // constant work (a few channels): no need to leave the GIL
+    let found = detach_unless_small(py, true, || core_same_rotation_map(mode, &source, &target));
+    Ok(found.map(|(a, c)| (a.into_pyarray(py), c.into_pyarray(py))))
+}
+
+/// direction_steps(directions: ArrayLike) -> FloatArray
+///
+/// The angle between each two consecutive rows of ``directions`` (N, 3) (any nonzero
+/// lengths): (N - 1,) angles in [0, pi], ``atan2(|a x b|, a . b)``, exact near 0 and near
+/// pi where ``arccos`` of a dot product loses digits; 0 where a row is zero.
+#[pyfunction]
+fn direction_steps<'py>(
+    py: Python<'py>,
+    directions: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    const F: &str = DirectionSteps::NAME;
+    let directions = float_array(F, "directions", directions)?;
+    let n = rows3_len(&directions);
+    check_budget(
+        F,
+        directions.copy() + Footprint::of::<DVec3>(n) + Footprint::of::<f64>(n),
+        "the direction steps",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    let directions = directions.read()?;
+    let view = directions.as_array();
+    let out = py.detach(|| -> PyResult<Vec<f64>> {
+        let directions = read_vec3s(F, "directions", &view)?;
+        core_direction_steps(&directions).map_err(|e| to_py_err(F, e))
+    })?;
+    Ok(out.into_pyarray(py))
+}
+
 /// The poses of [`partial_moves`] and which were cut short.
 type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
 
@@ -874,6 +989,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels_near, m)?)?;
     m.add_function(wrap_pyfunction!(turn_vectors, m)?)?;
+    m.add_function(wrap_pyfunction!(angles_near, m)?)?;
+    m.add_function(wrap_pyfunction!(same_rotation_map, m)?)?;
+    m.add_function(wrap_pyfunction!(direction_steps, m)?)?;
     m.add_function(wrap_pyfunction!(partial_moves, m)?)?;
     m.add_function(wrap_pyfunction!(memory_budget, m)?)?;
     m.add_function(wrap_pyfunction!(set_memory_budget, m)?)?;
@@ -920,5 +1038,47 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
         modes.set_item(mode.name(), (mode.property(), mode.width()))?;
     }
     m.add("ROTATION_MODES", modes)?;
+    // stub:
+    // stub: CONTINUED_ROTATION_MODES: tuple[str, ...]
+    // stub: """The rotation modes whose channels continue the values before them (``previous`` of
+    // stub: ``rotation_channels`` and ``sample_channels``: a bake from its first key's values, a piece
+    // stub: from the piece before): quaternion and the Euler orders. Axis-angle channels start from
+    // stub: their own first rotation."""
+    let continued: Vec<&str> = RotationMode::ALL
+        .into_iter()
+        .filter(|mode| mode.continued())
+        .map(RotationMode::name)
+        .collect();
+    m.add(
+        "CONTINUED_ROTATION_MODES",
+        pyo3::types::PyTuple::new(m.py(), continued)?,
+    )?;
+    // stub:
+    // stub: NORMALISED_CHANNELS: dict[str, tuple[int, int]]
+    // stub: """The channels ``start:stop`` of a rotation mode that Blender normalises before it uses them
+    // stub: (scaling them together keeps the rotation): ``"QUATERNION"`` -> ``(0, 4)``, ``"AXIS_ANGLE"``
+    // stub: -> ``(1, 4)`` (the axis); Euler orders have none."""
+    let normalised = pyo3::types::PyDict::new(m.py());
+    for mode in RotationMode::ALL {
+        if let Some(channels) = mode.normalised() {
+            normalised.set_item(mode.name(), channels)?;
+        }
+    }
+    m.add("NORMALISED_CHANNELS", normalised)?;
+    // stub:
+    // stub: TIMINGS: tuple[str, ...]
+    // stub: """Every timing, the core's: ``("smooth", "linear", "keys")``."""
+    m.add("TIMINGS", pyo3::types::PyTuple::new(m.py(), Timing::NAMES)?)?;
+    // stub:
+    // stub: PACED_TIMINGS: tuple[str, ...]
+    // stub: """The timings that follow the pace of Blender's playback (``("keys",)``): not a map of time
+    // stub: alone, they need the body's size and the playback (``timed_frames``); ``sample`` and its
+    // stub: kin refuse them."""
+    let paced: Vec<&str> = Timing::ALL
+        .into_iter()
+        .filter(|timing| timing.paced())
+        .map(Timing::name)
+        .collect();
+    m.add("PACED_TIMINGS", pyo3::types::PyTuple::new(m.py(), paced)?)?;
     Ok(())
 }

@@ -211,6 +211,24 @@ pub enum Error {
         /// How to ask for less (may be empty).
         hint: &'static str,
     },
+    /// [`Error::Limit`] for work summed over parts (the samples of all key spans), with how
+    /// many parts ask for it.
+    LimitOver {
+        /// The argument that asks for the work.
+        what: &'static str,
+        /// How many parts ask for the work.
+        parts: usize,
+        /// What the parts are (for example `"key spans"`).
+        of: &'static str,
+        /// What is counted (for example `"samples"`).
+        counted: &'static str,
+        /// How many the parts ask for together (saturated at `usize::MAX`).
+        count: usize,
+        /// The most one call accepts.
+        limit: usize,
+        /// How to ask for less (may be empty).
+        hint: &'static str,
+    },
     /// Input of the right form that has no unique answer: points on a line, coincident keys,
     /// a singular system, an empty mesh.
     Degenerate {
@@ -358,6 +376,18 @@ pub enum Expected {
     },
     /// Finite once rounded to `float32`, as Blender stores it (the field named).
     FiniteInF32(&'static str),
+    /// [`Expected::AtLeast`] for a length cutting a range of known length: at least `min`, so
+    /// that cutting `range` makes at most `limit` of `counted`.
+    AtLeastCutting {
+        /// The smallest value accepted.
+        min: f64,
+        /// The length of the range cut (for example the key range's).
+        range: f64,
+        /// The most pieces a call makes.
+        limit: usize,
+        /// What the pieces are.
+        counted: &'static str,
+    },
 }
 
 /// `x` as messages show it: plain for moderate sizes, `1e30` for large or tiny ones.
@@ -406,6 +436,17 @@ impl fmt::Display for Expected {
                 counted,
             } => write!(f, "at least {} (at most {limit} {counted})", number(*min)),
             Self::FiniteInF32(field) => write!(f, "finite in float32 ({field})"),
+            Self::AtLeastCutting {
+                min,
+                range,
+                limit,
+                counted,
+            } => write!(
+                f,
+                "at least {} (at most {limit} {counted}, {} long)",
+                number(*min),
+                number(*range)
+            ),
         }
     }
 }
@@ -451,6 +492,7 @@ impl Error {
             | Self::Index { what, .. }
             | Self::Spacing { what, .. }
             | Self::Limit { what, .. }
+            | Self::LimitOver { what, .. }
             | Self::Degenerate { what, .. }
             | Self::NotUnique { what, .. }
             | Self::Conflict { what, .. }
@@ -458,6 +500,15 @@ impl Error {
             | Self::Worker { what } => Some(what),
             _ => None,
         }
+    }
+}
+
+/// `": {hint}"`, or nothing for an empty hint (the end of a limit's message).
+fn write_hint(f: &mut fmt::Formatter<'_>, hint: &str) -> fmt::Result {
+    if hint.is_empty() {
+        Ok(())
+    } else {
+        write!(f, ": {hint}")
     }
 }
 
@@ -625,11 +676,23 @@ impl fmt::Display for Error {
                     f,
                     "{what}: {count} {counted} exceed the limit of {limit} in one call"
                 )?;
-                if hint.is_empty() {
-                    Ok(())
-                } else {
-                    write!(f, ": {hint}")
-                }
+                write_hint(f, hint)
+            }
+            Self::LimitOver {
+                what,
+                parts,
+                of,
+                counted,
+                count,
+                limit,
+                hint,
+            } => {
+                write!(
+                    f,
+                    "{what}: the {parts} {of} would take {count} {counted}, over the limit of \
+                     {limit} in one call"
+                )?;
+                write_hint(f, hint)
             }
             Self::Degenerate { what, at, reason } => {
                 write!(f, "{what}: {}{reason}", prefix(at))

@@ -985,8 +985,9 @@ pub fn fit_angular_velocity(
                     what: "fragment_duration",
                     at: None,
                     value: d,
-                    expected: Expected::AtLeast {
+                    expected: Expected::AtLeastCutting {
                         min: span / MAX_FRAGMENTS as f64,
+                        range: span,
                         limit: MAX_FRAGMENTS,
                         counted: "fragments of the key range",
                     },

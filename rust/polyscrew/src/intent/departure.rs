@@ -1,13 +1,14 @@
 //! How far a result departs from the playback it was made from: per frame, the distance
 //! between the origins and the angle between the rotations.
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 
 use super::limits::{check_footprint, collected, filled};
 use super::playback::{rotation_matrix, Playback};
 use super::spans::rotation_angle;
 use crate::memory::try_vec;
-use crate::{Error, EulerOrder, Result, RotationMode};
+use crate::motion::channels::rotation_quat;
+use crate::{Error, Result};
 
 /// Frames evaluated at once (bounds the work buffer whatever the number of frames).
 const CHUNK: usize = 4096;
@@ -178,43 +179,6 @@ fn compare(playback: &Playback, row: &[f64], location: &[f64], rotation: &[f64])
         ),
     };
     (distance, angle)
-}
-
-/// The rotation of `values` in `mode` as a quaternion of any non-zero length, as
-/// [`rotation_matrix`] reads them: a quaternion scaled by its largest component (the
-/// identity for zero), Euler angles as the product of their axes' half-angle quaternions
-/// (`q = q(a3) q(a2) q(a1)`, `R = R(a3) R(a2) R(a1)`); `None` for axis-angle.
-fn rotation_quat(mode: RotationMode, values: &[f64]) -> Option<DQuat> {
-    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
-    match mode {
-        RotationMode::Quaternion => {
-            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
-            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
-            Some(if largest > 0.0 {
-                q / largest
-            } else {
-                DQuat::IDENTITY
-            })
-        }
-        RotationMode::AxisAngle => None,
-        RotationMode::Euler(order) => {
-            let about = |axis: usize| match axis {
-                0 => DQuat::from_rotation_x(v(0)),
-                1 => DQuat::from_rotation_y(v(1)),
-                _ => DQuat::from_rotation_z(v(2)),
-            };
-            // (the axes in the order they apply, as `EulerOrder::to_mat3`)
-            let [first, second, third] = match order {
-                EulerOrder::Xyz => [0, 1, 2],
-                EulerOrder::Xzy => [0, 2, 1],
-                EulerOrder::Yxz => [1, 0, 2],
-                EulerOrder::Yzx => [1, 2, 0],
-                EulerOrder::Zxy => [2, 0, 1],
-                EulerOrder::Zyx => [2, 1, 0],
-            };
-            Some(about(third) * about(second) * about(first))
-        }
-    }
 }
 
 /// What the report needs of a departure (see [`measure_departure`]).
@@ -430,6 +394,7 @@ pub fn measured_frames(
 #[cfg(test)]
 mod angle_tests {
     use super::*;
+    use crate::{EulerOrder, RotationMode};
 
     /// The angle between two rotations as [`compare`] takes it from quaternions equals
     /// [`rotation_angle`] of their matrices, in every quaternion and Euler mode (unnormalised,

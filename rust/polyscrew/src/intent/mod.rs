@@ -54,8 +54,8 @@ pub use departure::{
     departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
 };
 pub use pace::{
-    keys_parameters, keys_parameters_played, pace_parameters, screw_pace_poses, travel, KeysTiming,
-    DENSE_PACE_SAMPLES, PACE_SAMPLES,
+    keys_parameters, keys_parameters_played, pace_parameters, screw_pace_poses, timed_frames,
+    travel, KeysTiming, PaceSource, Timed, DENSE_PACE_SAMPLES, PACE_SAMPLES,
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
 pub use spans::{

@@ -175,6 +175,107 @@ pub fn keys_parameters_played(
     parameters_and_played(timing, frames, smooth, true)
 }
 
+/// The smoothed motion a paced timing measures its travel along.
+#[derive(Debug, Clone, Copy)]
+pub enum PaceSource<'a> {
+    /// The key poses, smoothed by the [`MotionSpec`]'s scheme and levels
+    /// ([`screw_pace_poses`]).
+    Keys(&'a [Pose]),
+    /// The smoothed motion's poses at [`pace_parameters`], computed by the caller (feature
+    /// points).
+    Given(&'a [Pose]),
+}
+
+/// Where a motion keyed at the key frames is sampled for the output frames
+/// ([`timed_frames`]).
+#[derive(Debug, Clone, PartialEq)]
+pub enum Timed {
+    /// At the frames themselves, keys at their frames, with the [`MotionSpec`] as given: the
+    /// timing is a map of time ([`TimeMap`](crate::TimeMap): Smooth, Linear).
+    Frames,
+    /// At `parameters`, keys at `0, 1, ..., K - 1`, with `spec` (linear timing, period `K`
+    /// for a cycle): the motion parameter is the motion's own.
+    Parameters {
+        /// Key `i` at `i`.
+        key_times: Vec<f64>,
+        /// The motion parameter of each output frame ([`keys_parameters`]).
+        parameters: Vec<f64>,
+        /// The given spec with linear timing and, closed, the period `K`.
+        spec: MotionSpec,
+        /// With `played`: the playback's rows at the output frames
+        /// ([`keys_parameters_played`]); else empty.
+        played: Vec<f64>,
+    },
+}
+
+/// How the motion of keys at `key_frames` with `spec` is sampled at `frames`: one entry for
+/// every [`Timing`]. A map of time (Smooth, Linear) samples at the frames themselves
+/// ([`Timed::Frames`]); a [`paced`](Timing::paced) timing (Keys) at the motion parameters
+/// [`keys_parameters`] gives from `size` and `playback` (the body's half-extent and
+/// Blender's playback, see [`KeysTiming`]), along the smoothed motion `source`, with the
+/// playback's rows at the frames when `played` ([`keys_parameters_played`]); sampling the
+/// motion there with [`Timed::Parameters`]' key times and spec is timing Keys, to the bit.
+///
+/// # Errors
+/// For a paced timing: [`Error::Value`] without a size, [`Error::Period`] for a closed
+/// motion without its period, then the errors of [`screw_pace_poses`] and
+/// [`keys_parameters`].
+pub fn timed_frames(
+    key_frames: &[f64],
+    frames: &[f64],
+    spec: &MotionSpec,
+    size: Option<f64>,
+    playback: Option<&Playback>,
+    source: PaceSource<'_>,
+    played: bool,
+) -> Result<Timed> {
+    if !spec.timing.paced() {
+        return Ok(Timed::Frames);
+    }
+    let size = size.ok_or(Error::Value {
+        what: "size",
+        at: None,
+        value: f64::NAN,
+        expected: Expected::PositiveUpTo(MAX_COORDINATE),
+    })?;
+    let period = match (spec.closed, spec.period) {
+        (true, None) => {
+            return Err(Error::Period {
+                period: f64::NAN,
+                span: 0.0,
+            })
+        }
+        (true, period) => period,
+        (false, _) => None,
+    };
+    let timing = KeysTiming {
+        key_frames,
+        period,
+        size,
+        playback,
+    };
+    let smoothed;
+    let smooth = match source {
+        PaceSource::Keys(keys) => {
+            smoothed = screw_pace_poses(keys, spec.scheme, spec.levels, spec.closed)?;
+            &smoothed[..]
+        }
+        PaceSource::Given(smooth) => smooth,
+    };
+    let (parameters, played) = parameters_and_played(&timing, frames, smooth, played)?;
+    let k = key_frames.len();
+    Ok(Timed::Parameters {
+        key_times: collected(k, (0..k).map(|i| i as f64), "key parameters")?,
+        parameters,
+        spec: MotionSpec {
+            period: spec.closed.then_some(k as f64),
+            timing: Timing::Linear,
+            ..*spec
+        },
+        played,
+    })
+}
+
 /// [`keys_parameters`], with the played rows of [`keys_parameters_played`] when `played`
 /// (else an empty vector).
 fn parameters_and_played(
@@ -478,4 +579,170 @@ fn playback_fractions(
     }
     finish(&mut done, start, sum);
     Ok(done)
+}
+
+#[cfg(test)]
+mod timed_tests {
+    use glam::DQuat;
+
+    use super::super::tests::{curve, playback};
+    use super::*;
+    use crate::{sample, Channel, EulerOrder, Interpolation, RotationMode};
+
+    /// Three keys: a move along X and a turn about Z, Blender's playback of them (Bezier,
+    /// auto handles) and the key poses.
+    fn scene() -> (Playback, Vec<f64>, Vec<Pose>) {
+        let key_frames = vec![1.0, 9.0, 30.0];
+        let x = [(1.0, 0.0), (9.0, 2.0), (30.0, 7.0)];
+        let z = [(1.0, 0.0), (9.0, 0.8), (30.0, 2.5)];
+        let p = playback(
+            vec![
+                (Channel::Location(0), curve(&x, Interpolation::Bezier)),
+                (Channel::Rotation(2), curve(&z, Interpolation::Bezier)),
+            ],
+            RotationMode::Euler(EulerOrder::Xyz),
+        );
+        let poses = x
+            .iter()
+            .zip(&z)
+            .map(|(&(_, tx), &(_, rz))| {
+                Pose::from_rotation_translation(
+                    DQuat::from_rotation_z(f64::from(rz)),
+                    DVec3::new(f64::from(tx), 0.0, 0.0),
+                )
+            })
+            .collect();
+        (p, key_frames, poses)
+    }
+
+    #[test]
+    fn a_map_of_time_samples_at_the_frames_themselves() {
+        let (p, key_frames, poses) = scene();
+        for timing in [Timing::Smooth, Timing::Linear] {
+            let spec = MotionSpec {
+                timing,
+                ..MotionSpec::default()
+            };
+            let timed = timed_frames(
+                &key_frames,
+                &[2.0, 5.0],
+                &spec,
+                None,
+                Some(&p),
+                PaceSource::Keys(&poses),
+                true,
+            );
+            assert_eq!(timed, Ok(Timed::Frames), "{timing:?}");
+        }
+    }
+
+    #[test]
+    fn timing_keys_is_keys_parameters_and_samples_as_before_to_the_bit() {
+        let (p, key_frames, poses) = scene();
+        let frames: Vec<f64> = (0..=70).map(|i| 0.5 * i as f64).collect();
+        for closed in [false, true] {
+            let period = closed.then_some(35.0);
+            let spec = MotionSpec {
+                scheme: Scheme::FourPoint,
+                levels: 3,
+                closed,
+                period,
+                timing: Timing::Keys,
+            };
+            let Timed::Parameters {
+                key_times,
+                parameters,
+                spec: linear,
+                played,
+            } = timed_frames(
+                &key_frames,
+                &frames,
+                &spec,
+                Some(1.5),
+                Some(&p),
+                PaceSource::Keys(&poses),
+                true,
+            )
+            .unwrap()
+            else {
+                panic!("timing Keys is paced");
+            };
+            // what the add-on computed before: keys_parameters on the screw pace poses, then
+            // the motion at those parameters, keys at 0..K-1, linear timing
+            let smooth = screw_pace_poses(&poses, Scheme::FourPoint, 3, closed).unwrap();
+            let timing = KeysTiming {
+                key_frames: &key_frames,
+                period,
+                size: 1.5,
+                playback: Some(&p),
+            };
+            let (want, want_rows) = keys_parameters_played(&timing, &frames, &smooth).unwrap();
+            assert_eq!(parameters, want, "closed {closed}");
+            assert_eq!(played.len(), want_rows.len());
+            assert!(played
+                .iter()
+                .zip(&want_rows)
+                .all(|(a, b)| a.to_bits() == b.to_bits()));
+            assert_eq!(key_times, [0.0, 1.0, 2.0]);
+            let before = MotionSpec {
+                scheme: Scheme::FourPoint,
+                levels: 3,
+                closed,
+                period: closed.then_some(3.0),
+                timing: Timing::Linear,
+            };
+            assert_eq!(linear, before);
+            assert_eq!(
+                sample(&poses, &key_times, &parameters, &linear).unwrap(),
+                sample(&poses, &[0.0, 1.0, 2.0], &want, &before).unwrap()
+            );
+            // the pace's smoothed motion given by the caller: the same parameters
+            let given = timed_frames(
+                &key_frames,
+                &frames,
+                &spec,
+                Some(1.5),
+                Some(&p),
+                PaceSource::Given(&smooth),
+                false,
+            )
+            .unwrap();
+            assert!(
+                matches!(&given, Timed::Parameters { parameters: u, played, .. } if *u == want && played.is_empty()),
+                "{given:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn timing_keys_needs_the_size_and_a_closed_motion_its_period() {
+        let (p, key_frames, poses) = scene();
+        let keys = MotionSpec {
+            timing: Timing::Keys,
+            ..MotionSpec::default()
+        };
+        let source = PaceSource::Keys(&poses);
+        let err = timed_frames(&key_frames, &[2.0], &keys, None, Some(&p), source, false);
+        assert!(
+            matches!(err, Err(Error::Value { what: "size", .. })),
+            "{err:?}"
+        );
+        let closed = MotionSpec {
+            closed: true,
+            ..keys
+        };
+        let err = timed_frames(&key_frames, &[2.0], &closed, Some(1.0), None, source, false);
+        assert!(matches!(err, Err(Error::Period { .. })), "{err:?}");
+        // and the motion itself refuses a paced timing: it is not a map of time alone
+        let err = sample(&poses, &key_frames, &[2.0], &keys).unwrap_err();
+        assert!(
+            matches!(err, Error::Conflict { what: "timing", .. }),
+            "{err}"
+        );
+        assert_eq!(
+            err.to_string(),
+            "timing: timing keys follows a playback's pace: it needs the body's size and the \
+             playback, not only the key times"
+        );
+    }
 }

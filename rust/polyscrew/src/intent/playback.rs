@@ -42,11 +42,7 @@ impl Channel {
                 return Err(Error::Choice {
                     what: "property",
                     got: property.to_owned(),
-                    expected: match mode {
-                        RotationMode::Quaternion => &["location", "rotation_quaternion", "scale"],
-                        RotationMode::AxisAngle => &["location", "rotation_axis_angle", "scale"],
-                        RotationMode::Euler(_) => &["location", "rotation_euler", "scale"],
-                    },
+                    expected: mode.transform_properties(),
                 })
             }
         };

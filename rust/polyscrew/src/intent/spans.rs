@@ -146,7 +146,7 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
 /// # Errors
 /// [`Error::TooFew`] for fewer than two frames, [`Error::KeyTimes`] for frames that are not
 /// finite and strictly increasing, the errors of [`Playback::channels`], and a request over
-/// the size limit ([`check_footprint`]), [`Error::Limit`] for spans that would
+/// the size limit ([`check_footprint`]), [`Error::LimitOver`] for spans that would
 /// take more than [`MAX_ANALYSIS_SAMPLES`] samples in all (before any is taken).
 pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Result<Spans> {
     let k = frames.len();
@@ -184,9 +184,11 @@ pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Resul
     )?;
     let total = counts.iter().fold(0usize, |a, &c| a.saturating_add(c));
     if total > MAX_ANALYSIS_SAMPLES {
-        return Err(Error::Limit {
+        return Err(Error::LimitOver {
             what: "frames",
-            counted: "samples of the playback (for the key spans)",
+            parts: spans,
+            of: "key spans",
+            counted: "samples of the playback",
             count: total,
             limit: MAX_ANALYSIS_SAMPLES,
             hint: "analyse fewer key frames at once (a span takes one sample per few degrees \

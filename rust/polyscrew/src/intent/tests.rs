@@ -658,11 +658,19 @@ fn span_analysis_refuses_more_samples_than_its_cap_before_taking_any() {
     assert!(
         matches!(
             err,
-            Error::Limit {
+            Error::LimitOver {
+                parts: 513,
                 count: 2101248,
                 limit: 2097152,
                 ..
             }
+        ),
+        "{err}"
+    );
+    assert!(
+        err.to_string().starts_with(
+            "frames: the 513 key spans would take 2101248 samples of the playback, over the \
+             limit of 2097152 in one call: "
         ),
         "{err}"
     );

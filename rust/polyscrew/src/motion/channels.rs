@@ -192,6 +192,16 @@ impl RotationMode {
         }
     }
 
+    /// The transform properties of an owner in this mode: `"location"`, its
+    /// [`property`](Self::property), `"scale"`.
+    pub const fn transform_properties(self) -> &'static [&'static str] {
+        match self {
+            Self::Quaternion => &["location", "rotation_quaternion", "scale"],
+            Self::AxisAngle => &["location", "rotation_axis_angle", "scale"],
+            Self::Euler(_) => &["location", "rotation_euler", "scale"],
+        }
+    }
+
     /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
     /// quaternions, the angle of axis-angle, the three Euler angles.
     fn angles(self) -> usize {
@@ -208,6 +218,33 @@ impl RotationMode {
             Self::Euler(_) => 3,
             _ => 4,
         }
+    }
+
+    /// Whether channel values written in this mode continue the values before them (a bake
+    /// from the first key's values, one piece of a motion from the piece before: `previous`
+    /// of [`rotation_channels`]): quaternions (their sign) and Euler angles (twin and whole
+    /// turns). Axis-angle channels do not: each sequence starts from its own first rotation
+    /// (the angle in `[0, pi]`, the axis the quaternion's), as the add-on has always
+    /// written them.
+    pub const fn continued(self) -> bool {
+        !matches!(self, Self::AxisAngle)
+    }
+
+    /// The channels `start..end` Blender normalises before it uses them, so that scaling
+    /// them together keeps the rotation: a quaternion's four, an axis-angle's axis (`1..4`);
+    /// `None` for Euler angles.
+    pub const fn normalised(self) -> Option<(usize, usize)> {
+        match self {
+            Self::Quaternion => Some((0, 4)),
+            Self::AxisAngle => Some((1, 4)),
+            Self::Euler(_) => None,
+        }
+    }
+
+    /// Whether channel `channel` is an angle, radians that wrap by whole turns: the three
+    /// Euler angles, the axis-angle angle (channel 0); no quaternion channel.
+    pub fn is_angle(self, channel: usize) -> bool {
+        channel < self.angles()
     }
 }
 
@@ -585,6 +622,145 @@ pub fn channels_near(
     Ok(out)
 }
 
+/// Each of `values` of channel `channel` in `mode` moved by whole turns to within half a turn
+/// of its entry of `reference` when the channel is an angle ([`RotationMode::is_angle`]:
+/// `v - round((v - r) / 2 pi) 2 pi`, ties away from zero), unchanged otherwise: the same
+/// rotation, written like the reference.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `reference` is not as long as `values`,
+/// [`Error::Memory`] over the memory budget.
+pub fn angles_near(
+    values: &[f64],
+    reference: &[f64],
+    mode: RotationMode,
+    channel: usize,
+) -> Result<Vec<f64>> {
+    if reference.len() != values.len() {
+        return Err(Error::LengthMismatch {
+            what: "reference",
+            expected: values.len(),
+            got: reference.len(),
+        });
+    }
+    Footprint::of::<f64>(values.len()).check("angles", CHANNELS_HINT)?;
+    let mut out = try_vec(values.len(), "angles")?;
+    if mode.is_angle(channel) {
+        out.extend(
+            values
+                .iter()
+                .zip(reference)
+                .map(|(&v, &r)| wrap_towards(v, r)),
+        );
+    } else {
+        out.extend_from_slice(values);
+    }
+    Ok(out)
+}
+
+/// How far `a source + c` may stray from `target` (relative to the largest `|target|`, at
+/// least 1) for [`same_rotation_map`] to accept the map `(a, c)`.
+pub const SAME_ROTATION_TOLERANCE: f64 = 1e-5;
+
+/// The per-channel affine map `(a, c)`, `a[i] source[i] + c[i] == target[i]` within
+/// [`SAME_ROTATION_TOLERANCE`], that keeps every rotation channel values in `mode` can hold:
+/// applied to any values (a curve's keys and handles), the rotation Blender plays from the
+/// mapped values is the rotation it plays from the values. `None` when no such map takes
+/// `source` to `target` (both [`RotationMode::width`] values; other lengths too).
+///
+/// - quaternion: a common scale `a = (target . source) / |source|^2` (the sign, and a length
+///   Blender normalises away), `c = 0`;
+/// - axis-angle: the angle `+-1` times the source's plus whole turns, the axis scaled by a
+///   length of that same sign (`(angle, axis)` and `(-angle, -axis)` are one rotation);
+/// - Euler: each angle plus whole turns (`a = 1`), or the twin triple `(x + pi, pi - y,
+///   z + pi)` (the middle axis of the order negated) plus whole turns.
+pub fn same_rotation_map(
+    mode: RotationMode,
+    source: &[f64],
+    target: &[f64],
+) -> Option<(Vec<f64>, Vec<f64>)> {
+    let width = mode.width();
+    if source.len() != width || target.len() != width {
+        return None;
+    }
+    let largest = target.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let tol = SAME_ROTATION_TOLERANCE * largest;
+    let turns = |d: f64| TAU * (d / TAU).round_ties_even();
+    let dot = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>();
+    let mut candidates: Vec<(Vec<f64>, Vec<f64>)> = Vec::with_capacity(2);
+    match mode {
+        RotationMode::Quaternion => {
+            let norm = dot(source, source);
+            if norm > 0.0 {
+                candidates.push((vec![dot(target, source) / norm; width], vec![0.0; width]));
+            }
+        }
+        RotationMode::AxisAngle => {
+            let axis = dot(&source[1..], &source[1..]);
+            for sign in [1.0, -1.0] {
+                if axis > 0.0 {
+                    // the axis: the sign times a positive length
+                    let scale = dot(&target[1..], &source[1..]) / axis;
+                    if scale * sign > 0.0 {
+                        let c = turns(target[0] - sign * source[0]);
+                        candidates.push((vec![sign, scale, scale, scale], vec![c, 0.0, 0.0, 0.0]));
+                    }
+                }
+            }
+        }
+        RotationMode::Euler(order) => {
+            candidates.push((
+                vec![1.0; 3],
+                source
+                    .iter()
+                    .zip(target)
+                    .map(|(s, t)| turns(t - s))
+                    .collect(),
+            ));
+            let middle = order.axes().0[1];
+            let mut a = vec![1.0; 3];
+            a[middle] = -1.0;
+            let c = (0..3)
+                .map(|i| PI + turns(target[i] - (a[i] * source[i] + PI)))
+                .collect();
+            candidates.push((a, c));
+        }
+    }
+    candidates
+        .into_iter()
+        .find(|(a, c)| (0..width).all(|i| (a[i] * source[i] + c[i] - target[i]).abs() <= tol))
+}
+
+/// The rotation of `values` in `mode` as a quaternion of any non-zero length, as
+/// [`rotation_matrix`] reads them (the departure's angle): a quaternion scaled by its largest component (the
+/// identity for zero), Euler angles as the product of their axes' half-angle quaternions
+/// (`q = q(a3) q(a2) q(a1)`, `R = R(a3) R(a2) R(a1)`); `None` for axis-angle.
+pub(crate) fn rotation_quat(mode: RotationMode, values: &[f64]) -> Option<DQuat> {
+    let v = |i: usize| values.get(i).copied().unwrap_or(0.0);
+    match mode {
+        RotationMode::Quaternion => {
+            let q = DQuat::from_xyzw(v(1), v(2), v(3), v(0));
+            let largest = q.to_array().into_iter().fold(0.0f64, |m, c| m.max(c.abs()));
+            Some(if largest > 0.0 {
+                q / largest
+            } else {
+                DQuat::IDENTITY
+            })
+        }
+        RotationMode::AxisAngle => None,
+        RotationMode::Euler(order) => {
+            let about = |axis: usize| match axis {
+                0 => DQuat::from_rotation_x(v(0)),
+                1 => DQuat::from_rotation_y(v(1)),
+                _ => DQuat::from_rotation_z(v(2)),
+            };
+            // (the axes in the order they apply, as `EulerOrder::to_mat3`)
+            let [first, second, third] = order.axes().0;
+            Some(about(third) * about(second) * about(first))
+        }
+    }
+}
+
 /// The rotation matrix of one set of rotation channels `values` in `mode`, as Blender builds
 /// it:
 ///
@@ -956,5 +1132,104 @@ mod tests {
             ),
             "{err:?}"
         );
+    }
+
+    /// The largest entry of `rotation_matrix(mode, a) - rotation_matrix(mode, b)`.
+    fn rotation_gap(mode: RotationMode, a: &[f64], b: &[f64]) -> f64 {
+        (rotation_matrix(mode, a) - rotation_matrix(mode, b))
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+    }
+
+    #[test]
+    fn same_rotation_maps_keep_every_rotation_and_refuse_other_ones() {
+        let rotations = [
+            DQuat::from_euler(glam::EulerRot::XYZ, 0.4, -1.1, 2.2),
+            DQuat::from_axis_angle(DVec3::new(0.2, -0.9, 0.4).normalize(), 2.9),
+        ];
+        let other = DQuat::from_euler(glam::EulerRot::ZXY, -2.0, 0.7, 0.3);
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let values = rotation_channels(&rotations, mode, None).unwrap();
+            let probe = rotation_channels(&[other], mode, None).unwrap();
+            for s in values.chunks_exact(w) {
+                // the same rotation written otherwise: its sign and length, whole turns, the
+                // other axis-angle, the twin Euler triple
+                let targets: Vec<Vec<f64>> = match mode {
+                    RotationMode::Quaternion => vec![
+                        s.iter().map(|v| -2.5 * v).collect(),
+                        s.iter().map(|v| 0.5 * v).collect(),
+                    ],
+                    RotationMode::AxisAngle => vec![
+                        vec![-s[0] + 2.0 * TAU, -0.7 * s[1], -0.7 * s[2], -0.7 * s[3]],
+                        vec![s[0] - TAU, 3.0 * s[1], 3.0 * s[2], 3.0 * s[3]],
+                    ],
+                    RotationMode::Euler(order) => {
+                        let middle = order.axes().0[1];
+                        let twin: Vec<f64> = (0..3)
+                            .map(|i| if i == middle { PI - s[i] } else { s[i] + PI })
+                            .map(|v| v - TAU)
+                            .collect();
+                        vec![vec![s[0] + TAU, s[1] - 2.0 * TAU, s[2]], twin]
+                    }
+                };
+                for t in &targets {
+                    assert!(rotation_gap(mode, s, t) < 1e-12, "{mode:?}: {s:?} vs {t:?}");
+                    let (a, c) = same_rotation_map(mode, s, t)
+                        .unwrap_or_else(|| panic!("{mode:?}: no map from {s:?} to {t:?}"));
+                    for i in 0..w {
+                        assert!((a[i] * s[i] + c[i] - t[i]).abs() < 1e-12, "{mode:?} {i}");
+                    }
+                    // and any other values keep their rotation under the map
+                    let mapped: Vec<f64> = (0..w).map(|i| a[i] * probe[i] + c[i]).collect();
+                    let gap = rotation_gap(mode, &probe, &mapped);
+                    assert!(gap < 1e-12, "{mode:?}: {probe:?} -> {mapped:?}: {gap}");
+                }
+                // another rotation: no map
+                let moved: Vec<f64> = s.iter().map(|v| v + 0.1).collect();
+                assert_eq!(same_rotation_map(mode, s, &moved), None, "{mode:?}");
+                assert_eq!(same_rotation_map(mode, s, &s[..w - 1]), None);
+            }
+        }
+    }
+
+    #[test]
+    fn angles_near_wrap_angles_only() {
+        let values = [0.5, 7.0, -20.0];
+        let reference = [0.0, 0.0, 0.0];
+        let wrapped = [0.5, 7.0 - TAU, -20.0 + 3.0 * TAU];
+        let euler = RotationMode::Euler(EulerOrder::Zxy);
+        for channel in 0..3 {
+            assert_eq!(
+                angles_near(&values, &reference, euler, channel).unwrap(),
+                wrapped
+            );
+        }
+        let axis_angle = RotationMode::AxisAngle;
+        assert_eq!(
+            angles_near(&values, &reference, axis_angle, 0).unwrap(),
+            wrapped
+        );
+        assert_eq!(
+            angles_near(&values, &reference, axis_angle, 1).unwrap(),
+            values
+        );
+        let quaternion = RotationMode::Quaternion;
+        assert_eq!(
+            angles_near(&values, &reference, quaternion, 0).unwrap(),
+            values
+        );
+        assert!(matches!(
+            angles_near(&values, &reference[..2], euler, 0),
+            Err(Error::LengthMismatch { .. })
+        ));
+        assert!(RotationMode::Quaternion.continued() && !RotationMode::AxisAngle.continued());
+        assert_eq!(RotationMode::AxisAngle.normalised(), Some((1, 4)));
+        assert_eq!(RotationMode::Euler(EulerOrder::Xyz).normalised(), None);
+        for mode in RotationMode::ALL {
+            assert_eq!(mode.transform_properties()[1], mode.property());
+        }
+        assert!(RotationMode::Euler(EulerOrder::Yzx).continued());
     }
 }

@@ -42,6 +42,25 @@ pub fn turn_vectors(a: &[DQuat], b: &[DQuat]) -> Result<Vec<DVec3>> {
     Ok(out)
 }
 
+/// The angle between each two consecutive directions (any nonzero lengths):
+/// `atan2(|a x b|, a . b)` in `[0, pi]` for `a = directions[i]`, `b = directions[i + 1]`
+/// (exact near 0 and near pi, where `arccos` of a dot product loses digits; 0 where either
+/// is zero). `directions.len() - 1` angles, none for fewer than two directions.
+///
+/// # Errors
+/// [`Error::Memory`] over the memory budget.
+pub fn direction_steps(directions: &[DVec3]) -> Result<Vec<f64>> {
+    let n = directions.len().saturating_sub(1);
+    Footprint::of::<f64>(n).check("direction steps", CHANNELS_HINT)?;
+    let mut out = try_vec(n, "direction steps")?;
+    out.extend(
+        directions
+            .windows(2)
+            .map(|w| w[0].cross(w[1]).length().atan2(w[0].dot(w[1]))),
+    );
+    Ok(out)
+}
+
 /// How far [`partial_move`] may move a pose: a turn angle (radians) and a distance of the
 /// pivot point, each finite and at least 0 (or `inf`: no bound).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -156,6 +175,23 @@ pub fn partial_moves(
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    #[test]
+    fn direction_steps_are_exact_near_no_turn_and_a_half_turn() {
+        let x = DVec3::X;
+        let tiny: f64 = 1e-9;
+        let near = DVec3::new(tiny.cos(), tiny.sin(), 0.0) * 3.0;
+        let back = DVec3::new(-(tiny.cos()), tiny.sin(), 0.0) * 0.25;
+        let steps = direction_steps(&[x, near, DVec3::Y * 2.0, -DVec3::Y, back]).unwrap();
+        assert_eq!(steps.len(), 4);
+        // arccos of the dot product gives 0 for the first (cos(1e-9) rounds to 1)
+        assert!((steps[0] - tiny).abs() < 1e-24, "{}", steps[0]);
+        assert!((steps[1] - (PI / 2.0 - tiny)).abs() < 1e-15, "{}", steps[1]);
+        assert_eq!(steps[2], PI);
+        assert!((steps[3] - (PI / 2.0 + tiny)).abs() < 1e-15, "{}", steps[3]);
+        assert_eq!(direction_steps(&[x]).unwrap(), Vec::<f64>::new());
+        assert_eq!(direction_steps(&[x, DVec3::ZERO]).unwrap(), [0.0]);
+    }
 
     #[test]
     fn turn_vector_is_axis_times_angle_in_the_world_frame() {

@@ -24,6 +24,10 @@ pub const MAX_TIME: f64 = 1e300;
 pub const MIN_KEY_SPACING: f64 = 1e-300;
 
 /// How time maps to the motion parameter between keys.
+///
+/// Adding a timing mode: its variant, its entry in [`Timing::ALL`], its [`name`](Self::name)
+/// and [`paced`](Self::paced), and (a map of time alone) the slopes and the parameter of
+/// [`TimeMap`], all in this file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
 pub enum Timing {
     /// The monotone C1 cubic: velocity stays continuous across unevenly spaced keys.
@@ -31,23 +35,46 @@ pub enum Timing {
     Smooth,
     /// Each key span mapped linearly: speed jumps where key spacing changes.
     Linear,
+    /// The pace of Blender's own playback of the keys: a frame gets the parameter at which
+    /// the smoothed motion has travelled the same fraction of its span as the playback has
+    /// ([`crate::intent::keys_parameters`]). Not a map of time alone: it needs the body's
+    /// size and the playback ([`paced`](Self::paced)), so [`TimeMap`] refuses it and
+    /// [`crate::intent::timed_frames`] turns it into parameters sampled with linear timing.
+    Keys,
 }
 
 impl Timing {
-    /// Parses `"smooth"` or `"linear"`.
+    /// Every timing, in the order the add-on lists them.
+    pub const ALL: [Self; 3] = [Self::Smooth, Self::Linear, Self::Keys];
+
+    /// [`name`](Self::name) of every timing of [`ALL`](Self::ALL), in its order (the
+    /// variants' order).
+    pub const NAMES: [&'static str; 3] = ["smooth", "linear", "keys"];
+
+    /// The timing's name: `"smooth"`, `"linear"`, `"keys"`.
+    pub const fn name(self) -> &'static str {
+        Self::NAMES[self as usize]
+    }
+
+    /// Whether the timing follows the pace of a playback (it needs the body's size and the
+    /// playback, not only the key times): [`Timing::Keys`].
+    pub const fn paced(self) -> bool {
+        matches!(self, Self::Keys)
+    }
+
+    /// Parses a name of [`Timing::NAMES`].
     ///
     /// # Errors
     /// [`Error::Choice`] for any other name.
     pub fn from_name(name: &str) -> Result<Self> {
-        match name {
-            "smooth" => Ok(Self::Smooth),
-            "linear" => Ok(Self::Linear),
-            _ => Err(Error::Choice {
+        Self::ALL
+            .into_iter()
+            .find(|timing| timing.name() == name)
+            .ok_or_else(|| Error::Choice {
                 what: "timing",
                 got: name.to_owned(),
-                expected: &["smooth", "linear"],
-            }),
-        }
+                expected: &Self::NAMES,
+            })
     }
 }
 
@@ -148,7 +175,8 @@ impl TimeMap {
     ///
     /// # Errors
     /// [`Error::TooFew`] for fewer than 2 keys, [`Error::KeyTimes`] for times that are not
-    /// strictly increasing, [`Error::Period`] for a period [`check_period`] refuses.
+    /// strictly increasing, [`Error::Period`] for a period [`check_period`] refuses,
+    /// [`Error::Conflict`] for a [`paced`](Timing::paced) timing (not a map of time alone).
     pub fn new(
         key_times: &[f64],
         closed: bool,
@@ -160,6 +188,16 @@ impl TimeMap {
             return Err(Error::TooFew { got: n, need: 2 });
         }
         check_key_times(key_times)?;
+        if timing.paced() {
+            return Err(Error::Conflict {
+                what: "timing",
+                reason: format!(
+                    "timing {} follows a playback's pace: it needs the body's size and the \
+                     playback, not only the key times",
+                    timing.name()
+                ),
+            });
+        }
         let span = key_times[n - 1] - key_times[0];
         let mut knots = key_times.to_vec();
         let period = if closed {
@@ -185,7 +223,7 @@ impl TimeMap {
             3.0 / (sum * (1.0 + 2.0 * a * b))
         };
         let slopes = match timing {
-            Timing::Linear => vec![0.0; m],
+            Timing::Linear | Timing::Keys => vec![0.0; m],
             Timing::Smooth => (0..m)
                 .map(|i| {
                     if closed {
@@ -236,7 +274,7 @@ impl TimeMap {
         let h = self.knots[k + 1] - self.knots[k];
         let s = (t - self.knots[k]) / h;
         let u = match self.timing {
-            Timing::Linear => s,
+            Timing::Linear | Timing::Keys => s,
             Timing::Smooth => {
                 // Cubic Hermite from 0 to 1 with end derivatives m h (in units of u per s).
                 let (m0, m1) = (self.slopes[k] * h, self.slopes[k + 1] * h);
@@ -290,6 +328,25 @@ mod tests {
                 "slope jump at {t}: {left} vs {right}"
             );
         }
+    }
+
+    #[test]
+    fn every_timing_parses_its_own_name_and_only_keys_is_paced() {
+        assert_eq!(Timing::NAMES, ["smooth", "linear", "keys"]);
+        for (i, timing) in Timing::ALL.into_iter().enumerate() {
+            assert_eq!(timing as usize, i);
+            assert_eq!(Timing::from_name(timing.name()), Ok(timing));
+            assert_eq!(timing.paced(), timing == Timing::Keys, "{timing:?}");
+        }
+        let err = Timing::from_name("cubic").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "timing: \"cubic\" is not one of \"smooth\", \"linear\", \"keys\""
+        );
+        assert!(matches!(
+            TimeMap::new(&[0.0, 1.0], false, None, Timing::Keys),
+            Err(Error::Conflict { what: "timing", .. })
+        ));
     }
 
     #[test]
