@@ -504,12 +504,7 @@ fn analyse_spans<'py>(
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
     turns: Choice<AnalyseSpans, Turns>,
-) -> PyResult<(
-    Bound<'py, PyArray1<bool>>,
-    Bound<'py, PyArray1<bool>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-)> {
+) -> PyResult<SpanArrays<'py>> {
     Ok(span_arrays(
         py,
         spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?,
@@ -517,20 +512,16 @@ fn analyse_spans<'py>(
     .0)
 }
 
+/// What ``analyse_spans`` returns: held, pops, turn, inserted.
+type SpanArrays<'py> = (
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
 /// The arrays of ``analyse_spans`` (held, pops, turn, inserted), and the flips.
-#[allow(clippy::type_complexity)]
-fn span_arrays(
-    py: Python<'_>,
-    spans: Spans,
-) -> (
-    (
-        Bound<'_, PyArray1<bool>>,
-        Bound<'_, PyArray1<bool>>,
-        Bound<'_, PyArray1<f64>>,
-        Bound<'_, PyArray1<f64>>,
-    ),
-    Bound<'_, PyArray1<bool>>,
-) {
+fn span_arrays(py: Python<'_>, spans: Spans) -> (SpanArrays<'_>, Bound<'_, PyArray1<bool>>) {
     (
         (
             spans.held.into_pyarray(py),

@@ -7,7 +7,7 @@ use super::limits::{check_footprint, collected, filled};
 use super::playback::{rotation_matrix, Playback};
 use super::spans::rotation_angle;
 use crate::memory::try_vec;
-use crate::{Error, EulerOrder, Result, RotationMode};
+use crate::{Error, Result, RotationMode};
 
 /// Frames evaluated at once (bounds the work buffer whatever the number of frames).
 const CHUNK: usize = 4096;
@@ -204,14 +204,7 @@ fn rotation_quat(mode: RotationMode, values: &[f64]) -> Option<DQuat> {
                 _ => DQuat::from_rotation_z(v(2)),
             };
             // (the axes in the order they apply, as `EulerOrder::to_mat3`)
-            let [first, second, third] = match order {
-                EulerOrder::Xyz => [0, 1, 2],
-                EulerOrder::Xzy => [0, 2, 1],
-                EulerOrder::Yxz => [1, 0, 2],
-                EulerOrder::Yzx => [1, 2, 0],
-                EulerOrder::Zxy => [2, 0, 1],
-                EulerOrder::Zyx => [2, 1, 0],
-            };
+            let ([first, second, third], _) = order.axes();
             Some(about(third) * about(second) * about(first))
         }
     }
@@ -443,17 +436,10 @@ mod angle_tests {
             seed ^= seed << 17;
             (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
         };
-        let orders = [
-            EulerOrder::Xyz,
-            EulerOrder::Xzy,
-            EulerOrder::Yxz,
-            EulerOrder::Yzx,
-            EulerOrder::Zxy,
-            EulerOrder::Zyx,
-        ];
-        let modes = orders
-            .map(RotationMode::Euler)
+        // the six Euler orders (after quaternion and axis-angle in `ALL`), then quaternion
+        let modes = RotationMode::ALL
             .into_iter()
+            .skip(2)
             .chain([RotationMode::Quaternion]);
         let mut worst = 0.0f64;
         let mut count = 0;
