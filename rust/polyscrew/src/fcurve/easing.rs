@@ -50,7 +50,9 @@ pub fn ease(
         (I::Cubic, Out) => cubic_out(t, b, c, d),
         (I::Cubic, InOut) => cubic_in_out(t, b, c, d),
         (I::Cubic, _) => cubic_in(t, b, c, d),
-        (I::Elastic, e) => elastic(e, t, b, c, d, amplitude, period),
+        (I::Elastic, In) => elastic::<ELASTIC_IN>(t, b, c, d, amplitude, period),
+        (I::Elastic, InOut) => elastic::<ELASTIC_IN_OUT>(t, b, c, d, amplitude, period),
+        (I::Elastic, _) => elastic::<ELASTIC_OUT>(t, b, c, d, amplitude, period),
         (I::Expo, Out) => expo_out(t, b, c, d),
         (I::Expo, InOut) => expo_in_out(t, b, c, d),
         (I::Expo, _) => expo_in(t, b, c, d),
@@ -200,14 +202,21 @@ fn elastic_wave(t: f32, duration: f32, period: f32, (s, f, a): (f32, f32, f32)) 
     f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin())
 }
 
-/// ELASTIC easing (`easing` resolved: in, in-out, or out for any other), as Blender's
+/// [`elastic`]'s `KIND`: ease in.
+const ELASTIC_IN: u8 = 0;
+/// [`elastic`]'s `KIND`: ease out.
+const ELASTIC_OUT: u8 = 1;
+/// [`elastic`]'s `KIND`: ease in and out.
+const ELASTIC_IN_OUT: u8 = 2;
+
+/// ELASTIC easing of `KIND` ([`ELASTIC_IN`], [`ELASTIC_OUT`], [`ELASTIC_IN_OUT`]: a
+/// constant, so that each is compiled without the others' branches), as Blender's
 /// `BLI_easing_elastic_ease_in`, `_ease_out` and `_ease_in_out`: the ends exact; else the
 /// time shifted (in: `t - 1`; out: `-t`; in-out: `2 t - 1`, over half the duration), the
 /// period defaulted (`0.3 d`, in-out `0.45 d`), and the [`elastic_wave`] added to `begin`
 /// (negated, in) or to `begin + change` (out); in-out is half of each, by the sign of its
 /// shifted time.
-fn elastic(
-    easing: Easing,
+fn elastic<const KIND: u8>(
     time: f32,
     begin: f32,
     change: f32,
@@ -218,7 +227,7 @@ fn elastic(
     if time == 0.0 {
         return begin;
     }
-    let in_out = easing == Easing::InOut;
+    let in_out = KIND == ELASTIC_IN_OUT;
     let (span, end, default_period) = if in_out {
         (duration / 2.0, 2.0, duration * (0.3 * 1.5))
     } else {
@@ -228,21 +237,17 @@ fn elastic(
     if t == end {
         return begin + change;
     }
-    let t = if easing == Easing::In || in_out {
-        t - 1.0
-    } else {
-        -t
-    };
+    let t = if KIND != ELASTIC_OUT { t - 1.0 } else { -t };
     let period = if period == 0.0 {
         default_period
     } else {
         period
     };
     let (s, f, a) = elastic_shape(t, change, duration, amplitude, period);
-    match easing {
-        Easing::In => elastic_wave(t, duration, period, (s, -f, a)) + begin,
-        Easing::InOut if t < 0.0 => elastic_wave(t, duration, period, (s, f * -0.5, a)) + begin,
-        Easing::InOut => elastic_wave(-t, duration, period, (s, f * 0.5, a)) + change + begin,
+    match KIND {
+        ELASTIC_IN => elastic_wave(t, duration, period, (s, -f, a)) + begin,
+        ELASTIC_IN_OUT if t < 0.0 => elastic_wave(t, duration, period, (s, f * -0.5, a)) + begin,
+        ELASTIC_IN_OUT => elastic_wave(-t, duration, period, (s, f * 0.5, a)) + change + begin,
         _ => elastic_wave(t, duration, period, (s, f, a)) + change + begin,
     }
 }
