@@ -33,10 +33,7 @@ fn feature_points_arg<'py>(
     function: &'static str,
     feature_points: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<(Option<crate::args::FloatArg<'py>>, usize)> {
-    let points = feature_points
-        .filter(|p| !p.is_none())
-        .map(|p| float_array(function, "feature_points", p))
-        .transpose()?;
+    let points = args::optional_float_array(function, "feature_points", feature_points)?;
     let k = points
         .as_ref()
         .map_or(6, |p| p.shape().first().copied().unwrap_or(0));
@@ -173,10 +170,7 @@ fn register_points<'py>(
     const F: &str = "register_points";
     let src = float_array(F, "src", src)?;
     let dst = float_array(F, "dst", dst)?;
-    let weights = weights
-        .filter(|w| !w.is_none())
-        .map(|w| float_array(F, "weights", w))
-        .transpose()?;
+    let weights = args::optional_float_array(F, "weights", weights)?;
     let k = src.len() + dst.len();
     check_budget(
         F,

@@ -358,14 +358,8 @@ impl PyPlayback {
         let w = inner.mode().width();
         let location = float_array(F, "location", location)?;
         let rotation = float_array(F, "rotation", rotation)?;
-        let played = played
-            .filter(|p| !p.is_none())
-            .map(|p| float_array(F, "played", p))
-            .transpose()?;
-        let key_frames = key_frames
-            .filter(|k| !k.is_none())
-            .map(|k| float_array(F, "key_frames", k))
-            .transpose()?;
+        let played = crate::args::optional_float_array(F, "played", played)?;
+        let key_frames = crate::args::optional_float_array(F, "key_frames", key_frames)?;
         let k = key_frames
             .as_ref()
             .map(|a| vector_len(F, "key_frames", a))
