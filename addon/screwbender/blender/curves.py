@@ -157,6 +157,21 @@ def _read(points, offsets: list[int], curves: Sequence[int], name: str, out: np.
             bulk.get(points[c], name, out[width * lo : width * hi])
 
 
+def _read_codes(
+    points, offsets: np.ndarray, bounds: list[int], curves: Sequence[int], name: str, fcurves, bad: list
+) -> np.ndarray:
+    """The enum `name` of the keys of `curves` (indices; the other keys' raw value 0) as
+    `polyscrew` codes (`bounds`: `offsets` as a list). Keys whose value has no code join
+    `bad`, and a non-empty `bad` (what was found before too) raises :class:`UnsupportedCurve`."""
+    raw = np.zeros(int(offsets[-1]), dtype=np.uint8)
+    _read(points, bounds, curves, name, raw)
+    codes = _codes(name, raw)
+    bad += _unknown(name, codes, raw, offsets, fcurves)
+    if bad:
+        raise UnsupportedCurve(bad)
+    return codes
+
+
 def read(fcurves: Sequence[bpy.types.FCurve], keys_only: bool = False) -> Packed:
     """The keys, extrapolation and Cycles modifier of every curve in `fcurves`, packed.
 
@@ -176,12 +191,7 @@ def read(fcurves: Sequence[bpy.types.FCurve], keys_only: bool = False) -> Packed
     np.cumsum([len(p) for p in points], out=offsets[1:])
     k, bounds, every = int(offsets[-1]), offsets.tolist(), range(len(fcurves))
 
-    raw = np.zeros(k, dtype=np.uint8)
-    _read(points, bounds, every, "interpolation", raw)
-    interpolation = _codes("interpolation", raw)
-    bad += _unknown("interpolation", interpolation, raw, offsets, fcurves)
-    if bad:
-        raise UnsupportedCurve(bad)
+    interpolation = _read_codes(points, offsets, bounds, every, "interpolation", fcurves, bad)
 
     pairs = {name: np.zeros(2 * k, dtype=np.float32) for name in ("co", "handle_left", "handle_right")}
     for name, out in pairs.items():
@@ -199,12 +209,7 @@ def read(fcurves: Sequence[bpy.types.FCurve], keys_only: bool = False) -> Packed
     easing_codes = np.zeros(k, dtype=np.int64)
     eased = curves_with(interpolation >= names.index("SINE"))
     if eased:
-        raw_easing = np.zeros(k, dtype=np.uint8)
-        _read(points, bounds, eased, "easing", raw_easing)
-        easing_codes = _codes("easing", raw_easing)
-        bad += _unknown("easing", easing_codes, raw_easing, offsets, fcurves)
-        if bad:
-            raise UnsupportedCurve(bad)
+        easing_codes = _read_codes(points, offsets, bounds, eased, "easing", fcurves, bad)
     scalars = {
         "back": np.full(k, 1.70158, dtype=np.float32),
         "amplitude": np.full(k, 0.8, dtype=np.float32),

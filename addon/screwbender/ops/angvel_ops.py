@@ -10,7 +10,7 @@ from bpy.props import EnumProperty, FloatProperty, IntProperty
 from ..blender import transaction
 from ..blender.angvel import SPEED_PROP, STROKE_TIMINGS, add_sketch, fit, sphere_of
 from ..blender.keys import SmoothError
-from . import pipeline
+from . import panels, pipeline
 
 
 class SCREWBENDER_OT_add_angular_velocity_sketch(bpy.types.Operator):
@@ -110,18 +110,14 @@ class SCREWBENDER_OT_fit_angular_velocity(bpy.types.Operator):
         return pipeline.run(self, "Fit Angular Velocity", work, report)
 
 
-class VIEW3D_PT_screwbender_angular_velocity(bpy.types.Panel):
+class VIEW3D_PT_screwbender_angular_velocity(panels.OperatorsPanel, panels.View3DSidebar, bpy.types.Panel):
     """Angular velocity editing in the 3D Viewport sidebar, Animation tab."""
 
     bl_label = "ScrewBender Angular Velocity"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Animation"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        layout = self.layout
-        layout.operator(SCREWBENDER_OT_add_angular_velocity_sketch.bl_idname, icon="SPHERE")
-        layout.operator(SCREWBENDER_OT_fit_angular_velocity.bl_idname, icon="FORCE_VORTEX")
+    panel_operators = (
+        (SCREWBENDER_OT_add_angular_velocity_sketch.bl_idname, "SPHERE"),
+        (SCREWBENDER_OT_fit_angular_velocity.bl_idname, "FORCE_VORTEX"),
+    )
 
 
 classes = (

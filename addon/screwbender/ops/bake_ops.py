@@ -8,7 +8,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, Po
 
 from ..blender import bake, channels, feature, owners, reduce, transaction
 from ..pure import intent
-from . import pipeline, reduce_ops
+from . import panels, pipeline, reduce_ops
 from .pipeline import report_notes, report_skipped  # noqa: F401  (bake_ops.report_*: the pipeline's)
 
 
@@ -56,7 +56,7 @@ def draw_options(layout: bpy.types.UILayout, settings) -> None:
     layout.prop(settings, "smooth_result")
 
 
-class SCREWBENDER_OT_smooth(bpy.types.Operator):
+class SCREWBENDER_OT_smooth(reduce_ops.SelectionOperator, bpy.types.Operator):
     """Replace the keyed motion of the selected objects by a smooth screw motion through their key poses, baked into a new action (the old one is kept)"""
 
     bl_idname = "screwbender.smooth"
@@ -175,14 +175,6 @@ class SCREWBENDER_OT_smooth(bpy.types.Operator):
     key_distance: reduce_ops.distance_property()
     key_angle: reduce_ops.angle_property()
 
-    @classmethod
-    def poll(cls, context: bpy.types.Context) -> bool:
-        return owners.poll_selection(cls, context)
-
-    def invoke(self, context: bpy.types.Context, event) -> set[str]:
-        reduce_ops.set_default_distance(self, context, "key_distance")
-        return self.execute(context)
-
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
         layout.use_property_split = True
@@ -282,7 +274,6 @@ class ScrewBenderSettings(bpy.types.PropertyGroup):
 
 class _SmoothPanel:
     bl_label = "ScrewBender"
-    bl_region_type = "UI"
 
     def draw(self, context: bpy.types.Context) -> None:
         settings = context.scene.screwbender
@@ -296,18 +287,12 @@ class _SmoothPanel:
         layout.operator(SCREWBENDER_OT_revert.bl_idname, icon="LOOP_BACK")
 
 
-class VIEW3D_PT_screwbender(_SmoothPanel, bpy.types.Panel):
+class VIEW3D_PT_screwbender(_SmoothPanel, panels.View3DSidebar, bpy.types.Panel):
     """Smooth Motion in the 3D Viewport sidebar, Animation tab."""
 
-    bl_space_type = "VIEW_3D"
-    bl_category = "Animation"
 
-
-class GRAPH_PT_screwbender(_SmoothPanel, bpy.types.Panel):
+class GRAPH_PT_screwbender(_SmoothPanel, panels.GraphSidebar, bpy.types.Panel):
     """Smooth Motion in the Graph Editor sidebar."""
-
-    bl_space_type = "GRAPH_EDITOR"
-    bl_category = "ScrewBender"
 
 
 def menu_func(self, context: bpy.types.Context) -> None:

@@ -8,10 +8,10 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
 from ..blender import bake, channels, denoise, owners, reduce
-from . import pipeline, reduce_ops
+from . import panels, pipeline, reduce_ops
 
 
-class SCREWBENDER_OT_denoise(bpy.types.Operator):
+class SCREWBENDER_OT_denoise(reduce_ops.SelectionOperator, bpy.types.Operator):
     """Remove the jitter of captured keys (camera tracks, motion capture, baked simulations) from the selected objects or bones: the rigid motion itself is smoothed, the same in any coordinate frame, with the strength chosen from the data. The keys stay keys (their values move), the old action is kept"""
 
     bl_idname = "screwbender.denoise"
@@ -76,14 +76,6 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         name="Translation Strength", description="The strength used for translation, frames (output)"
     )
 
-    @classmethod
-    def poll(cls, context: bpy.types.Context) -> bool:
-        return owners.poll_selection(cls, context)
-
-    def invoke(self, context: bpy.types.Context, event) -> set[str]:
-        reduce_ops.set_default_distance(self, context, "key_distance")
-        return self.execute(context)
-
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
         layout.use_property_split = True
@@ -144,30 +136,10 @@ class SCREWBENDER_OT_denoise(bpy.types.Operator):
         )
 
 
-class VIEW3D_PT_screwbender_denoise(bpy.types.Panel):
-    """Remove Noise in the 3D Viewport sidebar, Animation tab."""
-
-    bl_label = "ScrewBender Remove Noise"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Animation"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        layout = self.layout
-        layout.operator(SCREWBENDER_OT_denoise.bl_idname, icon="MOD_SMOOTH")
-        layout.label(text="Strength is chosen from the data; select keys to hold the others")
-
-
-class GRAPH_PT_screwbender_denoise(bpy.types.Panel):
-    """Remove Noise in the Graph Editor sidebar."""
-
-    bl_label = "Remove Noise"
-    bl_space_type = "GRAPH_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "ScrewBender"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        self.layout.operator(SCREWBENDER_OT_denoise.bl_idname, icon="MOD_SMOOTH")
+VIEW3D_PT_screwbender_denoise, GRAPH_PT_screwbender_denoise = panels.operator_panels(
+    __name__, "denoise", "Remove Noise", SCREWBENDER_OT_denoise.bl_idname, "MOD_SMOOTH",
+    "Strength is chosen from the data; select keys to hold the others",
+)
 
 
 def menu_func(self, context: bpy.types.Context) -> None:

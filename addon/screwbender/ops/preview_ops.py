@@ -19,7 +19,7 @@ from bpy.props import BoolProperty, EnumProperty, FloatProperty, FloatVectorProp
 
 from ..blender import bake, channels, insert_key, owners, preview, transaction
 from ..blender.keys import SmoothError
-from . import bake_ops, pipeline, preview_draw
+from . import bake_ops, panels, pipeline, preview_draw
 
 STYLES = (
     ("WIRE", "Wireframe", "Each instance drawn as the wireframe of its mesh"),
@@ -200,13 +200,10 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class VIEW3D_PT_screwbender_preview(bpy.types.Panel):
+class VIEW3D_PT_screwbender_preview(panels.View3DSidebar, bpy.types.Panel):
     """Live preview settings, under the ScrewBender panel of the 3D Viewport."""
 
     bl_label = "Live Preview"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Animation"
     bl_parent_id = "VIEW3D_PT_screwbender"
 
     def draw_header(self, context: bpy.types.Context) -> None:

@@ -10,7 +10,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, FloatProperty
 
 from ..blender import bake, channels, owners, reduce
-from . import pipeline
+from . import panels, pipeline
 
 
 def distance_property(name: str = "Distance") -> FloatProperty:
@@ -47,7 +47,23 @@ def set_default_distance(operator: bpy.types.Operator, context: bpy.types.Contex
         setattr(operator, name, reduce.default_distance(context.scene))
 
 
-class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
+class SelectionOperator:
+    """An operator on the selected objects or bones (its `poll` says why it cannot run) whose
+    tolerance distance `distance_name` is 1 mm at the scene's unit scale when it is invoked from
+    the interface (see :func:`set_default_distance`)."""
+
+    distance_name = "key_distance"
+
+    @classmethod
+    def poll(cls, context: bpy.types.Context) -> bool:
+        return owners.poll_selection(cls, context)
+
+    def invoke(self, context: bpy.types.Context, event) -> set[str]:
+        set_default_distance(self, context, self.distance_name)
+        return self.execute(context)
+
+
+class SCREWBENDER_OT_reduce_keys(SelectionOperator, bpy.types.Operator):
     """Replace the dense keys of the selected objects or bones (a bake, a capture, a Smooth Motion or Remove Noise result) by the fewest Bezier keys whose playback stays within a tolerance in world space; the old action is kept"""
 
     bl_idname = "screwbender.reduce_keys"
@@ -77,13 +93,7 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
         "(else the original keys again, replacing the earlier result)",
     )
 
-    @classmethod
-    def poll(cls, context: bpy.types.Context) -> bool:
-        return owners.poll_selection(cls, context)
-
-    def invoke(self, context: bpy.types.Context, event) -> set[str]:
-        set_default_distance(self, context, "distance")
-        return self.execute(context)
+    distance_name = "distance"
 
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
@@ -116,30 +126,10 @@ class SCREWBENDER_OT_reduce_keys(bpy.types.Operator):
         )
 
 
-class VIEW3D_PT_screwbender_reduce(bpy.types.Panel):
-    """Reduce Keys in the 3D Viewport sidebar, Animation tab."""
-
-    bl_label = "ScrewBender Reduce Keys"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Animation"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        layout = self.layout
-        layout.operator(SCREWBENDER_OT_reduce_keys.bl_idname, icon="IPO_BEZIER")
-        layout.label(text="Tolerance in world space: 1 mm and 0.5 degrees by default")
-
-
-class GRAPH_PT_screwbender_reduce(bpy.types.Panel):
-    """Reduce Keys in the Graph Editor sidebar."""
-
-    bl_label = "Reduce Keys"
-    bl_space_type = "GRAPH_EDITOR"
-    bl_region_type = "UI"
-    bl_category = "ScrewBender"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        self.layout.operator(SCREWBENDER_OT_reduce_keys.bl_idname, icon="IPO_BEZIER")
+VIEW3D_PT_screwbender_reduce, GRAPH_PT_screwbender_reduce = panels.operator_panels(
+    __name__, "reduce", "Reduce Keys", SCREWBENDER_OT_reduce_keys.bl_idname, "IPO_BEZIER",
+    "Tolerance in world space: 1 mm and 0.5 degrees by default",
+)
 
 
 def draw_key_options(layout: bpy.types.UILayout, settings) -> None:

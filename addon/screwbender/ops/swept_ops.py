@@ -10,7 +10,7 @@ from bpy.props import BoolProperty, FloatProperty, IntProperty
 
 from ..blender import swept, transaction
 from ..pure import sweep_report
-from . import pipeline
+from . import panels, pipeline
 
 
 class SCREWBENDER_OT_sweep(bpy.types.Operator):
@@ -184,18 +184,14 @@ class SCREWBENDER_OT_check_clearance(bpy.types.Operator):
         return pipeline.run(self, "Check Clearance", work, report, refusals=(swept.SweepError,))
 
 
-class VIEW3D_PT_screwbender_sweep(bpy.types.Panel):
+class VIEW3D_PT_screwbender_sweep(panels.OperatorsPanel, panels.View3DSidebar, bpy.types.Panel):
     """Swept regions in the 3D Viewport sidebar, Animation tab."""
 
     bl_label = "ScrewBender Swept Region"
-    bl_space_type = "VIEW_3D"
-    bl_region_type = "UI"
-    bl_category = "Animation"
-
-    def draw(self, context: bpy.types.Context) -> None:
-        layout = self.layout
-        layout.operator(SCREWBENDER_OT_sweep.bl_idname, icon="MOD_SCREW")
-        layout.operator(SCREWBENDER_OT_check_clearance.bl_idname, icon="MOD_BOOLEAN")
+    panel_operators = (
+        (SCREWBENDER_OT_sweep.bl_idname, "MOD_SCREW"),
+        (SCREWBENDER_OT_check_clearance.bl_idname, "MOD_BOOLEAN"),
+    )
 
 
 classes = (SCREWBENDER_OT_sweep, SCREWBENDER_OT_check_clearance, VIEW3D_PT_screwbender_sweep)

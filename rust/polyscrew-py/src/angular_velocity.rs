@@ -418,14 +418,8 @@ fn fit_angular_velocity(
     let key_times = float_array(F, "key_times", key_times)?;
     let target_times = float_array(F, "target_times", target_times)?;
     let target_omega = float_array(F, "target_omega", target_omega)?;
-    let target_speed = target_speed
-        .filter(|o| !o.is_none())
-        .map(|s| float_array(F, "target_speed", s))
-        .transpose()?;
-    let sample_times = sample_times
-        .filter(|o| !o.is_none())
-        .map(|s| float_array(F, "sample_times", s))
-        .transpose()?;
+    let target_speed = args::optional_float_array(F, "target_speed", target_speed)?;
+    let sample_times = args::optional_float_array(F, "sample_times", sample_times)?;
     let fragment_duration = args::optional_float(F, "fragment_duration", fragment_duration)?;
     let n = key_quaternions.shape().first().copied().unwrap_or(0);
     let n_targets = target_times.len();

@@ -487,6 +487,17 @@ pub fn optional_float(
     }
 }
 
+/// An optional float array-like ([`float_array`]): None (or Python's None) when not given.
+pub fn optional_float_array<'py>(
+    function: &'static str,
+    what: &'static str,
+    obj: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Option<FloatArg<'py>>> {
+    obj.filter(|o| !o.is_none())
+        .map(|o| float_array(function, what, o))
+        .transpose()
+}
+
 /// An int in `lo..=hi`: a `ValueError` naming the argument, the value and the range for any
 /// int outside it (huge ones included), a `TypeError` for a float or any other type.
 pub fn int_in(

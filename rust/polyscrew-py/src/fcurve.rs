@@ -17,7 +17,7 @@ use polyscrew::fcurve::{
 };
 use polyscrew::memory::{try_vec, Footprint};
 
-use crate::args::{self, copy_of, float_array, int_array, FloatArg, FloatArray, IntArray, Most};
+use crate::args::{self, copy_of, float_array, int_array, FloatArray, IntArray, Most};
 use crate::arrays::{read_vector, vector_len};
 use crate::errors::{shape_err, to_py_err};
 
@@ -49,17 +49,6 @@ fn filled<T: Clone>(f: &str, value: T, n: usize, what: &'static str) -> PyResult
     let mut out = try_vec(n, what).map_err(|e| to_py_err(f, e))?;
     out.resize(n, value);
     Ok(out)
-}
-
-/// An optional float array-like (`None` stays `None`).
-fn optional_floats<'py>(
-    f: &'static str,
-    what: &'static str,
-    a: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Option<FloatArg<'py>>> {
-    a.filter(|a| !a.is_none())
-        .map(|a| float_array(f, what, a))
-        .transpose()
 }
 
 /// One extrapolation name for every curve, or a sequence of `c` names (more are refused
@@ -286,9 +275,9 @@ impl<'py> CurveInput<'py> {
         let handle_right = float_array(f, "handle_right", handle_right)?;
         let interpolation = int_array(f, "interpolation", interpolation)?;
         let easing = int_array(f, "easing", easing)?;
-        let back = optional_floats(f, "back", back)?;
-        let amplitude = optional_floats(f, "amplitude", amplitude)?;
-        let period = optional_floats(f, "period", period)?;
+        let back = args::optional_float_array(f, "back", back)?;
+        let amplitude = args::optional_float_array(f, "amplitude", amplitude)?;
+        let period = args::optional_float_array(f, "period", period)?;
 
         if offsets.ndim() != 1 {
             return Err(shape_err(f, "offsets", "(N,)", offsets.shape()));

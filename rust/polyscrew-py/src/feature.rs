@@ -27,9 +27,27 @@ fn read_points(function: &str, what: &str, array: &ArrayViewD<'_, f64>) -> PyRes
     read_rows3(function, what, array, "(K, 3)")
 }
 
-/// The feature points' count of an optional `(K, 3)` argument.
-fn points_len(points: Option<&crate::args::FloatArg<'_>>) -> usize {
-    points.map_or(6, |p| p.shape().first().copied().unwrap_or(0))
+/// The `feature_points` argument (None: not given) and how many points it gives (6, the
+/// inertia points, when it is not given).
+fn feature_points_arg<'py>(
+    function: &'static str,
+    feature_points: Option<&Bound<'py, PyAny>>,
+) -> PyResult<(Option<crate::args::FloatArg<'py>>, usize)> {
+    let points = args::optional_float_array(function, "feature_points", feature_points)?;
+    let k = points
+        .as_ref()
+        .map_or(6, |p| p.shape().first().copied().unwrap_or(0));
+    Ok((points, k))
+}
+
+/// Reads the `feature_points` view, if given, as `(K, 3)` points (no GIL needed).
+fn read_feature_points(
+    function: &str,
+    points: Option<&ArrayViewD<'_, f64>>,
+) -> PyResult<Option<Vec<DVec3>>> {
+    points
+        .map(|p| read_points(function, "feature_points", p))
+        .transpose()
 }
 
 /// The `stiffness` argument, read but not yet one value per key (that copy waits for the
@@ -152,10 +170,7 @@ fn register_points<'py>(
     const F: &str = "register_points";
     let src = float_array(F, "src", src)?;
     let dst = float_array(F, "dst", dst)?;
-    let weights = weights
-        .filter(|w| !w.is_none())
-        .map(|w| float_array(F, "weights", w))
-        .transpose()?;
+    let weights = args::optional_float_array(F, "weights", weights)?;
     let k = src.len() + dst.len();
     check_budget(
         F,
@@ -278,11 +293,7 @@ fn feature_motion<'py>(
         stiffness,
         inserted_stiffness,
     )?;
-    let points = feature_points
-        .filter(|p| !p.is_none())
-        .map(|p| float_array(F, "feature_points", p))
-        .transpose()?;
-    let k = points_len(points.as_ref());
+    let (points, k) = feature_points_arg(F, feature_points)?;
     let out_len = if n >= 2 {
         polyscrew::subdivided_len(n, levels, closed)
     } else {
@@ -308,10 +319,7 @@ fn feature_motion<'py>(
     let out = py.detach(|| -> PyResult<_> {
         let (v, p) = &views;
         let keys = read_keys(F, v)?;
-        let points = p
-            .as_ref()
-            .map(|p| read_points(F, "feature_points", p))
-            .transpose()?;
+        let points = read_feature_points(F, p.as_ref())?;
         core_feature_motion(&keys, points.as_deref(), &spec)
             .and_then(|d| poses_to_array(&d))
             .map_err(|e| to_py_err(F, e))
@@ -380,11 +388,7 @@ fn sample_feature<'py>(
     let times = float_array(F, "times", times)?;
     let n_key_times = vector_len(F, "key_times", &key_times)?;
     let m = vector_len(F, "times", &times)?;
-    let points = feature_points
-        .filter(|p| !p.is_none())
-        .map(|p| float_array(F, "feature_points", p))
-        .transpose()?;
-    let k = points_len(points.as_ref());
+    let (points, k) = feature_points_arg(F, feature_points)?;
     check_budget(
         F,
         poses.copy()
@@ -417,10 +421,7 @@ fn sample_feature<'py>(
         let keys = read_keys(F, v)?;
         let key_times = read_vector(F, "key_times", kt)?;
         let times = read_vector(F, "times", tt)?;
-        let points = p
-            .as_ref()
-            .map(|p| read_points(F, "feature_points", p))
-            .transpose()?;
+        let points = read_feature_points(F, p.as_ref())?;
         polyscrew::feature_motion_timed(&keys, &key_times, points.as_deref(), &spec, period, timing)
             .and_then(|m| m.sample(&times))
             .and_then(|p| poses_to_array(&p))

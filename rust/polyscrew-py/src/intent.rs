@@ -358,14 +358,8 @@ impl PyPlayback {
         let w = inner.mode().width();
         let location = float_array(F, "location", location)?;
         let rotation = float_array(F, "rotation", rotation)?;
-        let played = played
-            .filter(|p| !p.is_none())
-            .map(|p| float_array(F, "played", p))
-            .transpose()?;
-        let key_frames = key_frames
-            .filter(|k| !k.is_none())
-            .map(|k| float_array(F, "key_frames", k))
-            .transpose()?;
+        let played = crate::args::optional_float_array(F, "played", played)?;
+        let key_frames = crate::args::optional_float_array(F, "key_frames", key_frames)?;
         let k = key_frames
             .as_ref()
             .map(|a| vector_len(F, "key_frames", a))
@@ -504,12 +498,7 @@ fn analyse_spans<'py>(
     playback: &Bound<'py, PyAny>,
     frames: &Bound<'py, PyAny>,
     turns: Choice<AnalyseSpans, Turns>,
-) -> PyResult<(
-    Bound<'py, PyArray1<bool>>,
-    Bound<'py, PyArray1<bool>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-)> {
+) -> PyResult<SpanArrays<'py>> {
     Ok(span_arrays(
         py,
         spans_of(py, AnalyseSpans::NAME, playback, frames, turns.0)?,
@@ -517,20 +506,16 @@ fn analyse_spans<'py>(
     .0)
 }
 
+/// What ``analyse_spans`` returns: held, pops, turn, inserted.
+type SpanArrays<'py> = (
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<bool>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+);
+
 /// The arrays of ``analyse_spans`` (held, pops, turn, inserted), and the flips.
-#[allow(clippy::type_complexity)]
-fn span_arrays(
-    py: Python<'_>,
-    spans: Spans,
-) -> (
-    (
-        Bound<'_, PyArray1<bool>>,
-        Bound<'_, PyArray1<bool>>,
-        Bound<'_, PyArray1<f64>>,
-        Bound<'_, PyArray1<f64>>,
-    ),
-    Bound<'_, PyArray1<bool>>,
-) {
+fn span_arrays(py: Python<'_>, spans: Spans) -> (SpanArrays<'_>, Bound<'_, PyArray1<bool>>) {
     (
         (
             spans.held.into_pyarray(py),

@@ -438,10 +438,7 @@ fn sample_channels<'py>(
     let poses = float_array(F, "poses", poses)?;
     let n = key_count(F, &poses)?;
     let input = read_timed(F, key_times, times)?;
-    let previous = previous
-        .filter(|p| !p.is_none())
-        .map(|p| float_array(F, "previous", p))
-        .transpose()?;
+    let previous = crate::args::optional_float_array(F, "previous", previous)?;
     let m = input.n_times;
     let width = mode.width();
     check_budget(
@@ -654,10 +651,7 @@ fn rotation_channels<'py>(
     const F: &str = RotationChannels::NAME;
     let mode = mode.0;
     let rotations = float_array(F, "rotations", rotations)?;
-    let previous = previous
-        .filter(|p| !p.is_none())
-        .map(|p| float_array(F, "previous", p))
-        .transpose()?;
+    let previous = crate::args::optional_float_array(F, "previous", previous)?;
     let n = rotations.shape().first().copied().unwrap_or(0);
     let width = mode.width();
     check_budget(

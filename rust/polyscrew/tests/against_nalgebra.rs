@@ -11,15 +11,9 @@ use polyscrew::{s, Pose};
 mod nalgebra_conv;
 use nalgebra_conv::{from_nalgebra, to_nalgebra};
 
-/// `a` moved by the fraction `u` of the screw about the line through `p` along `axis` by
-/// `angle`, sliding `slide` along it.
-fn exact(axis: DVec3, p: DVec3, angle: f64, slide: f64, u: f64, a: &Pose) -> Pose {
-    let r = DQuat::from_axis_angle(axis, u * angle);
-    Pose {
-        rotation: r * a.rotation,
-        translation: r * (a.translation - p) + p + u * slide * axis,
-    }
-}
+#[path = "fixtures/poses.rs"]
+mod poses;
+use poses::exact;
 
 fn key() -> (Pose, DVec3, DVec3) {
     let a = Pose {

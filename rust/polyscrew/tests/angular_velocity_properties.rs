@@ -8,11 +8,9 @@ use glam::{DQuat, DVec3, DVec4};
 use polyscrew::{fit_angular_velocity, AngularVelocityTarget, FitOptions};
 use proptest::prelude::*;
 
-fn unit() -> impl Strategy<Value = DVec3> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
-        .prop_filter("non-degenerate", |(x, y, z)| x * x + y * y + z * z > 0.01)
-        .prop_map(|(x, y, z)| DVec3::new(x, y, z).normalize())
-}
+#[path = "fixtures/poses.rs"]
+mod poses;
+use poses::unit;
 
 fn rotation() -> impl Strategy<Value = DQuat> {
     (unit(), 0.0..PI).prop_map(|(axis, angle)| DQuat::from_axis_angle(axis, angle))

@@ -4,34 +4,22 @@
 
 use std::f64::consts::PI;
 
-use glam::{DQuat, DVec3};
+use glam::DVec3;
 use polyscrew::{
     feature_motion, register, CurveScheme, FeatureSpec, InertiaFrame, Parametrization, Pose,
     Stiffness,
 };
 use proptest::prelude::*;
 
+#[path = "fixtures/poses.rs"]
+mod poses;
+use poses::{point, pose, rigidity_error};
+
 fn config() -> ProptestConfig {
     ProptestConfig {
         cases: 300,
         ..ProptestConfig::default()
     }
-}
-
-fn unit() -> impl Strategy<Value = DVec3> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
-        .prop_filter("non-degenerate", |(x, y, z)| x * x + y * y + z * z > 0.01)
-        .prop_map(|(x, y, z)| DVec3::new(x, y, z).normalize())
-}
-
-fn point(range: f64) -> impl Strategy<Value = DVec3> {
-    (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
-}
-
-fn pose(max_angle: f64, spread: f64) -> impl Strategy<Value = Pose> {
-    (unit(), 0.0..max_angle, point(spread)).prop_map(|(axis, angle, t)| {
-        Pose::from_rotation_translation(DQuat::from_axis_angle(axis, angle), t)
-    })
 }
 
 /// Keys of a wandering body: each turns by at most 1.2 rad from the previous one (so no
@@ -82,18 +70,6 @@ fn spec() -> impl Strategy<Value = FeatureSpec> {
                 },
             }
         })
-}
-
-fn rigidity_error(p: &Pose) -> f64 {
-    let m = p.to_rows();
-    let mut worst: f64 = 0.0;
-    for i in 0..3 {
-        for j in 0..3 {
-            let dot: f64 = (0..3).map(|k| m[k][i] * m[k][j]).sum();
-            worst = worst.max((dot - if i == j { 1.0 } else { 0.0 }).abs());
-        }
-    }
-    worst
 }
 
 proptest! {

@@ -3,9 +3,13 @@
 
 use std::f64::consts::PI;
 
-use glam::{DQuat, DVec3};
+use glam::DQuat;
 use polyscrew::{s, subdivide, Pose, Scheme, Screw};
 use proptest::prelude::*;
+
+#[path = "fixtures/poses.rs"]
+mod poses;
+use poses::{exact, point, rigidity_error, unit};
 
 const SCHEMES: [Scheme; 3] = [Scheme::FourPoint, Scheme::BSpline, Scheme::Jarek];
 
@@ -16,43 +20,8 @@ fn config() -> ProptestConfig {
     }
 }
 
-fn unit() -> impl Strategy<Value = DVec3> {
-    (-1.0..1.0f64, -1.0..1.0f64, -1.0..1.0f64)
-        .prop_filter("non-degenerate", |(x, y, z)| x * x + y * y + z * z > 0.01)
-        .prop_map(|(x, y, z)| DVec3::new(x, y, z).normalize())
-}
-
-fn point(range: f64) -> impl Strategy<Value = DVec3> {
-    (-range..range, -range..range, -range..range).prop_map(|(x, y, z)| DVec3::new(x, y, z))
-}
-
 fn pose() -> impl Strategy<Value = Pose> {
-    (unit(), 0.0..PI, point(2.0)).prop_map(|(axis, angle, t)| {
-        Pose::from_rotation_translation(DQuat::from_axis_angle(axis, angle), t)
-    })
-}
-
-/// The exact screw motion by its parameters, evaluated directly: rotation by `u * angle`
-/// about the line through `p` along `axis`, plus `u * slide` along it, applied to `x`.
-fn exact(axis: DVec3, p: DVec3, angle: f64, slide: f64, u: f64, x: &Pose) -> Pose {
-    let r = DQuat::from_axis_angle(axis, u * angle);
-    Pose {
-        rotation: r * x.rotation,
-        translation: r * (x.translation - p) + p + u * slide * axis,
-    }
-}
-
-/// Largest deviation of a pose's matrix from orthonormality.
-fn rigidity_error(p: &Pose) -> f64 {
-    let m = p.to_rows();
-    let mut worst: f64 = 0.0;
-    for i in 0..3 {
-        for j in 0..3 {
-            let dot: f64 = (0..3).map(|k| m[k][i] * m[k][j]).sum();
-            worst = worst.max((dot - if i == j { 1.0 } else { 0.0 }).abs());
-        }
-    }
-    worst
+    poses::pose(PI, 2.0)
 }
 
 proptest! {

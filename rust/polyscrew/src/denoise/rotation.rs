@@ -120,6 +120,21 @@ impl<const M: usize> RotationSpline<M> {
         energy
     }
 
+    /// The coefficients of every stencil row: `c[l] = row[l + 1] + ... + row[M]` for
+    /// `l < M`.
+    fn set_coefficients(&mut self, st: &Stencils) {
+        let m = Self::ORDER;
+        debug_assert_eq!(st.order, m);
+        self.coeff.clear();
+        for row in &st.rows {
+            let mut c = [0.0; MAX_ORDER];
+            for l in 0..m {
+                c[l] = row[l + 1..=m].iter().sum();
+            }
+            self.coeff.push(c);
+        }
+    }
+
     /// Minimises the energy from the start `r` (the data, or a held-consistent guess; held
     /// frames must already equal their data), in place. `held` frames do not move.
     pub(crate) fn solve(
@@ -132,16 +147,7 @@ impl<const M: usize> RotationSpline<M> {
         held: Option<&[bool]>,
     ) -> Solve {
         let n = r.len();
-        let m = Self::ORDER;
-        debug_assert_eq!(st.order, m);
-        self.coeff.clear();
-        for row in &st.rows {
-            let mut c = [0.0; MAX_ORDER];
-            for l in 0..m {
-                c[l] = row[l + 1..=m].iter().sum();
-            }
-            self.coeff.push(c);
-        }
+        self.set_coefficients(st);
         let mut energy = self.evaluate(st, u, q, r, lambda);
         let mut iterations = 0;
         let mut converged = false;
@@ -332,14 +338,7 @@ mod tests {
             r: &[DQuat],
             lambda: f64,
         ) -> f64 {
-            self.coeff.clear();
-            for row in &st.rows {
-                let mut c = [0.0; MAX_ORDER];
-                for l in 0..M {
-                    c[l] = row[l + 1..=M].iter().sum();
-                }
-                self.coeff.push(c);
-            }
+            self.set_coefficients(st);
             self.evaluate(st, u, q, r, lambda)
         }
     }

@@ -50,9 +50,9 @@ pub fn ease(
         (I::Cubic, Out) => cubic_out(t, b, c, d),
         (I::Cubic, InOut) => cubic_in_out(t, b, c, d),
         (I::Cubic, _) => cubic_in(t, b, c, d),
-        (I::Elastic, In) => elastic_in(t, b, c, d, amplitude, period),
-        (I::Elastic, InOut) => elastic_in_out(t, b, c, d, amplitude, period),
-        (I::Elastic, _) => elastic_out(t, b, c, d, amplitude, period),
+        (I::Elastic, In) => elastic::<ELASTIC_IN>(t, b, c, d, amplitude, period),
+        (I::Elastic, InOut) => elastic::<ELASTIC_IN_OUT>(t, b, c, d, amplitude, period),
+        (I::Elastic, _) => elastic::<ELASTIC_OUT>(t, b, c, d, amplitude, period),
         (I::Expo, Out) => expo_out(t, b, c, d),
         (I::Expo, InOut) => expo_in_out(t, b, c, d),
         (I::Expo, _) => expo_in(t, b, c, d),
@@ -196,57 +196,27 @@ fn elastic_shape(
     }
 }
 
-fn elastic_in(
-    time: f32,
-    begin: f32,
-    change: f32,
-    duration: f32,
-    amplitude: f32,
-    period: f32,
-) -> f32 {
-    if time == 0.0 {
-        return begin;
-    }
-    let mut t = time / duration;
-    if t == 1.0 {
-        return begin + change;
-    }
-    t -= 1.0;
-    let period = if period == 0.0 {
-        duration * 0.3
-    } else {
-        period
-    };
-    let (s, f, a) = elastic_shape(t, change, duration, amplitude, period);
-    (-f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin())) + begin
+/// Blender's ELASTIC wave at the shifted `time` (`t`): `f a 2^(10 t) sin((t d - s) 2 pi / p)`
+/// for the phase shift `s`, blend factor `f` and amplitude `a` of [`elastic_shape`].
+fn elastic_wave(t: f32, duration: f32, period: f32, (s, f, a): (f32, f32, f32)) -> f32 {
+    f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin())
 }
 
-fn elastic_out(
-    time: f32,
-    begin: f32,
-    change: f32,
-    duration: f32,
-    amplitude: f32,
-    period: f32,
-) -> f32 {
-    if time == 0.0 {
-        return begin;
-    }
-    let mut t = time / duration;
-    if t == 1.0 {
-        return begin + change;
-    }
-    t = -t;
-    let period = if period == 0.0 {
-        duration * 0.3
-    } else {
-        period
-    };
-    let (s, f, a) = elastic_shape(t, change, duration, amplitude, period);
-    (f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin())) + change + begin
-}
+/// [`elastic`]'s `KIND`: ease in.
+const ELASTIC_IN: u8 = 0;
+/// [`elastic`]'s `KIND`: ease out.
+const ELASTIC_OUT: u8 = 1;
+/// [`elastic`]'s `KIND`: ease in and out.
+const ELASTIC_IN_OUT: u8 = 2;
 
-fn elastic_in_out(
+/// ELASTIC easing of `KIND` ([`ELASTIC_IN`], [`ELASTIC_OUT`], [`ELASTIC_IN_OUT`]: a
+/// constant, so that each is compiled without the others' branches), as Blender's
+/// `BLI_easing_elastic_ease_in`, `_ease_out` and `_ease_in_out`: the ends exact; else the
+/// time shifted (in: `t - 1`; out: `-t`; in-out: `2 t - 1`, over half the duration), the
+/// period defaulted (`0.3 d`, in-out `0.45 d`), and the [`elastic_wave`] added to `begin`
+/// (negated, in) or to `begin + change` (out); in-out is half of each, by the sign of its
+/// shifted time.
+fn elastic<const KIND: u8>(
     time: f32,
     begin: f32,
     change: f32,
@@ -257,25 +227,29 @@ fn elastic_in_out(
     if time == 0.0 {
         return begin;
     }
-    let mut t = time / (duration / 2.0);
-    if t == 2.0 {
+    let in_out = KIND == ELASTIC_IN_OUT;
+    let (span, end, default_period) = if in_out {
+        (duration / 2.0, 2.0, duration * (0.3 * 1.5))
+    } else {
+        (duration, 1.0, duration * 0.3)
+    };
+    let t = time / span;
+    if t == end {
         return begin + change;
     }
-    t -= 1.0;
+    let t = if KIND != ELASTIC_OUT { t - 1.0 } else { -t };
     let period = if period == 0.0 {
-        duration * (0.3 * 1.5)
+        default_period
     } else {
         period
     };
     let (s, f, a) = elastic_shape(t, change, duration, amplitude, period);
-    if t < 0.0 {
-        let f = f * -0.5;
-        return (f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin()))
-            + begin;
+    match KIND {
+        ELASTIC_IN => elastic_wave(t, duration, period, (s, -f, a)) + begin,
+        ELASTIC_IN_OUT if t < 0.0 => elastic_wave(t, duration, period, (s, f * -0.5, a)) + begin,
+        ELASTIC_IN_OUT => elastic_wave(-t, duration, period, (s, f * 0.5, a)) + change + begin,
+        _ => elastic_wave(t, duration, period, (s, f, a)) + change + begin,
     }
-    t = -t;
-    let f = f * 0.5;
-    (f * (a * 2f32.powf(10.0 * t) * ((t * duration - s) * TWO_PI / period).sin())) + change + begin
 }
 
 /// `2^-10`: where Blender's EXPO curve starts, rescaled to reach 0 and 1 exactly.

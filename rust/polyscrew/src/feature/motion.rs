@@ -330,6 +330,11 @@ pub fn sample_feature_motion(
     feature_motion_timed(keys, key_times, feature_points, spec, period, timing)?.sample(times)
 }
 
+/// The tests' rigidity measure (a test fixture, not part of the library).
+#[cfg(test)]
+#[path = "../../tests/fixtures/rigidity.rs"]
+mod rigidity;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -386,15 +391,7 @@ mod tests {
     }
 
     fn rigidity(p: &Pose) -> f64 {
-        let r = p.to_rows();
-        let mut worst: f64 = 0.0;
-        for a in 0..3 {
-            for b in 0..3 {
-                let dot: f64 = (0..3).map(|i| r[i][a] * r[i][b]).sum();
-                worst = worst.max((dot - if a == b { 1.0 } else { 0.0 }).abs());
-            }
-        }
-        worst
+        super::rigidity::rigidity_error(&p.to_rows())
     }
 
     #[test]

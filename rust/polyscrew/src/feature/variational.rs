@@ -242,6 +242,32 @@ pub fn spans_spacing(
     }
 }
 
+/// Checks the span spacings of `n` points (`n - 1` spans open, `n` closed): one per span,
+/// each finite and positive.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] for a wrong number of spacings, [`Error::Value`] (at the span)
+/// for a spacing that is not finite and positive.
+fn check_spacing(spacing: &[f64], n: usize, closed: bool) -> Result<()> {
+    let spans = if closed { n } else { n - 1 };
+    if spacing.len() != spans {
+        return Err(Error::LengthMismatch {
+            what: "spacing",
+            expected: spans,
+            got: spacing.len(),
+        });
+    }
+    if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
+        return Err(Error::Value {
+            what: "spacing",
+            at: Some(At::new("span", i)),
+            value: spacing[i],
+            expected: Expected::Positive("spacing"),
+        });
+    }
+    Ok(())
+}
+
 /// One level's linear system, shared by all curves designed together.
 #[derive(Debug, Clone)]
 pub struct VariationalLevel {
@@ -268,27 +294,12 @@ impl VariationalLevel {
         if n < 2 {
             return Err(Error::TooFew { got: n, need: 2 });
         }
-        let spans = if closed { n } else { n - 1 };
-        if spacing.len() != spans {
-            return Err(Error::LengthMismatch {
-                what: "spacing",
-                expected: spans,
-                got: spacing.len(),
-            });
-        }
+        check_spacing(spacing, n, closed)?;
         if lambda.len() != n {
             return Err(Error::LengthMismatch {
                 what: "stiffness",
                 expected: n,
                 got: lambda.len(),
-            });
-        }
-        if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
-            return Err(Error::Value {
-                what: "spacing",
-                at: Some(At::new("span", i)),
-                value: spacing[i],
-                expected: Expected::Positive("spacing"),
             });
         }
         let m = if closed { 2 * n } else { 2 * n - 1 };
@@ -494,22 +505,7 @@ pub fn variational_subdivide(
             got: bad.len(),
         });
     }
-    let spans = if closed { n } else { n - 1 };
-    if spacing.len() != spans {
-        return Err(Error::LengthMismatch {
-            what: "spacing",
-            expected: spans,
-            got: spacing.len(),
-        });
-    }
-    if let Some(i) = spacing.iter().position(|d| !(*d > 0.0 && d.is_finite())) {
-        return Err(Error::Value {
-            what: "spacing",
-            at: Some(At::new("span", i)),
-            value: spacing[i],
-            expected: Expected::Positive("spacing"),
-        });
-    }
+    check_spacing(spacing, n, closed)?;
     stiffness.check(n, closed)?;
     let mut current: Vec<Vec<DVec3>> = curves.to_vec();
     let mut spacing = spacing.to_vec();

@@ -365,21 +365,32 @@ fn smoothstep_playback() -> Playback {
     playback(vec![(Channel::Location(0), x)], XYZ)
 }
 
-#[test]
-fn keys_timing_of_a_straight_ease_is_the_smoothstep() {
-    let p = smoothstep_playback();
+/// [`smoothstep_playback`] and the 4-point motion (4 levels) through its two key poses: what
+/// Keys timing is measured on ([`ease_timing`]).
+fn straight_ease() -> (Playback, Vec<Pose>) {
     let keys = [
         Pose::IDENTITY,
         Pose::from_translation(DVec3::new(10.0, 0.0, 0.0)),
     ];
     let smooth = screw_pace_poses(&keys, Scheme::FourPoint, 4, false).unwrap();
-    let frames: Vec<f64> = (0..=40).map(|i| 1.0 + 0.5 * i as f64).collect();
-    let timing = KeysTiming {
+    (smoothstep_playback(), smooth)
+}
+
+/// Keys timing of the keys of [`straight_ease`] (frames 1 and 21), following `playback`.
+fn ease_timing(playback: &Playback) -> KeysTiming<'_> {
+    KeysTiming {
         key_frames: &[1.0, 21.0],
         period: None,
         size: 1.0,
-        playback: Some(&p),
-    };
+        playback: Some(playback),
+    }
+}
+
+#[test]
+fn keys_timing_of_a_straight_ease_is_the_smoothstep() {
+    let (p, smooth) = straight_ease();
+    let timing = ease_timing(&p);
+    let frames: Vec<f64> = (0..=40).map(|i| 1.0 + 0.5 * i as f64).collect();
     let u = keys_parameters(&timing, &frames, &smooth).unwrap();
     for (f, u) in frames.iter().zip(&u) {
         let tau = (f - 1.0) / 20.0;
@@ -405,19 +416,9 @@ fn keys_timing_of_a_straight_ease_is_the_smoothstep() {
 fn keys_timing_of_a_long_bake_interpolates_a_fine_grid() {
     // 20,000 frames in one span: the playback is measured on DENSE_PACE_SAMPLES steps, and
     // the frames between them still follow the smoothstep closely.
-    let p = smoothstep_playback();
-    let keys = [
-        Pose::IDENTITY,
-        Pose::from_translation(DVec3::new(10.0, 0.0, 0.0)),
-    ];
-    let smooth = screw_pace_poses(&keys, Scheme::FourPoint, 4, false).unwrap();
+    let (p, smooth) = straight_ease();
+    let timing = ease_timing(&p);
     let frames: Vec<f64> = (0..=20_000).map(|i| 1.0 + 0.001 * i as f64).collect();
-    let timing = KeysTiming {
-        key_frames: &[1.0, 21.0],
-        period: None,
-        size: 1.0,
-        playback: Some(&p),
-    };
     let u = keys_parameters(&timing, &frames, &smooth).unwrap();
     let worst = frames
         .iter()

@@ -52,7 +52,7 @@ pub enum EulerOrder {
 impl EulerOrder {
     /// The axes in the order they are applied, and whether that permutation is odd
     /// (Blender's `RotOrderInfo`).
-    fn axes(self) -> ([usize; 3], bool) {
+    pub(crate) fn axes(self) -> ([usize; 3], bool) {
         match self {
             Self::Xyz => ([0, 1, 2], false),
             Self::Xzy => ([0, 2, 1], true),

@@ -539,12 +539,19 @@ mod tests {
         }
     }
 
-    #[test]
-    fn endpoints_and_parameters() {
+    /// A key pose turned about a tilted axis and moved off the origin, and the axis direction
+    /// and point of a screw from it.
+    fn tilted_key() -> (Pose, DVec3, DVec3) {
         let a = Pose::from_rotation_translation(
             DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
             DVec3::new(1.0, 2.0, -0.5),
         );
+        (a, DVec3::new(0.0, 0.6, 0.8), DVec3::new(0.5, -0.3, 0.1))
+    }
+
+    #[test]
+    fn endpoints_and_parameters() {
+        let (a, _, _) = tilted_key();
         let axis = DVec3::new(1.0, 1.0, 0.0).normalize();
         let p = DVec3::new(0.0, 0.0, 3.0);
         let b = exact(axis, p, 2.0, 0.25, 1.0, &a);
@@ -585,12 +592,7 @@ mod tests {
 
     #[test]
     fn midpoint_equals_half_screw() {
-        let a = Pose::from_rotation_translation(
-            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
-            DVec3::new(1.0, 2.0, -0.5),
-        );
-        let axis = DVec3::new(0.0, 0.6, 0.8);
-        let p = DVec3::new(0.5, -0.3, 0.1);
+        let (a, axis, p) = tilted_key();
         for angle in [0.0, 1e-12, 1e-6, 0.5, 2.0, PI - 1e-6] {
             let b = exact(axis, p, angle, 0.7, 1.0, &a);
             let err = midpoint(&a, &b).max_abs_diff(&exact(axis, p, angle, 0.7, 0.5, &a));
@@ -600,12 +602,7 @@ mod tests {
 
     #[test]
     fn eval_sixteenths_matches_eval() {
-        let a = Pose::from_rotation_translation(
-            DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7),
-            DVec3::new(1.0, 2.0, -0.5),
-        );
-        let axis = DVec3::new(0.0, 0.6, 0.8);
-        let p = DVec3::new(0.5, -0.3, 0.1);
+        let (a, axis, p) = tilted_key();
         let ks = [
             -34, -18, -17, -16, -14, -2, -1, 0, 1, 2, 4, 7, 8, 12, 14, 16, 17, 18, 30, 33,
         ];
