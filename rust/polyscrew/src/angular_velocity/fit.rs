@@ -118,19 +118,7 @@ fn fragment_count(keys: usize, options: &FitOptions) -> Option<usize> {
 }
 
 fn check_fit_time(what: &'static str, index: usize, t: f64) -> Result<()> {
-    if t.abs() <= FIT_MAX_TIME {
-        return Ok(());
-    }
-    if t.is_finite() {
-        Err(Error::OutOfRange {
-            what,
-            index,
-            value: t,
-            limit: FIT_MAX_TIME,
-        })
-    } else {
-        Err(Error::NotFinite { what, index })
-    }
+    crate::motion::timing::check_time_within(what, index, t, FIT_MAX_TIME)
 }
 
 /// The paper's weight of the tangential-acceleration term `W_T` (section 2: 0.002; it found

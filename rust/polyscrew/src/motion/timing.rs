@@ -152,7 +152,16 @@ pub fn check_period(key_times: &[f64], period: f64) -> Result<f64> {
 /// [`Error::NotFinite`] or [`Error::OutOfRange`] naming `what` and `index`.
 #[inline]
 pub fn check_time(what: &'static str, index: usize, t: f64) -> Result<()> {
-    if t.abs() <= MAX_TIME {
+    check_time_within(what, index, t, MAX_TIME)
+}
+
+/// Checks one time: finite and within `limit` (a domain's own bound, at most [`MAX_TIME`]).
+///
+/// # Errors
+/// [`Error::NotFinite`] or [`Error::OutOfRange`] naming `what`, `index` and `limit`.
+#[inline]
+pub fn check_time_within(what: &'static str, index: usize, t: f64, limit: f64) -> Result<()> {
+    if t.abs() <= limit {
         return Ok(());
     }
     if t.is_finite() {
@@ -160,7 +169,7 @@ pub fn check_time(what: &'static str, index: usize, t: f64) -> Result<()> {
             what,
             index,
             value: t,
-            limit: MAX_TIME,
+            limit,
         })
     } else {
         Err(Error::NotFinite { what, index })
