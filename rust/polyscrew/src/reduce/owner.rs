@@ -76,6 +76,9 @@ pub(crate) struct Workspace {
     reduced: Vec<Pose>,
     quats: Vec<DQuat>,
     jac: Vec<[[f64; 4]; 3]>,
+    /// The dense local motion before its parent's error is composed in, for a child that
+    /// does not key one of its groups ([`held_error`]).
+    dense: Vec<Pose>,
 }
 
 /// What every owner shares: the inputs, the sample times.
@@ -245,6 +248,14 @@ impl<'a> Context<'a> {
         } else {
             ws.scale.resize(m, DVec3::ONE);
         }
+        // A group the owner does not key (a connected bone's location) plays its dense
+        // value, not the target's: kept to measure the error in world space (`held_error`).
+        let holds = parent.is_some() && !(keyed.location && keyed.rotation);
+        ws.dense.clear();
+        if holds {
+            ws.dense.reserve(m);
+            ws.dense.extend_from_slice(&ws.local);
+        }
         // The target of the owner's own channels: `O^-1 @ E_parent @ O @ L` (module docs).
         if let Some(p) = parent {
             let o = offset;
@@ -340,6 +351,34 @@ impl<'a> Context<'a> {
             let keys = if cols.is_empty() { 0 } else { spans.len() + 1 };
             (curves, keys, d, a)
         };
+        let (distance_error, angle_error) = if holds {
+            if keyed.scale {
+                // (the scale's error per sample is not kept: Blender's evaluation again)
+                let mut v = try_vec(m, "channel rows")?;
+                v.extend_from_slice(&ws.v);
+                hold_rows(&mut v, &ws.dense, mode, keyed, start)?;
+                let whole = Fitter {
+                    v: &v,
+                    keyed: Keyed {
+                        location: true,
+                        rotation: true,
+                        scale: true,
+                    },
+                    ..fitter
+                };
+                whole.check_curves(&cols, &curves, &mut ws.reduced)?
+            } else {
+                held_error(
+                    &mut ws.reduced,
+                    &ws.target,
+                    &ws.dense,
+                    keyed,
+                    self.input.radius[o],
+                )
+            }
+        } else {
+            (distance_error, angle_error)
+        };
         let world = if keep_world {
             let mut error = try_vec(m, "error transforms")?;
             error.extend(
@@ -403,6 +442,61 @@ impl<'a> Context<'a> {
         }
         Ok(last.expect("at least one round"))
     }
+}
+
+/// The error of the played poses `reduced` against `target` where the groups the owner does
+/// not key play their `dense` values (a connected bone's location: Blender ignores it), and
+/// `reduced` made those played poses (what its children make up for): the largest
+/// `|dt| + 2 r sin(theta / 2)` and `theta` over the samples, in world space along the chain
+/// (the search counted those groups as exact: they carry the parent's error, which only a
+/// smaller tolerance on the parents reduces).
+fn held_error(
+    reduced: &mut [Pose],
+    target: &[Pose],
+    dense: &[Pose],
+    keyed: Keyed,
+    radius: f64,
+) -> (f64, f64) {
+    let (mut dmax, mut tmax) = (0.0f64, Turn::default());
+    for ((played, aim), held) in reduced.iter_mut().zip(target).zip(dense) {
+        if !keyed.location {
+            played.translation = held.translation;
+        }
+        if !keyed.rotation {
+            played.rotation = held.rotation;
+        }
+        let turn = Turn::between(aim.rotation, played.rotation);
+        let d = (played.translation - aim.translation).length() + 2.0 * radius * turn.sin_half();
+        dmax = dmax.max(d);
+        if turn.exceeds(tmax) {
+            tmax = turn;
+        }
+    }
+    (dmax, tmax.angle())
+}
+
+/// Channel rows `v` with the groups the owner does not key set to their `dense` values.
+fn hold_rows(
+    v: &mut [[f64; STRIDE]],
+    dense: &[Pose],
+    mode: RotationMode,
+    keyed: Keyed,
+    start: Option<&[f64]>,
+) -> Result<()> {
+    if !keyed.location {
+        for (row, p) in v.iter_mut().zip(dense) {
+            row[0..3].copy_from_slice(&p.translation.to_array());
+        }
+    }
+    if !keyed.rotation {
+        let width = mode.width();
+        let quats: Vec<DQuat> = dense.iter().map(|p| p.rotation).collect();
+        let rot = rotation_channels(&quats, mode, start)?;
+        for (row, r) in v.iter_mut().zip(rot.chunks_exact(width)) {
+            row[ROT..ROT + width].copy_from_slice(r);
+        }
+    }
+    Ok(())
 }
 
 /// `a @ b` without renormalising the product of the unit quaternions (unit to rounding; the
