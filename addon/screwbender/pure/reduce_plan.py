@@ -85,9 +85,6 @@ class Item:
     linear: np.ndarray | None = None
     #: Whole frames among the dense frames (quarter frames aside), for the report.
     whole: int = 0
-    #: The reference at the probes of every span when it is not the screw between the frames
-    #: (:func:`measured`): Blender's playback of LINEAR keys there.
-    probe_ref: np.ndarray | None = None
 
 
 @dataclass

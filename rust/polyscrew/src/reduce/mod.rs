@@ -259,13 +259,13 @@ pub fn sample_count(n: usize) -> usize {
 pub fn reduce_footprint(bodies: usize, n: usize, threads: usize, with_parents: bool) -> Footprint {
     let m = sample_count(n);
     let workers = effective_threads(threads, bodies).max(1);
-    let per_owner = Footprint::of::<Pose>(m.saturating_mul(2))
+    let per_owner = Footprint::of::<Pose>(m.saturating_mul(6))
         .and::<DVec3>(m)
         .and::<f64>(m.saturating_mul(compose::STRIDE + 4))
-        .and::<[f64; compose::STRIDE]>(m.saturating_mul(2))
+        .and::<[f64; compose::STRIDE]>(m.saturating_mul(3))
         .and::<usize>(m);
     let worlds = if with_parents {
-        Footprint::of::<Pose>(m).times(bodies)
+        Footprint::of::<Pose>(m.saturating_mul(2)).times(bodies)
     } else {
         Footprint::ZERO
     };

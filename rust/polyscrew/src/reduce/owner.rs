@@ -51,9 +51,16 @@ pub struct ReducedKey {
 /// `played^-1 @ target` in its own channels' space). A child of offset `O` and dense local
 /// motion `L` then has the target `(W_reduced @ O)^-1 @ W_dense @ O @ L = O^-1 @ E @ O @ L`,
 /// and its own `E` is again `played^-1 @ target`: no world pose is ever formed.
+///
+/// `error` is what the children compensate: the played pose counts the groups the owner does
+/// not key as exact (they carry the parent's error, which the owner cannot change). `held`,
+/// when the owner or one of its ancestors does not key a group, is the error transform of
+/// what Blender plays (those groups at their dense values), which the error reported in world
+/// space is measured with ([`held_error`]).
 #[derive(Debug, Clone)]
 pub(crate) struct World {
     pub error: Vec<Pose>,
+    pub held: Option<Vec<Pose>>,
 }
 
 /// What one owner's reduction gives.
@@ -76,6 +83,9 @@ pub(crate) struct Workspace {
     reduced: Vec<Pose>,
     quats: Vec<DQuat>,
     jac: Vec<[[f64; 4]; 3]>,
+    /// The dense local motion before its parent's error is composed in, for a child that
+    /// does not key one of its groups ([`held_error`]).
+    dense: Vec<Pose>,
 }
 
 /// What every owner shares: the inputs, the sample times.
@@ -245,6 +255,14 @@ impl<'a> Context<'a> {
         } else {
             ws.scale.resize(m, DVec3::ONE);
         }
+        // A group the owner does not key (a connected bone's location) plays its dense
+        // value, not the target's: kept to measure the error in world space (`held_error`).
+        let holds = parent.is_some_and(|p| p.held.is_some() || !(keyed.location && keyed.rotation));
+        ws.dense.clear();
+        if holds {
+            ws.dense.reserve(m);
+            ws.dense.extend_from_slice(&ws.local);
+        }
         // The target of the owner's own channels: `O^-1 @ E_parent @ O @ L` (module docs).
         if let Some(p) = parent {
             let o = offset;
@@ -340,6 +358,43 @@ impl<'a> Context<'a> {
             let keys = if cols.is_empty() { 0 } else { spans.len() + 1 };
             (curves, keys, d, a)
         };
+        let held = match parent {
+            Some(p) if holds => Some(held_error(
+                &ws.reduced,
+                &ws.dense,
+                p.held.as_ref().unwrap_or(&p.error),
+                &offset,
+                keyed,
+                self.input.radius[o],
+            )?),
+            _ => None,
+        };
+        let (distance_error, angle_error, held) = match (held, parent) {
+            (Some((_, _, chain)), Some(p)) if keyed.scale => {
+                // (the scale's error per sample is not kept: Blender's evaluation again,
+                // against the target of the chain as played)
+                let mut v = try_vec(m, "channel rows")?;
+                v.extend_from_slice(&ws.v);
+                hold_rows(&mut v, &ws.dense, mode, keyed, start)?;
+                let target = chain_target(p.held.as_ref().unwrap_or(&p.error), &offset, &ws.dense)?;
+                let whole = Fitter {
+                    v: &v,
+                    target: &target,
+                    keyed: Keyed {
+                        location: true,
+                        rotation: true,
+                        scale: true,
+                    },
+                    ..fitter
+                };
+                let mut played = try_vec(m, "played poses")?;
+                played.resize(m, Pose::IDENTITY);
+                let (d, a) = whole.check_curves(&cols, &curves, &mut played)?;
+                (d, a, Some(chain))
+            }
+            (Some((d, a, chain)), _) => (d, a, Some(chain)),
+            (None, _) => (distance_error, angle_error, None),
+        };
         let world = if keep_world {
             let mut error = try_vec(m, "error transforms")?;
             error.extend(
@@ -348,7 +403,7 @@ impl<'a> Context<'a> {
                     .zip(&ws.target)
                     .map(|(played, target)| mul_inverse(played, target)),
             );
-            Some(World { error })
+            Some(World { error, held })
         } else {
             None
         };
@@ -403,6 +458,84 @@ impl<'a> Context<'a> {
         }
         Ok(last.expect("at least one round"))
     }
+}
+
+/// The target of a child of offset `offset` and dense local motion `dense` whose parent's
+/// error transform is `e`: `O^-1 @ E @ O @ L` (module docs).
+fn chain_target(e: &[Pose], offset: &Pose, dense: &[Pose]) -> Result<Vec<Pose>> {
+    let mut out = try_vec(dense.len(), "targets")?;
+    out.extend(
+        e.iter()
+            .zip(dense)
+            .map(|(e, l)| mul(&mul_inverse(offset, &mul(e, offset)), l)),
+    );
+    Ok(out)
+}
+
+/// The error in world space of an owner whose played poses are `reduced` (the groups it does
+/// not key counted as exact), where those groups play their `dense` values (a connected
+/// bone's location: Blender ignores it) and its parent's played error transform is `e`
+/// ([`World::held`], else [`World::error`]): the largest `|dt| + 2 r sin(theta / 2)` and
+/// `theta` over the samples, and its own played error transform (for its children). The
+/// search counted those groups as exact: they carry the parents' error, which only a smaller
+/// tolerance on the parents reduces.
+fn held_error(
+    reduced: &[Pose],
+    dense: &[Pose],
+    e: &[Pose],
+    offset: &Pose,
+    keyed: Keyed,
+    radius: f64,
+) -> Result<(f64, f64, Vec<Pose>)> {
+    let target = chain_target(e, offset, dense)?;
+    let (mut dmax, mut tmax) = (0.0f64, Turn::default());
+    let mut chain = try_vec(reduced.len(), "error transforms")?;
+    for ((played, aim), held) in reduced.iter().zip(&target).zip(dense) {
+        let played = Pose {
+            rotation: if keyed.rotation {
+                played.rotation
+            } else {
+                held.rotation
+            },
+            translation: if keyed.location {
+                played.translation
+            } else {
+                held.translation
+            },
+        };
+        let turn = Turn::between(aim.rotation, played.rotation);
+        let d = (played.translation - aim.translation).length() + 2.0 * radius * turn.sin_half();
+        dmax = dmax.max(d);
+        if turn.exceeds(tmax) {
+            tmax = turn;
+        }
+        chain.push(mul_inverse(&played, aim));
+    }
+    Ok((dmax, tmax.angle(), chain))
+}
+
+/// Channel rows `v` with the groups the owner does not key set to their `dense` values.
+fn hold_rows(
+    v: &mut [[f64; STRIDE]],
+    dense: &[Pose],
+    mode: RotationMode,
+    keyed: Keyed,
+    start: Option<&[f64]>,
+) -> Result<()> {
+    if !keyed.location {
+        for (row, p) in v.iter_mut().zip(dense) {
+            row[0..3].copy_from_slice(&p.translation.to_array());
+        }
+    }
+    if !keyed.rotation {
+        let width = mode.width();
+        let quats: Vec<DQuat> = dense.iter().map(|p| p.rotation).collect();
+        let rot = rotation_channels(&quats, mode, start)?;
+        for (row, r) in v.iter_mut().zip(rot.chunks_exact(width)) {
+            row[ROT..ROT + width].copy_from_slice(r);
+        }
+    }
+    Ok(())
 }
 
 /// `a @ b` without renormalising the product of the unit quaternions (unit to rounding; the

@@ -1,0 +1,88 @@
+"""Reduce Keys' own time (issue 26, item 1): the dense motion is played once per owner (the
+probes of the spans cut at their quarter frames come from that one playback), the reduced
+curves are not played a second time by the add-on (the core measures them in world space, a
+connected bone's head included), one `polyscrew.reduce_keys` call; and Blender's playback of
+the result stays within the tolerance in world space at every frame and three subframes, on a
+rig whose connected bone carries its parent's error and whose last bone keys its scale."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+
+import bpy
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+import bake_helpers as h
+import bone_helpers as bh
+from conftest import addon_module
+from test_reduce_keys import check_within, play, sample_times, transform_keys
+
+DISTANCE, ANGLE = 0.001, math.radians(0.5)
+
+
+@contextlib.contextmanager
+def counting_calls():
+    """Counts `polyscrew.reduce_keys` and `polyscrew.evaluate_fcurves` calls of the Reduce
+    Keys module and the playbacks of the dense motion (`Source.channels`)."""
+    reduce = addon_module("blender.reduce")
+    intent = addon_module("pure.intent")
+    calls = {"reduce_keys": 0, "evaluate_fcurves": 0, "channels": 0}
+    originals = {name: getattr(reduce.polyscrew, name) for name in ("reduce_keys", "evaluate_fcurves")}
+    channels = intent.Source.channels
+
+    def counted(name):
+        def call(*args, **kwargs):
+            calls[name] += 1
+            return originals[name](*args, **kwargs)
+
+        return call
+
+    def counted_channels(self, frames):
+        calls["channels"] += 1
+        return channels(self, frames)
+
+    for name in originals:
+        setattr(reduce.polyscrew, name, counted(name))
+    intent.Source.channels = counted_channels
+    try:
+        yield calls
+    finally:
+        for name, original in originals.items():
+            setattr(reduce.polyscrew, name, original)
+        intent.Source.channels = channels
+
+
+def test_reduce_keys_plays_the_dense_motion_once_and_measures_in_the_core(sb):
+    bones = ("Upper", "Fore", "Hand")
+    rig = bh.armature("Rig", bones=(("Upper", None, False), ("Fore", "Upper", True), ("Hand", "Fore", False)))
+    frames = np.arange(1, 97, dtype=float)
+    t = (frames - 1) / 24.0
+    for i, bone in enumerate(bones):
+        rot = Rotation.from_rotvec(np.stack([0.5 * np.sin(1.3 * t + i), 0.3 * np.cos(0.8 * t), 0.2 * t], axis=1))
+        loc = np.stack([0.1 * np.sin(t + i), 0.05 * t, 0.0 * t], axis=1)
+        scales = np.stack([1.0 + 0.1 * np.sin(t), np.ones_like(t), np.ones_like(t)], axis=1) if bone == "Hand" else None
+        bh.key_bone(rig, bone, frames, h.rigid(loc, rot.as_matrix()), scales=scales)
+    owners_ = [(rig, b) for b in bones]
+    times = sample_times(1, 96)
+    ref = play(owners_, times)
+    before = sum(transform_keys(rig, b) for b in bones)
+    h.select_only(rig)
+    bpy.ops.object.mode_set(mode="POSE")
+    bh.select_bones(rig, list(bones))
+    with counting_calls() as calls:
+        assert bpy.ops.screwbender.reduce_keys(distance=DISTANCE, angle=ANGLE) == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    after = sum(transform_keys(rig, b) for b in bones)
+    print(f"rig: {before} key frames -> {after}; calls {calls}")
+    # one playback of the keys at the key frames (reading) and one of the dense frames with
+    # their probes per owner (before: a second one where spans were cut at their quarter
+    # frames), no second evaluation of the reduced curves (before: one per reduce_keys call)
+    assert calls["channels"] == 2 * len(bones), calls
+    assert calls["evaluate_fcurves"] == 0, calls
+    assert 1 <= calls["reduce_keys"] <= 1 + addon_module("blender.reduce").RETRIES
+    assert after < 0.5 * before
+    # Blender's playback in world space: the connected bone's head carries the upper arm's
+    # error, the hand's scale is keyed
+    check_within(owners_, ref, times, DISTANCE, ANGLE, "connected rig")
