@@ -473,7 +473,9 @@ pub(super) fn sweep_closed_with(
     match evaluation {
         Evaluation::NarrowBand => {
             let coarse = BodyField::new(body, cell, COARSE_BAND_CELLS * cell)?;
-            narrow_band(&field, &coarse, body, &motion, &to_body, grid, &mut g, &mut arg);
+            narrow_band(
+                &field, &coarse, body, &motion, &to_body, grid, &mut g, &mut arg,
+            );
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
@@ -624,9 +626,7 @@ fn narrow_band(
             for bi in 0..blocks[0] {
                 let (i0, i1) = (bi * BLOCK_POINTS, ((bi + 1) * BLOCK_POINTS).min(nx) - 1);
                 let c = origin
-                    + 0.5
-                        * DVec3::new((i0 + i1) as f64, (j0 + j1) as f64, (k0 + k1) as f64)
-                        * cell;
+                    + 0.5 * DVec3::new((i0 + i1) as f64, (j0 + j1) as f64, (k0 + k1) as f64) * cell;
                 near.clear();
                 let mut m = coarse.band;
                 for (j, (w, inv)) in centres.iter().zip(to_body).enumerate() {
