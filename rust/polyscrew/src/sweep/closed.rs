@@ -13,7 +13,8 @@
 //!    the point on average);
 //! 2. the motion is sampled densely (no body point moves more than a cell between two
 //!    samples, each span on its own screw) and the region's field `g(x) = min_j d(P_j^-1 x)`
-//!    is taken on a world grid of spacing `cell` around the region;
+//!    is taken on a world grid of spacing `cell` around the region, only in the blocks of
+//!    the grid that may hold the boundary (see `narrow_band`; elsewhere only its sign);
 //! 3. each grid cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the
 //!    main diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where
 //!    `g` changes sign gives one triangle or a quad (two triangles) with its vertices on the
