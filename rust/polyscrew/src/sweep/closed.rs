@@ -59,7 +59,7 @@ pub const BLOCK_POINTS: usize = 4;
 /// distances within this many cells of the surface. It must exceed the test's reach
 /// (`sqrt(3) (1 + (BLOCK_POINTS + 1) / 2 + 1 / BODY_SUBCELLS)`, 6.4 cells) plus the coarse
 /// field's own trilinear error (`sqrt(3)` cells): then a value that rules a block out is an
-/// unclamped distance, inside or outside (see [`narrow_band`]).
+/// unclamped distance, inside or outside (see `narrow_band` and docs/sweep.md).
 pub const COARSE_BAND_CELLS: f64 = 9.0;
 
 /// Slack of the blocks' test, in cells: covers the float32 rounding of stored distances
