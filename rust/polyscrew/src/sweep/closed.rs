@@ -13,7 +13,8 @@
 //!    the point on average);
 //! 2. the motion is sampled densely (no body point moves more than a cell between two
 //!    samples, each span on its own screw) and the region's field `g(x) = min_j d(P_j^-1 x)`
-//!    is taken on a world grid of spacing `cell` around the region;
+//!    is taken on a world grid of spacing `cell` around the region, only in the blocks of
+//!    the grid that may hold the boundary (see `narrow_band`; elsewhere only its sign);
 //! 3. each grid cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the
 //!    main diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where
 //!    `g` changes sign gives one triangle or a quad (two triangles) with its vertices on the
@@ -49,6 +50,21 @@ pub const BODY_SUBCELLS: f64 = 6.0;
 /// it beyond): enough for the trilinear reads of every grid point whose cube the surface
 /// crosses (`sqrt(3)` cells from the surface at most, plus the body grid's own cube).
 pub const BAND_CELLS: f64 = 2.5;
+
+/// Side of a narrow-band block, in world grid points: the region's field is evaluated on the
+/// fine grid only in the blocks whose coarse test cannot rule out the boundary.
+pub const BLOCK_POINTS: usize = 4;
+
+/// The coarse body field (spacing one world cell) behind the blocks' test holds exact
+/// distances within this many cells of the surface. It must exceed the test's reach
+/// (`sqrt(3) (1 + (BLOCK_POINTS + 1) / 2 + 1 / BODY_SUBCELLS)`, 6.4 cells) plus the coarse
+/// field's own trilinear error (`sqrt(3)` cells): then a value that rules a block out is an
+/// unclamped distance, inside or outside (see `narrow_band` and docs/sweep.md).
+pub const COARSE_BAND_CELLS: f64 = 9.0;
+
+/// Slack of the blocks' test, in cells: covers the float32 rounding of stored distances
+/// (below `1e-6` cells at these bands) with a wide margin.
+const BLOCK_SLACK_CELLS: f64 = 1e-4;
 
 /// Poses per sample interval at which a vertex's refinement evaluates the body.
 pub const REFINE_POSES: usize = 8;
@@ -343,6 +359,26 @@ impl DenseMotion {
 ///   `extent /` [`MAX_CELLS_PER_EXTENT`], or a motion needing more than [`MAX_POSES`] poses;
 /// - [`Error::Memory`] for grids or a mesh over the memory budget.
 pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedMesh> {
+    sweep_closed_with(body, poses, options, Evaluation::NarrowBand)
+}
+
+/// Where the region's field is evaluated on the world grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Evaluation {
+    /// Only in the blocks that may hold the boundary (see [`narrow_band`]).
+    NarrowBand,
+    /// At every grid point of every instance's box (the reference the band must reproduce).
+    #[cfg_attr(not(test), allow(dead_code))]
+    Dense,
+}
+
+/// [`sweep_closed`] with the world grid's evaluation chosen.
+pub(super) fn sweep_closed_with(
+    body: &Body,
+    poses: &[Pose],
+    options: &ClosedOptions,
+    evaluation: Evaluation,
+) -> Result<ClosedMesh> {
     if poses.len() < 2 {
         return Err(Error::TooFew {
             got: poses.len(),
@@ -434,33 +470,15 @@ pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Res
     g.resize(count, band as f32);
     let mut arg: Vec<u32> = try_vec(count, "the region's distance grid")?;
     arg.resize(count, u32::MAX);
-    let deep = -(band as f32);
-    for (j, (inv, (lo, hi))) in to_body.iter().zip(&boxes).enumerate() {
-        let i0 = ((lo.x - origin.x) / cell).floor().max(0.0) as usize;
-        let i1 = (((hi.x - origin.x) / cell).ceil() as usize).min(nx - 1);
-        let j0 = ((lo.y - origin.y) / cell).floor().max(0.0) as usize;
-        let j1 = (((hi.y - origin.y) / cell).ceil() as usize).min(ny - 1);
-        let k0 = ((lo.z - origin.z) / cell).floor().max(0.0) as usize;
-        let k1 = (((hi.z - origin.z) / cell).ceil() as usize).min(nz - 1);
-        let dx = inv.matrix3.x_axis * cell;
-        for k in k0..=k1 {
-            for jj in j0..=j1 {
-                let row = (k * ny + jj) * nx;
-                let mut p = inv
-                    .transform_point3(origin + DVec3::new(i0 as f64, jj as f64, k as f64) * cell);
-                for i in i0..=i1 {
-                    let slot = row + i;
-                    if g[slot] > deep {
-                        let v = field.at(p) as f32;
-                        if v < g[slot] {
-                            g[slot] = v;
-                            arg[slot] = j as u32;
-                        }
-                    }
-                    p += dx;
-                }
-            }
+    let grid = Grid { origin, cell, n };
+    match evaluation {
+        Evaluation::NarrowBand => {
+            let coarse = BodyField::new(body, cell, COARSE_BAND_CELLS * cell)?;
+            narrow_band(
+                &field, &coarse, body, &motion, &to_body, grid, &mut g, &mut arg,
+            );
         }
+        Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
     let refine = Refiner::new(&field, &motion)?;
     let mut out = ClosedMesh {
@@ -471,6 +489,182 @@ pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Res
     contour(&g, &arg, n, origin, cell, &refine, &mut out)?;
     out.error_bound += 0.5 * 3f64.sqrt() * field.h;
     Ok(out)
+}
+
+/// The world grid: `n` points per axis from `origin`, `cell` apart (point `(i, j, k)` at slot
+/// `(k * ny + j) * nx + i`).
+#[derive(Debug, Clone, Copy)]
+struct Grid {
+    origin: DVec3,
+    cell: f64,
+    n: [usize; 3],
+}
+
+/// Lowers `g` (and records the pose in `arg`) at the grid points `i0..=i1` of row `(jj, k)`
+/// by the body's field read through `inv` (world -> body), as long as a point is not already
+/// at the field's floor.
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn lower_row(
+    field: &BodyField,
+    inv: &DAffine3,
+    pose: u32,
+    grid: Grid,
+    [i0, i1, jj, k]: [usize; 4],
+    g: &mut [f32],
+    arg: &mut [u32],
+) {
+    let Grid { origin, cell, n } = grid;
+    let deep = -(field.band as f32);
+    let row = (k * n[1] + jj) * n[0];
+    let dx = inv.matrix3.x_axis * cell;
+    let mut p = inv.transform_point3(origin + DVec3::new(i0 as f64, jj as f64, k as f64) * cell);
+    for i in i0..=i1 {
+        let slot = row + i;
+        if g[slot] > deep {
+            let v = field.at(p) as f32;
+            if v < g[slot] {
+                g[slot] = v;
+                arg[slot] = pose;
+            }
+        }
+        p += dx;
+    }
+}
+
+/// The region's field at every grid point of every instance's box (`boxes`, world frame).
+fn dense(
+    field: &BodyField,
+    to_body: &[DAffine3],
+    boxes: &[(DVec3, DVec3)],
+    grid: Grid,
+    g: &mut [f32],
+    arg: &mut [u32],
+) {
+    let Grid { origin, cell, n } = grid;
+    let [nx, ny, nz] = n;
+    for (j, (inv, (lo, hi))) in to_body.iter().zip(boxes).enumerate() {
+        let i0 = ((lo.x - origin.x) / cell).floor().max(0.0) as usize;
+        let i1 = (((hi.x - origin.x) / cell).ceil() as usize).min(nx - 1);
+        let j0 = ((lo.y - origin.y) / cell).floor().max(0.0) as usize;
+        let j1 = (((hi.y - origin.y) / cell).ceil() as usize).min(ny - 1);
+        let k0 = ((lo.z - origin.z) / cell).floor().max(0.0) as usize;
+        let k1 = (((hi.z - origin.z) / cell).ceil() as usize).min(nz - 1);
+        for k in k0..=k1 {
+            for jj in j0..=j1 {
+                lower_row(field, inv, j as u32, grid, [i0, i1, jj, k], g, arg);
+            }
+        }
+    }
+}
+
+/// The region's field `g = min_j f_j` (`f_j` the fine body field read through pose `j`) only
+/// where the boundary can be; elsewhere `g` is left at `+band` (outside) or set to `-band`
+/// (inside), with the same sign as the field there.
+///
+/// The grid is cut into blocks of [`BLOCK_POINTS`]^3 points. Every grid cube touching a
+/// block's points lies in the ball of radius `rho = sqrt(3) (BLOCK_POINTS + 1) / 2` cells
+/// about the block's centre `c`. With `e(H) = sqrt(3) H` the trilinear error of a body field
+/// of spacing `H` (a corner is within `sqrt(3) H` of the point read and the clamped distance
+/// is 1-Lipschitz), the coarse field `F_j` (spacing `H` = one cell, band `B_c`) and the fine
+/// one `f_j` (spacing `h`, band `b`) bound the body's distance `d_j` through pose `j`, for
+/// every `y` in the ball and `a = e(H) + rho`:
+///
+/// `d_j(y) >= F_j(c) - a` where `F_j(c) > e(H) - B_c`, and `d_j(y) <= F_j(c) + a` where
+/// `F_j(c) < B_c - e(H)` (a clamped corner only bounds `d_j` on its own side);
+/// `min(d_j, b) - e(h) <= f_j <= max(d_j, -b) + e(h)`.
+///
+/// So with `m = min_j F_j(c)`: if `m > a + e(h)`, every `f_j > 0` on the ball; if
+/// `m < -(a + e(h))`, the pose reaching `m` has `f_j < 0` on the ball. Either way no grid cube
+/// touching the block changes sign, so marching tetrahedra sees exactly the cubes it saw on
+/// the dense grid (the same values and poses there: below). Otherwise the block is evaluated,
+/// with only the poses that can reach the minimum: pose `j` cannot if
+/// `min(F_j(c) - a, b) - e(h) > min(m + a, b) + e(h)` (its `f_j` is above the value another
+/// pose gives everywhere on the ball), nor if its bounding sphere stays `B_c + e(H)` off `c`
+/// (its `f_j` is the clamp `b` there, which never lowers `g`). The poses kept are read in the
+/// dense order, so the minimum and the pose giving it are those of the dense grid.
+#[allow(clippy::too_many_arguments)]
+fn narrow_band(
+    field: &BodyField,
+    coarse: &BodyField,
+    body: &Body,
+    motion: &DenseMotion,
+    to_body: &[DAffine3],
+    grid: Grid,
+    g: &mut [f32],
+    arg: &mut [u32],
+) {
+    let Grid { origin, cell, n } = grid;
+    let [nx, ny, nz] = n;
+    let root3 = 3f64.sqrt();
+    let verts = body.vertices();
+    let (lo, hi) = verts
+        .iter()
+        .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    let centre = 0.5 * (lo + hi);
+    let radius = verts
+        .iter()
+        .map(|&v| v.distance(centre))
+        .fold(0.0, f64::max);
+    let centres: Vec<DVec3> = motion
+        .poses
+        .iter()
+        .map(|p| p.transform_point3(centre))
+        .collect();
+    let rho = root3 * (BLOCK_POINTS as f64 + 1.0) / 2.0 * cell;
+    let a = root3 * coarse.h + rho;
+    let fine_err = root3 * field.h + BLOCK_SLACK_CELLS * cell;
+    let reach = a + fine_err;
+    let sphere = radius + coarse.band + root3 * coarse.h;
+    let b = field.band;
+    let deep = -(b as f32);
+    let blocks = n.map(|m| m.div_ceil(BLOCK_POINTS));
+    let mut near: Vec<(u32, f64)> = Vec::new();
+    for bk in 0..blocks[2] {
+        let (k0, k1) = (bk * BLOCK_POINTS, ((bk + 1) * BLOCK_POINTS).min(nz) - 1);
+        for bj in 0..blocks[1] {
+            let (j0, j1) = (bj * BLOCK_POINTS, ((bj + 1) * BLOCK_POINTS).min(ny) - 1);
+            for bi in 0..blocks[0] {
+                let (i0, i1) = (bi * BLOCK_POINTS, ((bi + 1) * BLOCK_POINTS).min(nx) - 1);
+                let c = origin
+                    + 0.5 * DVec3::new((i0 + i1) as f64, (j0 + j1) as f64, (k0 + k1) as f64) * cell;
+                near.clear();
+                let mut m = coarse.band;
+                for (j, (w, inv)) in centres.iter().zip(to_body).enumerate() {
+                    if c.distance_squared(*w) > sphere * sphere {
+                        continue;
+                    }
+                    let v = coarse.at(inv.transform_point3(c));
+                    m = m.min(v);
+                    near.push((j as u32, v));
+                }
+                if m > reach {
+                    continue;
+                }
+                if m < -reach {
+                    for k in k0..=k1 {
+                        for jj in j0..=j1 {
+                            let row = (k * ny + jj) * nx;
+                            g[row + i0..=row + i1].fill(deep);
+                        }
+                    }
+                    continue;
+                }
+                let upper = (m + a).min(b) + fine_err;
+                for &(j, v) in &near {
+                    if (v - a).min(b) - fine_err > upper {
+                        continue;
+                    }
+                    let inv = &to_body[j as usize];
+                    for k in k0..=k1 {
+                        for jj in j0..=j1 {
+                            lower_row(field, inv, j, grid, [i0, i1, jj, k], g, arg);
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Evaluates the region's field between the motion's samples.

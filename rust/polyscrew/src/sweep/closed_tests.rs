@@ -240,3 +240,29 @@ fn every_vertex_lies_on_the_swept_boundary_within_the_bound() {
         );
     }
 }
+
+/// The narrow band evaluates the region's field only where the boundary can be: the mesh is
+/// the dense grid's, vertex for vertex and triangle for triangle (the band holds every sign
+/// change, with the dense grid's values and poses there). The two single screws (convex and
+/// non-convex body): the dense grid is the slow reference.
+#[test]
+fn the_narrow_band_gives_the_dense_grids_mesh() {
+    use super::closed::{sweep_closed_with, Evaluation};
+    for (name, body, poses) in cases().into_iter().take(2) {
+        let time = |evaluation| {
+            let start = std::time::Instant::now();
+            let out = sweep_closed_with(&body, &poses, &options(&body), evaluation).unwrap();
+            (start.elapsed().as_secs_f64(), out)
+        };
+        let (dense_s, dense) = time(Evaluation::Dense);
+        let (band_s, band) = time(Evaluation::NarrowBand);
+        println!(
+            "{name}: dense {dense_s:.3} s, narrow band {band_s:.3} s, {} triangles",
+            band.triangles.len()
+        );
+        assert!(!band.triangles.is_empty(), "{name}: empty");
+        assert_eq!(band.triangles, dense.triangles, "{name}: triangles");
+        assert_eq!(band.vertices, dense.vertices, "{name}: vertices");
+        assert_eq!(band.error_bound, dense.error_bound, "{name}: bound");
+    }
+}
