@@ -16,6 +16,11 @@
 #                                  or major.minor, space-separated; scripts/blender_matrix.sh
 #                                  reads it): what scripts/demo.sh installs (one Blender, about
 #                                  350 MB, not four, about 1.4 GB); scripts/test.sh installs all
+#   BLENDER_VERSIONS=5.0 scripts/bootstrap.sh --demo
+#                                  what scripts/demo.sh runs, and nothing else: maturin and
+#                                  ziglang (the wheel), numpy and matplotlib (the demo's parts) as
+#                                  tests/requirements.txt pins them, and the bpy wheels named;
+#                                  not the test-only oracles (scipy, numba, hypothesis, ...)
 #   scripts/bootstrap.sh --build   only what building the extension needs (what
 #                                  scripts/build_extension.sh runs when it misses it): maturin and
 #                                  ziglang in .venv, and Blender's extension tool (blender_ext.py
@@ -25,11 +30,12 @@ set -euo pipefail
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 venv="$root/.venv"
 source "$root/scripts/blender_matrix.sh"
-build_only=false
+build_only=false demo_only=false
 case "${1:-}" in
   "") ;;
   --build) build_only=true ;;
-  *) echo "usage: scripts/bootstrap.sh [--build]" >&2; exit 2 ;;
+  --demo) demo_only=true ;;
+  *) echo "usage: scripts/bootstrap.sh [--build|--demo]" >&2; exit 2 ;;
 esac
 pip_cache=${SCREWBENDER_PIP_CACHE:-$venv/pip-cache}
 
@@ -79,7 +85,18 @@ PY
 fi
 
 req_hash=$(sha256sum "$root/tests/requirements.txt" | cut -c1-16)
-if [ ! -f "$venv/.stamp-requirements-$req_hash" ]; then
+if $demo_only; then
+  # the demo's part of tests/requirements.txt (a full bootstrap's stamp covers it too)
+  demo_reqs=$(grep -E '^(maturin|ziglang|numpy|matplotlib)\b' "$root/tests/requirements.txt" | sed -E 's/ *#.*//')
+  stamp="$venv/.stamp-demo-$(echo "$demo_reqs" | sha256sum | cut -c1-16)"
+  if [ ! -f "$stamp" ] && [ ! -f "$venv/.stamp-requirements-$req_hash" ]; then
+    echo "bootstrap: installing $(echo $demo_reqs) into .venv (the demo only)"
+    pip_in "$venv" install -q --upgrade pip
+    # shellcheck disable=SC2086
+    pip_in "$venv" install -q $(echo "$demo_reqs" | tr '\n' ' ')
+    touch "$stamp"
+  fi
+elif [ ! -f "$venv/.stamp-requirements-$req_hash" ]; then
   echo "bootstrap: installing tests/requirements.txt into .venv"
   pip_in "$venv" install -q --upgrade pip
   pip_in "$venv" install -q -r "$root/tests/requirements.txt"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The ScrewBender demo, one command on a fresh machine:
-#   1. scripts/bootstrap.sh with BLENDER_VERSIONS=5.0: .venv with numpy, maturin and the one
-#      bpy wheel the demo runs (Blender 5.0, about 350 MB), not the four scripts/test.sh needs;
+#   1. BLENDER_VERSIONS=5.0 scripts/bootstrap.sh --demo: .venv with maturin, ziglang, numpy,
+#      matplotlib and the one bpy wheel the demo runs (Blender 5.0, about 350 MB), not the four
+#      bpy wheels and the test-only packages scripts/test.sh needs;
 #   2. scripts/build_extension.sh: the polyscrew wheel and the installable extension .zip;
 #   3. every scripts/demo/NN_*.py in order, each a standalone script run with the Blender 5.0
 #      bpy wheel and `--out-dir out`:
@@ -29,7 +30,7 @@ stage() { echo; echo "=== $* ($(( $(date +%s) - start )) s)"; }
 
 demo_blender=5.0  # the Blender whose bpy wheel runs the demo (a row of scripts/blender_matrix.sh)
 stage "bootstrap (bpy $demo_blender only)"
-BLENDER_VERSIONS=$demo_blender scripts/bootstrap.sh
+BLENDER_VERSIONS=$demo_blender scripts/bootstrap.sh --demo
 py="$root/.venv/bin/python"
 bpy_dir="$root/.venv/bpy/$demo_blender"
 [ -d "$bpy_dir" ] || { echo "demo: $bpy_dir missing (scripts/bootstrap.sh installs it)" >&2; exit 1; }

@@ -125,36 +125,17 @@ def bench_angvel(rec: Records, repeat: int) -> None:
     if not hasattr(polyscrew, "fit_angular_velocity"):
         rec.notes.append("angular-velocity fitting: not available: polyscrew.fit_angular_velocity is not in this build")
         return
-    # A spinning top: precession about z at 1 rad/s, spin 6 rad/s about the tilted body axis;
-    # 20 keys over 10 s sampled from it, the target angular velocity its analytic one.
-    def top(t):
-        tilt = 0.4
-        qz = np.array([math.cos(t / 2), 0, 0, math.sin(t / 2)])
-        qx = np.array([math.cos(tilt / 2), math.sin(tilt / 2), 0, 0])
-        qs = np.array([math.cos(3 * t), 0, 0, math.sin(3 * t)])
-        return qmul(qmul(qz, qx), qs)
+    # The paper's spinning top (tests/fixtures/spinning_top.py, the twin of the Rust fixture),
+    # the case of benches/angular_velocity.rs's fit_angular_velocity/top_20_keys: 20 keys over
+    # 4 s, every third and the last constrained, the wobbly sketch sampled at 60 Hz.
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "fixtures"))
+    from spinning_top import top_rotation, top_target
 
-    def qmul(p, q):
-        w1, x1, y1, z1 = p
-        w2, x2, y2, z2 = q
-        return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-                         w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2])
-
-    key_times = np.linspace(0.0, 10.0, 20)
-    keys = np.array([top(t) for t in key_times])
-    for k in range(1, len(keys)):
-        if np.dot(keys[k], keys[k - 1]) < 0:
-            keys[k] = -keys[k]
-    target_times = np.linspace(0.0, 10.0, 400)
-    h = 1e-5
-    omega = []
-    for t in target_times:
-        q, dq = top(t), (top(t + h) - top(t - h)) / (2 * h)
-        qc = q * np.array([1, -1, -1, -1])
-        omega.append(2 * qmul(dq, qc)[1:])
-    omega = np.array(omega)
-    constrained = np.zeros(len(keys), bool)
-    constrained[[0, -1]] = True
+    key_times = np.linspace(0.0, 4.0, 20)
+    keys = np.roll(top_rotation(key_times).as_quat(), 1, axis=-1)  # w, x, y, z
+    target_times = np.linspace(0.0, 4.0, 241)
+    omega = top_target(target_times)
+    constrained = np.array([i % 3 == 0 or i == len(keys) - 1 for i in range(len(keys))])
     fit = polyscrew.fit_angular_velocity(keys, key_times, target_times, omega, constrained=constrained)
     rec.add("polyscrew.fit_angular_velocity, 20 keys (spinning top)",
             lambda: polyscrew.fit_angular_velocity(keys, key_times, target_times, omega, constrained=constrained),

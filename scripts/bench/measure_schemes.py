@@ -13,6 +13,7 @@ Run: PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/measure_schemes.py
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import sys
 from pathlib import Path
 
@@ -56,11 +57,11 @@ def random_scene(seed: int) -> bpy.types.Object:
 
 
 def demo_scene() -> list[bpy.types.Object]:
-    source = demo_common.ROOT / "out" / "demo_source.blend"
-    if not source.exists():
-        print(f"({source} missing: run scripts/demo.sh first; measuring random motions only)")
-        return []
-    bpy.ops.wm.open_mainfile(filepath=str(source))
+    """The demo's keyed scene, built in memory by scripts/demo/10_scene.py (no out/ file needed)."""
+    spec = importlib.util.spec_from_file_location("demo_scene", Path(__file__).resolve().parents[1] / "demo" / "10_scene.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    module.build()
     return [o for o in bpy.context.scene.objects if o.animation_data and o.animation_data.action]
 
 
@@ -81,7 +82,6 @@ def stray(objects, scheme: str) -> tuple[float, float]:
 
 def main() -> None:
     scenes = {"demo scene": demo_scene()}
-    bpy.ops.wm.read_homefile(use_empty=True) if not scenes["demo scene"] else None
     results = {}
     for name, objects in scenes.items():
         if objects:
