@@ -204,7 +204,7 @@ impl RotationMode {
 
     /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
     /// quaternions, the angle of axis-angle, the three Euler angles.
-    fn angles(self) -> usize {
+    const fn angles(self) -> usize {
         match self {
             Self::Quaternion => 0,
             Self::AxisAngle => 1,
@@ -246,6 +246,63 @@ impl RotationMode {
     pub fn is_angle(self, channel: usize) -> bool {
         channel < self.angles()
     }
+
+    /// Whether two keys' values in this mode can say that the rotation turns more than half a
+    /// turn between them (a spin the animator typed, `0 -> 270` degrees): the mode has an angle
+    /// channel ([`is_angle`](Self::is_angle): Euler, axis-angle). A quaternion's values cannot
+    /// (`q` and `-q` are one rotation: a sign is no turn).
+    pub const fn holds_spins(self) -> bool {
+        self.angles() > 0
+    }
+
+    /// How keys' values set from matrices (a script, an importer, a visual-keyed bake) in this
+    /// mode can lie far apart for nearby rotations, so that Blender's playback, channel by
+    /// channel, turns the long way between them: the mode's kind of [`Flip`].
+    pub const fn flip(self) -> Flip {
+        match self {
+            Self::Quaternion => Flip::Sign,
+            Self::AxisAngle => Flip::Never,
+            Self::Euler(order) => Flip::Wrap(order),
+        }
+    }
+
+    /// How far the channel values move from `a` to `b` (radians; rows of
+    /// [`width`](Self::width) values), the measure of a span's change by its keys alone: the
+    /// sum of the changes of the angle channels, `sum |b_i - a_i|` (Euler), `|b_0 - a_0|`
+    /// (axis-angle); for a quaternion twice the angle between the 4-vectors,
+    /// `2 acos(a . b / |a| |b|)` (up to 2 pi for a sign flip, which Blender plays the long
+    /// way). `None` for a quaternion of zero length or NaN.
+    #[inline]
+    pub fn channel_change(self, a: &[f64], b: &[f64]) -> Option<f64> {
+        match self {
+            Self::Quaternion => {
+                let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+                let norms = a.iter().map(|x| x * x).sum::<f64>().sqrt()
+                    * b.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if norms <= 0.0 || norms.is_nan() {
+                    return None;
+                }
+                Some(2.0 * (dot / norms).clamp(-1.0, 1.0).acos())
+            }
+            Self::AxisAngle => Some((b[0] - a[0]).abs()),
+            Self::Euler(_) => Some(a.iter().zip(b).map(|(x, y)| (y - x).abs()).sum()),
+        }
+    }
+}
+
+/// How two neighbouring keys' values of a [`RotationMode`] can lie far apart for nearby
+/// rotations when they were set from matrices ([`RotationMode::flip`]): what a flip between
+/// them is, for the intent analysis to tell flips from typed spins (`intent::turns`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Flip {
+    /// Angles that wrap by whole turns per channel (a matrix gives each inside `[-pi, pi]`),
+    /// and the order's twin triple `(x + pi, pi - y, z + pi)` (Euler angles).
+    Wrap(EulerOrder),
+    /// A sign-symmetric unit quaternion: a matrix does not fix its sign (`q` and `-q` are one
+    /// rotation).
+    Sign,
+    /// No flip: the values are typed (axis-angle's angle about its axis).
+    Never,
 }
 
 /// `atan2(-y, -x)` given `a = atan2(y, x)`: the opposite direction, half a turn away, with
