@@ -143,9 +143,10 @@ impl RotationMode {
 
     /// Every rotation mode, in Blender's order of the `rotation_mode` enum's values that
     /// [`RotationMode::from_name`] parses. Adding a mode: its variant, its entry here, its
-    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), and
-    /// its conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all
-    /// in this file.
+    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), its
+    /// [`flip`](Self::flip) and [`channel_change`](Self::channel_change), and its
+    /// conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all in
+    /// this file.
     pub const ALL: [Self; 8] = [
         Self::Quaternion,
         Self::AxisAngle,
@@ -1249,6 +1250,72 @@ mod tests {
                 assert_eq!(same_rotation_map(mode, s, &s[..w - 1]), None);
             }
         }
+    }
+
+    #[test]
+    fn the_mode_says_its_flips_spins_and_change() {
+        let e = [0.4, -1.1, 2.2];
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let values = rotation_channels(
+                &[DQuat::from_euler(glam::EulerRot::XYZ, e[0], e[1], e[2])],
+                mode,
+                None,
+            )
+            .unwrap();
+            // holds spins: a whole turn on some channel is the same rotation
+            let turned = (0..w).any(|i| {
+                let mut v = values.clone();
+                v[i] += TAU;
+                rotation_gap(mode, &values, &v) < 1e-12
+            });
+            assert_eq!(mode.holds_spins(), turned, "{mode:?}");
+            match mode.flip() {
+                Flip::Sign => {
+                    let minus: Vec<f64> = values.iter().map(|v| -v).collect();
+                    assert!(rotation_gap(mode, &values, &minus) < 1e-15, "{mode:?}");
+                    assert!(!mode.holds_spins());
+                }
+                Flip::Wrap(order) => {
+                    let m = order.to_mat3(DVec3::from_slice(&values));
+                    assert_eq!(rotation_matrix(mode, &values), m, "{mode:?}");
+                }
+                Flip::Never => assert_eq!(mode, RotationMode::AxisAngle),
+            }
+        }
+        // a quaternion's change is twice the angle between its 4-vectors: the turn between
+        // the rotations (moves::turn_vector), or a full turn less it for opposite signs
+        let quat = RotationMode::Quaternion;
+        let a = DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7);
+        for (angle, scale) in [(0.0, 1.0), (0.4, 2.5), (2.9, 0.3), (3.1, -1.0), (1.2, -4.0)] {
+            let b = DQuat::from_axis_angle(DVec3::new(-0.5, 0.8, 0.1).normalize(), angle) * a;
+            let turn = crate::motion::moves::turn_vector(a, b).length();
+            let (av, bv) = (
+                [a.w, a.x, a.y, a.z],
+                [b.w * scale, b.x * scale, b.y * scale, b.z * scale],
+            );
+            let got = quat.channel_change(&av, &bv).unwrap();
+            let want = if a.dot(b) * scale >= 0.0 {
+                turn
+            } else {
+                TAU - turn
+            };
+            assert!(
+                (got - want).abs() < 1e-7,
+                "{angle} {scale}: {got} vs {want}"
+            );
+        }
+        assert_eq!(quat.channel_change(&[0.0; 4], &[1.0, 0.0, 0.0, 0.0]), None);
+        let euler = RotationMode::Euler(EulerOrder::Zxy);
+        assert_eq!(
+            euler.channel_change(&[0.0, 1.0, -1.0], &[TAU, 0.5, 0.0]),
+            Some(TAU + 1.5)
+        );
+        let aa = RotationMode::AxisAngle;
+        assert_eq!(
+            aa.channel_change(&[-1.0, 0.0, 0.0, 1.0], &[3.0, 1.0, 0.0, 0.0]),
+            Some(4.0)
+        );
     }
 
     #[test]
