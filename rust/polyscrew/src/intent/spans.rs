@@ -71,25 +71,18 @@ fn span_samples(start: f64, end: f64, count: usize, out: &mut Vec<f64>) {
 }
 
 /// Samples for a span whose rotation channels change from `a` to `b` (channel rows' rotation
-/// parts): one per [`DEGREES_PER_SAMPLE`] of change, within
-/// [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]. Quaternions: [`SPAN_SAMPLES`], unless their
-/// turns are followed (`follow_quaternions`, [`Turns::AsPlayed`]): then the change is the
-/// angle between the keys' 4-vectors, doubled (`2 acos(a . b / |a| |b|)`, up to 360 degrees
-/// for a sign flip that Blender plays the long way).
-fn sample_count(mode: RotationMode, a: &[f64], b: &[f64], follow_quaternions: bool) -> usize {
-    let change = match mode {
-        RotationMode::Quaternion if !follow_quaternions => return SPAN_SAMPLES,
-        RotationMode::Quaternion => {
-            let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
-            let norms = a.iter().map(|x| x * x).sum::<f64>().sqrt()
-                * b.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norms <= 0.0 || norms.is_nan() {
-                return SPAN_SAMPLES;
-            }
-            2.0 * (dot / norms).clamp(-1.0, 1.0).acos()
-        }
-        RotationMode::AxisAngle => (b[0] - a[0]).abs(),
-        RotationMode::Euler(_) => a.iter().zip(b).map(|(x, y)| (y - x).abs()).sum(),
+/// parts): one per [`DEGREES_PER_SAMPLE`] of their change ([`RotationMode::channel_change`]),
+/// within [`SPAN_SAMPLES`]..=[`MAX_SPAN_SAMPLES`]. A mode whose values hold no spins
+/// (quaternions, [`RotationMode::holds_spins`]): [`SPAN_SAMPLES`], unless every span's turns
+/// are followed (`follow_all`, [`Turns::AsPlayed`]): then by the change too (for
+/// quaternions the angle between the keys' 4-vectors, doubled: up to 360 degrees for a sign
+/// flip that Blender plays the long way).
+fn sample_count(mode: RotationMode, a: &[f64], b: &[f64], follow_all: bool) -> usize {
+    if !mode.holds_spins() && !follow_all {
+        return SPAN_SAMPLES;
+    }
+    let Some(change) = mode.channel_change(a, b) else {
+        return SPAN_SAMPLES;
     };
     let count = (change.to_degrees() / DEGREES_PER_SAMPLE).ceil();
     count.clamp(SPAN_SAMPLES as f64, MAX_SPAN_SAMPLES as f64) as usize
@@ -136,8 +129,9 @@ pub fn analyse_spans(playback: &Playback, frames: &[f64]) -> Result<Spans> {
 /// [`rotation_angle`]s between consecutive samples and from the last sample to the span's
 /// end. All spans together take at most [`MAX_ANALYSIS_SAMPLES`] samples. A span is a flip when it is not held and its key values are an Euler wrap or a
 /// quaternion sign flip ([`is_flip`]). A span is *followed* when `turns` is
-/// [`Turns::AsPlayed`]; with [`Turns::Auto`] when it is not a flip and the mode is Euler or
-/// axis-angle (quaternion keys keep the shortest arc); never with [`Turns::Shortest`]. Spins:
+/// [`Turns::AsPlayed`]; with [`Turns::Auto`] when it is not a flip and the mode's values hold
+/// spins ([`RotationMode::holds_spins`]: Euler, axis-angle; quaternion keys keep the shortest
+/// arc); never with [`Turns::Shortest`]. Spins:
 /// a followed span that is not held and turns more than [`WIND_LIMIT`], together with the
 /// runs of neighbouring followed spans that are not held and turn more than [`WIND_STEP`],
 /// gets `ceil(turn / WIND_STEP) - 1` frames where the accumulated turn along its samples
@@ -240,7 +234,7 @@ pub fn analyse_turns(playback: &Playback, frames: &[f64], turns: Turns) -> Resul
         !held[s]
             && match turns {
                 Turns::AsPlayed => true,
-                Turns::Auto => mode != RotationMode::Quaternion && !flips[s],
+                Turns::Auto => mode.holds_spins() && !flips[s],
                 Turns::Shortest => false,
             }
     };

@@ -20,7 +20,7 @@
 
 use glam::DVec3;
 
-use crate::motion::channels::{euler_compatible, EulerOrder};
+use crate::motion::channels::{euler_compatible, EulerOrder, Flip};
 use crate::{Error, Result, RotationMode};
 
 /// How far beyond `[-pi, pi]` an Euler key value may lie and still count as inside the range
@@ -91,16 +91,17 @@ pub fn is_sign_flip(a: &[f64], b: &[f64]) -> bool {
     a.iter().zip(b).map(|(x, y)| x * y).sum::<f64>() < 0.0
 }
 
-/// Whether the span between the rotation channel values `a` and `b` of `mode` is a flip: an
-/// Euler wrap or a quaternion sign flip (never for axis-angle).
+/// Whether the span between the rotation channel values `a` and `b` of `mode` is a flip of
+/// the mode's kind ([`RotationMode::flip`]): an Euler wrap or a quaternion sign flip (never
+/// for axis-angle).
 pub fn is_flip(mode: RotationMode, a: &[f64], b: &[f64]) -> bool {
-    match mode {
-        RotationMode::Euler(order) => is_euler_wrap(
+    match mode.flip() {
+        Flip::Wrap(order) => is_euler_wrap(
             order,
             DVec3::new(a[0], a[1], a[2]),
             DVec3::new(b[0], b[1], b[2]),
         ),
-        RotationMode::Quaternion => is_sign_flip(a, b),
-        RotationMode::AxisAngle => false,
+        Flip::Sign => is_sign_flip(a, b),
+        Flip::Never => false,
     }
 }

@@ -143,9 +143,10 @@ impl RotationMode {
 
     /// Every rotation mode, in Blender's order of the `rotation_mode` enum's values that
     /// [`RotationMode::from_name`] parses. Adding a mode: its variant, its entry here, its
-    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), and
-    /// its conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all
-    /// in this file.
+    /// [`name`](Self::name), [`property`](Self::property) and [`width`](Self::width), its
+    /// [`flip`](Self::flip) and [`channel_change`](Self::channel_change), and its
+    /// conversions ([`rotation_matrix`], [`rotation_channels`], [`channels_near`]), all in
+    /// this file.
     pub const ALL: [Self; 8] = [
         Self::Quaternion,
         Self::AxisAngle,
@@ -204,7 +205,7 @@ impl RotationMode {
 
     /// How many of the channel values are angles (radians that wrap by whole turns): 0 for
     /// quaternions, the angle of axis-angle, the three Euler angles.
-    fn angles(self) -> usize {
+    const fn angles(self) -> usize {
         match self {
             Self::Quaternion => 0,
             Self::AxisAngle => 1,
@@ -246,6 +247,63 @@ impl RotationMode {
     pub fn is_angle(self, channel: usize) -> bool {
         channel < self.angles()
     }
+
+    /// Whether two keys' values in this mode can say that the rotation turns more than half a
+    /// turn between them (a spin the animator typed, `0 -> 270` degrees): the mode has an angle
+    /// channel ([`is_angle`](Self::is_angle): Euler, axis-angle). A quaternion's values cannot
+    /// (`q` and `-q` are one rotation: a sign is no turn).
+    pub const fn holds_spins(self) -> bool {
+        self.angles() > 0
+    }
+
+    /// How keys' values set from matrices (a script, an importer, a visual-keyed bake) in this
+    /// mode can lie far apart for nearby rotations, so that Blender's playback, channel by
+    /// channel, turns the long way between them: the mode's kind of [`Flip`].
+    pub const fn flip(self) -> Flip {
+        match self {
+            Self::Quaternion => Flip::Sign,
+            Self::AxisAngle => Flip::Never,
+            Self::Euler(order) => Flip::Wrap(order),
+        }
+    }
+
+    /// How far the channel values move from `a` to `b` (radians; rows of
+    /// [`width`](Self::width) values), the measure of a span's change by its keys alone: the
+    /// sum of the changes of the angle channels, `sum |b_i - a_i|` (Euler), `|b_0 - a_0|`
+    /// (axis-angle); for a quaternion twice the angle between the 4-vectors,
+    /// `2 acos(a . b / |a| |b|)` (up to 2 pi for a sign flip, which Blender plays the long
+    /// way). `None` for a quaternion of zero length or NaN.
+    #[inline]
+    pub fn channel_change(self, a: &[f64], b: &[f64]) -> Option<f64> {
+        match self {
+            Self::Quaternion => {
+                let dot: f64 = a.iter().zip(b).map(|(x, y)| x * y).sum();
+                let norms = a.iter().map(|x| x * x).sum::<f64>().sqrt()
+                    * b.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if norms <= 0.0 || norms.is_nan() {
+                    return None;
+                }
+                Some(2.0 * (dot / norms).clamp(-1.0, 1.0).acos())
+            }
+            Self::AxisAngle => Some((b[0] - a[0]).abs()),
+            Self::Euler(_) => Some(a.iter().zip(b).map(|(x, y)| (y - x).abs()).sum()),
+        }
+    }
+}
+
+/// How two neighbouring keys' values of a [`RotationMode`] can lie far apart for nearby
+/// rotations when they were set from matrices ([`RotationMode::flip`]): what a flip between
+/// them is, for the intent analysis to tell flips from typed spins (`intent::turns`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Flip {
+    /// Angles that wrap by whole turns per channel (a matrix gives each inside `[-pi, pi]`),
+    /// and the order's twin triple `(x + pi, pi - y, z + pi)` (Euler angles).
+    Wrap(EulerOrder),
+    /// A sign-symmetric unit quaternion: a matrix does not fix its sign (`q` and `-q` are one
+    /// rotation).
+    Sign,
+    /// No flip: the values are typed (axis-angle's angle about its axis).
+    Never,
 }
 
 /// `atan2(-y, -x)` given `a = atan2(y, x)`: the opposite direction, half a turn away, with
@@ -1192,6 +1250,72 @@ mod tests {
                 assert_eq!(same_rotation_map(mode, s, &s[..w - 1]), None);
             }
         }
+    }
+
+    #[test]
+    fn the_mode_says_its_flips_spins_and_change() {
+        let e = [0.4, -1.1, 2.2];
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let values = rotation_channels(
+                &[DQuat::from_euler(glam::EulerRot::XYZ, e[0], e[1], e[2])],
+                mode,
+                None,
+            )
+            .unwrap();
+            // holds spins: a whole turn on some channel is the same rotation
+            let turned = (0..w).any(|i| {
+                let mut v = values.clone();
+                v[i] += TAU;
+                rotation_gap(mode, &values, &v) < 1e-12
+            });
+            assert_eq!(mode.holds_spins(), turned, "{mode:?}");
+            match mode.flip() {
+                Flip::Sign => {
+                    let minus: Vec<f64> = values.iter().map(|v| -v).collect();
+                    assert!(rotation_gap(mode, &values, &minus) < 1e-15, "{mode:?}");
+                    assert!(!mode.holds_spins());
+                }
+                Flip::Wrap(order) => {
+                    let m = order.to_mat3(DVec3::from_slice(&values));
+                    assert_eq!(rotation_matrix(mode, &values), m, "{mode:?}");
+                }
+                Flip::Never => assert_eq!(mode, RotationMode::AxisAngle),
+            }
+        }
+        // a quaternion's change is twice the angle between its 4-vectors: the turn between
+        // the rotations (moves::turn_vector), or a full turn less it for opposite signs
+        let quat = RotationMode::Quaternion;
+        let a = DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 0.9).normalize(), 0.7);
+        for (angle, scale) in [(0.0, 1.0), (0.4, 2.5), (2.9, 0.3), (3.1, -1.0), (1.2, -4.0)] {
+            let b = DQuat::from_axis_angle(DVec3::new(-0.5, 0.8, 0.1).normalize(), angle) * a;
+            let turn = crate::motion::moves::turn_vector(a, b).length();
+            let (av, bv) = (
+                [a.w, a.x, a.y, a.z],
+                [b.w * scale, b.x * scale, b.y * scale, b.z * scale],
+            );
+            let got = quat.channel_change(&av, &bv).unwrap();
+            let want = if a.dot(b) * scale >= 0.0 {
+                turn
+            } else {
+                TAU - turn
+            };
+            assert!(
+                (got - want).abs() < 1e-7,
+                "{angle} {scale}: {got} vs {want}"
+            );
+        }
+        assert_eq!(quat.channel_change(&[0.0; 4], &[1.0, 0.0, 0.0, 0.0]), None);
+        let euler = RotationMode::Euler(EulerOrder::Zxy);
+        assert_eq!(
+            euler.channel_change(&[0.0, 1.0, -1.0], &[TAU, 0.5, 0.0]),
+            Some(TAU + 1.5)
+        );
+        let aa = RotationMode::AxisAngle;
+        assert_eq!(
+            aa.channel_change(&[-1.0, 0.0, 0.0, 1.0], &[3.0, 1.0, 0.0, 0.0]),
+            Some(4.0)
+        );
     }
 
     #[test]
