@@ -137,6 +137,17 @@ class Sampled:
     played: np.ndarray | None = None
 
 
+def _put_poses(pose, rows, poses, location, mode, previous):
+    """Writes the world poses `pose` (k, 4, 4) to `rows` of `poses`, or, when sampling channels
+    (`poses` None), their location to `location` and returns their rotation channels
+    (continued from `previous`); None without channels."""
+    if poses is not None:
+        poses[rows] = pose
+        return None
+    location[rows] = pose[:, :3, 3]
+    return polyscrew.rotation_channels(pose, mode, previous=previous)
+
+
 def sample(
     motion: keys.KeyedMotion,
     frames: np.ndarray,
@@ -187,11 +198,7 @@ def sample(
         rows = slice(None) if len(seg.rows) == n else seg.rows
         if seg.held:
             pose = np.repeat(motion.poses[seg.lo][None], len(seg.rows), axis=0)
-            if channels:
-                location[rows] = pose[:, :3, 3]
-                values = polyscrew.rotation_channels(pose, mode, previous=last_rotation)
-            else:
-                poses[rows] = pose
+            values = _put_poses(pose, rows, poses, location, mode, last_rotation)
             if scaled:
                 log_scales[rows] = logs[seg.lo]
             if motion.pops is not None and motion.pops[seg.lo]:
@@ -210,11 +217,7 @@ def sample(
             spec = dict(scheme=options.scheme, levels=options.levels, closed=piece.closed, period=period, timing=timing)
             if options.method == "FEATURE" and features is not None:
                 piece_poses = features(piece, key_times, at, spec["period"], spec["timing"])
-                if channels:
-                    location[rows] = piece_poses[:, :3, 3]
-                    values = polyscrew.rotation_channels(piece_poses, mode, previous=last_rotation)
-                else:
-                    poses[rows] = piece_poses
+                values = _put_poses(piece_poses, rows, poses, location, mode, last_rotation)
             elif channels:
                 loc, values = polyscrew.sample_channels(piece.poses, key_times, at, mode, last_rotation, **spec)
                 location[rows] = loc

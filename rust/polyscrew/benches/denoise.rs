@@ -11,7 +11,6 @@
 //!
 //! Run: `cargo bench -p polyscrew --bench denoise`.
 use std::hint::black_box;
-use std::time::Duration;
 
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -100,21 +99,14 @@ fn scaling(c: &mut Criterion<CpuTime>) {
     group.finish();
 }
 
-fn config<M: Measurement>(m: M) -> Criterion<M> {
-    Criterion::default()
-        .with_measurement(m)
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(10))
-}
-
 criterion_group! {
     name = cpu;
-    config = config(CpuTime);
+    config = common::long_config(CpuTime);
     targets = rig, scaling
 }
 criterion_group! {
     name = wall;
-    config = config(WallTime);
+    config = common::long_config(WallTime);
     targets = rig_wall
 }
 criterion_main!(cpu, wall);

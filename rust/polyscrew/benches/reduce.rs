@@ -14,16 +14,17 @@
 //! environment the bench binary reduces the rig once on one thread and exits (no criterion):
 //! for instruction counts, `REDUCE_RIG_ONCE=1 valgrind --tool=callgrind <bench binary>`.
 use std::hint::black_box;
-use std::time::Duration;
 
 use criterion::measurement::{Measurement, WallTime};
 use criterion::{criterion_group, BenchmarkId, Criterion, Throughput};
 use glam::{DQuat, DVec3};
-use polyscrew::reduce::{ReduceInput, ReduceOptions, Tolerance};
+use polyscrew::reduce::{ReduceInput, ReduceOptions};
 use polyscrew::{reduce_keys, Pose, RotationMode};
 
 mod common;
 use common::CpuTime;
+#[path = "../tests/fixtures/reduce.rs"]
+mod fixtures;
 
 /// Bone `b`'s swing over `n` frames at 30 fps (a root also travels).
 pub fn swing(b: usize, n: usize, root: bool) -> Vec<Pose> {
@@ -58,6 +59,11 @@ fn rig(bones: usize, n: usize) -> (Vec<Pose>, Vec<f64>, Vec<Option<usize>>, Vec<
     (poses, frames, parents, offsets)
 }
 
+/// The benches' tolerance (1 mm, 0.5 degrees) on one thread.
+fn bench_options() -> ReduceOptions {
+    fixtures::options(1e-3, 0.5f64.to_radians())
+}
+
 /// The rig bench's input and options on `threads` threads, handed to `f`.
 fn with_rig<R>(threads: usize, f: impl FnOnce(&ReduceInput<'_>, &ReduceOptions) -> R) -> R {
     let bones = 100;
@@ -65,26 +71,13 @@ fn with_rig<R>(threads: usize, f: impl FnOnce(&ReduceInput<'_>, &ReduceOptions) 
     let modes = vec![RotationMode::Euler(polyscrew::EulerOrder::Xyz); bones];
     let radius = vec![0.1; bones];
     let input = ReduceInput {
-        poses: &poses,
-        frames: &frames,
-        modes: &modes,
-        radius: &radius,
-        scales: None,
-        channels: None,
         parents: Some(&parents),
         offsets: Some(&offsets),
-        constant: None,
-        start: None,
+        ..fixtures::input(&poses, &frames, &modes, &radius)
     };
     let options = ReduceOptions {
-        tolerance: Tolerance {
-            distance: 1e-3,
-            angle: 0.5f64.to_radians(),
-        },
-        cyclic: false,
-        per_channel: false,
         threads,
-        between: Default::default(),
+        ..bench_options()
     };
     f(&input, &options)
 }
@@ -127,28 +120,8 @@ fn scaling(c: &mut Criterion<CpuTime>) {
         let poses = swing(3, n, true);
         let frames: Vec<f64> = (1..=n).map(|i| i as f64).collect();
         let modes = [RotationMode::Quaternion];
-        let input = ReduceInput {
-            poses: &poses,
-            frames: &frames,
-            modes: &modes,
-            radius: &[0.3],
-            scales: None,
-            channels: None,
-            parents: None,
-            offsets: None,
-            constant: None,
-            start: None,
-        };
-        let options = ReduceOptions {
-            tolerance: Tolerance {
-                distance: 1e-3,
-                angle: 0.5f64.to_radians(),
-            },
-            cyclic: false,
-            per_channel: false,
-            threads: 1,
-            between: Default::default(),
-        };
+        let input = fixtures::input(&poses, &frames, &modes, &[0.3]);
+        let options = bench_options();
         group.throughput(Throughput::Elements(n as u64));
         group.bench_with_input(BenchmarkId::from_parameter(n), &n, |bench, _| {
             bench.iter(|| black_box(reduce_keys(black_box(&input), &options).unwrap()))
@@ -157,21 +130,14 @@ fn scaling(c: &mut Criterion<CpuTime>) {
     group.finish();
 }
 
-fn config<M: Measurement>(m: M) -> Criterion<M> {
-    Criterion::default()
-        .with_measurement(m)
-        .sample_size(10)
-        .measurement_time(Duration::from_secs(10))
-}
-
 criterion_group! {
     name = cpu;
-    config = config(CpuTime);
+    config = common::long_config(CpuTime);
     targets = rig_cpu, scaling
 }
 criterion_group! {
     name = wall;
-    config = config(WallTime);
+    config = common::long_config(WallTime);
     targets = rig_wall
 }
 fn main() {

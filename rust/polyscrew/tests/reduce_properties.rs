@@ -70,18 +70,7 @@ fn play(r: &Reduced, o: usize, mode: RotationMode, times: &[f64], dense: &[Pose]
     let mut loc: Vec<Option<Vec<f64>>> = vec![None; 3];
     let mut rot: Vec<Option<Vec<f64>>> = vec![None; w];
     for c in r.curves.iter().filter(|c| c.owner == o) {
-        let keys: Vec<Key> = c
-            .keys
-            .iter()
-            .map(|k| {
-                Key::new(k.co[0] as f32, k.co[1] as f32)
-                    .with_handles(
-                        [k.handle_left[0] as f32, k.handle_left[1] as f32],
-                        [k.handle_right[0] as f32, k.handle_right[1] as f32],
-                    )
-                    .with_interpolation(k.interpolation)
-            })
-            .collect();
+        let keys: Vec<Key> = c.keys.iter().map(|k| k.key()).collect();
         let curve = FCurve::new(keys, Extrapolation::Constant, None).unwrap();
         let values: Vec<f64> = times.iter().map(|t| curve.evaluate(*t).unwrap()).collect();
         match c.group {
@@ -143,35 +132,9 @@ fn error(a: &Pose, b: &Pose, r: f64) -> (f64, f64) {
     )
 }
 
-fn options(distance: f64, angle: f64) -> ReduceOptions {
-    ReduceOptions {
-        tolerance: Tolerance { distance, angle },
-        cyclic: false,
-        per_channel: false,
-        threads: 1,
-        between: Default::default(),
-    }
-}
-
-fn input<'a>(
-    poses: &'a [Pose],
-    frames: &'a [f64],
-    modes: &'a [RotationMode],
-    radius: &'a [f64],
-) -> ReduceInput<'a> {
-    ReduceInput {
-        poses,
-        frames,
-        modes,
-        radius,
-        scales: None,
-        channels: None,
-        parents: None,
-        offsets: None,
-        constant: None,
-        start: None,
-    }
-}
+#[path = "fixtures/reduce.rs"]
+mod fixtures;
+use fixtures::{input, options};
 
 /// Plays every owner, asserts the tolerance at every sample and the reported errors.
 fn assert_within(

@@ -10,7 +10,7 @@
 pub mod nalgebra_conv;
 
 use criterion::measurement::{Measurement, ValueFormatter};
-use criterion::Throughput;
+use criterion::{Criterion, Throughput};
 use glam::{DQuat, DVec3};
 use polyscrew::Pose;
 
@@ -114,4 +114,13 @@ impl ValueFormatter for NanosFormatter {
     fn scale_for_machines(&self, _values: &mut [f64]) -> &'static str {
         "ns"
     }
+}
+
+/// Ten samples of ten seconds each: the configuration of the slow benches (`reduce.rs`,
+/// `denoise.rs`).
+pub fn long_config<M: Measurement>(m: M) -> Criterion<M> {
+    Criterion::default()
+        .with_measurement(m)
+        .sample_size(10)
+        .measurement_time(std::time::Duration::from_secs(10))
 }

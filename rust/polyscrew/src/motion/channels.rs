@@ -879,10 +879,11 @@ pub fn max_channel_jump(values: &[f64], width: usize) -> f64 {
 pub const HALF_TURN: f64 = PI;
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    const ORDERS: [EulerOrder; 6] = [
+    /// The six Euler orders (also used by the tests of `reduce/compose.rs`).
+    pub(crate) const ORDERS: [EulerOrder; 6] = [
         EulerOrder::Xyz,
         EulerOrder::Xzy,
         EulerOrder::Yxz,
@@ -890,6 +891,14 @@ mod tests {
         EulerOrder::Zxy,
         EulerOrder::Zyx,
     ];
+
+    /// The largest absolute difference between the entries of `a` and `b`.
+    pub(crate) fn max_abs_diff(a: DMat3, b: DMat3) -> f64 {
+        (a - b)
+            .to_cols_array()
+            .iter()
+            .fold(0.0f64, |a, v| a.max(v.abs()))
+    }
 
     #[test]
     fn atan2_matches_std() {
@@ -982,10 +991,7 @@ mod tests {
             let m = order.to_mat3(e);
             let got = euler_compatible(&m, order, None);
             let back = order.to_mat3(got);
-            let err = (back - m)
-                .to_cols_array()
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let err = max_abs_diff(back, m);
             assert!(err < 1e-14, "{order:?}: {got} -> error {err}");
         }
     }
@@ -1097,10 +1103,7 @@ mod tests {
                 "{e:?} from {previous}"
             );
             let m = EulerOrder::Xyz.to_mat3(DVec3::new(e[0], e[1], e[2]));
-            let err = (m - DMat3::from_quat(q))
-                .to_cols_array()
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let err = max_abs_diff(m, DMat3::from_quat(q));
             assert!(err < 1e-6, "previous {previous}: error {err}");
         }
     }
@@ -1171,10 +1174,7 @@ mod tests {
                     assert!((a - b).abs() < 1e-9, "{mode:?}: {row:?} vs {want:?}");
                 }
                 let m = rotation_matrix(mode, row);
-                let err = (m - DMat3::from_quat(*q))
-                    .to_cols_array()
-                    .iter()
-                    .fold(0.0f64, |a, v| a.max(v.abs()));
+                let err = max_abs_diff(m, DMat3::from_quat(*q));
                 assert!(err < 1e-12, "{mode:?}: {row:?}");
             }
         }

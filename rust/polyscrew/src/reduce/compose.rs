@@ -317,25 +317,16 @@ pub fn row_error(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::motion::channels::tests::{max_abs_diff, ORDERS};
     use glam::DMat3;
 
     #[test]
     fn euler_rotation_matches_the_channel_matrices() {
         let e = DVec3::new(0.3, -1.2, 2.2);
-        for order in [
-            EulerOrder::Xyz,
-            EulerOrder::Xzy,
-            EulerOrder::Yxz,
-            EulerOrder::Yzx,
-            EulerOrder::Zxy,
-            EulerOrder::Zyx,
-        ] {
+        for order in ORDERS {
             let q = rotation(RotationMode::Euler(order), &e.to_array());
             let m = order.to_mat3(e);
-            let d = (DMat3::from_quat(q) - m)
-                .to_cols_array()
-                .iter()
-                .fold(0.0f64, |a, v| a.max(v.abs()));
+            let d = max_abs_diff(DMat3::from_quat(q), m);
             assert!(d < 1e-14, "{order:?}: {d}");
         }
     }
@@ -343,14 +334,7 @@ mod tests {
     #[test]
     fn jacobian_gives_the_small_turns() {
         let mut cases = vec![];
-        for order in [
-            EulerOrder::Xyz,
-            EulerOrder::Xzy,
-            EulerOrder::Yxz,
-            EulerOrder::Yzx,
-            EulerOrder::Zxy,
-            EulerOrder::Zyx,
-        ] {
+        for order in ORDERS {
             for r in [
                 [0.4, -0.9, 2.1],
                 [3.0, 2.5, -7.0],

@@ -46,6 +46,18 @@ pub struct ReducedKey {
     pub interpolation: Interpolation,
 }
 
+impl ReducedKey {
+    /// The key as Blender stores it (`f32` frame, value and handles): what plays.
+    pub fn key(&self) -> Key {
+        Key::new(self.co[0] as f32, self.co[1] as f32)
+            .with_handles(
+                [self.handle_left[0] as f32, self.handle_left[1] as f32],
+                [self.handle_right[0] as f32, self.handle_right[1] as f32],
+            )
+            .with_interpolation(self.interpolation)
+    }
+}
+
 /// What an owner's children need of it at every sample: its error transform
 /// `E = W_reduced^-1 @ W_dense` (its played world pose's inverse times its dense world pose,
 /// `played^-1 @ target` in its own channels' space). A child of offset `O` and dense local
@@ -1292,18 +1304,7 @@ impl Fitter<'_> {
     ) -> Result<(f64, f64)> {
         let mut fcurves = Vec::with_capacity(curves.len());
         for c in curves {
-            let keys = c
-                .keys
-                .iter()
-                .map(|k| {
-                    Key::new(k.co[0] as f32, k.co[1] as f32)
-                        .with_handles(
-                            [k.handle_left[0] as f32, k.handle_left[1] as f32],
-                            [k.handle_right[0] as f32, k.handle_right[1] as f32],
-                        )
-                        .with_interpolation(k.interpolation)
-                })
-                .collect();
+            let keys = c.keys.iter().map(ReducedKey::key).collect();
             fcurves.push(FCurve::new(keys, Extrapolation::Constant, None)?);
         }
         let (mut dmax, mut amax) = (0.0f64, 0.0f64);

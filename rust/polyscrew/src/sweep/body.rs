@@ -393,25 +393,9 @@ impl Body {
 mod tests {
     use super::*;
 
-    pub(crate) fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
-        let v: Vec<DVec3> = (0..8)
-            .map(|i| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64))
-            .collect();
-        let t = vec![
-            [0, 2, 1],
-            [1, 2, 3],
-            [4, 5, 6],
-            [5, 7, 6],
-            [0, 1, 4],
-            [1, 5, 4],
-            [2, 6, 3],
-            [3, 6, 7],
-            [0, 4, 2],
-            [2, 4, 6],
-            [1, 3, 5],
-            [3, 7, 5],
-        ];
-        (v, t)
+    /// The unit cube (`sweep::tests::cuboid` of `(1, 1, 1)`).
+    fn cube() -> (Vec<DVec3>, Vec<[i64; 3]>) {
+        crate::sweep::tests::cuboid(DVec3::ONE)
     }
 
     #[test]

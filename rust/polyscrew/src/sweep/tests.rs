@@ -89,7 +89,7 @@ fn rel_velocity(a: &Pose, b: &Pose) -> Velocity {
 }
 
 /// Distance from `p` to the nearest triangle of `body` (exact point-triangle distance).
-fn distance_to_surface(body: &Body, p: DVec3) -> f64 {
+pub(crate) fn distance_to_surface(body: &Body, p: DVec3) -> f64 {
     body.triangles()
         .iter()
         .map(|t| {

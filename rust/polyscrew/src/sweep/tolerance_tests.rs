@@ -12,7 +12,7 @@ use std::f64::consts::PI;
 
 use glam::{DQuat, DVec3};
 
-use super::tests::{cuboid, point_triangle, torus};
+use super::tests::{cuboid, distance_to_surface, torus};
 use super::*;
 use crate::motion::subdivision::{subdivide, Scheme};
 
@@ -171,15 +171,7 @@ fn worst_distance(
 }
 
 fn mesh_surface(body: &Body) -> impl Fn(DVec3) -> f64 + '_ {
-    move |p| {
-        body.triangles()
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|i| body.vertices()[i as usize]);
-                point_triangle(p, a, b, c)
-            })
-            .fold(f64::INFINITY, f64::min)
-    }
+    move |p| distance_to_surface(body, p)
 }
 
 #[test]
