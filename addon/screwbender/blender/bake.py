@@ -419,10 +419,8 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     key frames, values and interpolations (one `foreach_get` each, but for the curves whose
     :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
     added or deleted, its interpolation changed, a curve added or removed, changes it."""
-    crc32 = zlib.crc32
-    digest = crc32(b"keys:")
-    # (each curve's path and index read once; Revert checks every curve of every result: the
-    # per-curve Python is kept to the two reads and the sums, :func:`curve_digest` inlined)
+    digest = zlib.crc32(b"keys:")
+    # (each curve's path and index read once: Revert checks every curve of every result)
     listed = sorted((fc.data_path, fc.array_index, i, fc) for i, fc in enumerate(channels.action_fcurves(action, identifier)))
     for path, index, _, fcurve in listed:
         sub = known.get((path, index)) if known else None
@@ -433,8 +431,8 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
             bulk.get(points, "co", co)
             interpolation = np.empty(n, dtype=np.uint8)
             bulk.get(points, "interpolation", interpolation)
-            sub = crc32(interpolation, crc32(co, crc32(f"{n}:".encode())))  # = curve_digest(co, interpolation)
-        digest = crc32(f"{path}[{index}]:{sub}|".encode(), digest)
+            sub = curve_digest(co, interpolation)
+        digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
     return f"crc32:{digest:08x}"
 
 
