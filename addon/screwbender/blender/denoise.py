@@ -165,7 +165,7 @@ def prepare(
     owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
     `keys.read`'s, kept for one run (an object's checks made once for all its bones)."""
     motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
-                       packed=None if read is None else _part(owner, fcurves, read), cache=cache)
+                       packed=None if read is None else _part(owner, fcurves, read), cache=cache, key_values=True)
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
