@@ -4,6 +4,10 @@ counted through wrappers, and the keys it writes the same as when it does it.
 - A curve keyed on every key frame without modifiers plays its key values there: the key poses
   are read from them, not from the curves' playback (`intent.Source.channels`), and they are
   the playback's values bit for bit.
+- Keys whose handles are all automatic (AUTO, AUTO_CLAMPED) get their handles from
+  `fc.update()`: only `co` is written to them (one `foreach_set`, not three), and the keys
+  are those written with the handles, bit for bit; a curve with other handles still gets its
+  handles written.
 """
 
 from __future__ import annotations
@@ -14,7 +18,7 @@ import pytest
 
 import bake_helpers as h
 from conftest import addon_module
-from test_noise_batch import FRAMES_A, noisy_keys, owners_of
+from test_noise_batch import FRAMES_A, noisy_keys, owners_of, written
 
 
 def capture(count: int, mode: str = "XYZ", seed: int = 5) -> list[bpy.types.Object]:
@@ -72,3 +76,36 @@ def test_a_capture_is_read_from_its_key_values_not_its_playback(monkeypatch, mod
     h.select_only(ob)
     assert bpy.ops.screwbender.denoise() == {"FINISHED"}
     assert len(calls) == 1
+
+
+def test_automatic_handles_are_left_to_update(monkeypatch):
+    """Four objects keyed on every frame (AUTO_CLAMPED handles), one of them with FREE handles
+    on its rotation curves: `co` written once per curve, the handles only to the three FREE
+    curves (three writes per curve before), and every key, handle and handle type is what
+    writing every curve's handles gives."""
+    denoise, bulk = addon_module("blender.denoise"), addon_module("blender.bulk")
+
+    def scene() -> list:
+        objects = capture(4)
+        for fc in addon_module("blender.channels").object_fcurves(objects[1]):
+            if fc.data_path == "rotation_euler":
+                for point in fc.keyframe_points:
+                    point.handle_left_type = point.handle_right_type = "FREE"
+        return objects
+
+    objects = scene()
+    puts: list = []
+    counting(monkeypatch, bulk, "put", puts)
+    assert bpy.ops.screwbender.denoise() == {"FINISHED"}
+    attrs = [args[1] for args in puts]
+    assert attrs.count("co") == 4 * 6
+    assert attrs.count("handle_left") == attrs.count("handle_right") == 3, attrs
+    fast = {(o.obj.name, o.bone): written(o) for o in owners_of(objects)}
+    # Every curve's handles written (as before): the same keys.
+    objects = scene()
+    monkeypatch.setattr(denoise, "_automatic_handles", lambda points: False)
+    puts.clear()
+    assert bpy.ops.screwbender.denoise() == {"FINISHED"}
+    assert [args[1] for args in puts].count("handle_left") == 4 * 6
+    slow = {(o.obj.name, o.bone): written(o) for o in owners_of(objects)}
+    assert fast == slow

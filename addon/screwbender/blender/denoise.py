@@ -380,8 +380,9 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         right[edit, 1] += delta
         co[edit, 1] = target  # exact, not the sum
         bulk.put(points, "co", co.ravel())
-        bulk.put(points, "handle_left", left.ravel())
-        bulk.put(points, "handle_right", right.ravel())
+        if not _automatic_handles(points):  # (else `fc.update()` makes them from the keys)
+            bulk.put(points, "handle_left", left.ravel())
+            bulk.put(points, "handle_right", right.ravel())
         fc.update()
         outside = ~(near & in_range[row])
         if outside.any():  # (else no handle can have changed outside the range)
@@ -389,6 +390,21 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
 
 
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
+#: Handle types that `fc.update()` computes from the keys alone (Blender's
+#: `BKE_fcurve_handles_recalc`): a value written to such a handle is replaced.
+_AUTOMATIC = [bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items[name].value
+              for name in ("AUTO", "AUTO_CLAMPED")]
+
+
+def _automatic_handles(points) -> bool:
+    """Whether both handles of every key of `points` are automatic (:data:`_AUTOMATIC`):
+    two byte reads, cheaper than writing the handles that `fc.update()` would replace."""
+    kinds = np.empty(len(points), dtype=np.uint8)
+    for side in ("handle_left_type", "handle_right_type"):
+        bulk.get(points, side, kinds)
+        if not np.isin(kinds, _AUTOMATIC).all():
+            return False
+    return True
 
 
 def _keep_handles_outside(fc, outside: np.ndarray, left: np.ndarray, right: np.ndarray) -> None:
