@@ -392,8 +392,9 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
 #: Handle types that `fc.update()` computes from the keys alone (Blender's
 #: `BKE_fcurve_handles_recalc`): a value written to such a handle is replaced.
-_AUTOMATIC = [bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items[name].value
-              for name in ("AUTO", "AUTO_CLAMPED")]
+_AUTOMATIC = np.zeros(256, dtype=bool)  # (indexed by the type's value)
+_AUTOMATIC[[bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items[name].value
+            for name in ("AUTO", "AUTO_CLAMPED")]] = True
 
 
 def _automatic_handles(points) -> bool:
@@ -402,7 +403,7 @@ def _automatic_handles(points) -> bool:
     kinds = np.empty(len(points), dtype=np.uint8)
     for side in ("handle_left_type", "handle_right_type"):
         bulk.get(points, side, kinds)
-        if not np.isin(kinds, _AUTOMATIC).all():
+        if not _AUTOMATIC[kinds].all():
             return False
     return True
 
