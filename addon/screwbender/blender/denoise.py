@@ -165,7 +165,7 @@ def prepare(
     owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
     `keys.read`'s, kept for one run (an object's checks made once for all its bones)."""
     motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
-                       packed=None if read is None else _part(owner, fcurves, read), cache=cache)
+                       packed=None if read is None else _part(owner, fcurves, read), cache=cache, key_values=True)
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
@@ -380,8 +380,9 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
         right[edit, 1] += delta
         co[edit, 1] = target  # exact, not the sum
         bulk.put(points, "co", co.ravel())
-        bulk.put(points, "handle_left", left.ravel())
-        bulk.put(points, "handle_right", right.ravel())
+        if not _automatic_handles(points):  # (else `fc.update()` makes them from the keys)
+            bulk.put(points, "handle_left", left.ravel())
+            bulk.put(points, "handle_right", right.ravel())
         fc.update()
         outside = ~(near & in_range[row])
         if outside.any():  # (else no handle can have changed outside the range)
@@ -389,6 +390,22 @@ def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
 
 
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
+#: Handle types that `fc.update()` computes from the keys alone (Blender's
+#: `BKE_fcurve_handles_recalc`): a value written to such a handle is replaced.
+_AUTOMATIC = np.zeros(256, dtype=bool)  # (indexed by the type's value)
+_AUTOMATIC[[bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items[name].value
+            for name in ("AUTO", "AUTO_CLAMPED")]] = True
+
+
+def _automatic_handles(points) -> bool:
+    """Whether both handles of every key of `points` are automatic (:data:`_AUTOMATIC`):
+    two byte reads, cheaper than writing the handles that `fc.update()` would replace."""
+    kinds = np.empty(len(points), dtype=np.uint8)
+    for side in ("handle_left_type", "handle_right_type"):
+        bulk.get(points, side, kinds)
+        if not _AUTOMATIC[kinds].all():
+            return False
+    return True
 
 
 def _keep_handles_outside(fc, outside: np.ndarray, left: np.ndarray, right: np.ndarray) -> None:

@@ -128,6 +128,7 @@ def read(
     turns: str = "AUTO",
     packed: tuple[list, curves.Packed] | None = None,
     cache: dict | None = None,
+    key_values: bool = False,
 ) -> KeyedMotion:
     """The key poses of `owner`: an object, or a pose bone (an :class:`owners.Owner`).
 
@@ -148,7 +149,9 @@ def read(
     for one run, holds the keys read per set of curves: objects sharing an action (linked
     duplicates) read its curves once. `packed`: (curves, their keys) that the caller has read
     with `curves.read(curves, keys_only=True)` already (the preview's key hash): used, not read
-    again, when `curves` are the transform curves read here.
+    again, when `curves` are the transform curves read here. `key_values`: when every curve is
+    keyed on every key frame without modifiers (a capture), the channels are its key values,
+    which is what Blender plays there, without evaluating the playback (Remove Noise).
 
     Raises :class:`SmoothError` for anything the add-on cannot smooth, also for curves that
     `polyscrew` refuses to play (a NaN key or handle, keys out of time order, too many keys):
@@ -156,7 +159,7 @@ def read(
     """
     owner = owners.as_owner(owner)
     try:
-        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, cache, packed)
+        return _read(owner, closed, action, slot, extend_to, fcurves, analyse, turns, cache, packed, key_values)
     except SmoothError:
         raise
     except ValueError as err:  # polyscrew refusing the curves or the key poses
@@ -174,6 +177,7 @@ def _read(
     turns: str = "AUTO",
     cache: dict | None = None,
     given: tuple[list, curves.Packed] | None = None,
+    key_values: bool = False,
 ) -> KeyedMotion:
     """:func:`read`, raising `ValueError` for what `polyscrew` refuses."""
     check_editable(owner, cache)
@@ -257,7 +261,10 @@ def _read(
                 out[:, i] = [fc.evaluate(f) for f in frames]
         return out
 
-    if source is not None:
+    # Curves keyed on every key frame without modifiers play their key values there (a
+    # capture): with `key_values`, taken as they are, without evaluating the playback.
+    every_frame = key_values and not modified and all(np.array_equal(p[:, 0], frames) for p in points.values())
+    if source is not None and not every_frame:
         at_keys = source.channels(frames)
         location, rotation, scale = at_keys["location"], at_keys[paths[1]], at_keys["scale"]
     else:

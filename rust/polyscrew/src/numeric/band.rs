@@ -150,33 +150,44 @@ impl<E: Entry, const W: usize> Band<E, W> {
         let n = self.len();
         self.inv.clear();
         self.inv.reserve(n);
+        // The first W rows reach past the start; the others take the row inlined with
+        // `first = 0`, loops of constant length (the same operations in the same order).
+        for i in 0..W.min(n) {
+            self.factor_row(i, W - i)?;
+        }
+        for i in W.min(n)..n {
+            self.factor_row(i, 0)?;
+        }
+        Ok(())
+    }
+
+    /// Row `i` of [`Band::factor_or_pivot`], whose band starts at column `i - W + first`.
+    #[inline(always)]
+    fn factor_row(&mut self, i: usize, first: usize) -> Result<(), usize> {
         // ld[q] = L[i][k] D[k] for k = i - W + q, the row being factorised.
         let mut ld = [E::ZERO; W];
-        for i in 0..n {
-            let first = W.saturating_sub(i);
-            let mut row = self.off[i];
-            for p in first..W {
-                // j = i - W + p; L[j][k] for k = i - W + q sits at W - p + q in row j.
-                let j = i + p - W;
-                let rj = &self.off[j];
-                let mut s = row[p];
-                for q in first..p {
-                    s = s - ld[q] * rj[W - p + q].transpose();
-                }
-                ld[p] = s;
-                row[p] = s * self.inv[j];
+        let mut row = self.off[i];
+        for p in first..W {
+            // j = i - W + p; L[j][k] for k = i - W + q sits at W - p + q in row j.
+            let j = i + p - W;
+            let rj = &self.off[j];
+            let mut s = row[p];
+            for q in first..p {
+                s = s - ld[q] * rj[W - p + q].transpose();
             }
-            let mut d = self.diag[i];
-            for p in first..W {
-                d = d - row[p] * ld[p].transpose();
-            }
-            let Some((d, inv)) = E::pivot(d) else {
-                return Err(i);
-            };
-            self.off[i] = row;
-            self.diag[i] = d;
-            self.inv.push(inv);
+            ld[p] = s;
+            row[p] = s * self.inv[j];
         }
+        let mut d = self.diag[i];
+        for p in first..W {
+            d = d - row[p] * ld[p].transpose();
+        }
+        let Some((d, inv)) = E::pivot(d) else {
+            return Err(i);
+        };
+        self.off[i] = row;
+        self.diag[i] = d;
+        self.inv.push(inv);
         Ok(())
     }
 
@@ -187,20 +198,42 @@ impl<E: Entry, const W: usize> Band<E, W> {
         E: Acts<V>,
     {
         let n = self.len();
-        for i in 0..n {
-            let row = &self.off[i];
+        let (off, inv, b) = (&self.off[..n], &self.inv[..n], &mut b[..n]);
+        // The first and last W rows reach past an end of the band; the rows between take
+        // all W terms in a loop of constant length (the same operations in the same order).
+        let head = W.min(n);
+        for i in 0..head {
             let mut s = b[i];
-            for p in W.saturating_sub(i)..W {
-                s = s - row[p].apply(b[i + p - W]);
+            for p in W - i..W {
+                s = s - off[i][p].apply(b[i + p - W]);
             }
             b[i] = s;
         }
-        for i in (0..n).rev() {
-            let mut s = self.inv[i].apply(b[i]);
-            for t in 1..=W.min(n - 1 - i) {
-                s = s - self.off[i + t][W - t].transpose().apply(b[i + t]);
+        for i in head..n {
+            let (done, rest) = b.split_at_mut(i);
+            let (row, before) = (&off[i], &done[i - W..]);
+            let mut s = rest[0];
+            for p in 0..W {
+                s = s - row[p].apply(before[p]);
+            }
+            rest[0] = s;
+        }
+        let tail = n.saturating_sub(W);
+        for i in (tail..n).rev() {
+            let mut s = inv[i].apply(b[i]);
+            for t in 1..n - i {
+                s = s - off[i + t][W - t].transpose().apply(b[i + t]);
             }
             b[i] = s;
+        }
+        for i in (0..tail).rev() {
+            let (head, after) = b.split_at_mut(i + 1);
+            let (rows, after) = (&off[i + 1..=i + W], &after[..W]);
+            let mut s = inv[i].apply(head[i]);
+            for t in 1..=W {
+                s = s - rows[t - 1][W - t].transpose().apply(after[t - 1]);
+            }
+            head[i] = s;
         }
     }
 }
