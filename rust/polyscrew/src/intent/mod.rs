@@ -35,6 +35,7 @@
 //! Every size input can drive is checked in one place ([`limits`]) before it is allocated;
 //! bad input is an [`Error`](crate::Error), never a panic.
 
+pub mod batch;
 pub mod departure;
 pub(crate) mod interp;
 pub mod limits;
@@ -50,6 +51,7 @@ mod tests;
 #[cfg(test)]
 mod turns_tests;
 
+pub use batch::{sample_owner_channels, OwnerChannels, OwnerMotion, Segment};
 pub use departure::{
     departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
 };
