@@ -194,3 +194,187 @@ pub fn sample_owner_channels(owner: &OwnerMotion<'_>, mode: RotationMode) -> Res
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{EulerOrder, Scheme, Timing};
+
+    fn keys() -> (Vec<Pose>, Vec<f64>) {
+        let poses = (0..5)
+            .map(|i| {
+                let a = 0.9 * i as f64;
+                Pose::from_rotation_translation(
+                    DQuat::from_euler(glam::EulerRot::ZYX, a, 0.3 * a, -0.2 * a),
+                    DVec3::new(a, (2.0 * a).sin(), 0.1 * a * a),
+                )
+            })
+            .collect();
+        (poses, vec![1.0, 4.0, 11.0, 15.0, 24.0])
+    }
+
+    fn spec(timing: Timing) -> MotionSpec {
+        MotionSpec {
+            scheme: Scheme::FourPoint,
+            levels: 3,
+            closed: false,
+            period: None,
+            timing,
+        }
+    }
+
+    #[test]
+    fn one_piece_is_sample_then_rotation_channels_to_the_bit() {
+        let (poses, key_frames) = keys();
+        let frames: Vec<f64> = (0..26).map(|f| f as f64).collect();
+        let mode = RotationMode::Euler(EulerOrder::Xyz);
+        for timing in [Timing::Smooth, Timing::Linear] {
+            let segments = [Segment {
+                lo: 0,
+                hi: 4,
+                start: 0,
+                end: frames.len(),
+            }];
+            let owner = OwnerMotion {
+                keys: &poses,
+                key_frames: &key_frames,
+                log_scales: None,
+                frames: &frames,
+                segments: &segments,
+                spec: spec(timing),
+                size: Some(1.0),
+                playback: None,
+                previous: Some(&[0.0, 0.0, 0.0]),
+                played: true,
+            };
+            let got = sample_owner_channels(&owner, mode).unwrap();
+            let dense = sample(&poses, &key_frames, &frames, &spec(timing)).unwrap();
+            let quats: Vec<DQuat> = dense.iter().map(|p| p.rotation).collect();
+            let want = rotation_channels(&quats, mode, Some(&[0.0, 0.0, 0.0])).unwrap();
+            assert_eq!(got.rotations, want, "{timing:?}");
+            assert!(got
+                .locations
+                .iter()
+                .zip(&dense)
+                .all(|(a, b)| *a == b.translation));
+            assert!(got.played.is_none() && got.log_scales.is_empty());
+        }
+    }
+
+    #[test]
+    fn a_hold_repeats_its_key_and_the_next_piece_continues_from_it() {
+        let (mut poses, key_frames) = keys();
+        poses[2] = poses[1]; // keys 1..2 held
+        let frames: Vec<f64> = (1..25).map(|f| f as f64).collect();
+        let mode = RotationMode::Quaternion;
+        // frames 1..3 (rows 0..3) the piece 0..1, 4..10 the hold of key 1, 11..24 the piece 2..4
+        let segments = [
+            Segment {
+                lo: 0,
+                hi: 1,
+                start: 0,
+                end: 3,
+            },
+            Segment {
+                lo: 1,
+                hi: 1,
+                start: 3,
+                end: 10,
+            },
+            Segment {
+                lo: 2,
+                hi: 4,
+                start: 10,
+                end: 24,
+            },
+        ];
+        let logs: Vec<DVec3> = (0..5).map(|i| DVec3::splat(0.1 * i as f64)).collect();
+        let owner = OwnerMotion {
+            keys: &poses,
+            key_frames: &key_frames,
+            log_scales: Some(&logs),
+            frames: &frames,
+            segments: &segments,
+            spec: spec(Timing::Smooth),
+            size: None,
+            playback: None,
+            previous: None,
+            played: false,
+        };
+        let got = sample_owner_channels(&owner, mode).unwrap();
+        assert_eq!(got.locations.len(), 24);
+        assert!(got.locations[3..10]
+            .iter()
+            .all(|l| *l == poses[1].translation));
+        assert!(got.log_scales[3..10].iter().all(|l| *l == logs[1]));
+        // the last piece, sampled alone from the hold's last channels
+        let dense = sample(
+            &poses[2..],
+            &key_frames[2..],
+            &frames[10..],
+            &spec(Timing::Smooth),
+        )
+        .unwrap();
+        let quats: Vec<DQuat> = dense.iter().map(|p| p.rotation).collect();
+        let want = rotation_channels(&quats, mode, Some(&got.rotations[9 * 4..10 * 4])).unwrap();
+        assert_eq!(&got.rotations[10 * 4..], &want[..]);
+        let scales = sample(
+            &logs[2..],
+            &key_frames[2..],
+            &frames[10..],
+            &spec(Timing::Smooth),
+        )
+        .unwrap();
+        assert_eq!(&got.log_scales[10..], &scales[..]);
+    }
+
+    #[test]
+    fn segments_that_do_not_cover_the_frames_are_refused() {
+        let (poses, key_frames) = keys();
+        let frames = [1.0, 2.0, 3.0];
+        for segments in [
+            vec![Segment {
+                lo: 0,
+                hi: 4,
+                start: 0,
+                end: 2,
+            }],
+            vec![Segment {
+                lo: 0,
+                hi: 5,
+                start: 0,
+                end: 3,
+            }],
+            vec![Segment {
+                lo: 3,
+                hi: 2,
+                start: 0,
+                end: 3,
+            }],
+        ] {
+            let owner = OwnerMotion {
+                keys: &poses,
+                key_frames: &key_frames,
+                log_scales: None,
+                frames: &frames,
+                segments: &segments,
+                spec: spec(Timing::Smooth),
+                size: None,
+                playback: None,
+                previous: None,
+                played: false,
+            };
+            let err = sample_owner_channels(&owner, RotationMode::Quaternion).unwrap_err();
+            assert!(
+                matches!(
+                    err,
+                    crate::Error::LengthMismatch {
+                        what: "segments",
+                        ..
+                    }
+                ),
+                "{segments:?}: {err}"
+            );
+        }
+    }
+}
