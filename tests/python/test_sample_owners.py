@@ -156,3 +156,22 @@ def test_sample_many_makes_one_call_per_rotation_mode(monkeypatch):
         sampling.sample(motion, frames, options, channels=True, previous=previous, played=True)
     print(f"40 owners: 2 calls batched, {len(calls)} owner by owner")
     assert len(calls) >= 80
+
+
+def test_sample_many_leaves_to_sample_what_it_cannot_batch():
+    """Frames out of order (`sample` sorts them) and a batch over the memory budget come back
+    None: the caller samples those owners alone, as before."""
+    rng = np.random.default_rng(9)
+    items = owners(rng, 4)
+    motion, frames, previous = items[1]
+    items[1] = (motion, frames[::-1].copy(), previous)
+    options = SimpleNamespace(scheme="jarek", levels=2, timing="smooth", method="SCREW")
+    got = sampling.sample_many(items, options)
+    assert got[1] is None and all(g is not None for i, g in enumerate(got) if i != 1)
+    budget = polyscrew.memory_budget()
+    try:
+        polyscrew.set_memory_budget(64)
+        assert sampling.sample_many(items, options) == [None] * 4
+    finally:
+        polyscrew.set_memory_budget(budget)
+    assert polyscrew.memory_budget() == budget

@@ -266,13 +266,16 @@ def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | Non
     """:func:`sample` of many motions as channels with their played rows (the screw method):
     for each `(motion, frames, previous)` of `items` (frames sorted), what `sample(motion,
     frames, options, channels=True, previous=previous, played=True)` gives, to the bit, or
-    None where the core refused that motion (sample it alone to learn why).
+    None where the core refused that motion (sample it alone to learn why) and for frames out
+    of order (:func:`sample` sorts them).
 
     One `polyscrew.sample_owners` call per rotation mode for every motion's pieces and holds
     (:func:`segments`), instead of calls per piece per motion."""
     out: list[Sampled | None] = [None] * len(items)
     by_mode: dict[str, list[int]] = {}
-    for i, (motion, _, _) in enumerate(items):
+    for i, (motion, frames, _) in enumerate(items):
+        if len(frames) < 1 or np.any(np.diff(frames) < 0.0):
+            continue
         by_mode.setdefault(motion.rotation_mode, []).append(i)
     for mode, indices in by_mode.items():
         motions = [items[i][0] for i in indices]
@@ -289,19 +292,22 @@ def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | Non
             [(s.lo, s.hi, s.rows[0], s.rows[-1] + 1) for p in pieces for s in p], dtype=np.int64
         ).reshape(-1, 4)
         counts = np.array([(len(m.frames), len(f), len(p)) for m, f, p in zip(motions, frames, pieces)], dtype=np.int64)
-        location, rotation, log_scales, played, status = polyscrew.sample_owners(
-            np.concatenate([m.poses for m in motions]), np.concatenate([m.frames for m in motions]),
-            np.concatenate(frames), counts, table, mode,
-            closed=np.array([m.closed for m in motions], dtype=np.int64),
-            period=np.array([np.nan if m.period is None else m.period for m in motions]),
-            size=np.array([np.nan if m.size is None else m.size for m in motions]),
-            playbacks=[m.source.playback if m.source is not None else None for m in motions],
-            previous=previous,
-            log_scales=np.concatenate([np.zeros_like(m.scales) if log is None else log for m, log in zip(motions, logs)])
-            if any(scaled) else None,
-            scaled=np.array(scaled, dtype=np.int64),
-            scheme=options.scheme, levels=options.levels, timing=options.timing, played=True,
-        )
+        try:
+            location, rotation, log_scales, played, status = polyscrew.sample_owners(
+                np.concatenate([m.poses for m in motions]), np.concatenate([m.frames for m in motions]),
+                np.concatenate(frames), counts, table, mode,
+                closed=np.array([m.closed for m in motions], dtype=np.int64),
+                period=np.array([np.nan if m.period is None else m.period for m in motions]),
+                size=np.array([np.nan if m.size is None else m.size for m in motions]),
+                playbacks=[m.source.playback if m.source is not None else None for m in motions],
+                previous=previous,
+                log_scales=np.concatenate([np.zeros_like(m.scales) if log is None else log for m, log in zip(motions, logs)])
+                if any(scaled) else None,
+                scaled=np.array(scaled, dtype=np.int64),
+                scheme=options.scheme, levels=options.levels, timing=options.timing, played=True,
+            )
+        except (ValueError, MemoryError):  # the batch as a whole refused (its memory, a key pose): each alone
+            continue
         ends = np.cumsum(counts[:, 1])
         for row, i in enumerate(indices):
             if status[row] < 0:
