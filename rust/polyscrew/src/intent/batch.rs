@@ -223,6 +223,29 @@ mod tests {
         }
     }
 
+    /// An owner of `poses` at `key_frames` sampled at `frames` in `segments`: no scale, size,
+    /// playback or previous channels.
+    fn motion<'a>(
+        poses: &'a [Pose],
+        key_frames: &'a [f64],
+        frames: &'a [f64],
+        segments: &'a [Segment],
+        timing: Timing,
+    ) -> OwnerMotion<'a> {
+        OwnerMotion {
+            keys: poses,
+            key_frames,
+            log_scales: None,
+            frames,
+            segments,
+            spec: spec(timing),
+            size: None,
+            playback: None,
+            previous: None,
+            played: false,
+        }
+    }
+
     #[test]
     fn one_piece_is_sample_then_rotation_channels_to_the_bit() {
         let (poses, key_frames) = keys();
@@ -236,16 +259,10 @@ mod tests {
                 end: frames.len(),
             }];
             let owner = OwnerMotion {
-                keys: &poses,
-                key_frames: &key_frames,
-                log_scales: None,
-                frames: &frames,
-                segments: &segments,
-                spec: spec(timing),
                 size: Some(1.0),
-                playback: None,
                 previous: Some(&[0.0, 0.0, 0.0]),
                 played: true,
+                ..motion(&poses, &key_frames, &frames, &segments, timing)
             };
             let got = sample_owner_channels(&owner, mode).unwrap();
             let dense = sample(&poses, &key_frames, &frames, &spec(timing)).unwrap();
@@ -290,16 +307,8 @@ mod tests {
         ];
         let logs: Vec<DVec3> = (0..5).map(|i| DVec3::splat(0.1 * i as f64)).collect();
         let owner = OwnerMotion {
-            keys: &poses,
-            key_frames: &key_frames,
             log_scales: Some(&logs),
-            frames: &frames,
-            segments: &segments,
-            spec: spec(Timing::Smooth),
-            size: None,
-            playback: None,
-            previous: None,
-            played: false,
+            ..motion(&poses, &key_frames, &frames, &segments, Timing::Smooth)
         };
         let got = sample_owner_channels(&owner, mode).unwrap();
         assert_eq!(got.locations.len(), 24);
@@ -352,18 +361,7 @@ mod tests {
                 end: 3,
             }],
         ] {
-            let owner = OwnerMotion {
-                keys: &poses,
-                key_frames: &key_frames,
-                log_scales: None,
-                frames: &frames,
-                segments: &segments,
-                spec: spec(Timing::Smooth),
-                size: None,
-                playback: None,
-                previous: None,
-                played: false,
-            };
+            let owner = motion(&poses, &key_frames, &frames, &segments, Timing::Smooth);
             let err = sample_owner_channels(&owner, RotationMode::Quaternion).unwrap_err();
             assert!(
                 matches!(
