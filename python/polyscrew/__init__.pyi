@@ -971,6 +971,47 @@ closer (radians, 45 degrees, sum over the three angles) to its first key (``anal
 RANGE_TOLERANCE: float
 """How far beyond -pi..pi an Euler key may lie and still be inside the range (1e-6 radians)."""
 
+def sample_owners(
+    poses: ArrayLike,
+    key_frames: ArrayLike,
+    frames: ArrayLike,
+    counts: ArrayLike,
+    segments: ArrayLike,
+    mode: RotationModeName,
+    *,
+    closed: ArrayLike | None = None,
+    period: ArrayLike | None = None,
+    size: ArrayLike | None = None,
+    playbacks: Sequence[Playback | None] | None = None,
+    previous: ArrayLike | None = None,
+    log_scales: ArrayLike | None = None,
+    scaled: ArrayLike | None = None,
+    scheme: SchemeName = "four_point",
+    levels: int = 4,
+    timing: TimingName = "smooth",
+    played: bool = False,
+) -> tuple[FloatArray, FloatArray, FloatArray | None, FloatArray | None, IntArray]:
+    """Many owners' smoothed motions (rotation ``mode``) as Blender channels in one call: for
+    each owner, exactly what ``timed_frames`` then ``sample_channels`` (and ``sample_vectors``
+    of its log-scales) give for each of its pieces, and ``rotation_channels`` for each hold,
+    channels continued from segment to segment.
+
+    The owners' arrays are concatenated: ``poses`` (K, 4, 4) and ``key_frames`` (K,) the keys,
+    ``frames`` (T,) the output frames (sorted per owner); ``counts`` (O, 3) each owner's keys,
+    frames and segments; ``segments`` (S, 4) rows ``(lo, hi, start, end)``: rows ``start:end``
+    of the owner's frames sampled from its keys ``lo..hi`` (a hold of key ``lo`` when ``hi ==
+    lo``; a piece that is not the whole motion is open). Per owner, optional: ``closed`` (0 or
+    1) and ``period`` (NaN: none) of the whole motion, ``size`` (NaN: none), its ``playbacks``
+    entry, ``previous`` (O, width) rotation channels to continue from (a NaN row: none),
+    ``scaled`` (0 or 1) whether its rows of ``log_scales`` (K, 3) are sampled.
+
+    Returns locations (T, 3), rotation channels (T, width), log-scales (T, 3) (zero rows for
+    owners not scaled; None without ``log_scales``), with ``played`` the rows timing Keys
+    played (T, 3 + width; NaN elsewhere; else None), and per owner a status (int64): 1 sampled
+    with played rows, 0 sampled, -1 refused (its rows zero: sample that owner alone to learn
+    why). GIL released. Raises ValueError for arrays that do not fit together.
+    """
+
 class Denoised:
     """The result of ``denoise``: the smooth poses and what was chosen on the way.
 

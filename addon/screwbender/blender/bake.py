@@ -4,10 +4,10 @@
 The pipeline, per object:
 
 1. :func:`keys.read` turns the transform F-curves into key poses (nothing changes).
-2. :func:`sample_channels` samples the subdivided motion at every baked frame: one
-   `polyscrew.sample_channels` call for location and rotation channels (Feature Points:
-   `polyscrew.sample_feature` then `polyscrew.rotation_channels`), one
-   `polyscrew.sample_vectors` call for log-scale.
+2. :func:`sample_channels` samples the subdivided motion at every baked frame as location,
+   rotation and log-scale channels: for every owner of one Smooth Motion together, one
+   `polyscrew.sample_owners` call per rotation mode (:func:`sampling.sample_many`; Feature
+   Points: `polyscrew.sample_feature` then `polyscrew.rotation_channels` per owner).
 3. :func:`write` copies the source action, replaces its transform F-curves of this object by
    the dense baked ones (`keyframe_points.add` + `foreach_set`) and assigns the copy; the
    source action keeps a fake user and is recorded on the copy for :func:`revert`.
@@ -187,9 +187,33 @@ def sample_channels(
     `source_curves`, the owner's curves the keys were read from, when given: a Frame Range
     narrower than the keys smooths that part and keeps the source keys outside it
     (:mod:`range_join`), and channels they do not key stay unkeyed where the smoothed motion
-    leaves them constant.
+    leaves them constant. :func:`sample_many` does the same for many owners at once.
     """
-    owner = owners.as_owner(owner)
+    plan = _plan(owners.as_owner(owner), motion, options, budget, source_curves)
+    return _finish(plan, _sample_alone(plan, options))
+
+
+@dataclass
+class _Plan:
+    """What sampling one owner takes (:func:`_plan`): the owner, its motion (cut to a Frame
+    Range), the baked frames, the channels they continue from."""
+
+    owner: owners.Owner
+    motion: keys.KeyedMotion
+    options: Options
+    join: range_join.Join | None
+    start: float
+    end: float
+    frames: np.ndarray
+    previous: np.ndarray | None
+    source_curves: list | None
+
+
+def _plan(
+    owner: owners.Owner, motion: keys.KeyedMotion, options: Options, budget: list[int] | None, source_curves: list | None
+) -> _Plan:
+    """Everything :func:`sample_channels` does before sampling: the Frame Range's cut, the
+    budget's check, the baked frames. Raises :class:`SmoothError`."""
     join = None
     if source_curves is not None:
         try:
@@ -222,34 +246,66 @@ def sample_channels(
             last = int(np.ceil((end - key_frames[0]) / motion.period))
             key_frames = (key_frames[None] + motion.period * np.arange(first, last + 1)[:, None]).ravel()
         frames = with_key_frames(frames, key_frames)
-        mode = motion.rotation_mode
-        previous = keys.continued(mode, motion.first_rotation)
-        # one polyscrew call per piece from keys to channels, no (frames, 4, 4) in between
-        sampled = sampling.sample(
-            motion, frames, options, feature.sampler(owner, options), channels=True, previous=previous, played=True
-        )
-        location, rotation, scales, constant = sampled.location, sampled.rotation, sampled.scales, sampled.constant
-        values = {"location": location, keys.rotation_path(mode): rotation}
-        if not motion.located:
-            del values["location"]
-        if scales is not None:
-            values["scale"] = scales[:, motion.scale_axes]
-    except ValueError as err:  # polyscrew's ValueError, or ours (SmoothError) for the range
+    except ValueError as err:  # ours (SmoothError) for the range
         raise SmoothError(f"{owner.name}: {err}") from err
+    previous = keys.continued(motion.rotation_mode, motion.first_rotation)
+    return _Plan(owner, motion, options, join, start, end, frames, previous, source_curves)
+
+
+def _sample_alone(plan: _Plan, options: Options) -> sampling.Sampled:
+    """The channels of `plan`'s owner from its own polyscrew calls (one per piece: the
+    Feature Points method, or to learn why :func:`sample_many`'s batch refused it)."""
+    try:
+        return sampling.sample(
+            plan.motion, plan.frames, options, feature.sampler(plan.owner, options), channels=True,
+            previous=plan.previous, played=True,
+        )
+    except ValueError as err:  # polyscrew's ValueError
+        raise SmoothError(f"{plan.owner.name}: {err}") from err
+
+
+def _sample_plans(plans: list[_Plan], options: Options) -> list[sampling.Sampled | SmoothError]:
+    """The channels of every plan, or the error refusing it: the screw method samples every
+    owner in one polyscrew call per rotation mode (:func:`sampling.sample_many`), Feature
+    Points each owner alone (its sampler reads the owner's points)."""
+    batched = [None] * len(plans)
+    if options.method != "FEATURE" and plans:
+        batched = sampling.sample_many([(p.motion, p.frames, p.previous) for p in plans], options)
+    out: list[sampling.Sampled | SmoothError] = []
+    for plan, sampled in zip(plans, batched):
+        if sampled is None:  # (Feature Points, or refused: alone, for its own error)
+            try:
+                sampled = _sample_alone(plan, options)
+            except SmoothError as err:
+                sampled = err
+        out.append(sampled)
+    return out
+
+
+def _finish(plan: _Plan, sampled: sampling.Sampled) -> Baked:
+    """The bake of `plan`'s owner from its sampled channels: the values per property, the
+    Frame Range's join maps, the channels left unkeyed, the cycle."""
+    owner, motion, options, join, end, frames = plan.owner, plan.motion, plan.options, plan.join, plan.end, plan.frames
+    mode = motion.rotation_mode
+    values = {"location": sampled.location, keys.rotation_path(mode): sampled.rotation}
+    if not motion.located:
+        del values["location"]
+    if sampled.scales is not None:
+        values["scale"] = sampled.scales[:, motion.scale_axes]
     end_maps = range_join.end_maps(join, motion, join.played, values, frames) if join is not None else None
     if join is not None:
         _check_mapped_modifiers(owner, join, end_maps)
     unkeyed = frozenset()
-    if source_curves is not None:
-        unkeyed = _left_unkeyed(owner, source_curves, values, motion)
+    if plan.source_curves is not None:
+        unkeyed = _left_unkeyed(owner, plan.source_curves, values, motion)
     # The baked curves repeat (Cycles modifier) when they span exactly one period of a motion
     # that was cyclic in the source.
     whole_period = options.frame_range is None and abs(frames[-1] - end) < keys.FRAME_TOLERANCE
     cyclic = motion.cyclic and motion.closed and whole_period
     modes = motion.cycle_modes if whole_period and motion.cycle_modes else None
     return Baked(
-        owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=constant, cycle_modes=modes,
-        join=join, end_maps=end_maps, unkeyed=unkeyed, played=sampled.played,
+        owner=owner, motion=motion, frames=frames, values=values, cyclic=cyclic, constant=sampled.constant,
+        cycle_modes=modes, join=join, end_maps=end_maps, unkeyed=unkeyed, played=sampled.played,
     )
 
 
@@ -620,13 +676,29 @@ def users_by_slot(pointers: set[int]) -> dict[tuple[int, str], list[bpy.types.Ob
     return out
 
 
-def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[list[ActionBake], list, list[str]]:
-    """Reads and samples the owners that share one action (and slot).
+@dataclass
+class _GroupRead:
+    """One action group read (:func:`_read_group`): its motions, what the bake needs of the
+    action, and what was skipped and noted so far."""
 
-    Returns the action bakes (one for the whole group when every object has the same key
-    poses for every owner, else one per object), the skipped owners with their messages, and
-    notes for the report.
-    """
+    group: _Group
+    source: bpy.types.Action
+    current: bpy.types.Action
+    identifier: str
+    #: motions[bone][object index]
+    motions: dict[str, list[keys.KeyedMotion]]
+    #: (objects, column of `motions`' rows): the objects given one action each.
+    units: list[tuple[list[bpy.types.Object], int]]
+    by_owner: dict
+    #: (data path, index) -> "muted" / "empty": the current action's curves not read.
+    unread: dict
+    skipped: list
+    notes: list[str]
+
+
+def _read_group(group: _Group, options: Options) -> _GroupRead:
+    """Reads the owners that share one action (and slot): one bake for the whole group when
+    every object has the same key poses for every owner, else one per object (`units`)."""
     first = group.objects[0]
     current = first.animation_data.action
     identifier = channels.slot_identifier(first)
@@ -639,7 +711,6 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
             "them, a second Revert to the original)"
         )
     read_from = None if source is current else source
-    # motions[bone][object index]
     motions: dict[str, list[keys.KeyedMotion]] = {}
     skipped = []
     # The objects share the action: its curves grouped by owner once (not scanned per bone).
@@ -662,48 +733,88 @@ def _read_group(group: _Group, options: Options, budget: list[int]) -> tuple[lis
                 break
         else:
             motions[bone] = row
+    read = _GroupRead(group, source, current, identifier, motions, [], by_owner, {}, skipped, notes)
     if not motions:
-        return [], skipped, []
+        return read
     shared = all(_same_motion(row[0], m) for row in motions.values() for m in row[1:])
     if shared:
-        units = [(group.objects, 0)]
+        read.units = [(group.objects, 0)]
     else:
-        units = [([obj], i) for i, obj in enumerate(group.objects)]
+        read.units = [([obj], i) for i, obj in enumerate(group.objects)]
         notes.append(
             f"{', '.join(o.name for o in group.objects)} share action '{current.name}' but differ in "
             "unkeyed channels or rotation mode: each got its own smoothed action"
         )
     # Curves of the current action that were not read (muted, keyless): a baked channel
     # replaces them, which the report tells.
-    unread = {
+    read.unread = {
         (fc.data_path, fc.array_index): "muted" if fc.mute else "empty"
         for fc in (listed if read_from is None else channels.action_fcurves(current, identifier))
         if fc.mute or len(fc.keyframe_points) == 0
     }
-    bakes = []
-    for objects, column in units:
-        parts = []
-        for bone, row in motions.items():
-            owner = owners.Owner(objects[0], bone)
-            try:
-                part = sample_channels(owner, row[column], options, budget, source_curves=by_owner.get(bone, []))
-            except SmoothError as err:
-                skipped.append((owner, str(err)))
-                continue
-            parts.append(part)
-            if row[column].kept:
-                notes.append(f"{owner.name}: kept {'; '.join(row[column].kept)}")
-            if row[column].removed:
-                notes.append(f"{owner.name}: removed {'; '.join(row[column].removed)}")
-            departed = _departure_note(owner, row[column], part, options)
-            if departed is not None:
-                notes.append(departed)
-            for prop, index in part.written:
-                what = unread.get((owner.path(prop), index))
-                if what is not None:
-                    notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
-        if parts:
-            bakes.append(ActionBake(objects, parts, source, current, identifier))
+    return read
+
+
+def _bake_groups(
+    groups: list[_Group],
+    options: Options,
+    budget: list[int],
+    progress: Callable[[int, int], None] | None = None,
+    total: int = 0,
+) -> tuple[list[ActionBake], list, list[str]]:
+    """Reads and samples every group's owners: every group read, then every owner planned
+    (in order, against `budget`), then sampled together (:func:`_sample_plans`: one polyscrew
+    call per rotation mode), then each group's action bakes made, its skipped owners with
+    their messages and its notes told in the order one group after another would give them.
+    `progress(done, total)` as each group is done."""
+    reads = [_read_group(group, options) for group in groups]
+    # (read, objects, owner, motion, plan or the error refusing it) per owner, in order
+    planned = []
+    for read in reads:
+        for objects, column in read.units:
+            for bone, row in read.motions.items():
+                owner = owners.Owner(objects[0], bone)
+                try:
+                    plan = _plan(owner, row[column], options, budget, read.by_owner.get(bone, []))
+                except SmoothError as err:
+                    plan = err
+                planned.append((read, objects, owner, row[column], plan))
+    plans = [p for *_, p in planned if isinstance(p, _Plan)]
+    sampled = iter(_sample_plans(plans, options))
+    bakes, skipped, notes = [], [], []
+    by_unit: dict[tuple[int, int], list[Baked]] = {}
+    for read, objects, owner, motion, plan in planned:
+        try:
+            if isinstance(plan, SmoothError):
+                raise plan
+            channels_of = next(sampled)
+            if isinstance(channels_of, SmoothError):
+                raise channels_of
+            part = _finish(plan, channels_of)
+        except SmoothError as err:
+            read.skipped.append((owner, str(err)))
+            continue
+        by_unit.setdefault((id(read), id(objects)), []).append(part)
+        if motion.kept:
+            read.notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
+        if motion.removed:
+            read.notes.append(f"{owner.name}: removed {'; '.join(motion.removed)}")
+        departed = _departure_note(owner, motion, part, options)
+        if departed is not None:
+            read.notes.append(departed)
+        for prop, index in part.written:
+            what = read.unread.get((owner.path(prop), index))
+            if what is not None:
+                read.notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
+    for i, read in enumerate(reads):
+        for objects, _ in read.units:
+            parts = by_unit.get((id(read), id(objects)))
+            if parts:
+                bakes.append(ActionBake(objects, parts, read.source, read.current, read.identifier))
+        skipped += read.skipped
+        notes += read.notes
+        if progress is not None:
+            progress(i + 1, total)
     return bakes, skipped, notes
 
 
@@ -751,14 +862,8 @@ def prepare(selection: Iterable, options: Options) -> tuple[list[ActionBake], li
     returns the action bakes, the messages of what was skipped, and notes."""
     selection = list(selection)
     groups, skipped = _action_groups(selection)
-    bakes, notes = [], []
-    budget = [MAX_KEYS]
-    for group in groups:
-        done, messages, told = _read_group(group, options, budget)
-        bakes += done
-        skipped += messages
-        notes += told
-    return bakes, _in_order(selection, skipped), notes
+    bakes, messages, notes = _bake_groups(groups, options, [MAX_KEYS])
+    return bakes, _in_order(selection, skipped + messages), notes
 
 
 def smooth(
@@ -780,16 +885,8 @@ def smooth(
     selection = list(selection)
     groups, skipped = _action_groups(selection)
     total = len(groups) * 2
-    bakes, notes = [], []
-    budget = [MAX_KEYS]
-    for i, group in enumerate(groups):
-        done, messages, told = _read_group(group, options, budget)
-        bakes += done
-        skipped += messages
-        notes += told
-        if progress is not None:
-            progress(i + 1, total)
-    skipped = _in_order(selection, skipped)
+    bakes, messages, notes = _bake_groups(groups, options, [MAX_KEYS], progress, total)
+    skipped = _in_order(selection, skipped + messages)
     if strict and skipped:
         raise SmoothError("; ".join(skipped))
     selected = {owners.as_owner(item).obj.name for item in selection}

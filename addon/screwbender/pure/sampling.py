@@ -185,15 +185,14 @@ def sample(
     poses = np.empty((n, 4, 4)) if not channels else None
     location = np.empty((n, 3)) if channels else None
     rotation = None
-    constant = np.zeros(n, dtype=bool)
     scaled = motion.scale_keyed
-    # log-scale of the keyed axes (positive); an unkeyed axis is not smoothed (it is the owner's
-    # own scale afterwards) and may be 0 or negative: log(1) = 0 stands in for it
-    logs = np.log(np.where(motion.scale_axes, motion.scales, 1.0)) if scaled else None
+    logs = _log_scales(motion)
     log_scales = np.empty((n, 3)) if scaled else None
     last_rotation = previous
     played_rows = None
-    for seg in segments(motion, frames):
+    pieces = segments(motion, frames)
+    constant = _constant(motion, pieces, n)
+    for seg in pieces:
         # (every frame in one piece, the usual case: a slice, no index arrays to scatter through)
         rows = slice(None) if len(seg.rows) == n else seg.rows
         if seg.held:
@@ -201,8 +200,6 @@ def sample(
             values = _put_poses(pose, rows, poses, location, mode, last_rotation)
             if scaled:
                 log_scales[rows] = logs[seg.lo]
-            if motion.pops is not None and motion.pops[seg.lo]:
-                constant[rows] = True
         else:
             whole = seg.lo == 0 and seg.hi == len(motion.frames) - 1
             piece = motion if whole else _sub(motion, seg.lo, seg.hi)
@@ -230,12 +227,96 @@ def sample(
                 rotation = np.empty((n, values.shape[1]))
             rotation[rows] = values
             last_rotation = keys.continued(mode, values[-1])
-    scales = None
-    if scaled:
-        scales = np.empty((n, 3))
-        scales[:] = motion.scales[0]  # unkeyed axes: the owner's own scale, possibly negative
-        axes = motion.scale_axes
-        scales[:, axes] = np.exp(log_scales[:, axes])
     return Sampled(
-        poses=poses, location=location, rotation=rotation, scales=scales, constant=constant, played=played_rows
+        poses=poses, location=location, rotation=rotation, scales=_scales(motion, log_scales), constant=constant,
+        played=played_rows,
     )
+
+
+def _log_scales(motion: keys.KeyedMotion) -> np.ndarray | None:
+    """The log-scale of the keyed axes of `motion`'s keys (positive), None when scale is not
+    keyed; an unkeyed axis is not smoothed (it is the owner's own scale afterwards) and may be
+    0 or negative: log(1) = 0 stands in for it."""
+    return np.log(np.where(motion.scale_axes, motion.scales, 1.0)) if motion.scale_keyed else None
+
+
+def _scales(motion: keys.KeyedMotion, log_scales: np.ndarray | None) -> np.ndarray | None:
+    """The scales (T, 3) of sampled `log_scales` (None: scale not keyed): the keyed axes
+    smoothed, the others the owner's own scale, possibly negative."""
+    if log_scales is None:
+        return None
+    scales = np.empty((len(log_scales), 3))
+    scales[:] = motion.scales[0]
+    axes = motion.scale_axes
+    scales[:, axes] = np.exp(log_scales[:, axes])
+    return scales
+
+
+def _constant(motion: keys.KeyedMotion, pieces: list[Segment], n: int) -> np.ndarray:
+    """Per frame of `pieces` (n in all): in a held span that pops at its end."""
+    constant = np.zeros(n, dtype=bool)
+    if motion.pops is not None:
+        for seg in pieces:
+            if seg.held and motion.pops[seg.lo]:
+                constant[seg.rows] = True
+    return constant
+
+
+def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | None]], options) -> list[Sampled | None]:
+    """:func:`sample` of many motions as channels with their played rows (the screw method):
+    for each `(motion, frames, previous)` of `items` (frames sorted), what `sample(motion,
+    frames, options, channels=True, previous=previous, played=True)` gives, to the bit, or
+    None where the core refused that motion (sample it alone to learn why) and for frames out
+    of order (:func:`sample` sorts them).
+
+    One `polyscrew.sample_owners` call per rotation mode for every motion's pieces and holds
+    (:func:`segments`), instead of calls per piece per motion."""
+    out: list[Sampled | None] = [None] * len(items)
+    by_mode: dict[str, list[int]] = {}
+    for i, (motion, frames, _) in enumerate(items):
+        if len(frames) < 1 or np.any(np.diff(frames) < 0.0):
+            continue
+        by_mode.setdefault(motion.rotation_mode, []).append(i)
+    for mode, indices in by_mode.items():
+        motions = [items[i][0] for i in indices]
+        frames = [np.asarray(items[i][1], dtype=np.float64) for i in indices]
+        pieces = [segments(m, f) for m, f in zip(motions, frames)]
+        logs = [_log_scales(m) for m in motions]
+        scaled = [log is not None for log in logs]
+        width = len(motions[0].first_rotation)
+        previous = np.full((len(indices), width), np.nan)
+        for row, i in enumerate(indices):
+            if items[i][2] is not None:
+                previous[row] = items[i][2]
+        table = np.array(
+            [(s.lo, s.hi, s.rows[0], s.rows[-1] + 1) for p in pieces for s in p], dtype=np.int64
+        ).reshape(-1, 4)
+        counts = np.array([(len(m.frames), len(f), len(p)) for m, f, p in zip(motions, frames, pieces)], dtype=np.int64)
+        try:
+            location, rotation, log_scales, played, status = polyscrew.sample_owners(
+                np.concatenate([m.poses for m in motions]), np.concatenate([m.frames for m in motions]),
+                np.concatenate(frames), counts, table, mode,
+                closed=np.array([m.closed for m in motions], dtype=np.int64),
+                period=np.array([np.nan if m.period is None else m.period for m in motions]),
+                size=np.array([np.nan if m.size is None else m.size for m in motions]),
+                playbacks=[m.source.playback if m.source is not None else None for m in motions],
+                previous=previous,
+                log_scales=np.concatenate([np.zeros_like(m.scales) if log is None else log for m, log in zip(motions, logs)])
+                if any(scaled) else None,
+                scaled=np.array(scaled, dtype=np.int64),
+                scheme=options.scheme, levels=options.levels, timing=options.timing, played=True,
+            )
+        except (ValueError, MemoryError):  # the batch as a whole refused (its memory, a key pose): each alone
+            continue
+        ends = np.cumsum(counts[:, 1])
+        for row, i in enumerate(indices):
+            if status[row] < 0:
+                continue
+            motion, rows = motions[row], slice(ends[row] - counts[row, 1], ends[row])
+            out[i] = Sampled(
+                poses=None, location=location[rows], rotation=rotation[rows],
+                scales=_scales(motion, log_scales[rows] if scaled[row] else None),
+                constant=_constant(motion, pieces[row], int(counts[row, 1])),
+                played=played[rows] if status[row] > 0 else None,
+            )
+    return out

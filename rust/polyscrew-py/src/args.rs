@@ -213,6 +213,7 @@ functions!(
     AnalyseSpans = "analyse_spans",
     AnalyseTurns = "analyse_turns",
     ReduceKeys = "reduce_keys",
+    SampleOwners = "sample_owners",
 );
 
 /// The name of `obj`'s type, for messages.

@@ -37,7 +37,7 @@ fn rows_array(values: Vec<f64>, width: usize) -> Array2<f64> {
 }
 
 /// The `Playback` argument `obj`, or a `TypeError` naming `function` and `what`.
-fn playback_arg<'a, 'py>(
+pub(crate) fn playback_arg<'a, 'py>(
     function: &str,
     what: &str,
     obj: &'a Bound<'py, PyAny>,
@@ -93,7 +93,7 @@ fn located(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
 /// wrong length or not finite.
 #[pyclass(frozen, module = "polyscrew", name = "Playback")]
 pub struct PyPlayback {
-    inner: Playback,
+    pub(crate) inner: Playback,
 }
 
 #[pymethods]

@@ -10,6 +10,7 @@
 mod angular_velocity;
 mod args;
 mod arrays;
+mod batch;
 mod denoise;
 mod errors;
 mod fcurve;
@@ -120,6 +121,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     feature::register(m)?;
     fcurve::register(m)?;
     intent::register(m)?;
+    batch::register(m)?;
     denoise::register(m)?;
     reduce::register(m)?;
     Ok(())

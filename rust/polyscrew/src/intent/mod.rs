@@ -31,10 +31,14 @@
 //!   displacement of six points at `+-size` along the body's axes ([`travel`]),
 //!   `sqrt(|dt|^2 + size^2 / 3 |dR|_F^2)`, summed over [`PACE_SAMPLES`] steps per span (and
 //!   the output frames inside it) along both motions.
+//! - [`sample_owner_channels`] ([`mod@batch`]): an owner's smoothed motion as Blender channels,
+//!   piece after piece and hold after hold, each piece timed by [`timed_frames`]: what Smooth
+//!   Motion bakes, many owners in one call of the binding.
 //!
 //! Every size input can drive is checked in one place ([`limits`]) before it is allocated;
 //! bad input is an [`Error`](crate::Error), never a panic.
 
+pub mod batch;
 pub mod departure;
 pub(crate) mod interp;
 pub mod limits;
@@ -50,6 +54,7 @@ mod tests;
 #[cfg(test)]
 mod turns_tests;
 
+pub use batch::{sample_owner_channels, OwnerChannels, OwnerMotion, Segment};
 pub use departure::{
     departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
 };
