@@ -4,6 +4,8 @@
 - Insert Key on Motion samples each owner's motion twice (before and after the new key, at
   the frames it compares), not three times: the pose it keys is the one sampled before at
   its frame (which is among those frames), bit for bit the pose sampled at that frame alone.
+- Revert reads each result's facts once per run: one pass over the selection for the
+  actions, their slots and originals (on 148afe3: `bake.source_of` three times per object).
 
 Counted or compared, not timed (speed: scripts/bench/bench_floor.py).
 """
@@ -74,3 +76,41 @@ def test_insert_key_keys_the_pose_sampled_at_its_frame_alone(timing, method, fra
     assert np.array_equal(result.values["rotation_euler"], polyscrew.rotation_channels(pose, "XYZ", previous=previous)[0])
     assert np.array_equal(result.values["scale"], scale[0])
 
+
+def test_revert_reads_each_objects_facts_once():
+    """Revert of twenty objects (two pairs sharing an action, one edited result): the smoothed
+    actions are found in one pass over the selection (`bake.source_of` only in the poll, which
+    `bpy.ops` runs twice here; on 148afe3 also twice per object: 40 calls), each result's edit check made once per
+    action, and what Revert promises still holds: every object has its original back, the
+    edited result is kept with a fake user and named in the report, the others are removed."""
+    bake, channels = addon_module("blender.bake"), addon_module("blender.channels")
+    objects = many(18)
+    for name in ("TwinA", "TwinB"):  # linked duplicates of the first two: they share their action
+        twin = bpy.data.objects.new(name, objects[0 if name == "TwinA" else 1].data)
+        bpy.context.scene.collection.objects.link(twin)
+        original = objects[0 if name == "TwinA" else 1]
+        twin.animation_data_create()
+        channels.assign(twin, original.animation_data.action, channels.slot_identifier(original))
+        objects.append(twin)
+    sources = {o.name: o.animation_data.action for o in objects}
+    actions = len(bpy.data.actions)
+    h.select_only(*objects)
+    assert bpy.ops.screwbender.smooth() == {"FINISHED"}
+    assert objects[-2].animation_data.action is objects[0].animation_data.action
+    edited = objects[5].animation_data.action
+    h.fcurves(objects[5])[0].keyframe_points[3].co.y += 0.5
+    edited_name = edited.name
+    found: list = []
+    digests: list = []
+    originals = (_counting(bake, "source_of", found), _counting(bake, "keys_digest", digests, lambda a: a.as_pointer()))
+    try:
+        assert bpy.ops.screwbender.revert() == {"FINISHED"}
+    finally:
+        bake.source_of, bake.keys_digest = originals
+    print(f"Revert of {len(objects)} objects (18 actions): source_of {len(found)} calls, "
+          f"keys_digest {len(digests)} (148afe3: 40 and 18)")
+    assert len(found) <= 2  # (the poll's)
+    assert len(digests) == 18 and len(set(digests)) == 18
+    assert all(o.animation_data.action is sources[o.name] for o in objects)
+    assert edited_name in bpy.data.actions and bpy.data.actions[edited_name].use_fake_user
+    assert len(bpy.data.actions) == actions + 1  # the other results removed
