@@ -410,8 +410,16 @@ def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> int:
     count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
     of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
     # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
-    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), zlib.crc32(f"{len(interpolation)}:".encode()))
+    n = len(interpolation)
+    prefix = _COUNT_PREFIX.get(n)
+    if prefix is None:
+        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), prefix)
     return zlib.crc32(np.ascontiguousarray(interpolation, dtype=np.uint8), digest)
+
+
+#: :func:`curve_digest`'s CRC-32 of "<key count>:" per key count (the curves of a scene share a few).
+_COUNT_PREFIX: dict[int, int] = {}
 
 
 def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
@@ -422,16 +430,18 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     digest = zlib.crc32(b"keys:")
     # (each curve's path and index read once: Revert checks every curve of every result)
     listed = sorted((fc.data_path, fc.array_index, i, fc) for i, fc in enumerate(channels.action_fcurves(action, identifier)))
+    buffers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # per key count: (co, interpolation), reused
     for path, index, _, fcurve in listed:
         sub = known.get((path, index)) if known else None
         if sub is None:
             points = fcurve.keyframe_points
             n = len(points)
-            co = np.empty(2 * n, dtype=np.float32)
-            bulk.get(points, "co", co)
-            interpolation = np.empty(n, dtype=np.uint8)
-            bulk.get(points, "interpolation", interpolation)
-            sub = curve_digest(co, interpolation)
+            arrays = buffers.get(n)
+            if arrays is None:
+                arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8))
+            bulk.get(points, "co", arrays[0])
+            bulk.get(points, "interpolation", arrays[1])
+            sub = curve_digest(*arrays)
         digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
     return f"crc32:{digest:08x}"
 
