@@ -5,7 +5,9 @@
   the frames it compares), not three times: the pose it keys is the one sampled before at
   its frame (which is among those frames), bit for bit the pose sampled at that frame alone.
 - Revert reads each result's facts once per run: one pass over the selection for the
-  actions, their slots and originals (on 148afe3: `bake.source_of` three times per object).
+  actions, their slots and originals (on 148afe3: `bake.source_of` twice per object).
+- Reduce Keys lists the scene's objects once for all the actions it replaces (on 148afe3:
+  once per action, `bake.users_of`: a run that grew as actions x objects).
 
 Counted or compared, not timed (speed: scripts/bench/bench_floor.py).
 """
@@ -114,3 +116,29 @@ def test_revert_reads_each_objects_facts_once():
     assert all(o.animation_data.action is sources[o.name] for o in objects)
     assert edited_name in bpy.data.actions and bpy.data.actions[edited_name].use_fake_user
     assert len(bpy.data.actions) == actions + 1  # the other results removed
+
+
+def test_reduce_keys_lists_the_scenes_objects_once():
+    """Twelve objects with their own actions and a linked duplicate sharing the first one's:
+    `bake.users_by_slot` once for the run, `bake.users_of` never (on 148afe3: 12 and 12); every
+    object gets the reduced action, the duplicate the same as the object it shares with."""
+    bake, channels = addon_module("blender.bake"), addon_module("blender.channels")
+    objects = [keyed_object(f"Reduced{i:02d}", 0.4 * i) for i in range(12)]
+    twin = bpy.data.objects.new("ReducedTwin", objects[0].data)
+    bpy.context.scene.collection.objects.link(twin)
+    twin.animation_data_create()
+    channels.assign(twin, objects[0].animation_data.action, channels.slot_identifier(objects[0]))
+    before = {o.name: o.animation_data.action for o in [*objects, twin]}
+    h.select_only(*objects)
+    calls = {"users_by_slot": [], "users_of": []}
+    originals = {name: _counting(bake, name, calls[name]) for name in calls}
+    try:
+        assert bpy.ops.screwbender.reduce_keys() == {"FINISHED"}
+    finally:
+        for name, original in originals.items():
+            setattr(bake, name, original)
+    counts = {name: len(made) for name, made in calls.items()}
+    print(f"Reduce Keys, 12 objects and a linked duplicate: {counts} (148afe3: 12 and 12)")
+    assert counts == {"users_by_slot": 1, "users_of": 0}
+    assert all(o.animation_data.action is not before[o.name] for o in [*objects, twin])
+    assert twin.animation_data.action is objects[0].animation_data.action
