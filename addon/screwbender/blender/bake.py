@@ -466,8 +466,16 @@ def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> int:
     count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
     of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
     # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
-    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), zlib.crc32(f"{len(interpolation)}:".encode()))
+    n = len(interpolation)
+    prefix = _COUNT_PREFIX.get(n)
+    if prefix is None:
+        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), prefix)
     return zlib.crc32(np.ascontiguousarray(interpolation, dtype=np.uint8), digest)
+
+
+#: :func:`curve_digest`'s CRC-32 of "<key count>:" per key count (the curves of a scene share a few).
+_COUNT_PREFIX: dict[int, int] = {}
 
 
 def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
@@ -478,16 +486,18 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     digest = zlib.crc32(b"keys:")
     # (each curve's path and index read once: Revert checks every curve of every result)
     listed = sorted((fc.data_path, fc.array_index, i, fc) for i, fc in enumerate(channels.action_fcurves(action, identifier)))
+    buffers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # per key count: (co, interpolation), reused
     for path, index, _, fcurve in listed:
         sub = known.get((path, index)) if known else None
         if sub is None:
             points = fcurve.keyframe_points
             n = len(points)
-            co = np.empty(2 * n, dtype=np.float32)
-            bulk.get(points, "co", co)
-            interpolation = np.empty(n, dtype=np.uint8)
-            bulk.get(points, "interpolation", interpolation)
-            sub = curve_digest(co, interpolation)
+            arrays = buffers.get(n)
+            if arrays is None:
+                arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8))
+            bulk.get(points, "co", arrays[0])
+            bulk.get(points, "interpolation", arrays[1])
+            sub = curve_digest(*arrays)
         digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
     return f"crc32:{digest:08x}"
 
@@ -935,40 +945,39 @@ def source_of(obj: bpy.types.Object) -> bpy.types.Action | None:
     return source if isinstance(source, bpy.types.Action) else None
 
 
-def revert(
-    obj: bpy.types.Object,
-    t: transaction.Transaction,
-    kept: list[str] | None = None,
-    users: dict[tuple[int, str], list[bpy.types.Object]] | None = None,
-    removals: list[bpy.types.Action] | None = None,
-) -> list[bpy.types.Object]:
-    """Gives `obj`, and every object sharing its smoothed action, back the action they had
-    before smoothing (bones included: the whole action); drops the smoothed copy once nothing
-    uses it, unless the animator edited it since it was made: that one is kept with a fake
-    user and its name appended to `kept`. Returns the objects. `users`: the caller's
-    :func:`users_by_slot` of the smoothed actions, made before any was reverted (many objects
-    reverted at once: one pass over the scene's objects, not one per action); `removals`: a
-    list the caller passes to :func:`remove_unused` once `t` commits (else each smoothed copy
-    is removed on its own)."""
-    source = source_of(obj)
-    if source is None:
-        raise SmoothError(f"{obj.name}: its action was not made by Smooth Motion: nothing to revert")
-    smoothed = obj.animation_data.action
-    identifier = channels.slot_identifier(obj)
-    if users is not None:
-        sharing = users.get((smoothed.as_pointer(), identifier)) or [obj]
-    else:
-        sharing = users_of(smoothed, identifier)
-    source_slot = smoothed.get(SOURCE_SLOT_KEY, "")
-    for other in sharing:
-        t.assign_action(other, source, source_slot)
-    t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
-    if was_edited(smoothed, identifier):
-        t.set(smoothed, "use_fake_user", True)  # an edit is never thrown away
-        if kept is not None:
+def revert(objects: Iterable[bpy.types.Object], t: transaction.Transaction) -> tuple[list[bpy.types.Object], list[str]]:
+    """Gives each of `objects` whose action Smooth Motion made (others are passed over), and
+    every object sharing that action, back the action they had before smoothing (bones
+    included: the whole action), inside the transaction `t`. Each smoothed copy is removed once
+    `t` commits and nothing uses it, unless the animator edited it since it was made: that one
+    is kept with a fake user. Returns the objects given their original back and the names of
+    the edited results kept.
+
+    One pass over `objects` for their actions, slots and originals, one over the scene's
+    objects for those sharing them (:func:`users_by_slot`), each result's edit check once, and
+    the unused results removed in one :func:`remove_unused` (per object, these made Revert of
+    many objects grow faster than the objects)."""
+    # (action pointer, slot identifier) -> (smoothed action, identifier, original, first object)
+    found: dict[tuple[int, str], tuple] = {}
+    for obj in objects:
+        adt = obj.animation_data
+        smoothed = adt.action if adt is not None else None
+        source = smoothed.get(SOURCE_KEY) if smoothed is not None else None
+        if isinstance(source, bpy.types.Action):
+            identifier = channels.slot_identifier(obj)
+            found.setdefault((smoothed.as_pointer(), identifier), (smoothed, identifier, source, obj))
+    users = users_by_slot({pointer for pointer, _ in found})  # (before any is reverted)
+    reverted, kept, removals = [], [], []
+    for key, (smoothed, identifier, source, obj) in found.items():
+        source_slot = smoothed.get(SOURCE_SLOT_KEY, "")
+        for other in users.get(key) or [obj]:
+            t.assign_action(other, source, source_slot)
+            reverted.append(other)
+        t.set(source, "use_fake_user", bool(smoothed.get(SOURCE_FAKE_USER_KEY, False)))
+        if was_edited(smoothed, identifier):
+            t.set(smoothed, "use_fake_user", True)  # an edit is never thrown away
             kept.append(smoothed.name)
-    elif removals is not None:
-        removals.append(smoothed)
-    else:
-        t.on_commit(lambda: _remove_if_unused(smoothed), key=("remove", smoothed.as_pointer()))
-    return sharing
+        else:
+            removals.append(smoothed)
+    t.on_commit(lambda: remove_unused(removals))
+    return reverted, kept

@@ -194,10 +194,14 @@ def insert_key(
     )
     frames = check_frames(before, frame)
     try:
-        poses_before, _ = bake.sample_poses(before, frames, options, owner)
-        pose, scale = bake.sample_poses(before, np.array([frame], dtype=np.float64), options, owner)
+        poses_before, scales_before = bake.sample_poses(before, frames, options, owner)
     except ValueError as err:
         raise SmoothError(f"{name}: {err}") from err
+    # The pose keyed is the motion's at `frame`, one of the frames just sampled (sampling is
+    # per frame: the same values as sampling `frame` alone, without a polyscrew call of its own).
+    at = int(np.searchsorted(frames, frame))
+    pose = poses_before[at : at + 1]
+    scale = scales_before[at : at + 1] if scales_before is not None else None
 
     mode = owner.rotation_mode
     rotation_path = keys.rotation_path(mode)

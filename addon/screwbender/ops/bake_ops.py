@@ -210,27 +210,18 @@ class SCREWBENDER_OT_revert(bpy.types.Operator):
         return True
 
     def execute(self, context: bpy.types.Context) -> set[str]:
-        reverted: dict[str, bpy.types.Object] = {}
-        kept: list[str] = []
-
-        def work(progress: pipeline.Progress) -> None:
+        def work(progress: pipeline.Progress) -> tuple[list[bpy.types.Object], list[str]]:
             with transaction.atomic() as t:
-                chosen = [o for o in sorted(context.selected_objects, key=lambda o: o.name) if bake.source_of(o) is not None]
-                # who uses each smoothed action: one pass over the scene's objects for all of them
-                users = bake.users_by_slot({o.animation_data.action.as_pointer() for o in chosen})
-                removals: list[bpy.types.Action] = []  # the smoothed copies, removed at once
-                for obj in chosen:
-                    if obj.name not in reverted:
-                        reverted.update((o.name, o) for o in bake.revert(obj, t, kept, users, removals))
-                t.on_commit(lambda: bake.remove_unused(removals))
+                return bake.revert(sorted(context.selected_objects, key=lambda o: o.name), t)
 
-        return pipeline.run(self, "Revert Smoothing", work, lambda _: self.report_reverted(context, reverted, kept))
+        return pipeline.run(self, "Revert Smoothing", work, lambda done: self.report_reverted(context, *done))
 
-    def report_reverted(self, context: bpy.types.Context, reverted: dict, kept: list[str]) -> set[str]:
+    def report_reverted(self, context: bpy.types.Context, reverted: list, kept: list[str]) -> set[str]:
         selected = {o.name for o in context.selected_objects}
-        others = sorted(set(reverted) - selected)
+        names = {o.name for o in reverted}
+        others = sorted(names - selected)
         also = f" (and {bake.summary(others)}, which shared its action)" if others else ""
-        self.report({"INFO"}, f"Restored the original action of {bake.summary(sorted(set(reverted) & selected))}{also}")
+        self.report({"INFO"}, f"Restored the original action of {bake.summary(sorted(names & selected))}{also}")
         if kept:
             self.report({"INFO"}, f"kept the edited result {bake.summary(kept)} (fake user): it was edited after it was made")
         return {"FINISHED"}
