@@ -266,3 +266,150 @@ fn the_narrow_band_gives_the_dense_grids_mesh() {
         assert_eq!(band.error_bound, dense.error_bound, "{name}: bound");
     }
 }
+
+/// An upper bound on the distance from `x` to the boundary of the region whose signed
+/// distance is `sd` (1-Lipschitz): `sd(x)` outside; from inside, the way out along `dir` (unit)
+/// by sphere tracing (a step of `|sd| + eta` never goes further out than the boundary by more
+/// than `eta`), `f64::INFINITY` if it does not get out.
+fn boundary_distance(sd: &dyn Fn(DVec3) -> f64, x: DVec3, dir: DVec3, eta: f64) -> f64 {
+    let mut g = sd(x);
+    if g >= 0.0 {
+        return g;
+    }
+    let mut s = 0.0;
+    for _ in 0..64 {
+        s += -g + eta;
+        g = sd(x + s * dir);
+        if g >= 0.0 {
+            return s;
+        }
+    }
+    f64::INFINITY
+}
+
+/// The face points checked on a triangle: its corners, edge midpoints, centre and three
+/// interior barycentric points.
+fn face_points([a, b, c]: [DVec3; 3]) -> [DVec3; 10] {
+    let bary = |u: f64, v: f64| u * a + v * b + (1.0 - u - v) * c;
+    [
+        a,
+        b,
+        c,
+        0.5 * (a + b),
+        0.5 * (b + c),
+        0.5 * (c + a),
+        (a + b + c) / 3.0,
+        bary(0.6, 0.2),
+        bary(0.2, 0.6),
+        bary(0.2, 0.2),
+    ]
+}
+
+/// Each case's sweep at `cell_rel` of the body's extent, and the distance bounds of the face
+/// points of about `triangles[0]` of its triangles (`triangles[1]` for the torus, whose exact
+/// distance is slow), an even stride through them: (name, mesh, distances relative to the
+/// extent, sorted).
+fn face_distances(
+    cell_rel: f64,
+    triangles: [usize; 2],
+) -> Vec<(&'static str, ClosedMesh, Vec<f64>)> {
+    let mut out = Vec::new();
+    for (name, body, poses) in cases() {
+        let extent = body.extent();
+        let mesh = sweep_closed(
+            &body,
+            &poses,
+            &ClosedOptions {
+                cell: Some(cell_rel * extent),
+            },
+        )
+        .unwrap();
+        let is_cube = name.starts_with("cube");
+        let sd = |x: DVec3| {
+            min_over_motion(&poses, &|p: &Pose| {
+                let q = p.inverse().transform_point3(x);
+                if is_cube {
+                    sd_box(q, DVec3::ONE)
+                } else {
+                    sd_mesh(&body, q)
+                }
+            })
+        };
+        let probes = if name.starts_with("torus") {
+            triangles[1]
+        } else {
+            triangles[0]
+        };
+        let stride = mesh.triangles.len().div_ceil(probes).max(1);
+        let eta = 1e-4 * extent;
+        let mut d: Vec<f64> = mesh
+            .triangles
+            .iter()
+            .step_by(stride)
+            .flat_map(|t| {
+                let p = t.map(|k| mesh.vertices[k as usize]);
+                let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                face_points(p).map(|x| boundary_distance(&sd, x, n, eta) / extent)
+            })
+            .collect();
+        d.sort_by(f64::total_cmp);
+        out.push((name, mesh, d));
+    }
+    out
+}
+
+/// Issue 29: every face point (corners, edge midpoints, centres, interior points), not only
+/// the vertices, within the reported bound of the swept boundary (the exact motion, the
+/// body's exact distance), on the four cases at the tests' cell.
+///
+/// Ignored: it fails on today's closed sweep (the bound covers the vertices only; faces
+/// across the region's creases cut it by up to about a cell). It is the acceptance test of
+/// issue 29's face bound: `cargo test --release -- --ignored every_face_point`.
+#[test]
+#[ignore]
+fn every_face_point_lies_within_the_bound() {
+    for (name, mesh, d) in face_distances(CELL_REL, [120, 20]) {
+        let extent = mesh.cell / CELL_REL;
+        let (worst, p99) = (d[d.len() - 1], d[(d.len() * 99) / 100]);
+        println!(
+            "{name}: {} face points, worst {:.3} %, 99th percentile {:.3} %, bound {:.3} % of \
+             the extent",
+            d.len(),
+            100.0 * worst,
+            100.0 * p99,
+            100.0 * mesh.error_bound / extent
+        );
+        assert!(
+            worst * extent <= mesh.error_bound,
+            "{name}: a face point {:e} off, over the bound {:e}",
+            worst * extent,
+            mesh.error_bound
+        );
+    }
+}
+
+/// The same at the default cell, with more points (slow in a debug build: run with
+/// `cargo test --release -- --ignored face_points_at_the_default_cell`): the bound within
+/// 0.5 % of the body's extent (issue 29's goal). Ignored: it fails today (see
+/// [`every_face_point_lies_within_the_bound`]); it prints each case's worst face point and
+/// 99th percentile, the measurement issue 29 asks for.
+#[test]
+#[ignore]
+fn face_points_at_the_default_cell() {
+    for (name, mesh, d) in face_distances(DEFAULT_CELL_REL, [3000, 300]) {
+        let extent = mesh.cell / DEFAULT_CELL_REL;
+        let (worst, p99) = (d[d.len() - 1], d[(d.len() * 99) / 100]);
+        println!(
+            "{name}: {} triangles, {} face points, worst {:.3} %, 99th percentile {:.3} %, bound \
+             {:.3} % of the extent, volume {:.5}",
+            mesh.triangles.len(),
+            d.len(),
+            100.0 * worst,
+            100.0 * p99,
+            100.0 * mesh.error_bound / extent,
+            volume(&mesh.vertices, &mesh.triangles)
+        );
+        assert!(worst * extent <= mesh.error_bound, "{name}");
+        assert!(mesh.error_bound <= 0.005 * extent, "{name}");
+    }
+}
