@@ -205,21 +205,26 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
     }
 }
 
+/// A case's region signed distance at `x`: the exact motion (`min_over_motion`), the body's
+/// exact signed distance (closed form for the cube, `sd_mesh` otherwise).
+fn region_sd(name: &str, body: &Body, poses: &[Pose], x: DVec3) -> f64 {
+    let is_cube = name.starts_with("cube");
+    min_over_motion(poses, &|p: &Pose| {
+        let q = p.inverse().transform_point3(x);
+        if is_cube {
+            sd_box(q, DVec3::ONE)
+        } else {
+            sd_mesh(body, q)
+        }
+    })
+}
+
 #[test]
 fn every_vertex_lies_on_the_swept_boundary_within_the_bound() {
     for (name, body, poses) in cases() {
         let out = sweep_closed(&body, &poses, &options(&body)).unwrap();
         let is_cube = name.starts_with("cube");
-        let sd = |x: DVec3| {
-            min_over_motion(&poses, &|p: &Pose| {
-                let q = p.inverse().transform_point3(x);
-                if is_cube {
-                    sd_box(q, DVec3::ONE)
-                } else {
-                    sd_mesh(&body, q)
-                }
-            })
-        };
+        let sd = |x: DVec3| region_sd(name, &body, &poses, x);
         let probes = if is_cube { 1000 } else { 150 };
         let stride = out.vertices.len().div_ceil(probes).max(1);
         let worst = out
@@ -264,5 +269,147 @@ fn the_narrow_band_gives_the_dense_grids_mesh() {
         assert_eq!(band.triangles, dense.triangles, "{name}: triangles");
         assert_eq!(band.vertices, dense.vertices, "{name}: vertices");
         assert_eq!(band.error_bound, dense.error_bound, "{name}: bound");
+    }
+}
+
+/// An upper bound on the distance from `x` to the boundary of the region whose signed
+/// distance is `sd` (1-Lipschitz): `sd(x)` outside; from inside, the way out along `dir` (unit)
+/// by sphere tracing (a step of `|sd| + eta` never goes further out than the boundary by more
+/// than `eta`), `f64::INFINITY` if it does not get out.
+fn boundary_distance(sd: &dyn Fn(DVec3) -> f64, x: DVec3, dir: DVec3, eta: f64) -> f64 {
+    let mut g = sd(x);
+    if g >= 0.0 {
+        return g;
+    }
+    let mut s = 0.0;
+    for _ in 0..64 {
+        s += -g + eta;
+        g = sd(x + s * dir);
+        if g >= 0.0 {
+            return s;
+        }
+    }
+    f64::INFINITY
+}
+
+/// The face points checked on a triangle: its corners, edge midpoints, centre and three
+/// interior barycentric points.
+fn face_points([a, b, c]: [DVec3; 3]) -> [DVec3; 10] {
+    let bary = |u: f64, v: f64| u * a + v * b + (1.0 - u - v) * c;
+    [
+        a,
+        b,
+        c,
+        0.5 * (a + b),
+        0.5 * (b + c),
+        0.5 * (c + a),
+        (a + b + c) / 3.0,
+        bary(0.6, 0.2),
+        bary(0.2, 0.6),
+        bary(0.2, 0.2),
+    ]
+}
+
+/// Each case's sweep at `cell_rel` of the body's extent, and the distance bounds of the face
+/// points of about `triangles[0]` of its triangles (`triangles[1]` for the torus, whose exact
+/// distance is slow), an even stride through them: (name, mesh, distances relative to the
+/// extent, sorted).
+fn face_distances(
+    cell_rel: f64,
+    triangles: [usize; 2],
+) -> Vec<(&'static str, ClosedMesh, Vec<f64>)> {
+    let mut out = Vec::new();
+    for (name, body, poses) in cases() {
+        let extent = body.extent();
+        let mesh = sweep_closed(
+            &body,
+            &poses,
+            &ClosedOptions {
+                cell: Some(cell_rel * extent),
+            },
+        )
+        .unwrap();
+        let sd = |x: DVec3| region_sd(name, &body, &poses, x);
+        let probes = if name.starts_with("torus") {
+            triangles[1]
+        } else {
+            triangles[0]
+        };
+        let stride = mesh.triangles.len().div_ceil(probes).max(1);
+        let eta = 1e-4 * extent;
+        let mut d: Vec<f64> = mesh
+            .triangles
+            .iter()
+            .step_by(stride)
+            .flat_map(|t| {
+                let p = t.map(|k| mesh.vertices[k as usize]);
+                let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+                face_points(p).map(|x| boundary_distance(&sd, x, n, eta) / extent)
+            })
+            .collect();
+        d.sort_by(f64::total_cmp);
+        out.push((name, mesh, d));
+    }
+    out
+}
+
+/// Prints each case's face-point distances (worst, 99th percentile, bound, volume; % of the
+/// extent) and returns (name, worst distance, bound, extent) per case.
+fn face_report(cell_rel: f64, triangles: [usize; 2]) -> Vec<(&'static str, f64, f64, f64)> {
+    face_distances(cell_rel, triangles)
+        .into_iter()
+        .map(|(name, mesh, d)| {
+            let extent = mesh.cell / cell_rel;
+            let (worst, p99) = (d[d.len() - 1], d[(d.len() * 99) / 100]);
+            println!(
+                "{name}: {} triangles, {} face points, worst {:.3} %, 99th percentile {:.3} %, \
+                 bound {:.3} % of the extent, volume {:.5}",
+                mesh.triangles.len(),
+                d.len(),
+                100.0 * worst,
+                100.0 * p99,
+                100.0 * mesh.error_bound / extent,
+                volume(&mesh.vertices, &mesh.triangles)
+            );
+            (name, worst * extent, mesh.error_bound, extent)
+        })
+        .collect()
+}
+
+/// Issue 29: every face point (corners, edge midpoints, centres, interior points), not only
+/// the vertices, within the reported bound of the swept boundary (the exact motion, the
+/// body's exact distance), on the four cases at the tests' cell.
+///
+/// Ignored: it fails on today's closed sweep, whose bound covers the vertices only (at this
+/// cell an L-prism face across a crease is 2.54 % of the extent off, over the bound's 2.39 %).
+/// It is the acceptance test of issue 29's face bound:
+/// `cargo test --release -- --ignored every_face_point`.
+#[test]
+#[ignore]
+fn every_face_point_lies_within_the_bound() {
+    for (name, worst, bound, _) in face_report(CELL_REL, [120, 20]) {
+        assert!(
+            worst <= bound,
+            "{name}: a face point {worst:e} off, over the bound {bound:e}"
+        );
+    }
+}
+
+/// The same at the default cell, with more points (slow in a debug build: run with
+/// `cargo test --release -- --ignored face_points_at_the_default_cell`), and the bound within
+/// 0.5 % of the body's extent (issue 29's goal). Ignored: it fails today (see
+/// [`every_face_point_lies_within_the_bound`]).
+#[test]
+#[ignore]
+fn face_points_at_the_default_cell() {
+    for (name, worst, bound, extent) in face_report(DEFAULT_CELL_REL, [3000, 300]) {
+        assert!(
+            worst <= bound,
+            "{name}: a face point {worst:e} off, over the bound {bound:e}"
+        );
+        assert!(
+            bound <= 0.005 * extent,
+            "{name}: the bound {bound:e} over 0.5 % of {extent}"
+        );
     }
 }
