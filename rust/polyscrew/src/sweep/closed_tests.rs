@@ -385,7 +385,7 @@ fn face_report(cell_rel: f64, triangles: [usize; 2]) -> Vec<(&'static str, f64, 
 /// It is the acceptance test of issue 29's face bound:
 /// `cargo test --release -- --ignored every_face_point`.
 #[test]
-#[ignore]
+#[ignore = "issue 29: fails today (faces across creases are off the bound; docs/sweep.md, Faces, not only vertices)"]
 fn every_face_point_lies_within_the_bound() {
     for (name, worst, bound, _) in face_report(CELL_REL, [120, 20]) {
         assert!(
@@ -400,7 +400,7 @@ fn every_face_point_lies_within_the_bound() {
 /// 0.5 % of the body's extent (issue 29's goal). Ignored: it fails today (see
 /// [`every_face_point_lies_within_the_bound`]).
 #[test]
-#[ignore]
+#[ignore = "issue 29: fails today (faces across creases are off the bound; docs/sweep.md, Faces, not only vertices)"]
 fn face_points_at_the_default_cell() {
     for (name, worst, bound, extent) in face_report(DEFAULT_CELL_REL, [3000, 300]) {
         assert!(
