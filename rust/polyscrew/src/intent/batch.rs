@@ -96,13 +96,13 @@ pub fn sample_owner_channels(owner: &OwnerMotion<'_>, mode: RotationMode) -> Res
         && owner
             .segments
             .iter()
-            .all(|s| s.lo <= s.hi && s.hi < k && s.start < s.end && s.end <= n)
+            .all(|s| s.lo <= s.hi && s.hi < k && s.start < s.end)
+        // Contiguous from row 0 to row n: every row once, in order.
         && owner
             .segments
             .iter()
-            .map(|s| s.end - s.start)
-            .sum::<usize>()
-            == n;
+            .try_fold(0, |row, s| (s.start == row).then_some(s.end))
+            == Some(n);
     if !fits {
         return Err(crate::Error::LengthMismatch {
             what: "segments",
@@ -360,6 +360,21 @@ mod tests {
                 start: 0,
                 end: 3,
             }],
+            // as many rows as the frames, but row 0 twice and row 2 never
+            vec![
+                Segment {
+                    lo: 0,
+                    hi: 4,
+                    start: 0,
+                    end: 2,
+                },
+                Segment {
+                    lo: 4,
+                    hi: 4,
+                    start: 0,
+                    end: 1,
+                },
+            ],
         ] {
             let owner = motion(&poses, &key_frames, &frames, &segments, Timing::Smooth);
             let err = sample_owner_channels(&owner, RotationMode::Quaternion).unwrap_err();
