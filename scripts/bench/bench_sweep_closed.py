@@ -4,6 +4,9 @@ half turn, a ~2,000-triangle torus on a smoothed 4-key motion, and (``--big``) a
 100,000-triangle bumpy torus over 64 screws. CPU-time medians of alternating runs.
 
     PYTHONPATH=.pylib .venv/bin/python scripts/bench/bench_sweep_closed.py [--repeat 3] [--big]
+
+``--dump DIR`` instead writes the cases (all four) as text for the Rust driver
+``rust/polyscrew/examples/count_sweep_closed.rs`` (instruction counts under callgrind).
 """
 
 from __future__ import annotations
@@ -51,18 +54,34 @@ def cpu(f):
     return time.process_time() - start, out
 
 
+def dump(folder: Path, cases: dict) -> None:
+    """Each case as `folder/NAME.txt`: counts, then vertices, triangles and 4 x 4 poses, one a line."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, (v, t, poses) in cases.items():
+        v, t, poses = np.asarray(v, float), np.asarray(t, int), np.asarray(poses, float)
+        rows = [f"{len(v)} {len(t)} {len(poses)}"]
+        rows += [" ".join(repr(float(x)) for x in r) for r in v]
+        rows += [" ".join(str(int(x)) for x in r) for r in t]
+        rows += [" ".join(repr(float(x)) for x in m.reshape(-1)) for m in poses]
+        (folder / f"{name}.txt").write_text("\n".join(rows) + "\n")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--big", action="store_true", help="also the 100,000-triangle torus over 64 screws")
+    parser.add_argument("--dump", type=Path, help="write the cases to DIR for count_sweep_closed and stop")
     args = parser.parse_args()
     cases = {
         "cube, 120-degree screw + slide": (CUBE_V, CUBE_T, LONG),
         "L-prism, half turn": (*l_prism(), HALF),
         "torus 2,304 triangles, smoothed 4 keys": (*torus(48, 24), SMOOTH),
     }
-    if args.big:
+    if args.big or args.dump:
         cases["bumpy torus 100,000 triangles, 64 screws"] = (*torus(250, 200, bumps=0.25), helix(64))
+    if args.dump:
+        dump(args.dump, dict(zip(["cube", "lprism", "torus", "big"], cases.values())))
+        return
     print("| case | body triangles | sweep (open) CPU | sweep_closed CPU | closed triangles | cell | vertex bound |")
     print("|---|---|---|---|---|---|---|")
     for name, (v, t, poses) in cases.items():

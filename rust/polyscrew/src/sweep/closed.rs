@@ -56,15 +56,20 @@ pub const BAND_CELLS: f64 = 2.5;
 pub const BLOCK_POINTS: usize = 4;
 
 /// The coarse body field (spacing one world cell) behind the blocks' test holds exact
-/// distances within this many cells of the surface. It must exceed the test's reach
-/// (`sqrt(3) (1 + (BLOCK_POINTS + 1) / 2 + 1 / BODY_SUBCELLS)`, 6.4 cells) plus the coarse
-/// field's own trilinear error (`sqrt(3)` cells): then a value that rules a block out is an
-/// unclamped distance, inside or outside (see `narrow_band` and docs/sweep.md).
+/// distances within this many cells of the surface. It must exceed the test's reach (the
+/// ball about a block's centre, `sqrt(3) (BLOCK_POINTS + 1) / 2` cells, plus the fine field's
+/// error and the nearest grid point's distance, `sqrt(3) / 2` cells: 5.6 cells): then a value
+/// that decides a block is an unclamped distance, inside or outside (see `narrow_band` and
+/// docs/sweep.md).
 pub const COARSE_BAND_CELLS: f64 = 9.0;
 
 /// Slack of the blocks' test, in cells: covers the float32 rounding of stored distances
 /// (below `1e-6` cells at these bands) with a wide margin.
 const BLOCK_SLACK_CELLS: f64 = 1e-4;
+
+/// Round-off allowance of the distance bounds that skip work, relative to the largest
+/// coordinate involved (the computed distances are within about `1e-15` of it).
+const ROUNDOFF_REL: f64 = 1e-9;
 
 /// Poses per sample interval at which a vertex's refinement evaluates the body.
 pub const REFINE_POSES: usize = 8;
@@ -154,6 +159,25 @@ impl BodyField {
         c0 * (1.0 - fz) + c1 * fz
     }
 
+    /// The value at the grid point nearest `p` and that point's distance from `p`: the
+    /// distance at `p` is within that distance of the value (`d` is 1-Lipschitz) on the
+    /// value's unclamped side. Outside the grid, `band` at distance 0 (the distance there is
+    /// above the band).
+    #[inline]
+    fn nearest(&self, p: DVec3) -> (f64, f64) {
+        let u = ((p - self.origin) / self.h).round();
+        let [nx, ny, nz] = self.n;
+        if !(u.x >= 0.0 && u.y >= 0.0 && u.z >= 0.0) {
+            return (self.band, 0.0);
+        }
+        let (i, j, k) = (u.x as usize, u.y as usize, u.z as usize);
+        if i >= nx || j >= ny || k >= nz {
+            return (self.band, 0.0);
+        }
+        let node = self.origin + u * self.h;
+        (self.values[(k * ny + j) * nx + i] as f64, node.distance(p))
+    }
+
     /// Samples `body`'s signed distance (see the module documentation).
     fn new(body: &Body, h: f64, band: f64) -> Result<Self> {
         let verts = body.vertices();
@@ -182,7 +206,12 @@ impl BodyField {
             let b = (((hi - o) / h).ceil().max(0.0) as usize).min(m - 1);
             (a, b)
         };
-        // Unsigned distances within the band.
+        // Unsigned distances within the band. A point keeps the least distance, rounded once
+        // to f32 (rounding is monotone), so the order of the triangles does not matter, and a
+        // triangle is skipped at a point where a lower bound of its distance (to its plane, to
+        // its bounding sphere) is already above the point's least distance by more than
+        // round-off: it could not lower it. The values are those of testing every triangle.
+        let roundoff = ROUNDOFF_REL * (lo.abs().max(hi.abs()).max_element() + band + h);
         for t in body.triangles() {
             let [a, b, c] = t.map(|i| verts[i as usize]);
             let tlo = a.min(b).min(c) - DVec3::splat(band);
@@ -190,11 +219,46 @@ impl BodyField {
             let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
             let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
             let (k0, k1) = range(tlo.z, thi.z, origin.z, nz);
+            let normal = (b - a).cross(c - a).normalize_or_zero();
+            let centre = (a + b + c) / 3.0;
+            let radius = centre
+                .distance(a)
+                .max(centre.distance(b))
+                .max(centre.distance(c));
+            // Along a row, the points within `band` of the plane and of the sphere (both
+            // bounds a point's test below would also reject beyond) are an interval.
+            let far = band + roundoff;
             for k in k0..=k1 {
                 for j in j0..=j1 {
-                    for i in i0..=i1 {
-                        let d = point_triangle_distance(point(i, j, k), a, b, c);
+                    let p0 = point(0, j, k);
+                    let (dy, dz) = (p0.y - centre.y, p0.z - centre.z);
+                    let rest = (radius + far).powi(2) - dy * dy - dz * dz;
+                    if rest < 0.0 {
+                        continue;
+                    }
+                    let half = rest.sqrt();
+                    let (mut xlo, mut xhi) = (centre.x - half, centre.x + half);
+                    if normal.x != 0.0 {
+                        let off = normal.dot(p0 - a) - normal.x * p0.x;
+                        let (u, w) = ((-far - off) / normal.x, (far - off) / normal.x);
+                        xlo = xlo.max(u.min(w));
+                        xhi = xhi.min(u.max(w));
+                    }
+                    if xlo > xhi {
+                        continue;
+                    }
+                    let (a0, a1) = range(xlo, xhi, origin.x, nx);
+                    for i in a0.max(i0)..=a1.min(i1) {
+                        let p = point(i, j, k);
                         let slot = &mut values[(k * ny + j) * nx + i];
+                        let least = *slot as f64 + roundoff;
+                        let reach = least + radius;
+                        if normal.dot(p - a).abs() > least
+                            || p.distance_squared(centre) > reach * reach
+                        {
+                            continue;
+                        }
+                        let d = point_triangle_distance(p, a, b, c);
                         if d < *slot as f64 {
                             *slot = d as f32;
                         }
@@ -258,6 +322,18 @@ impl BodyField {
             band,
         })
     }
+}
+
+/// The body's distance grid of spacing `h` and band `band`: its origin, points per axis and
+/// values (for the tests).
+#[cfg(test)]
+pub(super) fn body_distance_grid(
+    body: &Body,
+    h: f64,
+    band: f64,
+) -> Result<(DVec3, [usize; 3], Vec<f32>)> {
+    let field = BodyField::new(body, h, band)?;
+    Ok((field.origin, field.n, field.values))
 }
 
 /// How to ask the closed sweep for less memory.
@@ -502,7 +578,7 @@ struct Grid {
 
 /// Lowers `g` (and records the pose in `arg`) at the grid points `i0..=i1` of row `(jj, k)`
 /// by the body's field read through `inv` (world -> body), as long as a point is not already
-/// at the field's floor.
+/// at the field's floor, at the points `i` that `read(i)` allows.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn lower_row(
@@ -513,6 +589,7 @@ fn lower_row(
     [i0, i1, jj, k]: [usize; 4],
     g: &mut [f32],
     arg: &mut [u32],
+    read: impl Fn(usize) -> bool,
 ) {
     let Grid { origin, cell, n } = grid;
     let deep = -(field.band as f32);
@@ -521,7 +598,7 @@ fn lower_row(
     let mut p = inv.transform_point3(origin + DVec3::new(i0 as f64, jj as f64, k as f64) * cell);
     for i in i0..=i1 {
         let slot = row + i;
-        if g[slot] > deep {
+        if g[slot] > deep && read(i) {
             let v = field.at(p) as f32;
             if v < g[slot] {
                 g[slot] = v;
@@ -552,7 +629,9 @@ fn dense(
         let k1 = (((hi.z - origin.z) / cell).ceil() as usize).min(nz - 1);
         for k in k0..=k1 {
             for jj in j0..=j1 {
-                lower_row(field, inv, j as u32, grid, [i0, i1, jj, k], g, arg);
+                lower_row(field, inv, j as u32, grid, [i0, i1, jj, k], g, arg, |_| {
+                    true
+                });
             }
         }
     }
@@ -564,25 +643,29 @@ fn dense(
 ///
 /// The grid is cut into blocks of [`BLOCK_POINTS`]^3 points. Every grid cube touching a
 /// block's points lies in the ball of radius `rho = sqrt(3) (BLOCK_POINTS + 1) / 2` cells
-/// about the block's centre `c`. With `e(H) = sqrt(3) H` the trilinear error of a body field
-/// of spacing `H` (a corner is within `sqrt(3) H` of the point read and the clamped distance
-/// is 1-Lipschitz), the coarse field `F_j` (spacing `H` = one cell, band `B_c`) and the fine
-/// one `f_j` (spacing `h`, band `b`) bound the body's distance `d_j` through pose `j`, for
-/// every `y` in the ball and `a = e(H) + rho`:
+/// about the block's centre `c`. The coarse field (spacing one cell, band `B_c`) is read at
+/// its grid point nearest `c_j = P_j^-1 c`: a value `v_j` at a distance `delta_j` from `c_j`
+/// (at most `sqrt(3) / 2` cells). The body's distance `d_j` through pose `j` is 1-Lipschitz,
+/// so at any `y` a distance `r` from `c`:
 ///
-/// `d_j(y) >= F_j(c) - a` where `F_j(c) > e(H) - B_c`, and `d_j(y) <= F_j(c) + a` where
-/// `F_j(c) < B_c - e(H)` (a clamped corner only bounds `d_j` on its own side);
-/// `min(d_j, b) - e(h) <= f_j <= max(d_j, -b) + e(h)`.
+/// `d_j(y) >= v_j - delta_j - r` unless `v_j` is the clamp `-B_c`, and
+/// `d_j(y) <= v_j + delta_j + r` unless it is the clamp `+B_c`; the fine field `f_j`
+/// (spacing `h`, band `b`, trilinear error `e = sqrt(3) h`) has
+/// `min(d_j, b) - e <= f_j <= max(d_j, -b) + e`.
 ///
-/// So with `m = min_j F_j(c)`: if `m > a + e(h)`, every `f_j > 0` on the ball; if
-/// `m < -(a + e(h))`, the pose reaching `m` has `f_j < 0` on the ball. Either way no grid cube
-/// touching the block changes sign, so marching tetrahedra sees exactly the cubes it saw on
-/// the dense grid (the same values and poses there: below). Otherwise the block is evaluated,
-/// with only the poses that can reach the minimum: pose `j` cannot if
-/// `min(F_j(c) - a, b) - e(h) > min(m + a, b) + e(h)` (its `f_j` is above the value another
-/// pose gives everywhere on the ball), nor if its bounding sphere stays `B_c + e(H)` off `c`
-/// (its `f_j` is the clamp `b` there, which never lowers `g`). The poses kept are read in the
-/// dense order, so the minimum and the pose giving it are those of the dense grid.
+/// With `lo = min_j (v_j - delta_j)` and `up = min_j (v_j + delta_j)`: if `lo > rho + e`,
+/// every `f_j > 0` on the ball; if `up < -(rho + e)`, the pose reaching `up` has `f_j < 0` on
+/// the ball (the deciding values are far inside `B_c`, so never clamps). Either way no grid
+/// cube touching the block changes sign, so marching tetrahedra sees exactly the cubes it saw
+/// on the dense grid (the same values and poses there: below). Otherwise the block's points
+/// are evaluated, each `y` (at `r` from `c`) only with the poses that can reach its minimum:
+/// `g(y) <= U(y) = min(max(up + r, -b), b) + e` (the pose reaching `up`; `b` is also where
+/// `g` starts), and pose `j` is above that if `min(v_j - delta_j - r, b) - e > U(y)`, by more
+/// than the float32 rounding of the stored values (the slack in `e`): it would neither lower
+/// `g(y)` nor be the first pose reaching it. A pose whose bounding sphere stays `B_c + sqrt(3)`
+/// cells off `c` is not read at all (its `f_j` is the clamp `b` there, which never lowers
+/// `g`). The poses kept are read in the dense order, so the minimum and the pose giving it are
+/// those of the dense grid.
 #[allow(clippy::too_many_arguments)]
 fn narrow_band(
     field: &BodyField,
@@ -612,36 +695,43 @@ fn narrow_band(
         .map(|p| p.transform_point3(centre))
         .collect();
     let rho = root3 * (BLOCK_POINTS as f64 + 1.0) / 2.0 * cell;
-    let a = root3 * coarse.h + rho;
+    // The farthest a block's own point is from its centre.
+    let r_max = root3 * (BLOCK_POINTS as f64 - 1.0) / 2.0 * cell;
     let fine_err = root3 * field.h + BLOCK_SLACK_CELLS * cell;
-    let reach = a + fine_err;
+    let reach = rho + fine_err;
     let sphere = radius + coarse.band + root3 * coarse.h;
     let b = field.band;
     let deep = -(b as f32);
     let blocks = n.map(|m| m.div_ceil(BLOCK_POINTS));
+    // The least value of `f_j` at a block point `r` from the centre (`low` = `v_j - delta_j`),
+    // and the most `g` can be there (`up` = `min_j (v_j + delta_j)`).
+    let floor = |low: f64, r: f64| (low - r).min(b) - fine_err;
+    let ceiling = |up: f64, r: f64| (up + r).max(-b).min(b) + fine_err;
     let mut near: Vec<(u32, f64)> = Vec::new();
+    let mut dist = [0.0f64; BLOCK_POINTS * BLOCK_POINTS * BLOCK_POINTS];
     for bk in 0..blocks[2] {
         let (k0, k1) = (bk * BLOCK_POINTS, ((bk + 1) * BLOCK_POINTS).min(nz) - 1);
         for bj in 0..blocks[1] {
             let (j0, j1) = (bj * BLOCK_POINTS, ((bj + 1) * BLOCK_POINTS).min(ny) - 1);
             for bi in 0..blocks[0] {
                 let (i0, i1) = (bi * BLOCK_POINTS, ((bi + 1) * BLOCK_POINTS).min(nx) - 1);
-                let c = origin
-                    + 0.5 * DVec3::new((i0 + i1) as f64, (j0 + j1) as f64, (k0 + k1) as f64) * cell;
+                let twice = DVec3::new((i0 + i1) as f64, (j0 + j1) as f64, (k0 + k1) as f64);
+                let c = origin + 0.5 * twice * cell;
                 near.clear();
-                let mut m = coarse.band;
+                let (mut low, mut up) = (coarse.band, coarse.band);
                 for (j, (w, inv)) in centres.iter().zip(to_body).enumerate() {
                     if c.distance_squared(*w) > sphere * sphere {
                         continue;
                     }
-                    let v = coarse.at(inv.transform_point3(c));
-                    m = m.min(v);
-                    near.push((j as u32, v));
+                    let (v, delta) = coarse.nearest(inv.transform_point3(c));
+                    low = low.min(v - delta);
+                    up = up.min(v + delta);
+                    near.push((j as u32, v - delta));
                 }
-                if m > reach {
+                if low > reach {
                     continue;
                 }
-                if m < -reach {
+                if up < -reach {
                     for k in k0..=k1 {
                         for jj in j0..=j1 {
                             let row = (k * ny + jj) * nx;
@@ -650,15 +740,31 @@ fn narrow_band(
                     }
                     continue;
                 }
-                let upper = (m + a).min(b) + fine_err;
+                // Each point's distance from the centre, by its offsets in the block.
+                let slot = |i: usize, jj: usize, k: usize| {
+                    ((k - k0) * BLOCK_POINTS + (jj - j0)) * BLOCK_POINTS + (i - i0)
+                };
+                for k in k0..=k1 {
+                    for jj in j0..=j1 {
+                        for i in i0..=i1 {
+                            let q = DVec3::new(i as f64, jj as f64, k as f64) - 0.5 * twice;
+                            dist[slot(i, jj, k)] = q.length() * cell;
+                        }
+                    }
+                }
+                let upper = ceiling(up, r_max);
                 for &(j, v) in &near {
-                    if (v - a).min(b) - fine_err > upper {
+                    if floor(v, r_max) > upper {
                         continue;
                     }
                     let inv = &to_body[j as usize];
                     for k in k0..=k1 {
                         for jj in j0..=j1 {
-                            lower_row(field, inv, j, grid, [i0, i1, jj, k], g, arg);
+                            let read = |i: usize| {
+                                let r = dist[slot(i, jj, k)];
+                                floor(v, r) <= ceiling(up, r)
+                            };
+                            lower_row(field, inv, j, grid, [i0, i1, jj, k], g, arg, read);
                         }
                     }
                 }
