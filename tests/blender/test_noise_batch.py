@@ -165,7 +165,7 @@ def test_one_read_one_pass_over_the_objects_one_call_per_mode(monkeypatch):
         objects.append(ob)
     h.select_only(*objects)
     curves, bake, denoise = (addon_module(f"blender.{m}") for m in ("curves", "bake", "denoise"))
-    calls = {"curves.read": 0, "users_by_slot": 0, "users_of": 0, "rotation_channels_near": 0, "denoise": 0}
+    calls = {"curves.read": 0, "users_by_slot": 0, "rotation_channels_near": 0, "denoise": 0}
 
     def counted(module, name, label):
         original = getattr(module, name)
@@ -178,11 +178,10 @@ def test_one_read_one_pass_over_the_objects_one_call_per_mode(monkeypatch):
 
     counted(curves, "read", "curves.read")
     counted(bake, "users_by_slot", "users_by_slot")
-    counted(bake, "users_of", "users_of")
     counted(denoise.polyscrew, "rotation_channels_near", "rotation_channels_near")
     counted(denoise.polyscrew, "denoise", "denoise")
     before = [ob.animation_data.action for ob in objects]
     assert bpy.ops.screwbender.denoise() == {"FINISHED"}
     print(f"Remove Noise, 40 objects: {calls}")
-    assert calls == {"curves.read": 1, "users_by_slot": 1, "users_of": 0, "rotation_channels_near": 2, "denoise": 1}
+    assert calls == {"curves.read": 1, "users_by_slot": 1, "rotation_channels_near": 2, "denoise": 1}
     assert all(ob.animation_data.action is not a for ob, a in zip(objects, before))

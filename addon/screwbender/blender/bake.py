@@ -668,15 +668,10 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
     return list(groups.values()), skipped
 
 
-def users_of(action: bpy.types.Action, identifier: str) -> list[bpy.types.Object]:
-    """The objects `action` animates through the slot `identifier` ("" before 4.4)."""
-    return users_by_slot({action.as_pointer()}).get((action.as_pointer(), identifier), [])
-
-
 def users_by_slot(pointers: set[int]) -> dict[tuple[int, str], list[bpy.types.Object]]:
     """The objects animated by the actions whose `as_pointer()` is in `pointers`, per (action
     pointer, slot identifier), in the order of `bpy.data.objects`: one pass over the objects
-    for many actions (:func:`users_of` of each would be one pass per action)."""
+    for many actions (one pass, not one per action)."""
     out: dict[tuple[int, str], list[bpy.types.Object]] = {}
     for o in bpy.data.objects:
         adt = o.animation_data
