@@ -48,6 +48,7 @@ sys.path.insert(0, str(ROOT / "tests" / "python"))
 sys.path.insert(0, str(ROOT / "tests" / "fixtures"))
 import bench_shapes  # noqa: E402
 import sweep_measures as sm  # noqa: E402
+from bench_sweep_peers import package_version  # noqa: E402
 from test_sweep_closed import (  # noqa: E402
     CUBE_T,
     CUBE_V,
@@ -244,7 +245,7 @@ def main() -> None:
                     "default_cell": polyscrew.DEFAULT_CLOSED_CELL, "cases": [], "notes": [],
                     "versions": {"python": platform.python_version(), "numpy": np.__version__}}
     for name in ("gpytoolbox", "sweep3d", "scikit-image", "scipy"):
-        result["versions"][name] = _version(name)
+        result["versions"][name] = package_version(name)
     start_all = time.perf_counter()
     for name, (v, t, sd, sdg, keys, body_error) in cases().items():
         if args.only and args.only not in name:
@@ -357,15 +358,6 @@ def helix(count: int) -> np.ndarray:
 
     return np.array([screw_matrix((0.3, 1.0, 0.5), (0.5, 0.0, 0.0), 2.0 * math.pi * k / count, 2.0 * k / count)
                      for k in range(count + 1)])
-
-
-def _version(name: str) -> str:
-    from importlib.metadata import PackageNotFoundError, version
-
-    try:
-        return version(name)
-    except PackageNotFoundError:
-        return "not installed"
 
 
 if __name__ == "__main__":

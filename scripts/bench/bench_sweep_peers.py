@@ -299,7 +299,7 @@ def main() -> None:
     try:
         import gpytoolbox  # noqa: F401
 
-        result["versions"]["gpytoolbox"] = _version("gpytoolbox")
+        result["versions"]["gpytoolbox"] = package_version("gpytoolbox")
         for eps in gpy_eps:
             seconds, gv, gf = run_gpytoolbox(vertices, triangles, stamps, eps)
             record(result["rows"], "gpytoolbox swept_volume", f"eps {eps:g}, {len(stamps)} poses", seconds,
@@ -339,7 +339,8 @@ def main() -> None:
     print(f"bench_sweep_peers: wrote {args.out}")
 
 
-def _version(name: str) -> str:
+def package_version(name: str) -> str:
+    """The installed version of a distribution, or "?"."""
     from importlib.metadata import PackageNotFoundError, version
 
     try:
