@@ -225,11 +225,11 @@ def main() -> None:
     parser.add_argument("--quick", action="store_true", help="a smoke run: coarse reference, coarse peers")
     parser.add_argument("--poses", type=int, default=256, help="dense poses (screws) given to every tool")
     parser.add_argument("--ref-cell", type=float, help="reference grid spacing / body size (default 0.003)")
-    parser.add_argument("--spacing", type=float, help="surface sample spacing / body size (default 0.001)")
+    parser.add_argument("--spacing", type=float, help="surface sample spacing / body size (default 0.002)")
     parser.add_argument("--gpy-eps", default="0.02,0.05", help="gpytoolbox grid sizes")
     parser.add_argument("--gpy-max-eps-torus", type=float, default=0.05,
                         help="the torus's finest gpytoolbox eps (the mesh's distance per grid node is slow)")
-    parser.add_argument("--sweep3d-cases", default="cube",
+    parser.add_argument("--sweep3d-cases", default="",
                         help="run sweep3d on the cases whose names contain one of these (comma-separated; '' for none): "
                         "its Python callback makes it minutes per case")
     parser.add_argument("--big", action="store_true", help="also sweep_closed on 100,000 triangles over 64 screws")
@@ -237,7 +237,7 @@ def main() -> None:
     args = parser.parse_args()
     quick = args.quick
     ref_cell = args.ref_cell or (0.01 if quick else 0.003)
-    spacing = args.spacing or (0.004 if quick else 0.001)
+    spacing = args.spacing or (0.004 if quick else 0.002)
     gpy_eps = [0.1] if quick else [float(e) for e in args.gpy_eps.split(",") if e]
     import polyscrew
 
@@ -315,7 +315,8 @@ def main() -> None:
             record("gpytoolbox swept_volume", f"eps {eps:g}", cpu, wall, gv, gf)
         if not any(w and w in name for w in args.sweep3d_cases.split(",")):
             case["rows"].append({"method": "sweep3d generalized_sweep", "note": "defaults", "skipped":
-                                 "not run here (minutes per case through its Python callback; --sweep3d-cases)"})
+                                 "not run here: minutes of CPU per case through its Python callback, past this part's budget "
+                                 "(--sweep3d-cases)"})
         else:
             try:
                 import sweep3d  # noqa: F401

@@ -214,7 +214,7 @@ def test_the_report_shows_the_three_case_table_and_the_goals(tmp_path):
 
 def test_the_report_quotes_the_issue_for_sweep3d_when_it_did_not_run(tmp_path):
     d = json.loads(json.dumps(CASES_JSON))
-    d["cases"][0]["rows"].pop()
+    d["cases"][0]["rows"][-1] = {"method": "sweep3d generalized_sweep", "note": "defaults", "skipped": "not run here"}
     (tmp_path / "sweep.cases.json").write_text(json.dumps(d))
     rep = report.Report(tmp_path, {})
     rep.sweep_section()
