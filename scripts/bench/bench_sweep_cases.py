@@ -224,7 +224,7 @@ def main() -> None:
     parser.add_argument("--out", type=Path, required=True, help="JSON results")
     parser.add_argument("--quick", action="store_true", help="a smoke run: coarse reference, coarse peers")
     parser.add_argument("--poses", type=int, default=256, help="dense poses (screws) given to every tool")
-    parser.add_argument("--ref-cell", type=float, help="reference grid spacing / body size (default 0.003)")
+    parser.add_argument("--ref-cell", type=float, help="reference grid spacing / body size (default 0.01)")
     parser.add_argument("--spacing", type=float, help="surface sample spacing / body size (default 0.002)")
     parser.add_argument("--gpy-eps", default="0.02,0.05", help="gpytoolbox grid sizes")
     parser.add_argument("--gpy-max-eps-torus", type=float, default=0.05,
@@ -236,7 +236,7 @@ def main() -> None:
     parser.add_argument("--only", help="the cases whose names contain this (default all)")
     args = parser.parse_args()
     quick = args.quick
-    ref_cell = args.ref_cell or (0.01 if quick else 0.003)
+    ref_cell = args.ref_cell or (0.02 if quick else 0.01)
     spacing = args.spacing or (0.004 if quick else 0.002)
     gpy_eps = [0.1] if quick else [float(e) for e in args.gpy_eps.split(",") if e]
     import polyscrew
