@@ -10,8 +10,10 @@
 #   - scripts/bench/bench_bake.py (the add-on's bake vs nla.bake vs a keyframe_insert loop);
 #   - scripts/bench/bench_reduce.py (Reduce Keys vs graph.decimate, five clips, three tolerances);
 #   - scripts/bench/bench_sweep_peers.py (polyscrew.sweep vs stroboscopic instancing, gpytoolbox and
-#     NVIDIA Warp, against a dense-stamp reference), with scripts/bench/requirements.txt
-#     (bench-only: gpytoolbox, warp-lang; never needed by the tests or CI) installed into .venv;
+#     NVIDIA Warp, against a dense-stamp reference) and scripts/bench/bench_sweep_cases.py (issue
+#     29's three cases: polyscrew.sweep_closed vs gpytoolbox and sweep3d against a fine reference),
+#     with scripts/bench/requirements.txt (bench-only: gpytoolbox, warp-lang, sweep3d,
+#     scikit-image; never needed by the tests or CI) installed into .venv;
 #   - scripts/bench/bench_floor.py (every writing operator against its floor, the Blender calls it
 #     cannot avoid, and against nla.bake / graph.gaussian_smooth / graph.decimate; its growth
 #     against owners and frames: issue 27; 31 minutes at load 15-20, about 10 estimated quiet);
@@ -210,6 +212,16 @@ else
   PYTHONPATH="$pylib" "$py" scripts/bench/bench_sweep_peers.py "${sweep_args[@]}" 2>&1 \
     | grep --line-buffered -v -i -e 'cuda' -e '^Warp ' -e '^ *Devices:' -e '"cpu"' -e 'Kernel cache' -e '\.cache/warp' -e '^Module warp' || true
   [ -f "$run/sweep.json" ] || echo "scripts/bench/bench_sweep_peers.py failed (see target/bench/log.txt)" | tee "$run/sweep.missing"
+fi
+# Issue 29's three cases: the closed boundary against gpytoolbox and sweep3d, each result against
+# a reference surface; and sweep_closed on 100,000 triangles over 64 screws.
+stage "sweep: issue 29's three cases, sweep_closed vs gpytoolbox and sweep3d against a fine reference"
+if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(polyscrew, "sweep_closed") else 1)' 2>/dev/null; then
+  echo "polyscrew.sweep_closed is not in this build" | tee "$run/sweep.cases.missing"
+else
+  cases_args=(--out "$run/sweep.cases.json" --big); [ "$quick" = 1 ] && cases_args+=(--quick)
+  PYTHONPATH="$pylib" timeout 2400 "$py" scripts/bench/bench_sweep_cases.py "${cases_args[@]}" 2>&1 | grep --line-buffered -v '\[sweep\] \[info\]' || true
+  [ -f "$run/sweep.cases.json" ] || echo "scripts/bench/bench_sweep_cases.py failed (see target/bench/log.txt)" | tee "$run/sweep.cases.missing"
 fi
 fi
 

@@ -653,8 +653,11 @@ class Report:
         if not js.exists():
             path = self.run / "sweep.missing"
             self.w("not available: " + (path.read_text().strip() if path.exists() else "not run"), "")
-            return
-        d = json.loads(js.read_text())
+        else:
+            self.sweep_open_peers(json.loads(js.read_text()))
+        self.sweep_cases()
+
+    def sweep_open_peers(self, d: dict) -> None:
         case, ref = d["case"], d["reference"]
         self.w(f"`scripts/bench/bench_sweep_peers.py`{' (quick: a smoke run)' if d.get('quick') else ''}. Case: a "
                f"{case['body']} ({case['triangles']:,} triangles) along a polyscrew of {case['poses']} poses "
@@ -714,6 +717,118 @@ class Report:
         for note in d.get("notes", []):
             self.w(f"- {note}")
         self.w("")
+
+    #: sweep3d on the issue's cases, as the issue reports them (its run, not this one).
+    SWEEP3D_ISSUE = ("126 s per case, Hausdorff 0.039 (cube) and 0.027 (prism), volume within 0.3 %, 32 to 86 "
+                     "self-intersecting faces and collapsed faces as returned")
+
+    def sweep_cases(self) -> None:
+        """Issue 29's three cases from scripts/bench/bench_sweep_cases.py (sweep.cases.json)."""
+        self.w("### Issue 29's three cases: the closed boundary against gpytoolbox and sweep3d", "")
+        js = self.run / "sweep.cases.json"
+        if not js.exists():
+            path = self.run / "sweep.cases.missing"
+            self.w("not available: " + (path.read_text().strip() if path.exists() else "not run"), "")
+            return
+        d = json.loads(js.read_text())
+        self.w(f"`scripts/bench/bench_sweep_cases.py`{' (quick: a smoke run)' if d.get('quick') else ''}. Every tool "
+               f"gets the same {d['poses']} screws' worth of dense poses along each motion (ours screws between them, "
+               "gpytoolbox interpolates them, sweep3d gets the space-time function of the body's exact signed "
+               "distance along the screws between them, with its gradient in closed form). Reference: the union of "
+               "the body over far denser poses (no body point moving more than half a reference cell between two), "
+               f"marching cubes (scikit-image) of the minimum over them of the body's exact signed distance on a grid "
+               f"of {100 * d['ref_cell']:g} % of the body's size evaluated only near the boundary, its vertices then "
+               "taken onto the boundary by Newton steps: the reference points. Per result: CPU (`process_time`) and "
+               "wall time of one run (ours open: median of 5), triangles, closed (every edge in two faces, once each "
+               "way), self-intersecting faces (an edge of one passing strictly through another, faces sharing a "
+               "vertex skipped, candidates on a uniform grid: `scripts/bench/sweep_measures.py`), degenerate faces, "
+               "volume against the reference's, and the two-sided Hausdorff distance to the boundary: result -> "
+               "boundary is the exact distance (the region's signed distance over the reference poses) at "
+               f"20,000 of the result's surface samples (exact outside the region, a lower bound inside it), "
+               f"boundary -> result the distance from every reference point to the result's samples "
+               f"(spacing {100 * d['spacing']:g} % of the size, scipy `cKDTree`). Sizes and distances in % of the "
+               "body's size (its bounding-box diagonal).", "")
+        self.w("| case | method | setting | CPU | wall | triangles | closed | self-int. faces | degenerate | "
+               "volume | Hausdorff |", "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+        goals = {"closed": [], "hausdorff": [], "volume": [], "speed": [], "fewer": []}
+        for c in d["cases"]:
+            ours = next((r for r in c["rows"] if r.get("ours")), None)
+            for r in c["rows"]:
+                if r.get("skipped"):
+                    self.w(f"| {c['name']} | {r['method']} | {r['note']} | {r['skipped']} | | | | | | | |")
+                    continue
+                if "hausdorff" not in r:
+                    self.w(f"| {c['name']} | {r['method']} | {r['note']} | {fmt_seconds(r['cpu'])} | "
+                           f"{fmt_seconds(r['wall'])} | 0 | | | | | |")
+                    continue
+                self.w(f"| {c['name']} | {r['method']} | {r['note']} | {fmt_seconds(r['cpu'])} | "
+                       f"{fmt_seconds(r['wall'])} | {r['triangles']:,} | {'yes' if r['closed'] else 'no'} | "
+                       f"{r['self_intersecting']:,} | {r['degenerate']:,} | {100 * r['volume_error']:+.2f} % | "
+                       f"{100 * r['hausdorff']:.3f} % |")
+            if not ours or "hausdorff" not in ours:
+                continue
+            goals["closed"].append((c["name"], ours["closed"] and ours["self_intersecting"] == 0))
+            goals["hausdorff"].append((c["name"], ours["hausdorff"]))
+            goals["volume"].append((c["name"], abs(ours["volume_error"])))
+            for r in c["rows"]:
+                if r.get("ours") or "hausdorff" not in r or r["method"].startswith("ours"):
+                    continue
+                if r["hausdorff"] >= ours["hausdorff"]:  # at equal or better accuracy: ours no worse
+                    goals["speed"].append((f"{c['name']}, {r['method']} {r['note']}", r["cpu"] / ours["cpu"]))
+                if r["method"].startswith("gpytoolbox") and r["note"] == "eps 0.02":
+                    goals["fewer"].append((c["name"], ours["triangles"] / r["triangles"]))
+        self.w("")
+        for c in d["cases"]:
+            ref = c["reference"]
+            self.w(f"- {c['name']} ({c['triangles']:,} triangles, size {c['size']:.3f}, {c['key_poses']} key poses, "
+                   f"{c['poses']} dense poses): reference of {ref['poses']:,} poses (largest move "
+                   f"{ref['largest_move']:.4f}), cell {ref['cell']:.4f}, {ref['points']:,} points, volume "
+                   f"{ref['volume']:.4f}, {fmt_seconds(ref['cpu'])} CPU; its points within "
+                   f"{100 * ref['max_error'] / c['size']:.4f} % of the size of the boundary (the flat marching-cubes "
+                   f"faces between them: {100 * ref['mc_max_error'] / c['size']:.3f} %)"
+                   + (f"; the body mesh lies within {100 * c['body_error'] / c['size']:.3f} % of the smooth torus "
+                      "the reference and sweep3d sweep" if c.get("body_error") else "") + ".")
+        big = d.get("big")
+        if big and big.get("unfinished"):
+            self.w("- `sweep_closed` on the 100,000-triangle bumpy torus over 64 screws did not finish within the "
+                   "bench's time limit (bench.sh stops the script after 40 minutes).")
+            big = None
+        if big:
+            self.w(f"- `sweep_closed` on the bumpy torus of {big['triangles']:,} triangles over {big['screws']} screws "
+                   f"(benches/sweep.rs's case), default cell {big['cell']:.4f}: {fmt_seconds(big['cpu'])} CPU, "
+                   f"{fmt_seconds(big['wall'])} wall, {big['out_triangles']:,} triangles.")
+        if not any(r["method"].startswith("sweep3d") and "hausdorff" in r for c in d["cases"] for r in c["rows"]):
+            self.w(f"- sweep3d was not run here; the issue's figures for it (its run, not measured here): "
+                   f"{self.SWEEP3D_ISSUE}.")
+        vers = ", ".join(f"{k} {v}" for k, v in d.get("versions", {}).items())
+        self.w("", f"Versions: {vers}. The whole script ran in {d['seconds']:.0f} s (wall).")
+        for note in d.get("notes", []):
+            self.w(f"- {note}")
+        self.w("")
+        if goals["closed"]:
+            self.targets.append(("sweep_closed at its default cell: closed manifold, 0 self-intersecting faces (issue "
+                                 "29's cases)", ", ".join(f"{n}: {'yes' if ok else 'no'}" for n, ok in goals["closed"]),
+                                 verdict(all(ok for _, ok in goals["closed"]))))
+            self.targets.append(("sweep_closed Hausdorff <= 0.5 % of the body's size",
+                                 ", ".join(f"{n} {100 * x:.2f} %" for n, x in goals["hausdorff"]),
+                                 verdict(max(x for _, x in goals["hausdorff"]) <= 0.005)))
+            self.targets.append(("sweep_closed volume within 0.5 %",
+                                 ", ".join(f"{n} {100 * x:.2f} %" for n, x in goals["volume"]),
+                                 verdict(max(x for _, x in goals["volume"]) <= 0.005)))
+        if goals["speed"]:
+            worst = min(goals["speed"], key=lambda g: g[1])
+            self.targets.append((">= 1,000x faster (CPU) than gpytoolbox and sweep3d at equal or better accuracy",
+                                 f"at least {worst[1]:.1f}x ({worst[0]})", verdict(worst[1] >= 1000)))
+        elif goals["closed"]:
+            self.targets.append((">= 1,000x faster (CPU) than gpytoolbox and sweep3d at equal or better accuracy",
+                                 "no peer result as accurate as ours to compare with", "n/a"))
+        if goals["fewer"]:
+            self.targets.append(("sweep_closed fewer triangles than gpytoolbox at eps 0.02",
+                                 ", ".join(f"{n} {x:.2f}x" for n, x in goals["fewer"]),
+                                 verdict(max(x for _, x in goals["fewer"]) < 1)))
+        if big:
+            self.targets.append(("sweep_closed: 100,000 triangles over 64 screws in under a second",
+                                 f"{fmt_seconds(big['cpu'])} CPU", verdict(big["cpu"] < 1.0)))
 
     def papers_section(self) -> None:
         self.w("## Figures from other machines (papers, not measured here)", "",

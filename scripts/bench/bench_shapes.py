@@ -5,17 +5,24 @@ from __future__ import annotations
 import numpy as np
 
 
-def bumpy_torus(n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
-    """The bumpy torus of benches/sweep.rs with `n x m` quads: vertices (n m, 3) and outward
-    triangles (2 n m, 3) int64."""
+def torus(n: int, m: int, big: float = 0.6, small: float = 0.22, bumps: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """A torus of `n x m` quads about z (radii `big` and `small`, the tube's radius scaled by
+    ``1 + bumps sin(5 u) cos(3 w)``): vertices (n m, 3), whose ring `i` at angle ``u = 2 pi i / n``
+    is vertices ``i m .. i m + m - 1``, and outward triangles (2 n m, 3) int64."""
     u = 2 * np.pi * np.arange(n) / n
     w = 2 * np.pi * np.arange(m) / m
     uu, ww = np.meshgrid(u, w, indexing="ij")
-    s = 0.22 * (1.0 + 0.25 * np.sin(5 * uu) * np.cos(3 * ww))
-    r = 0.6 + s * np.cos(ww)
+    s = small * (1.0 + bumps * np.sin(5 * uu) * np.cos(3 * ww))
+    r = big + s * np.cos(ww)
     v = np.stack([r * np.cos(uu), r * np.sin(uu), s * np.sin(ww)], axis=-1).reshape(-1, 3)
     i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
     i, j = i.ravel(), j.ravel()
     a, b = i * m + j, ((i + 1) % n) * m + j
     c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
     return v, np.vstack([np.c_[a, b, c], np.c_[a, c, d]]).astype(np.int64)
+
+
+def bumpy_torus(n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """The bumpy torus of benches/sweep.rs with `n x m` quads: vertices (n m, 3) and outward
+    triangles (2 n m, 3) int64."""
+    return torus(n, m, bumps=0.25)

@@ -12,7 +12,6 @@ half turn, a ~2,000-triangle torus on a smoothed 4-key motion, and (``--big``) a
 from __future__ import annotations
 
 import argparse
-import math
 import statistics
 import sys
 import time
@@ -21,31 +20,9 @@ from pathlib import Path
 import numpy as np
 import polyscrew
 
-ROOT = Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "tests" / "python"))
-sys.path.insert(0, str(ROOT / "tests" / "fixtures"))
-from screws import screw_matrix  # noqa: E402
-from test_sweep_closed import CUBE_T, CUBE_V, HALF, LONG, SMOOTH, l_prism  # noqa: E402
-
-
-def torus(n, m, big=0.6, small=0.22, bumps=0.0):
-    u = 2 * np.pi * np.arange(n) / n
-    w = 2 * np.pi * np.arange(m) / m
-    uu, ww = np.meshgrid(u, w, indexing="ij")
-    s = small * (1 + bumps * np.sin(5 * uu) * np.cos(3 * ww))
-    r = big + s * np.cos(ww)
-    v = np.stack([r * np.cos(uu), r * np.sin(uu), s * np.sin(ww)], axis=-1).reshape(-1, 3)
-    i, j = np.meshgrid(np.arange(n), np.arange(m), indexing="ij")
-    a, b = i * m + j, ((i + 1) % n) * m + j
-    c, d = ((i + 1) % n) * m + (j + 1) % m, i * m + (j + 1) % m
-    t = np.concatenate([np.stack([a, b, c], -1).reshape(-1, 3), np.stack([a, c, d], -1).reshape(-1, 3)])
-    return v, t
-
-
-def helix(count):
-    """`count + 1` poses on a helical path with tumbling (the Rust sweep bench's motion)."""
-    return np.array([screw_matrix((0.3, 1.0, 0.5), (0.5, 0.0, 0.0), 2.0 * math.pi * k / count, 2.0 * k / count)
-                     for k in range(count + 1)])
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_shapes import bumpy_torus  # noqa: E402
+from bench_sweep_cases import cases, helix  # noqa: E402  (issue 29's cases, one definition)
 
 
 def cpu(f):
@@ -72,19 +49,15 @@ def main() -> None:
     parser.add_argument("--big", action="store_true", help="also the 100,000-triangle torus over 64 screws")
     parser.add_argument("--dump", type=Path, help="write the cases to DIR for count_sweep_closed and stop")
     args = parser.parse_args()
-    cases = {
-        "cube, 120-degree screw + slide": (CUBE_V, CUBE_T, LONG),
-        "L-prism, half turn": (*l_prism(), HALF),
-        "torus 2,304 triangles, smoothed 4 keys": (*torus(48, 24), SMOOTH),
-    }
+    runs = {name: (v, t, keys) for name, (v, t, _, _, keys, _) in cases().items()}
     if args.big or args.dump:
-        cases["bumpy torus 100,000 triangles, 64 screws"] = (*torus(250, 200, bumps=0.25), helix(64))
+        runs["bumpy torus 100,000 triangles, 64 screws"] = (*bumpy_torus(250, 200), helix(64))
     if args.dump:
-        dump(args.dump, dict(zip(["cube", "lprism", "torus", "big"], cases.values())))
+        dump(args.dump, dict(zip(["cube", "lprism", "torus", "big"], runs.values())))
         return
     print("| case | body triangles | sweep (open) CPU | sweep_closed CPU | closed triangles | cell | vertex bound |")
     print("|---|---|---|---|---|---|---|")
-    for name, (v, t, poses) in cases.items():
+    for name, (v, t, poses) in runs.items():
         open_times, closed_times = [], []
         for _ in range(args.repeat):  # alternating A B A B
             open_times.append(cpu(lambda: polyscrew.sweep(v, t, poses))[0])

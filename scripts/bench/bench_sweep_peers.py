@@ -57,6 +57,7 @@ from scipy.spatial import cKDTree
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import bench_shapes  # noqa: E402
+from sweep_measures import hausdorff  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -109,18 +110,6 @@ def instance_arrays(vertices: np.ndarray, triangles: np.ndarray, poses: np.ndarr
 
 
 # --- measuring -------------------------------------------------------------------------------
-
-
-def hausdorff(a: np.ndarray, b: np.ndarray, tree_b: cKDTree | None = None) -> tuple[float, float]:
-    """Directed Hausdorff distances ``(max_a min_b |a - b|, max_b min_a |a - b|)`` between two
-    point sets (N, 3) and (M, 3), by a k-d tree each way (`tree_b`: one already built on `b`).
-    The two-sided Hausdorff distance is the larger of the two."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    if len(a) == 0 or len(b) == 0:
-        raise ValueError("hausdorff: both point sets must be non-empty")
-    ab = (tree_b if tree_b is not None else cKDTree(b)).query(a, k=1)[0].max()
-    ba = cKDTree(a).query(b, k=1)[0].max()
-    return float(ab), float(ba)
 
 
 def visible_points(view, depth: np.ndarray) -> np.ndarray:
@@ -310,7 +299,7 @@ def main() -> None:
     try:
         import gpytoolbox  # noqa: F401
 
-        result["versions"]["gpytoolbox"] = _version("gpytoolbox")
+        result["versions"]["gpytoolbox"] = package_version("gpytoolbox")
         for eps in gpy_eps:
             seconds, gv, gf = run_gpytoolbox(vertices, triangles, stamps, eps)
             record(result["rows"], "gpytoolbox swept_volume", f"eps {eps:g}, {len(stamps)} poses", seconds,
@@ -350,7 +339,8 @@ def main() -> None:
     print(f"bench_sweep_peers: wrote {args.out}")
 
 
-def _version(name: str) -> str:
+def package_version(name: str) -> str:
+    """The installed version of a distribution, or "?"."""
     from importlib.metadata import PackageNotFoundError, version
 
     try:
