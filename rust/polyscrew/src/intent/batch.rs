@@ -344,13 +344,13 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_hold_repeats_its_key_and_the_next_piece_continues_from_it() {
+    /// [`keys`] with keys 1..2 held, frames 1..24 in segments (rows 0..3 the piece 0..1, 3..10
+    /// the hold of key 1, 10..24 the piece 2..4), log-scales per key.
+    #[allow(clippy::type_complexity)]
+    fn held_keys() -> (Vec<Pose>, Vec<f64>, Vec<f64>, [Segment; 3], Vec<DVec3>) {
         let (mut poses, key_frames) = keys();
-        poses[2] = poses[1]; // keys 1..2 held
+        poses[2] = poses[1];
         let frames: Vec<f64> = (1..25).map(|f| f as f64).collect();
-        let mode = RotationMode::Quaternion;
-        // frames 1..3 (rows 0..3) the piece 0..1, 4..10 the hold of key 1, 11..24 the piece 2..4
         let segments = [
             Segment {
                 lo: 0,
@@ -372,6 +372,13 @@ mod tests {
             },
         ];
         let logs: Vec<DVec3> = (0..5).map(|i| DVec3::splat(0.1 * i as f64)).collect();
+        (poses, key_frames, frames, segments, logs)
+    }
+
+    #[test]
+    fn a_hold_repeats_its_key_and_the_next_piece_continues_from_it() {
+        let (poses, key_frames, frames, segments, logs) = held_keys();
+        let mode = RotationMode::Quaternion;
         let owner = OwnerMotion {
             log_scales: Some(&logs),
             ..motion(&poses, &key_frames, &frames, &segments, Timing::Smooth)
@@ -405,30 +412,7 @@ mod tests {
 
     #[test]
     fn poses_are_sample_per_piece_and_the_key_per_hold_to_the_bit() {
-        let (mut poses, key_frames) = keys();
-        poses[2] = poses[1]; // keys 1..2 held
-        let frames: Vec<f64> = (1..25).map(|f| f as f64).collect();
-        let segments = [
-            Segment {
-                lo: 0,
-                hi: 1,
-                start: 0,
-                end: 3,
-            },
-            Segment {
-                lo: 1,
-                hi: 1,
-                start: 3,
-                end: 10,
-            },
-            Segment {
-                lo: 2,
-                hi: 4,
-                start: 10,
-                end: 24,
-            },
-        ];
-        let logs: Vec<DVec3> = (0..5).map(|i| DVec3::splat(0.1 * i as f64)).collect();
+        let (poses, key_frames, frames, segments, logs) = held_keys();
         let owner = OwnerMotion {
             log_scales: Some(&logs),
             ..motion(&poses, &key_frames, &frames, &segments, Timing::Linear)
