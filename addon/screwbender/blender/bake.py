@@ -168,6 +168,28 @@ def sample_poses(
     return sampled.poses, sampled.scales
 
 
+def sample_poses_many(
+    items: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray]], options: Options
+) -> list[tuple[np.ndarray, np.ndarray | None] | SmoothError]:
+    """:func:`sample_poses` of each `(owner, motion, frames)` of `items`, or the
+    :class:`SmoothError` refusing it: the screw method samples every owner in one polyscrew
+    call per rotation mode (:func:`sampling.sample_many` with poses: the same values to the
+    bit), Feature Points and owners the batch refused each alone (as :func:`_sample_plans`)."""
+    batched = [None] * len(items)
+    if options.method != "FEATURE" and items:
+        batched = sampling.sample_many([(motion, frames, None) for _, motion, frames in items], options, poses=True)
+    out: list[tuple[np.ndarray, np.ndarray | None] | SmoothError] = []
+    for (owner, motion, frames), sampled in zip(items, batched):
+        if sampled is not None:
+            out.append((sampled.poses, sampled.scales))
+            continue
+        try:
+            out.append(sample_poses(motion, frames, options, owner))
+        except ValueError as err:  # polyscrew's ValueError
+            out.append(SmoothError(f"{owner.name}: {err}"))
+    return out
+
+
 def channel_count(motion: keys.KeyedMotion) -> int:
     """F-curves a bake of `motion` writes: location, rotation, keyed scale axes."""
     return len(keys.baked_channels(motion.rotation_mode, motion.located, motion.scale_axes))
