@@ -158,7 +158,8 @@ def sample_poses(
     feature points and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
     from polyscrew.
 
-    The live preview and Insert Key on Motion sample through here; Smooth Motion's bake
+    The live preview samples through here, Insert Key on Motion through
+    :func:`sample_poses_many` (all its owners at once, the same values); Smooth Motion's bake
     samples the same motion as channels (:func:`sample_channels`: `polyscrew.sample_channels`
     is `rotation_channels` of `polyscrew.sample`), so they show, key and bake one motion
     (:mod:`sampling`: pieces between holds, timing "keys").

@@ -25,6 +25,10 @@ its two neighbours only (and, on a cyclic curve, of the first and last two keys)
 read back one by one, not the whole curve (the new key whole, the others their handles). A curve with Auto Handle Smoothing
 (`auto_smoothing`: every handle may move) has its handles read again in full. Many owners of
 one action (a rig's bones) share one pass over its curves (:func:`owners.curves_by_owner`).
+
+Every owner of one run goes through the phases together (:func:`insert_keys`): the motions
+before the insertions are sampled in one `polyscrew.sample_owners` call per rotation mode, and
+so are the motions after (:func:`bake.sample_poses_many`), instead of two samplings per owner.
 """
 
 from __future__ import annotations
