@@ -104,3 +104,31 @@ def test_batched_keys_are_the_owner_by_owner_keys(monkeypatch, timing, frame):
         assert values.keys() == values_alone.keys()
         assert all(np.array_equal(values[p], values_alone[p]) for p in values)
     print(f"timing {timing}, frame {frame}: {len(found['alone'][1])} owners keyed the same")
+
+
+def test_a_refused_owner_is_told_as_alone_and_the_others_keyed():
+    """Among owners keyed together, one with a single key: refused with the message
+    `insert_key` gives it alone, its curves untouched; the others keyed."""
+    ik, owners, transaction, bake, channels = (
+        addon_module(m)
+        for m in ("blender.insert_key", "blender.owners", "blender.transaction", "blender.bake", "blender.channels")
+    )
+    options = bake.Options()
+    good = [keyed(f"Good{i}", seed=50 + i) for i in range(2)]
+    lone = h.new_object("Lone")
+    h.key_poses(lone, [5], h.rigid(np.zeros((1, 3)), np.eye(3)[None]))
+    before = keys_of(lone)
+    with transaction.atomic() as t:
+        with pytest.raises(addon_module("blender.keys").SmoothError) as alone:
+            with transaction.atomic(t) as one:
+                ik.insert_key(lone, 12.0, options, one)
+        got = ik.insert_keys(
+            [(owners.as_owner(o), channels.object_fcurves(o)) for o in [good[0], lone, good[1]]], 12.0, options, t
+        )
+    print(f"refused: {got[1]}")
+    assert isinstance(got[1], Exception) and str(got[1]) == str(alone.value)
+    assert all(isinstance(r, ik.InsertResult) for r in (got[0], got[2]))
+    after = keys_of(lone)
+    assert after.keys() == before.keys() and all(
+        np.array_equal(a, b) for name in after for a, b in zip(after[name], before[name])
+    )
