@@ -990,6 +990,7 @@ def sample_owners(
     levels: int = 4,
     timing: TimingName = "smooth",
     played: bool = False,
+    as_poses: bool = False,
 ) -> tuple[FloatArray, FloatArray, FloatArray | None, FloatArray | None, IntArray]:
     """Many owners' smoothed motions (rotation ``mode``) as Blender channels in one call: for
     each owner, exactly what ``timed_frames`` then ``sample_channels`` (and ``sample_vectors``
@@ -1009,7 +1010,10 @@ def sample_owners(
     owners not scaled; None without ``log_scales``), with ``played`` the rows timing Keys
     played (T, 3 + width; NaN elsewhere; else None), and per owner a status (int64): 1 sampled
     with played rows, 0 sampled, -1 refused (its rows zero: sample that owner alone to learn
-    why). GIL released. Raises ValueError for arrays that do not fit together.
+    why). With ``as_poses`` the second array is the rigid poses (T, 4, 4) instead of rotation
+    channels: exactly what ``timed_frames`` then ``sample`` give for each piece, a hold its
+    key pose (``previous`` unused). GIL released. Raises ValueError for arrays that do not
+    fit together.
     """
 
 class Denoised:

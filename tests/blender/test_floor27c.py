@@ -39,20 +39,23 @@ def _counting(module, name: str, calls: list, what=lambda first: first):
 
 
 def test_insert_key_samples_each_owner_twice():
-    """Five objects: ten samplings of a motion (before and after each insertion); on 148afe3
-    fifteen (a third one for the keyed pose alone). Every channel still gets its key."""
+    """Five objects: every motion sampled twice (before and after each insertion), all owners
+    together: two batched samplings (`bake.sample_poses_many`, each owner in it once), none
+    alone; on 148afe3 fifteen samplings alone (a third one for the keyed pose alone), on
+    ba6187d ten. Every channel still gets its key."""
     bake = addon_module("blender.bake")
     objects = [keyed_object(f"Twice{i}", 0.5 * i) for i in range(5)]
     bpy.context.scene.frame_set(14)
     h.select_only(*objects)
     calls: list = []
-    original = _counting(bake, "sample_poses", calls)
+    batched: list = []
+    originals = (_counting(bake, "sample_poses", calls), _counting(bake, "sample_poses_many", batched, len))
     try:
         assert bpy.ops.screwbender.insert_key() == {"FINISHED"}
     finally:
-        bake.sample_poses = original
-    print(f"Insert Key on Motion, 5 objects: {len(calls)} samplings (148afe3: 15)")
-    assert len(calls) == 2 * len(objects)
+        bake.sample_poses, bake.sample_poses_many = originals
+    print(f"Insert Key on Motion, 5 objects: {len(calls)} samplings alone, {batched} batched (148afe3: 15 alone)")
+    assert calls == [] and batched == [len(objects)] * 2
     for obj in objects:
         keyed = [fc for fc in h.fcurves(obj) if np.any(np.abs(h.curve_points(fc)[:, 0] - 14.0) < 1e-6)]
         assert len(keyed) == 9, obj.name

@@ -108,6 +108,26 @@ def test_sample_many_is_sample_owner_by_owner_to_the_bit(timing, scheme):
     print(f"timing {timing}, {scheme}: {len(items)} owners ({held} with holds, {popped} popping) bit for bit")
 
 
+@pytest.mark.parametrize("timing", ["smooth", "linear", "keys"])
+def test_sample_many_poses_are_sample_owner_by_owner_to_the_bit(timing):
+    """With `poses` (Insert Key on Motion's sampling): the rigid poses and scales `sample`
+    gives owner by owner (`polyscrew.sample` per piece, a hold its key's own matrix), every
+    mode, holds, cycles, to the bit."""
+    rng = np.random.default_rng(270 + len(timing))
+    items = owners(rng, 48)
+    options = SimpleNamespace(scheme="four_point", levels=3, timing=timing, method="SCREW")
+    got = sampling.sample_many(items, options, poses=True)
+    for (motion, frames, _), batched in zip(items, got):
+        want = sampling.sample(motion, frames, options)
+        assert batched is not None, f"{motion.rotation_mode}: sampled alone, refused in the batch"
+        for name in ("poses", "scales", "constant"):
+            assert same(getattr(batched, name), getattr(want, name)), (
+                f"{name} differs: mode {motion.rotation_mode}, closed {motion.closed}, held {motion.held}"
+            )
+        assert batched.location is None and batched.rotation is None and batched.played is None
+    assert sum(m.held is not None and m.held.any() for m, _, _ in items) >= 5
+
+
 def test_sample_many_tells_the_owners_the_core_refuses():
     """A closed motion without a period (the core refuses it: `Error::Period`) and a motion
     sampled beyond the working range come back None, the others sampled as alone."""

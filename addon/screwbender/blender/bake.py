@@ -158,7 +158,8 @@ def sample_poses(
     feature points and key selection), one `polyscrew.sample_vectors` call for log-scale. Raises `ValueError`
     from polyscrew.
 
-    The live preview and Insert Key on Motion sample through here; Smooth Motion's bake
+    The live preview samples through here, Insert Key on Motion through
+    :func:`sample_poses_many` (all its owners at once, the same values); Smooth Motion's bake
     samples the same motion as channels (:func:`sample_channels`: `polyscrew.sample_channels`
     is `rotation_channels` of `polyscrew.sample`), so they show, key and bake one motion
     (:mod:`sampling`: pieces between holds, timing "keys").
@@ -166,6 +167,28 @@ def sample_poses(
     owner = owners.as_owner(owner) if owner is not None else None
     sampled = sampling.sample(motion, frames, options, feature.sampler(owner, options))
     return sampled.poses, sampled.scales
+
+
+def sample_poses_many(
+    items: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray]], options: Options
+) -> list[tuple[np.ndarray, np.ndarray | None] | SmoothError]:
+    """:func:`sample_poses` of each `(owner, motion, frames)` of `items`, or the
+    :class:`SmoothError` refusing it: the screw method samples every owner in one polyscrew
+    call per rotation mode (:func:`sampling.sample_many` with poses: the same values to the
+    bit), Feature Points and owners the batch refused each alone (as :func:`_sample_plans`)."""
+    batched = [None] * len(items)
+    if options.method != "FEATURE" and items:
+        batched = sampling.sample_many([(motion, frames, None) for _, motion, frames in items], options, poses=True)
+    out: list[tuple[np.ndarray, np.ndarray | None] | SmoothError] = []
+    for (owner, motion, frames), sampled in zip(items, batched):
+        if sampled is not None:
+            out.append((sampled.poses, sampled.scales))
+            continue
+        try:
+            out.append(sample_poses(motion, frames, options, owner))
+        except ValueError as err:  # polyscrew's ValueError
+            out.append(SmoothError(f"{owner.name}: {err}"))
+    return out
 
 
 def channel_count(motion: keys.KeyedMotion) -> int:

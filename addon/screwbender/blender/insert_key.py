@@ -25,6 +25,10 @@ its two neighbours only (and, on a cyclic curve, of the first and last two keys)
 read back one by one, not the whole curve (the new key whole, the others their handles). A curve with Auto Handle Smoothing
 (`auto_smoothing`: every handle may move) has its handles read again in full. Many owners of
 one action (a rig's bones) share one pass over its curves (:func:`owners.curves_by_owner`).
+
+Every owner of one run goes through the phases together (:func:`insert_keys`): the motions
+before the insertions are sampled in one `polyscrew.sample_owners` call per rotation mode, and
+so are the motions after (:func:`bake.sample_poses_many`), instead of two samplings per owner.
 """
 
 from __future__ import annotations
@@ -167,19 +171,102 @@ def insert_key(
 ) -> InsertResult:
     """Keys the pose the smoothed motion of `owner` (an object or a pose bone) has at `frame`
     on its transform channels (inside the transaction `t`: the curves get their old keys back
-    if anything fails later).
+    if anything fails later): :func:`insert_keys` of one owner.
 
     `fcurves`: the owner's transform curves when the caller has grouped them
-    (:func:`owners.curves_by_owner`: many bones of one action without a scan of all its curves
-    per bone). `known`, a dict the caller keeps over one run: the packed keys per set of curves
-    read or keyed so far (owners sharing an action read it once, and see the keys inserted).
+    (:func:`owners.curves_by_owner`). `known`: as in :func:`insert_keys`.
 
     Raises :class:`SmoothError` (nothing changed) when the keys cannot be smoothed.
     """
     owner = owners.as_owner(owner)
-    name = owner.name
     listed = list(channels.object_fcurves(owner.obj) if fcurves is None else fcurves)
+    (outcome,) = insert_keys([(owner, listed)], frame, options, t, known)
+    if isinstance(outcome, SmoothError):
+        raise outcome
+    return outcome
+
+
+def _footprint(owner: owners.Owner) -> tuple:
+    """What the curves `owner` keys are known by: its action, slot and bone (linked
+    duplicates share them)."""
+    adt = owner.obj.animation_data
+    action = adt.action.as_pointer() if adt is not None and adt.action is not None else None
+    return action, channels.slot_identifier(owner.obj), owner.bone
+
+
+def _rounds(footprints: list[tuple]) -> list[list[int]]:
+    """The indices of `footprints` (one per owner, :func:`_footprint`) in rounds, in order: an
+    owner keying the curves of an earlier owner (a linked duplicate) goes in the round after
+    that owner's, so that it reads and samples the keys inserted before it, as one owner after
+    another would."""
+    rounds: list[list[int]] = []
+    last: dict[tuple, int] = {}  # footprint -> the last round holding it
+    for i, footprint in enumerate(footprints):
+        r = last.get(footprint, -1) + 1
+        if r == len(rounds):
+            rounds.append([])
+        rounds[r].append(i)
+        last[footprint] = r
+    return rounds
+
+
+@dataclass
+class _Keying:
+    """One owner's insertion on its way through :func:`insert_keys`' phases."""
+
+    owner: owners.Owner
+    listed: list
+    chosen: list
+    packed: curves.Packed | None
+    before: keys.KeyedMotion
+    frames: np.ndarray
+    #: Set by the insertion: the owner's nested transaction, values keyed, curves keyed and made.
+    one: transaction.Transaction | None = None
+    values: dict | None = None
+    keyed: list | None = None
+    made: list | None = None
+    given: tuple | None = None
+
+
+def insert_keys(
+    requests: list[tuple[owners.Owner, list]],
+    frame: float,
+    options: bake.Options,
+    t: transaction.Transaction,
+    known: dict | None = None,
+) -> list[InsertResult | SmoothError]:
+    """Keys, for each `(owner, its curves)` of `requests` (:func:`owners.curves_by_owner`'s
+    lists), the pose its smoothed motion has at `frame` (see :func:`insert_key`); returns per
+    request its :class:`InsertResult` or the :class:`SmoothError` refusing it (that owner left
+    unchanged: its keys are inserted in a transaction nested in `t`, undone when it fails).
+
+    In phases, for every owner together: read every owner's keys, sample every motion before
+    (one `polyscrew.sample_owners` call per rotation mode: :func:`bake.sample_poses_many`),
+    insert each owner's keys, read every owner's keys after, sample every motion after, compare.
+    Linked duplicates keying the same curves go in later rounds (:func:`_rounds`). `known`, a
+    dict the caller keeps over one run: the packed keys per set of curves read or keyed so far
+    (owners sharing an action read it once, and see the keys inserted).
+    """
     known = {} if known is None else known
+    out: list[InsertResult | SmoothError | None] = [None] * len(requests)
+    footprints = [_footprint(owner) for owner, _ in requests]
+    made: dict[tuple, list] = {}  # footprint -> the curves earlier rounds made for it
+    for indices in _rounds(footprints):
+        # (a later round's owner lists the curves made for its footprint, as a fresh grouping would)
+        this = [
+            (requests[i][0], list(requests[i][1]) + [fc for fc in made.get(footprints[i], []) if fc not in requests[i][1]])
+            for i in indices
+        ]
+        outcomes, keyed = _insert_round(this, frame, options, t, known)
+        for i, outcome, keying in zip(indices, outcomes, keyed):
+            out[i] = outcome
+            if keying is not None and keying.made:
+                made.setdefault(footprints[i], []).extend(keying.made)
+    return out
+
+
+def _read_before(owner: owners.Owner, listed: list, frame: float, options: bake.Options, known: dict) -> _Keying:
+    """The keys of `owner` before the insertion (each curve packed once: `known`)."""
     chosen = _transform_curves(owner, listed)
     pointers = tuple(fc.as_pointer() for fc in chosen)
     packed = known.get(pointers)
@@ -192,16 +279,78 @@ def insert_key(
         owner, options.closed, fcurves=listed, turns=options.turns,
         packed=(chosen, packed) if packed is not None else None,
     )
-    frames = check_frames(before, frame)
+    return _Keying(owner, listed, chosen, packed, before, check_frames(before, frame))
+
+
+def _insert_round(
+    requests: list[tuple[owners.Owner, list]], frame: float, options: bake.Options, t: transaction.Transaction,
+    known: dict,
+) -> tuple[list[InsertResult | SmoothError], list[_Keying | None]]:
+    """:func:`insert_keys` of owners that key different curves; also each owner's keying
+    where it succeeded (else None)."""
+    out: list[InsertResult | SmoothError | None] = [None] * len(requests)
+    done: list[_Keying | None] = [None] * len(requests)
+    work: list[tuple[int, _Keying]] = []
+    for i, (owner, listed) in enumerate(requests):
+        try:
+            work.append((i, _read_before(owner, list(listed), frame, options, known)))
+        except SmoothError as err:
+            out[i] = err
+    before = bake.sample_poses_many([(k.owner, k.before, k.frames) for _, k in work], options)
+    sampled = []
+    for (i, keying), got in zip(work, before):
+        if isinstance(got, SmoothError):
+            out[i] = got
+        else:
+            sampled.append((i, keying, got))
+    opened = []
     try:
-        poses_before, scales_before = bake.sample_poses(before, frames, options, owner)
-    except ValueError as err:
-        raise SmoothError(f"{name}: {err}") from err
-    # The pose keyed is the motion's at `frame`, one of the frames just sampled (sampling is
-    # per frame: the same values as sampling `frame` alone, without a polyscrew call of its own).
-    at = int(np.searchsorted(frames, frame))
-    pose = poses_before[at : at + 1]
-    scale = scales_before[at : at + 1] if scales_before is not None else None
+        for _, keying, (poses, scales) in sampled:
+            keying.one = transaction.Transaction(t)
+            opened.append(keying.one)
+            _insert(keying, poses, scales, frame)
+        reread = []
+        for i, keying, _ in sampled:
+            try:
+                after = keys.read(
+                    keying.owner, options.closed, fcurves=keying.listed, turns=options.turns, packed=keying.given
+                )
+                reread.append((i, keying, after))
+            except SmoothError as err:
+                out[i] = err
+        after = bake.sample_poses_many([(k.owner, a, k.frames) for _, k, a in reread], options)
+        poses_after = {i: got for (i, _, _), got in zip(reread, after)}
+        for i, keying, (poses, _) in sampled:
+            got = poses_after.get(i, out[i])
+            if isinstance(got, SmoothError):
+                out[i] = got
+                opened.remove(keying.one)
+                problems = keying.one.rollback()
+                if problems:
+                    raise transaction.RolledBack(f"{got}; undoing it also failed: {'; '.join(problems)}") from got
+                continue
+            opened.remove(keying.one)
+            keying.one.commit()
+            if keying.given is not None:
+                known[tuple(fc.as_pointer() for fc in keying.given[0])] = keying.given[1]
+            out[i] = _result(keying, poses, got[0], frame)
+            done[i] = keying
+    except BaseException:
+        for one in opened:  # the parent undoes them with everything else
+            one.commit()
+        raise
+    return out, done
+
+
+def _insert(keying: _Keying, poses: np.ndarray, scales: np.ndarray | None, frame: float) -> None:
+    """Inserts the keys of `keying`'s owner at `frame` (inside `keying.one`), the pose sampled
+    before at `frame` (among the compared frames: sampling is per frame, the same values as
+    sampling `frame` alone), and splices them into its packed keys (`keying.given`)."""
+    owner, listed, chosen, packed, before = keying.owner, keying.listed, keying.chosen, keying.packed, keying.before
+    t = keying.one
+    at = int(np.searchsorted(keying.frames, frame))
+    pose = poses[at : at + 1]
+    scale = scales[at : at + 1] if scales is not None else None
 
     mode = owner.rotation_mode
     rotation_path = keys.rotation_path(mode)
@@ -239,8 +388,8 @@ def insert_key(
                 t.keep_keys(fcurve)
             channels.insert_key(fcurve, frame, float(value))
             keyed.append(fcurve.as_pointer())
+    keying.values, keying.made = values, made
 
-    given = None
     if packed is not None:  # the keys now: the read above with the new keys spliced in
         listed_after = listed + made
         chosen_after = _transform_curves(owner, listed_after)
@@ -259,22 +408,19 @@ def insert_key(
             fresh = curves.read(unread, keys_only=True)
             ones = iter(_one(fresh, c) for c in range(len(unread)))
             parts = [p if p is not None else next(ones) for p in parts]
-        given = (chosen_after, _joined(parts))
-        listed = listed_after
-    after = keys.read(owner, options.closed, fcurves=listed, turns=options.turns, packed=given)
-    try:
-        poses_after, _ = bake.sample_poses(after, frames, options, owner)
-    except ValueError as err:
-        raise SmoothError(f"{name}: {err}") from err
-    if given is not None:
-        known[tuple(fc.as_pointer() for fc in given[0])] = given[1]
+        keying.given = (chosen_after, _joined(parts))
+        keying.listed = listed_after
+
+
+def _result(keying: _Keying, poses_before: np.ndarray, poses_after: np.ndarray, frame: float) -> InsertResult:
+    """What the insertion of `keying` did: the motion compared before and after."""
     translation, angle = pose_change(poses_before, poses_after)
     worst = int(np.argmax(translation))
     return InsertResult(
         frame=frame,
-        values=values,
+        values=keying.values,
         max_translation=float(translation.max()),
         max_angle=float(angle.max()),
-        worst_frame=float(frames[worst]),
-        checked_frames=frames,
+        worst_frame=float(keying.frames[worst]),
+        checked_frames=keying.frames,
     )

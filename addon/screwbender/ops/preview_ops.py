@@ -164,21 +164,22 @@ class SCREWBENDER_OT_insert_key(bpy.types.Operator):
         results = []
         errors = []
         grouped: dict = {}  # object -> its transform curves by owner: one pass over each action
-        known: dict = {}  # the keys read (and keyed) so far: each curve read once per run
 
         def work(progress: pipeline.Progress) -> None:
+            requests = []
+            for owner in selection:
+                by_owner = grouped.get(owner.obj.as_pointer())
+                if by_owner is None:
+                    by_owner = owners.curves_by_owner(channels.object_fcurves(owner.obj))
+                    grouped[owner.obj.as_pointer()] = by_owner
+                requests.append((owner, by_owner.get(owner.bone, [])))
             with transaction.atomic() as t:  # a failure takes back every key inserted so far
-                for owner in selection:  # an owner that cannot be smoothed is skipped unchanged
-                    by_owner = grouped.get(owner.obj.as_pointer())
-                    if by_owner is None:
-                        by_owner = owners.curves_by_owner(channels.object_fcurves(owner.obj))
-                        grouped[owner.obj.as_pointer()] = by_owner
-                    try:
-                        with transaction.atomic(t) as one:
-                            results.append((owner, insert_key.insert_key(
-                                owner, frame, options, one, by_owner.get(owner.bone, []), known)))
-                    except SmoothError as err:
-                        errors.append(str(err))
+                # every owner together (an owner that cannot be smoothed is skipped unchanged)
+                for owner, outcome in zip(selection, insert_key.insert_keys(requests, frame, options, t)):
+                    if isinstance(outcome, SmoothError):
+                        errors.append(str(outcome))
+                    else:
+                        results.append((owner, outcome))
 
         return pipeline.run(self, "Insert Key on Motion", work, lambda _: self.report_inserted(scene, frame, results, errors))
 

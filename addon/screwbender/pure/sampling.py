@@ -262,12 +262,16 @@ def _constant(motion: keys.KeyedMotion, pieces: list[Segment], n: int) -> np.nda
     return constant
 
 
-def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | None]], options) -> list[Sampled | None]:
+def sample_many(
+    items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | None]], options, poses: bool = False
+) -> list[Sampled | None]:
     """:func:`sample` of many motions as channels with their played rows (the screw method):
     for each `(motion, frames, previous)` of `items` (frames sorted), what `sample(motion,
     frames, options, channels=True, previous=previous, played=True)` gives, to the bit, or
     None where the core refused that motion (sample it alone to learn why) and for frames out
-    of order (:func:`sample` sorts them).
+    of order (:func:`sample` sorts them). With `poses`, what `sample(motion, frames, options)`
+    gives (rigid poses, `previous` unused, no played rows), to the bit: a held frame is its
+    key's own matrix, as there.
 
     One `polyscrew.sample_owners` call per rotation mode for every motion's pieces and holds
     (:func:`segments`), instead of calls per piece per motion."""
@@ -304,7 +308,8 @@ def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | Non
                 log_scales=np.concatenate([np.zeros_like(m.scales) if log is None else log for m, log in zip(motions, logs)])
                 if any(scaled) else None,
                 scaled=np.array(scaled, dtype=np.int64),
-                scheme=options.scheme, levels=options.levels, timing=options.timing, played=True,
+                scheme=options.scheme, levels=options.levels, timing=options.timing, played=not poses,
+                as_poses=poses,
             )
         except (ValueError, MemoryError):  # the batch as a whole refused (its memory, a key pose): each alone
             continue
@@ -313,10 +318,17 @@ def sample_many(items: list[tuple[keys.KeyedMotion, np.ndarray, np.ndarray | Non
             if status[row] < 0:
                 continue
             motion, rows = motions[row], slice(ends[row] - counts[row, 1], ends[row])
-            out[i] = Sampled(
-                poses=None, location=location[rows], rotation=rotation[rows],
-                scales=_scales(motion, log_scales[rows] if scaled[row] else None),
-                constant=_constant(motion, pieces[row], int(counts[row, 1])),
-                played=played[rows] if status[row] > 0 else None,
-            )
+            scales = _scales(motion, log_scales[rows] if scaled[row] else None)
+            constant = _constant(motion, pieces[row], int(counts[row, 1]))
+            if poses:
+                sampled = rotation[rows]
+                for seg in pieces[row]:
+                    if seg.held:  # (the core's hold is the key's rigid pose, through a quaternion)
+                        sampled[seg.rows] = motion.poses[seg.lo]
+                out[i] = Sampled(poses=sampled, location=None, rotation=None, scales=scales, constant=constant)
+            else:
+                out[i] = Sampled(
+                    poses=None, location=location[rows], rotation=rotation[rows], scales=scales, constant=constant,
+                    played=played[rows] if status[row] > 0 else None,
+                )
     return out

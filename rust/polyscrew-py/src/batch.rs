@@ -4,10 +4,12 @@
 
 use glam::DVec3;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn};
 use pyo3::prelude::*;
 
-use polyscrew::intent::{sample_owner_channels, OwnerMotion, Playback, Segment};
+use polyscrew::intent::{
+    sample_owner_channels, sample_owner_poses, OwnerMotion, Playback, Segment,
+};
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, Pose, RotationMode, Scheme, Timing};
 
@@ -19,10 +21,11 @@ use crate::intent::{playback_arg, PyPlayback};
 /// How to ask for less memory.
 const HINT: &str = "sample fewer owners or frames in one call";
 
-/// The result: locations, rotation channels, log-scales, played rows, status per owner.
+/// The result: locations, rotation channels (or poses), log-scales, played rows, status per
+/// owner.
 type Out<'py> = (
     Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArrayDyn<f64>>,
     Option<Bound<'py, PyArray2<f64>>>,
     Option<Bound<'py, PyArray2<f64>>>,
     Bound<'py, PyArray1<i64>>,
@@ -102,6 +105,7 @@ fn table(what: &'static str, obj: &Bound<'_, PyAny>, columns: usize) -> PyResult
 ///     levels: int = 4,
 ///     timing: TimingName = "smooth",
 ///     played: bool = False,
+///     as_poses: bool = False,
 /// ) -> tuple[FloatArray, FloatArray, FloatArray | None, FloatArray | None, IntArray]
 ///
 /// Many owners' smoothed motions (rotation ``mode``) as Blender channels in one call: for
@@ -122,11 +126,14 @@ fn table(what: &'static str, obj: &Bound<'_, PyAny>, columns: usize) -> PyResult
 /// owners not scaled; None without ``log_scales``), with ``played`` the rows timing Keys
 /// played (T, 3 + width; NaN elsewhere; else None), and per owner a status (int64): 1 sampled
 /// with played rows, 0 sampled, -1 refused (its rows zero: sample that owner alone to learn
-/// why). GIL released. Raises ValueError for arrays that do not fit together.
+/// why). With ``as_poses`` the second array is the rigid poses (T, 4, 4) instead of rotation
+/// channels: exactly what ``timed_frames`` then ``sample`` give for each piece, a hold its
+/// key pose (``previous`` unused). GIL released. Raises ValueError for arrays that do not
+/// fit together.
 #[pyfunction]
-#[pyo3(signature = (poses, key_frames, frames, counts, segments, mode, *, closed=None, period=None, size=None, playbacks=None, previous=None, log_scales=None, scaled=None, scheme=Choice::of(Scheme::FourPoint), levels=4, timing=Choice::of(Timing::Smooth), played=false))]
+#[pyo3(signature = (poses, key_frames, frames, counts, segments, mode, *, closed=None, period=None, size=None, playbacks=None, previous=None, log_scales=None, scaled=None, scheme=Choice::of(Scheme::FourPoint), levels=4, timing=Choice::of(Timing::Smooth), played=false, as_poses=false))]
 #[pyo3(
-    text_signature = "(poses, key_frames, frames, counts, segments, mode, *, closed=None, period=None, size=None, playbacks=None, previous=None, log_scales=None, scaled=None, scheme='four_point', levels=4, timing='smooth', played=False)"
+    text_signature = "(poses, key_frames, frames, counts, segments, mode, *, closed=None, period=None, size=None, playbacks=None, previous=None, log_scales=None, scaled=None, scheme='four_point', levels=4, timing='smooth', played=False, as_poses=False)"
 )]
 #[allow(clippy::too_many_arguments)]
 fn sample_owners<'py>(
@@ -148,10 +155,12 @@ fn sample_owners<'py>(
     #[pyo3(from_py_with = args::levels::<SampleOwners>)] levels: u32,
     timing: Choice<SampleOwners, Timing>,
     #[pyo3(from_py_with = played_arg)] played: bool,
+    #[pyo3(from_py_with = as_poses_arg)] as_poses: bool,
 ) -> PyResult<Out<'py>> {
     const F: &str = SampleOwners::NAME;
     let mode = mode.0;
     let width = mode.width();
+    let out_rotation = if as_poses { 16 } else { width };
     let counts = table("counts", counts, 3)?;
     let owners = counts.len() / 3;
     let segments = table("segments", segments, 4)?;
@@ -187,7 +196,7 @@ fn sample_owners<'py>(
     let previous = args::optional_float_array(F, "previous", previous)?;
     let log_scales = args::optional_float_array(F, "log_scales", log_scales)?;
     let (k, t) = (key_frames.len(), frames.len());
-    let out_width = 3 + width + 3 + if played { 3 + width } else { 0 };
+    let out_width = 3 + out_rotation + 3 + if played { 3 + width } else { 0 };
     check_budget(
         F,
         poses.copy()
@@ -271,7 +280,7 @@ fn sample_owners<'py>(
         let t = frames.len();
         let run = || -> Result<_, Error> {
             let mut locations = try_vec(t.saturating_mul(3), "locations")?;
-            let mut rotations = try_vec(t.saturating_mul(width), "rotation channels")?;
+            let mut rotations = try_vec(t.saturating_mul(out_rotation), "rotation channels")?;
             let mut scales = try_vec(
                 if any_scaled { t.saturating_mul(3) } else { 0 },
                 "log-scales",
@@ -322,36 +331,46 @@ fn sample_owners<'py>(
                     previous,
                     played,
                 };
-                let sampled = sample_owner_channels(&owner, mode);
+                let sampled = if as_poses {
+                    sample_owner_poses(&owner).map(|s| {
+                        let rows: Vec<f64> = s
+                            .poses
+                            .iter()
+                            .flat_map(|p| p.to_rows().into_iter().flatten())
+                            .collect();
+                        let at: Vec<DVec3> = s.poses.iter().map(|p| p.translation).collect();
+                        (at, rows, s.log_scales, s.played)
+                    })
+                } else {
+                    sample_owner_channels(&owner, mode)
+                        .map(|s| (s.locations, s.rotations, s.log_scales, s.played))
+                };
                 match sampled {
-                    Ok(s)
-                        if s.played
-                            .as_ref()
-                            .is_none_or(|p| p.len() == nf * played_width) =>
-                    {
-                        locations.extend(s.locations.iter().flat_map(|v| v.to_array()));
-                        rotations.extend_from_slice(&s.rotations);
+                    Ok(s) if s.3.as_ref().is_none_or(|p| p.len() == nf * played_width) => {
+                        let (at, rotation, log_scales, rows_of) = s;
+                        locations.extend(at.iter().flat_map(|v| v.to_array()));
+                        rotations.extend_from_slice(&rotation);
                         if any_scaled {
-                            match s.log_scales.is_empty() {
+                            match log_scales.is_empty() {
                                 true => scales.extend(std::iter::repeat_n(0.0, nf * 3)),
                                 false => {
-                                    scales.extend(s.log_scales.iter().flat_map(|v| v.to_array()))
+                                    scales.extend(log_scales.iter().flat_map(|v| v.to_array()))
                                 }
                             }
                         }
                         if played {
-                            match &s.played {
+                            match &rows_of {
                                 Some(p) => rows_played.extend_from_slice(p),
                                 None => rows_played
                                     .extend(std::iter::repeat_n(f64::NAN, nf * played_width)),
                             }
                         }
-                        status.push(i64::from(s.played.is_some()));
+                        status.push(i64::from(rows_of.is_some()));
                     }
                     // refused (or a playback in another mode): zero rows, told by the status
                     _ => {
                         locations.extend(std::iter::repeat_n(0.0, nf * 3));
-                        rotations.extend(std::iter::repeat_n(0.0, nf * width));
+                        rotations.extend(std::iter::repeat_n(0.0, nf * out_rotation));
                         if any_scaled {
                             scales.extend(std::iter::repeat_n(0.0, nf * 3));
                         }
@@ -369,9 +388,16 @@ fn sample_owners<'py>(
         };
         let (locations, rotations, scales, rows_played, status) =
             run().map_err(|e| to_py_err(F, e))?;
+        let rotations = match as_poses {
+            true => rows(rotations, 16)?
+                .into_shape_with_order((t, 4, 4))
+                .map_err(|e| invalid(format!("{F}: {e}")))?
+                .into_dyn(),
+            false => rows(rotations, width)?.into_dyn(),
+        };
         Ok((
             rows(locations, 3)?,
-            rows(rotations, width)?,
+            rotations,
             any_scaled.then(|| rows(scales, 3)).transpose()?,
             played.then(|| rows(rows_played, 3 + width)).transpose()?,
             Array1::from_vec(status),
@@ -389,6 +415,11 @@ fn sample_owners<'py>(
 /// `played`, a bool.
 fn played_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     args::bool_arg(SampleOwners::NAME, "played", obj)
+}
+
+/// `as_poses`, a bool.
+fn as_poses_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    args::bool_arg(SampleOwners::NAME, "as_poses", obj)
 }
 
 /// Registers `sample_owners`.

@@ -80,6 +80,25 @@ pub struct OwnerChannels {
     pub played: Option<Vec<f64>>,
 }
 
+/// One owner's sampled rigid poses, a row per output frame ([`sample_owner_poses`]).
+#[derive(Clone, Debug, Default)]
+pub struct OwnerPoses {
+    /// The poses (a hold: its key pose).
+    pub poses: Vec<Pose>,
+    /// Log-scales (empty when scale is not keyed).
+    pub log_scales: Vec<DVec3>,
+    /// As [`OwnerChannels::played`].
+    pub played: Option<Vec<f64>>,
+}
+
+/// What one segment gives ([`sample_segments`]): the poses of a piece, or a hold.
+enum Rows {
+    /// The piece's sampled poses, a row per frame of the segment.
+    Sampled(Vec<Pose>),
+    /// The segment holds its key `lo`.
+    Held,
+}
+
 /// The smoothed motion of `owner` at its frames as location and rotation channels in `mode`
 /// (and log-scales), segment after segment; see the [module](self).
 ///
@@ -89,8 +108,75 @@ pub struct OwnerChannels {
 /// keys or frames.
 pub fn sample_owner_channels(owner: &OwnerMotion<'_>, mode: RotationMode) -> Result<OwnerChannels> {
     let n = owner.frames.len();
-    let k = owner.keys.len();
     let width = mode.width();
+    let mut locations = try_vec(n, "sampled locations")?;
+    let mut all = try_vec(n.saturating_mul(width), "sampled rotation channels")?;
+    let mut last: Option<Vec<f64>> = owner.previous.map(<[f64]>::to_vec);
+    let (log_scales, played) = sample_segments(owner, |seg, rows| {
+        let count = seg.end - seg.start;
+        let rotations = match rows {
+            Rows::Held => {
+                let key = owner.keys[seg.lo];
+                locations.extend(std::iter::repeat_n(key.translation, count));
+                let mut quats = try_vec(count, "held rotations")?;
+                quats.extend(std::iter::repeat_n(key.rotation, count));
+                rotation_channels(&quats, mode, last.as_deref())?
+            }
+            Rows::Sampled(dense) => {
+                let mut quats: Vec<DQuat> = try_vec(dense.len(), "sampled rotations")?;
+                quats.extend(dense.iter().map(|p| p.rotation));
+                locations.extend(dense.iter().map(|p| p.translation));
+                drop(dense);
+                rotation_channels(&quats, mode, last.as_deref())?
+            }
+        };
+        last = mode
+            .continued()
+            .then(|| rotations[rotations.len() - width..].to_vec());
+        all.extend_from_slice(&rotations);
+        Ok(())
+    })?;
+    Ok(OwnerChannels {
+        locations,
+        rotations: all,
+        log_scales,
+        played,
+    })
+}
+
+/// The smoothed motion of `owner` at its frames as rigid poses (and log-scales), segment
+/// after segment: the poses [`sample_owner_channels`] turns into channels, a hold its key
+/// pose; one [`timed_frames`] and [`sample`] per piece, as `polyscrew.sample` gives them.
+///
+/// # Errors
+/// As [`sample_owner_channels`].
+pub fn sample_owner_poses(owner: &OwnerMotion<'_>) -> Result<OwnerPoses> {
+    let mut poses = try_vec(owner.frames.len(), "sampled poses")?;
+    let (log_scales, played) = sample_segments(owner, |seg, rows| {
+        match rows {
+            Rows::Held => {
+                poses.extend(std::iter::repeat_n(owner.keys[seg.lo], seg.end - seg.start))
+            }
+            Rows::Sampled(dense) => poses.extend(dense),
+        }
+        Ok(())
+    })?;
+    Ok(OwnerPoses {
+        poses,
+        log_scales,
+        played,
+    })
+}
+
+/// Samples `owner`'s segments in order, handing each one's rows to `put`; returns the
+/// log-scales (empty when scale is not keyed) and the played rows. Checks that the segments
+/// fit the keys and frames.
+fn sample_segments(
+    owner: &OwnerMotion<'_>,
+    mut put: impl FnMut(&Segment, Rows) -> Result<()>,
+) -> Result<(Vec<DVec3>, Option<Vec<f64>>)> {
+    let n = owner.frames.len();
+    let k = owner.keys.len();
     let fits = owner.key_frames.len() == k
         && owner.log_scales.is_none_or(|l| l.len() == k)
         && owner
@@ -110,89 +196,69 @@ pub fn sample_owner_channels(owner: &OwnerMotion<'_>, mode: RotationMode) -> Res
             got: owner.segments.iter().map(|s| s.end - s.start).sum(),
         });
     }
-    let mut out = OwnerChannels {
-        locations: try_vec(n, "sampled locations")?,
-        rotations: try_vec(n.saturating_mul(width), "sampled rotation channels")?,
-        log_scales: try_vec(
-            if owner.log_scales.is_some() { n } else { 0 },
-            "sampled log-scales",
-        )?,
-        played: None,
-    };
-    let mut last: Option<Vec<f64>> = owner.previous.map(<[f64]>::to_vec);
+    let mut log_scales = try_vec(
+        if owner.log_scales.is_some() { n } else { 0 },
+        "sampled log-scales",
+    )?;
+    let mut out_played: Option<Vec<f64>> = None;
     for seg in owner.segments {
         let count = seg.end - seg.start;
-        let rotations = if seg.held() {
-            let key = owner.keys[seg.lo];
-            out.locations
-                .extend(std::iter::repeat_n(key.translation, count));
+        if seg.held() {
             if let Some(logs) = owner.log_scales {
-                out.log_scales
-                    .extend(std::iter::repeat_n(logs[seg.lo], count));
+                log_scales.extend(std::iter::repeat_n(logs[seg.lo], count));
             }
-            let mut quats = try_vec(count, "held rotations")?;
-            quats.extend(std::iter::repeat_n(key.rotation, count));
-            rotation_channels(&quats, mode, last.as_deref())?
+            put(seg, Rows::Held)?;
+            continue;
+        }
+        let whole = seg.lo == 0 && seg.hi == k - 1;
+        let spec = if whole {
+            owner.spec
         } else {
-            let whole = seg.lo == 0 && seg.hi == k - 1;
-            let spec = if whole {
-                owner.spec
-            } else {
-                MotionSpec {
-                    closed: false,
-                    period: None,
-                    ..owner.spec
-                }
-            };
-            let (keys, key_frames) = (
-                &owner.keys[seg.lo..=seg.hi],
-                &owner.key_frames[seg.lo..=seg.hi],
-            );
-            let frames = &owner.frames[seg.start..seg.end];
-            let timed = timed_frames(
-                key_frames,
-                frames,
-                &spec,
-                owner.size,
-                owner.playback,
-                PaceSource::Keys(keys),
-                owner.played && owner.playback.is_some(),
-            )?;
-            let (key_times, times, spec, played) = match &timed {
-                Timed::Frames => (key_frames, frames, spec, &[][..]),
-                Timed::Parameters {
-                    key_times,
-                    parameters,
-                    spec,
-                    played,
-                } => (&key_times[..], &parameters[..], *spec, &played[..]),
-            };
-            if !played.is_empty() {
-                let row = played.len() / count;
-                let rows = out.played.get_or_insert_with(Vec::new);
-                if rows.is_empty() {
-                    *rows = try_vec(n.saturating_mul(row), "played rows")?;
-                    rows.resize(n.saturating_mul(row), f64::NAN);
-                }
-                rows[seg.start * row..seg.end * row].copy_from_slice(played);
+            MotionSpec {
+                closed: false,
+                period: None,
+                ..owner.spec
             }
-            let dense = sample(keys, key_times, times, &spec)?;
-            let mut quats: Vec<DQuat> = try_vec(dense.len(), "sampled rotations")?;
-            quats.extend(dense.iter().map(|p| p.rotation));
-            out.locations.extend(dense.iter().map(|p| p.translation));
-            drop(dense);
-            if let Some(logs) = owner.log_scales {
-                out.log_scales
-                    .extend(sample(&logs[seg.lo..=seg.hi], key_times, times, &spec)?);
-            }
-            rotation_channels(&quats, mode, last.as_deref())?
         };
-        last = mode
-            .continued()
-            .then(|| rotations[rotations.len() - width..].to_vec());
-        out.rotations.extend_from_slice(&rotations);
+        let (keys, key_frames) = (
+            &owner.keys[seg.lo..=seg.hi],
+            &owner.key_frames[seg.lo..=seg.hi],
+        );
+        let frames = &owner.frames[seg.start..seg.end];
+        let timed = timed_frames(
+            key_frames,
+            frames,
+            &spec,
+            owner.size,
+            owner.playback,
+            PaceSource::Keys(keys),
+            owner.played && owner.playback.is_some(),
+        )?;
+        let (key_times, times, spec, played) = match &timed {
+            Timed::Frames => (key_frames, frames, spec, &[][..]),
+            Timed::Parameters {
+                key_times,
+                parameters,
+                spec,
+                played,
+            } => (&key_times[..], &parameters[..], *spec, &played[..]),
+        };
+        if !played.is_empty() {
+            let row = played.len() / count;
+            let rows = out_played.get_or_insert_with(Vec::new);
+            if rows.is_empty() {
+                *rows = try_vec(n.saturating_mul(row), "played rows")?;
+                rows.resize(n.saturating_mul(row), f64::NAN);
+            }
+            rows[seg.start * row..seg.end * row].copy_from_slice(played);
+        }
+        let dense = sample(keys, key_times, times, &spec)?;
+        if let Some(logs) = owner.log_scales {
+            log_scales.extend(sample(&logs[seg.lo..=seg.hi], key_times, times, &spec)?);
+        }
+        put(seg, Rows::Sampled(dense))?;
     }
-    Ok(out)
+    Ok((log_scales, out_played))
 }
 
 #[cfg(test)]
@@ -278,13 +344,13 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_hold_repeats_its_key_and_the_next_piece_continues_from_it() {
+    /// [`keys`] with keys 1..2 held, frames 1..24 in segments (rows 0..3 the piece 0..1, 3..10
+    /// the hold of key 1, 10..24 the piece 2..4), log-scales per key.
+    #[allow(clippy::type_complexity)]
+    fn held_keys() -> (Vec<Pose>, Vec<f64>, Vec<f64>, [Segment; 3], Vec<DVec3>) {
         let (mut poses, key_frames) = keys();
-        poses[2] = poses[1]; // keys 1..2 held
+        poses[2] = poses[1];
         let frames: Vec<f64> = (1..25).map(|f| f as f64).collect();
-        let mode = RotationMode::Quaternion;
-        // frames 1..3 (rows 0..3) the piece 0..1, 4..10 the hold of key 1, 11..24 the piece 2..4
         let segments = [
             Segment {
                 lo: 0,
@@ -306,6 +372,13 @@ mod tests {
             },
         ];
         let logs: Vec<DVec3> = (0..5).map(|i| DVec3::splat(0.1 * i as f64)).collect();
+        (poses, key_frames, frames, segments, logs)
+    }
+
+    #[test]
+    fn a_hold_repeats_its_key_and_the_next_piece_continues_from_it() {
+        let (poses, key_frames, frames, segments, logs) = held_keys();
+        let mode = RotationMode::Quaternion;
         let owner = OwnerMotion {
             log_scales: Some(&logs),
             ..motion(&poses, &key_frames, &frames, &segments, Timing::Smooth)
@@ -335,6 +408,31 @@ mod tests {
         )
         .unwrap();
         assert_eq!(&got.log_scales[10..], &scales[..]);
+    }
+
+    #[test]
+    fn poses_are_sample_per_piece_and_the_key_per_hold_to_the_bit() {
+        let (poses, key_frames, frames, segments, logs) = held_keys();
+        let owner = OwnerMotion {
+            log_scales: Some(&logs),
+            ..motion(&poses, &key_frames, &frames, &segments, Timing::Linear)
+        };
+        let got = sample_owner_poses(&owner).unwrap();
+        let channels = sample_owner_channels(&owner, RotationMode::Quaternion).unwrap();
+        assert_eq!(got.log_scales, channels.log_scales);
+        assert!(got.poses[3..10].iter().all(|p| *p == poses[1]));
+        for (lo, hi, rows) in [(0, 1, 0..3), (2, 4, 10..24)] {
+            let want = sample(
+                &poses[lo..=hi],
+                &key_frames[lo..=hi],
+                &frames[rows.clone()],
+                &spec(Timing::Linear),
+            )
+            .unwrap();
+            assert_eq!(&got.poses[rows.clone()], &want[..], "keys {lo}..{hi}");
+            let locations: Vec<DVec3> = want.iter().map(|p| p.translation).collect();
+            assert_eq!(&channels.locations[rows], &locations[..], "keys {lo}..{hi}");
+        }
     }
 
     #[test]

@@ -33,7 +33,8 @@
 //!   the output frames inside it) along both motions.
 //! - [`sample_owner_channels`] ([`mod@batch`]): an owner's smoothed motion as Blender channels,
 //!   piece after piece and hold after hold, each piece timed by [`timed_frames`]: what Smooth
-//!   Motion bakes, many owners in one call of the binding.
+//!   Motion bakes, many owners in one call of the binding; [`sample_owner_poses`] the same
+//!   motion as rigid poses (what Insert Key on Motion keys and compares).
 //!
 //! Every size input can drive is checked in one place ([`limits`]) before it is allocated;
 //! bad input is an [`Error`](crate::Error), never a panic.
@@ -54,7 +55,9 @@ mod tests;
 #[cfg(test)]
 mod turns_tests;
 
-pub use batch::{sample_owner_channels, OwnerChannels, OwnerMotion, Segment};
+pub use batch::{
+    sample_owner_channels, sample_owner_poses, OwnerChannels, OwnerMotion, OwnerPoses, Segment,
+};
 pub use departure::{
     departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
 };
