@@ -20,7 +20,8 @@
 #   - scripts/bench/bench_denoise.py, scripts/bench/bench_denoise_rig.py (Remove Noise vs Blender's filters);
 #   - the measurements the docs quote (part "measure"): what Smooth Motion keeps of the
 #     animator's intent (measure_intent.py), how far each scheme strays from the keys
-#     (measure_schemes.py), where a bake's time goes (profile_bake.py), the live preview's
+#     (measure_schemes.py), where a bake's time goes (profile_bake.py), each writing operator
+#     against its floor, profiled (profile_floor.py, docs/performance.md), the live preview's
 #     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
 #     (bench_sweep_blender.py), the closed swept boundary against the open sweep
 #     (bench_sweep_closed.py), key fractions of reduce_keys (measure_reduce.py), memory
@@ -274,8 +275,8 @@ if [ -z "$wheel" ] || [ ! -d "$bpy_dir" ]; then
   echo "the wheel or the Blender module is missing" | tee "$run/measure.missing"
 else
   [ -f "$run/extension.txt" ] || SCREWBENDER_WHEEL="$wheel" scripts/build_extension.sh > "$run/extension.txt" 2>&1
-  profile_args=(); preview_args=()
-  [ "$quick" = 1 ] && profile_args=(--objects 30 --runs 2) && preview_args=(--quick)
+  profile_args=(); preview_args=(); floor_profile_args=()
+  [ "$quick" = 1 ] && profile_args=(--objects 30 --runs 2) && preview_args=(--quick) && floor_profile_args=(--quick)
   measure() {  # name, PYTHONPATH, arguments...
     local name=$1 path=$2; shift 2
     echo "--- $name"
@@ -290,6 +291,7 @@ else
   measure measure_intent "$pylib:$bpy_dir"
   measure measure_schemes "$pylib:$bpy_dir"
   measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
+  measure profile_floor "$pylib:$bpy_dir" "${floor_profile_args[@]}"
   measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
   measure bench_sweep_blender "$pylib:$bpy_dir"
   measure bench_sweep_closed "$pylib"

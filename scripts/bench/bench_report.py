@@ -879,6 +879,7 @@ class Report:
         ("measure_intent", "what Smooth Motion keeps of the animator's intent, against Blender's playback (issue 17)"),
         ("measure_schemes", "how far each subdivision scheme strays from the key poses (the Scheme tooltips)"),
         ("profile_bake", "where Smooth Motion's time goes on many objects, and Blender's own read and write calls"),
+        ("profile_floor", "each writing operator against its floor, profiled (issue 27; docs/performance.md)"),
         ("bench_preview", "the live preview's recompute (issue 8: 50 keys, 5 levels, 64 instances)"),
         ("bench_sweep_blender", "Build Swept Region on a 100,000-triangle mesh against stroboscopic instancing"),
         ("bench_sweep_closed", "the closed boundary of the swept region against the open sweep on issue 29's cases"),
