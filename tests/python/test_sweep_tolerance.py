@@ -134,6 +134,37 @@ def test_measures_of_a_closed_mesh_match_scipy():
     assert not sweep_report.is_closed(mixed)
 
 
+def test_is_closed_agrees_with_a_row_wise_edge_count_on_broken_meshes():
+    """`is_closed` packs each directed edge into one integer; a row-wise `np.unique` of the
+    edge pairs (the former code, the oracle here) must say the same on closed hulls and on
+    each way of breaking them: a hole, a flipped face, a repeated face, a face in a second
+    copy shifted to indices beyond the first, large and negative index offsets."""
+
+    def oracle(t):
+        directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
+        forward, counts = np.unique(directed, axis=0, return_counts=True)
+        backward = np.unique(directed[:, ::-1], axis=0)
+        return bool(np.all(counts == 1)) and len(backward) == len(forward) and bool(np.all(backward == forward))
+
+    rng = np.random.default_rng(7)
+    seen = {True: 0, False: 0}
+    for trial in range(40):
+        pts = rng.normal(size=(30 + trial, 3))
+        tris = ConvexHull(pts).simplices.copy()
+        a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
+        flip = np.einsum("ij,ij->i", np.cross(b - a, c - a), a - pts.mean(axis=0)) < 0
+        tris[flip] = tris[flip][:, ::-1]
+        k = rng.integers(len(tris))
+        flipped = tris.copy()
+        flipped[k] = flipped[k][::-1]
+        two = np.concatenate([tris, tris + len(pts)])  # two closed shells: closed
+        for t in (tris, tris[1:], flipped, np.concatenate([tris, tris[k : k + 1]]), two, two[:-1],
+                  tris + 10**9, tris - 5, np.concatenate([tris, tris])):
+            assert sweep_report.is_closed(t) == oracle(t)
+            seen[oracle(t)] += 1
+    assert seen[True] >= 80 and seen[False] >= 200  # both answers exercised
+
+
 def test_summary_names_tolerance_area_and_volume():
     text = sweep_report.summary(1, 6536, 0.05, 2.1, 0.00173, 0.00164, 12.3, 5.08)
     assert "tolerance 0.00173 (met within 0.00164)" in text and "area 12.3" in text and "volume 5.08" in text

@@ -24,16 +24,22 @@ class Measures:
 
 def is_closed(triangles: np.ndarray) -> bool:
     """Whether every edge of the triangles is used exactly twice, once in each direction
-    (closed and consistently oriented)."""
+    (closed and consistently oriented).
+
+    Each directed edge (a, b) is packed into one integer a n + b (n above every index), so
+    the check is two 1-D sorts: no repeated forward edge, and the reversed edges sort to the
+    forward ones (a row-wise `np.unique(axis=0)` took 28 ms of Build Swept Region's 34 ms per
+    object on a 20,000-triangle result; docs/performance.md)."""
     t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
     if len(t) == 0:
         return False
-    directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-    forward = np.unique(directed, axis=0, return_counts=True)
-    if np.any(forward[1] != 1):
+    t = t - t.min()  # (indices from 0: a n + b is then one-to-one and sorts as the pairs)
+    n = int(t.max()) + 1
+    start, end = t.ravel(), t[:, [1, 2, 0]].ravel()
+    forward = np.sort(start * n + end)
+    if np.any(forward[1:] == forward[:-1]):
         return False
-    backward = np.unique(directed[:, ::-1], axis=0)
-    return len(backward) == len(forward[0]) and bool(np.all(backward == forward[0]))
+    return bool(np.array_equal(forward, np.sort(end * n + start)))
 
 
 def measures(vertices: np.ndarray, triangles: np.ndarray) -> Measures:
