@@ -76,13 +76,74 @@ def test_reduce_keys_plays_the_dense_motion_once_and_measures_in_the_core(sb):
     bpy.ops.object.mode_set(mode="OBJECT")
     after = sum(transform_keys(rig, b) for b in bones)
     print(f"rig: {before} key frames -> {after}; calls {calls}")
-    # one playback of the keys at the key frames (reading) and one of the dense frames with
-    # their probes per owner (before: a second one where spans were cut at their quarter
-    # frames), no second evaluation of the reduced curves (before: one per reduce_keys call)
-    assert calls["channels"] == 2 * len(bones), calls
+    # one playback per owner, of the dense frames with their probes: the keys, keyed on every
+    # frame without modifiers, are read from their key values (before: a second playback at
+    # the key frames, and before that a third where spans were cut at their quarter frames),
+    # no second evaluation of the reduced curves (before: one per reduce_keys call)
+    assert calls["channels"] == len(bones), calls
     assert calls["evaluate_fcurves"] == 0, calls
     assert 1 <= calls["reduce_keys"] <= 1 + addon_module("blender.reduce").RETRIES
     assert after < 0.5 * before
     # Blender's playback in world space: the connected bone's head carries the upper arm's
     # error, the hand's scale is keyed
     check_within(owners_, ref, times, DISTANCE, ANGLE, "connected rig")
+
+
+def test_a_capture_read_from_its_key_values_reduces_to_the_same_keys(sb):
+    """Reduce Keys reads a capture (every curve keyed on every key frame, no modifiers) from
+    its key values, not from Blender's playback at the key frames: on two identical sets of
+    noisy captures in four rotation modes, one reduced with the playback read forced (the
+    former path) and one as it is, every written key, handle and interpolation is the same,
+    to the bit, and the forced path plays the keys once more per owner."""
+    from test_noise_batch import noisy_keys
+
+    keys = addon_module("blender.keys")
+    modes = ("XYZ", "ZXY", "QUATERNION", "AXIS_ANGLE")
+    frames = [float(f) for f in range(1, 121)]
+    sets = []
+    for label in ("played", "values"):
+        rng = np.random.default_rng(11)  # the same keys in both sets
+        objects = []
+        for mode in modes:
+            ob = bpy.data.objects.new(f"{label}_{mode}", None)
+            bpy.context.scene.collection.objects.link(ob)
+            noisy_keys(ob, frames, mode, rng)
+            objects.append(ob)
+        sets.append(objects)
+    read = keys.read
+
+    def played_read(*args, **kwargs):
+        kwargs["key_values"] = False
+        return read(*args, **kwargs)
+
+    plays = []
+    for objects, forced in zip(sets, (True, False)):
+        h.select_only(*objects)
+        if forced:
+            keys.read = played_read
+        try:
+            with counting_calls() as calls:  # (tolerances above the noise: keys are dropped)
+                assert bpy.ops.screwbender.reduce_keys(distance=0.05, angle=math.radians(5.0)) == {"FINISHED"}
+        finally:
+            keys.read = read
+        plays.append(calls["channels"])
+    assert plays == [2 * len(modes), len(modes)], plays  # (the forced path played the key frames too)
+
+    def written(ob):
+        """Every curve's keys, handles and interpolations as Blender holds them."""
+        arrays = {}
+        for fc in h.fcurves(ob):
+            points = fc.keyframe_points
+            for name, width, dtype in (("co", 2, np.float32), ("handle_left", 2, np.float32),
+                                       ("handle_right", 2, np.float32), ("interpolation", 1, np.int32)):
+                values = np.empty(len(points) * width, dtype=dtype)
+                points.foreach_get(name, values)
+                arrays[fc.data_path, fc.array_index, name] = values
+        return arrays
+
+    for a, b in zip(*sets):
+        first, second = written(a), written(b)
+        assert first.keys() == second.keys() and first, a.name
+        for key in first:
+            assert np.array_equal(first[key], second[key]), (a.name, key)
+        assert all(len(v) < len(frames) for k, v in first.items() if k[2] == "interpolation")  # keys were dropped

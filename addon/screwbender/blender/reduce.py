@@ -278,9 +278,10 @@ def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 def read_motion(owner: owners.Owner, fcurves: list, action=None, slot: str = "") -> keys.KeyedMotion:
-    """The owner's keys, read once (no analysis); refuses curves Blender plays in a way the
+    """The owner's keys, read once (no analysis; a capture's key poses from its key values,
+    which is what Blender plays at its key frames); refuses curves Blender plays in a way the
     add-on cannot evaluate (the reduced keys must match Blender's playback)."""
-    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False)
+    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False, key_values=True)
     if motion.source is None:
         raise SmoothError(f"{owner.name}: {'; '.join(motion.kept)}; Reduce Keys needs Blender's playback: skipped")
     return motion
