@@ -97,7 +97,7 @@ def test_batched_keys_are_the_owner_by_owner_keys(monkeypatch, timing):
         for n, bone in enumerate(("Upper", "Fore", "Hand")):
             bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=30 + n, gentle=True))
         if way == "alone":
-            monkeypatch.setattr(sampling, "sample_many", lambda items, options: [None] * len(items))
+            monkeypatch.setattr(sampling, "sample_many", lambda items, options, poses=False: [None] * len(items))
         h.select_only(*objects)
         assert bpy.ops.screwbender.smooth(timing=timing) == {"FINISHED"}
         h.select_only(rig)

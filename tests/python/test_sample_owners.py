@@ -195,3 +195,35 @@ def test_sample_many_leaves_to_sample_what_it_cannot_batch():
     finally:
         polyscrew.set_memory_budget(budget)
     assert polyscrew.memory_budget() == budget
+
+
+def test_sample_owners_refuses_tables_that_do_not_fit_with_a_value_error():
+    """Counts and segments that do not fit the arrays are a ValueError naming the function,
+    never a panic: counts whose sum wraps around (each one a valid int64), negative counts,
+    segments past an owner's keys or frames, overlapping segments, a `previous` of the wrong
+    shape, a `playbacks` list of the wrong length."""
+    big = 2**63 - 1
+    poses = np.tile(np.eye(4), (3, 1, 1))
+    key_frames = np.array([1.0, 2.0, 3.0])
+    frames = np.array([1.0, 2.0])
+    one = np.array([[0, 2, 0, 2]])
+    cases = {
+        "counts wrapping": (np.array([[big, 1, 1], [big, 1, 0], [5, 0, 0]]), one, {}),
+        "negative count": (np.array([[-1, 2, 1], [4, 0, 0]]), one, {}),
+        "keys short": (np.array([[2, 2, 1]]), one, {}),
+        "segment past the keys": (np.array([[3, 2, 1]]), np.array([[0, 3, 0, 2]]), {}),
+        "segment past the frames": (np.array([[3, 2, 1]]), np.array([[0, 2, 0, 3]]), {}),
+        "segments overlapping": (np.array([[3, 2, 2]]), np.array([[0, 2, 0, 1], [0, 2, 0, 1]]), {}),
+        "previous shape": (np.array([[3, 2, 1]]), one, {"previous": np.zeros((2, 3))}),
+        "playbacks length": (np.array([[3, 2, 1]]), one, {"playbacks": [None, None]}),
+    }
+    for name, (counts, segments, extra) in cases.items():
+        try:
+            got = polyscrew.sample_owners(poses, key_frames, frames, counts, segments, "XYZ", **extra)
+        except ValueError as err:
+            assert "sample_owners" in str(err), (name, err)
+            continue
+        # (a batch the core refuses owner by owner is told by the status, not raised)
+        assert list(got[-1]) == [-1], (name, got[-1])
+    fitting = polyscrew.sample_owners(poses, key_frames, frames, np.array([[3, 2, 1]]), one, "XYZ")
+    assert list(fitting[-1]) == [0] and np.all(np.isfinite(fitting[1]))

@@ -140,11 +140,7 @@ def test_is_closed_agrees_with_a_row_wise_edge_count_on_broken_meshes():
     each way of breaking them: a hole, a flipped face, a repeated face, a face in a second
     copy shifted to indices beyond the first, large and negative index offsets."""
 
-    def oracle(t):
-        directed = np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]])
-        forward, counts = np.unique(directed, axis=0, return_counts=True)
-        backward = np.unique(directed[:, ::-1], axis=0)
-        return bool(np.all(counts == 1)) and len(backward) == len(forward) and bool(np.all(backward == forward))
+    from test_sweep_closed import is_closed_oriented as oracle
 
     rng = np.random.default_rng(7)
     seen = {True: 0, False: 0}

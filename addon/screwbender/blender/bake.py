@@ -175,19 +175,37 @@ def sample_poses_many(
     """:func:`sample_poses` of each `(owner, motion, frames)` of `items`, or the
     :class:`SmoothError` refusing it: the screw method samples every owner in one polyscrew
     call per rotation mode (:func:`sampling.sample_many` with poses: the same values to the
-    bit), Feature Points and owners the batch refused each alone (as :func:`_sample_plans`)."""
+    bit), Feature Points and owners the batch refused each alone (:func:`_batched`)."""
+
+    def alone(item: tuple) -> tuple[np.ndarray, np.ndarray | None]:
+        owner, motion, frames = item
+        try:
+            return sample_poses(motion, frames, options, owner)
+        except ValueError as err:  # polyscrew's ValueError
+            raise SmoothError(f"{owner.name}: {err}") from err
+
+    batch = [(motion, frames, None) for _, motion, frames in items]
+    return [
+        (got.poses, got.scales) if isinstance(got, sampling.Sampled) else got
+        for got in _batched(items, batch, options, alone, poses=True)
+    ]
+
+
+def _batched(items: list, batch: list, options: Options, alone, poses: bool = False) -> list:
+    """For each of `items`, its :func:`sampling.sample_many` result from `batch` (the items'
+    `(motion, frames, previous)`, all in one call per rotation mode), or, for Feature Points
+    and the owners the batch refused, `alone(item)`, or the :class:`SmoothError` it raised."""
     batched = [None] * len(items)
     if options.method != "FEATURE" and items:
-        batched = sampling.sample_many([(motion, frames, None) for _, motion, frames in items], options, poses=True)
-    out: list[tuple[np.ndarray, np.ndarray | None] | SmoothError] = []
-    for (owner, motion, frames), sampled in zip(items, batched):
-        if sampled is not None:
-            out.append((sampled.poses, sampled.scales))
-            continue
-        try:
-            out.append(sample_poses(motion, frames, options, owner))
-        except ValueError as err:  # polyscrew's ValueError
-            out.append(SmoothError(f"{owner.name}: {err}"))
+        batched = sampling.sample_many(batch, options, poses=poses)
+    out = []
+    for item, sampled in zip(items, batched):
+        if sampled is None:  # (Feature Points, or refused: alone, for its own error)
+            try:
+                sampled = alone(item)
+            except SmoothError as err:
+                sampled = err
+        out.append(sampled)
     return out
 
 
@@ -210,10 +228,10 @@ def sample_channels(
     `source_curves`, the owner's curves the keys were read from, when given: a Frame Range
     narrower than the keys smooths that part and keeps the source keys outside it
     (:mod:`range_join`), and channels they do not key stay unkeyed where the smoothed motion
-    leaves them constant. :func:`sample_many` does the same for many owners at once.
+    leaves them constant. :func:`_sample_plans` samples many owners' plans at once.
     """
     plan = _plan(owners.as_owner(owner), motion, options, budget, source_curves)
-    return _finish(plan, _sample_alone(plan, options))
+    return _finish(plan, _sample_alone(plan))
 
 
 @dataclass
@@ -275,12 +293,12 @@ def _plan(
     return _Plan(owner, motion, options, join, start, end, frames, previous, source_curves)
 
 
-def _sample_alone(plan: _Plan, options: Options) -> sampling.Sampled:
+def _sample_alone(plan: _Plan) -> sampling.Sampled:
     """The channels of `plan`'s owner from its own polyscrew calls (one per piece: the
-    Feature Points method, or to learn why :func:`sample_many`'s batch refused it)."""
+    Feature Points method, or to learn why :func:`sampling.sample_many`'s batch refused it)."""
     try:
         return sampling.sample(
-            plan.motion, plan.frames, options, feature.sampler(plan.owner, options), channels=True,
+            plan.motion, plan.frames, plan.options, feature.sampler(plan.owner, plan.options), channels=True,
             previous=plan.previous, played=True,
         )
     except ValueError as err:  # polyscrew's ValueError
@@ -289,20 +307,9 @@ def _sample_alone(plan: _Plan, options: Options) -> sampling.Sampled:
 
 def _sample_plans(plans: list[_Plan], options: Options) -> list[sampling.Sampled | SmoothError]:
     """The channels of every plan, or the error refusing it: the screw method samples every
-    owner in one polyscrew call per rotation mode (:func:`sampling.sample_many`), Feature
-    Points each owner alone (its sampler reads the owner's points)."""
-    batched = [None] * len(plans)
-    if options.method != "FEATURE" and plans:
-        batched = sampling.sample_many([(p.motion, p.frames, p.previous) for p in plans], options)
-    out: list[sampling.Sampled | SmoothError] = []
-    for plan, sampled in zip(plans, batched):
-        if sampled is None:  # (Feature Points, or refused: alone, for its own error)
-            try:
-                sampled = _sample_alone(plan, options)
-            except SmoothError as err:
-                sampled = err
-        out.append(sampled)
-    return out
+    owner in one polyscrew call per rotation mode (:func:`_batched`), Feature Points each
+    owner alone (its sampler reads the owner's points)."""
+    return _batched(plans, [(p.motion, p.frames, p.previous) for p in plans], options, _sample_alone)
 
 
 def _finish(plan: _Plan, sampled: sampling.Sampled) -> Baked:

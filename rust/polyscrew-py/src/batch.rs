@@ -262,21 +262,17 @@ fn sample_owners<'py>(
                 ))
             }
         };
-        fill(
-            "keys of counts",
-            counts.chunks(3).map(|c| c[0]).sum(),
-            keys.len(),
-        )?;
-        fill(
-            "frames of counts",
-            counts.chunks(3).map(|c| c[1]).sum(),
-            frames.len(),
-        )?;
-        fill(
-            "segments of counts",
-            counts.chunks(3).map(|c| c[2]).sum(),
-            segments.len() / 4,
-        )?;
+        // Each column's sum, `usize::MAX` when it overflows (it then matches no length):
+        // every owner's rows then lie inside the arrays.
+        let total = |column: usize| {
+            counts
+                .chunks(3)
+                .try_fold(0usize, |sum, c| sum.checked_add(c[column]))
+                .unwrap_or(usize::MAX)
+        };
+        fill("keys of counts", total(0), keys.len())?;
+        fill("frames of counts", total(1), frames.len())?;
+        fill("segments of counts", total(2), segments.len() / 4)?;
         let t = frames.len();
         let run = || -> Result<_, Error> {
             let mut locations = try_vec(t.saturating_mul(3), "locations")?;
