@@ -43,6 +43,10 @@ WRITTEN_KEY = "screwbender_written"
 
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
+_BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
+#: The start of a :func:`keys_digest` that covers the handles of curves with a BEZIER key; a
+#: digest written before it ("crc32:", keys and interpolations only) is compared as it was made.
+DIGEST_HANDLES = "crc32h:"
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -385,52 +389,92 @@ def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion
     return frozenset(out)
 
 
-def _write_curves(
-    bag,
-    path: str,
-    frames: np.ndarray,
-    values: np.ndarray,
-    cyclic: bool,
-    indices: list[int] | np.ndarray | None = None,
-    group: str = channels.TRANSFORM_GROUP,
-    constant: np.ndarray | None = None,
-    cycle_modes: dict | None = None,
-    prop: str = "",
-    stacks: dict | None = None,
-    digests: dict | None = None,
-) -> None:
-    """One dense linear F-curve per column of `values` (array index `indices[column]`, by
-    default the column), keyed at `frames`, in F-curve group `group`; keys where `constant`
-    is set are CONSTANT (a held span that pops at its end). `cycle_modes` gives the Cycles
-    modifier (before, after) per (`prop`, index) of a motion baked over one extended cycle;
-    `stacks` the source curve's other F-curve modifiers per (`prop`, index), copied on top;
-    `digests` gets each written curve's :func:`curve_digest` per (path, index), from the arrays
-    written (no read back)."""
-    co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
-    co[:, 0] = frames
-    # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
-    # for an enum property (measured in Blender 4.2 and 5.0).
-    if constant is None or not constant.any():
-        interpolation = (_LINEAR,) * len(frames)
-        kinds = np.full(len(frames), _LINEAR, dtype=np.uint8)
-    else:
-        kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
-        interpolation = tuple(kinds.tolist())
-    if digests is not None:  # (:func:`curve_digest` of each curve, its shared parts hashed once)
-        prefix = zlib.crc32(f"{len(frames)}:".encode())
-        kinds = kinds.tobytes()
-    for column in range(values.shape[1]):
-        index = int(indices[column]) if indices is not None else column
-        fcurve = channels.new_fcurve(bag, path, index, group)
+@dataclass
+class _Curve:
+    """One dense baked curve, ready to write (:func:`pack_dense`): `co` the (2 K,) float32
+    frames and values as Blender stores them (a view into the operator's packed array),
+    `interpolation` the keys' interpolations as a tuple of Blender's enum values (shared by
+    the curves of one owner), `digest` its :func:`curve_digest`."""
+
+    prop: str
+    index: int
+    co: np.ndarray
+    interpolation: tuple
+    digest: int
+
+
+def pack_dense(parts: Iterable[Baked]) -> dict[int, list[_Curve]]:
+    """Every dense curve the bakes `parts` write (not those of a Frame Range joined to the
+    source keys, nor reduced ones), per `id(part)`: the frames and values of all of them in
+    one float32 array (two numpy assignments per owner, none per curve), the interpolations
+    and their bytes once per owner, each curve's :func:`curve_digest` from these arrays (what
+    Blender stores: no read back)."""
+    todo = []  # (part, [(prop, index, values column)])
+    total = 0
+    for part in parts:
+        if part.reduced is not None or part.join is not None:
+            continue
+        written = [(prop, index, part.values[prop][:, column]) for prop in part.values for column, index in part.columns(prop)]
+        todo.append((part, written))
+        total += len(written) * len(part.frames)
+    co = np.empty((total, 2), dtype=np.float32)  # Blender stores keys as float32
+    out: dict[int, list[_Curve]] = {}
+    lo = 0
+    for part, written in todo:
+        n, c = len(part.frames), len(written)
+        block = co[lo : lo + n * c].reshape(c, n, 2)
+        lo += n * c
+        block[:, :, 0] = part.frames
+        if c:
+            block[:, :, 1] = np.stack([values for *_, values in written])
+        constant = part.constant
+        if constant is None or not constant.any():
+            interpolation = _linear(n)
+            kinds = np.full(n, _LINEAR, dtype=np.uint8)
+        else:
+            kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
+            # A tuple of Python ints: foreach_set takes it several times faster than a numpy
+            # array for an enum property (measured in Blender 4.2 and 5.0).
+            interpolation = tuple(kinds.tolist())
+        prefix = _count_prefix(n)
+        out[id(part)] = [
+            _Curve(prop, index, row.ravel(), interpolation, zlib.crc32(kinds, zlib.crc32(row, prefix)))
+            for (prop, index, _), row in zip(written, block)
+        ]
+    return out
+
+
+_LINEARS: dict[int, tuple] = {}
+
+
+def _linear(n: int) -> tuple:
+    """(LINEAR,) * n, made once per key count."""
+    found = _LINEARS.get(n)
+    if found is None:
+        found = _LINEARS[n] = (_LINEAR,) * n
+    return found
+
+
+def _write_dense(bag, part: Baked, curves: list[_Curve], digests: dict | None, groups: dict) -> None:
+    """The dense curves `curves` of `part` (:func:`pack_dense`) into `bag`, in the owner's
+    F-curve group, each with a Cycles modifier when the bake repeats (or the modes of
+    `part.cycle_modes`) and the source curve's other modifiers copied on top; `digests` gets
+    each curve's digest per (path, index). Per curve only the Blender calls: the curve, its
+    keys, one `foreach_set` per written attribute."""
+    owner, stacks, cycle_modes = part.owner, part.motion.modifiers, part.cycle_modes
+    group = owner.group
+    paths = {prop: owner.path(prop) for prop in part.values}
+    for curve in curves:
+        prop, index = curve.prop, curve.index
+        path = paths[prop]
+        fcurve = channels.new_fcurve(bag, path, index, group, groups)
         points = fcurve.keyframe_points
-        points.add(len(frames))
-        co[:, 1] = values[:, column]
-        bulk.put(points, "co", co.ravel())
-        bulk.put(points, "interpolation", interpolation)
+        points.add(len(curve.interpolation))
+        bulk.put(points, "co", curve.co)
+        bulk.put(points, "interpolation", curve.interpolation)
         if digests is not None:
-            # (C-contiguous float32: summed in place, the bytes tobytes() gives)
-            digests[path, index] = zlib.crc32(kinds, zlib.crc32(co, prefix))
-        if cyclic:
+            digests[path, index] = curve.digest
+        if part.cyclic:
             fcurve.modifiers.new("CYCLES")
         elif cycle_modes and (prop, index) in cycle_modes:
             before, after = cycle_modes[prop, index]
@@ -490,53 +534,94 @@ def new_result(
     return result
 
 
-def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> int:
+def curve_digest(
+    co: np.ndarray, interpolation: np.ndarray, handle_left: np.ndarray | None = None, handle_right: np.ndarray | None = None
+) -> int:
     """A checksum of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
-    interpolations (Blender's enum values, as `foreach_get` gives them). CRC-32 of the key
+    interpolations (Blender's enum values, as `foreach_get` gives them) and, given, the
+    float32 handles, which count when a key is BEZIER (the only interpolation that plays
+    them: a handle edit there changes the motion; :data:`DIGEST_HANDLES`). CRC-32 of the key
     count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
     of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
     # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
-    n = len(interpolation)
-    prefix = _COUNT_PREFIX.get(n)
-    if prefix is None:
-        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
-    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), prefix)
-    return zlib.crc32(np.ascontiguousarray(interpolation, dtype=np.uint8), digest)
+    interpolation = np.ascontiguousarray(interpolation, dtype=np.uint8)
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), _count_prefix(len(interpolation)))
+    digest = zlib.crc32(interpolation, digest)
+    if handle_left is not None and (interpolation == _BEZIER).any():
+        digest = zlib.crc32(np.ascontiguousarray(handle_left, dtype=np.float32), digest)
+        digest = zlib.crc32(np.ascontiguousarray(handle_right, dtype=np.float32), digest)
+    return digest
 
 
 #: :func:`curve_digest`'s CRC-32 of "<key count>:" per key count (the curves of a scene share a few).
 _COUNT_PREFIX: dict[int, int] = {}
 
 
-def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
+def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None, handles: bool = True) -> str:
     """A digest of the keys of `action` for slot `identifier`: every curve's data path, index,
-    key frames, values and interpolations (one `foreach_get` each, but for the curves whose
-    :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
-    added or deleted, its interpolation changed, a curve added or removed, changes it."""
-    digest = zlib.crc32(b"keys:")
+    key frames, values and interpolations, and with `handles` the handles of a curve with a
+    BEZIER key (:func:`curve_digest`), read in one packed pass (:func:`_packed_digests`), but
+    for the curves whose :func:`curve_digest` is `known` per (data path, index): those just
+    written. A key moved, added or deleted, its interpolation changed, a BEZIER key's handle
+    moved, a curve added or removed, changes it. Without `handles`: the digest written before
+    handles counted ("crc32:"), to compare with one of those."""
     # (each curve's path and index read once: Revert checks every curve of every result)
     listed = sorted((fc.data_path, fc.array_index, i, fc) for i, fc in enumerate(channels.action_fcurves(action, identifier)))
-    buffers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # per key count: (co, interpolation), reused
-    for path, index, _, fcurve in listed:
-        sub = known.get((path, index)) if known else None
-        if sub is None:
-            points = fcurve.keyframe_points
-            n = len(points)
-            arrays = buffers.get(n)
-            if arrays is None:
-                arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8))
-            bulk.get(points, "co", arrays[0])
-            bulk.get(points, "interpolation", arrays[1])
-            sub = curve_digest(*arrays)
+    subs = [known.get((path, index)) if known else None for path, index, _, _ in listed]
+    read = [fcurve for (*_, fcurve), sub in zip(listed, subs) if sub is None]
+    if read:
+        digests = iter(_packed_digests([fc.keyframe_points for fc in read], handles))
+        subs = [next(digests) if sub is None else sub for sub in subs]
+    digest = zlib.crc32(b"keys:")
+    for (path, index, _, _), sub in zip(listed, subs):
         digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
-    return f"crc32:{digest:08x}"
+    return f"{DIGEST_HANDLES if handles else 'crc32:'}{digest:08x}"
+
+
+def _packed_digests(collections: list, handles: bool = True) -> list[int]:
+    """:func:`curve_digest` of the keys of each of `collections` (`keyframe_points`): their
+    frames, values and interpolations (and with `handles`, for the curves with a BEZIER key,
+    both handles) read into one packed array per attribute (one `foreach_get` per attribute
+    and non-empty curve, no buffer per curve), each curve's CRC-32 summed over its slices."""
+    counts = [len(points) for points in collections]
+    offsets = [0]
+    for n in counts:
+        offsets.append(offsets[-1] + n)
+    co = np.empty(2 * offsets[-1], dtype=np.float32)
+    kinds = np.empty(offsets[-1], dtype=np.uint8)
+    out = []
+    for points, n, lo in zip(collections, counts, offsets):
+        if n:
+            bulk.get(points, "co", co[2 * lo : 2 * (lo + n)])
+            bulk.get(points, "interpolation", kinds[lo : lo + n])
+        out.append(zlib.crc32(kinds[lo : lo + n], zlib.crc32(co[2 * lo : 2 * (lo + n)], _count_prefix(n))))
+    if handles and offsets[-1]:
+        bezier = kinds == _BEZIER
+        starts = np.array(offsets[:-1])[np.array(counts) > 0]
+        with_bezier = np.zeros(len(collections), dtype=bool)
+        with_bezier[np.array(counts) > 0] = np.add.reduceat(bezier, starts) > 0
+        for c in np.flatnonzero(with_bezier).tolist():
+            points, n, lo = collections[c], counts[c], offsets[c]
+            pair = np.empty((2, 2 * n), dtype=np.float32)
+            bulk.get(points, "handle_left", pair[0])
+            bulk.get(points, "handle_right", pair[1])
+            out[c] = zlib.crc32(pair[1], zlib.crc32(pair[0], out[c]))
+    return out
+
+
+def _count_prefix(n: int) -> int:
+    """The CRC-32 of "<n>:", the start of :func:`curve_digest` of n keys (cached)."""
+    prefix = _COUNT_PREFIX.get(n)
+    if prefix is None:
+        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
+    return prefix
 
 
 def was_edited(action: bpy.types.Action, identifier: str) -> bool:
     """Whether the keys of `action` (a result, slot `identifier`) changed after it was
     written (False for a result written before digests were kept: nothing to compare)."""
     written = action.get(WRITTEN_KEY)
-    return isinstance(written, str) and written != keys_digest(action, identifier)
+    return isinstance(written, str) and written != keys_digest(action, identifier, handles=written.startswith(DIGEST_HANDLES))
 
 
 def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Action, str] | None:
@@ -564,10 +649,13 @@ def source_action(
     return found[0], found[1], False
 
 
-def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
+def write(bake: ActionBake, t: transaction.Transaction, dense: dict[int, list[_Curve]] | None = None) -> bpy.types.Action:
     """Gives the objects of `bake` a copy of their current action whose transform curves of
     the smoothed owners are the baked ones (every other curve as it was); see
-    :func:`new_result`."""
+    :func:`new_result`. `dense`: :func:`pack_dense` of the operator's bakes (made here for
+    this bake alone when not given)."""
+    if dense is None:
+        dense = pack_dense(bake.parts)
 
     def replace_curves(bag) -> None:
         # The curves the bake writes replace those of the same (data path, index); every other
@@ -577,6 +665,7 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
             replaced |= {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.unkeyed}
         for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
+        groups: dict = {}  # (the F-curve groups made or found, once per action)
         for part in bake.parts:
             if part.reduced is not None:
                 from . import reduce
@@ -590,19 +679,13 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
                     if stack and fcurve is not None and (prop, index) in part.reduced.curves:
                         modifiers.copy_onto(stack, fcurve)
                 continue
-            for prop, values in part.values.items():
-                columns = part.columns(prop)
-                if not columns:
-                    continue
-                if part.join is not None:
-                    _write_joined(bag, part, prop, columns)
-                    continue
-                if len(columns) < values.shape[1]:  # channels left unkeyed are not written
-                    values = values[:, [c for c, _ in columns]]
-                _write_curves(
-                    bag, part.owner.path(prop), part.frames, values, part.cyclic, [i for _, i in columns],
-                    part.owner.group, part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
-                )
+            if part.join is not None:  # a Frame Range narrower than the keys: joined to them
+                for prop in part.values:
+                    columns = part.columns(prop)
+                    if columns:
+                        _write_joined(bag, part, prop, columns)
+                continue
+            _write_dense(bag, part, dense[id(part)], digests, groups)
 
     digests: dict = {}
     return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves, digests=digests)
@@ -950,7 +1033,8 @@ def smooth(
         from . import reduce
 
         notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
-    actions = action_groups.write_all(bakes, write, t, progress, len(groups), total)
+    dense = pack_dense(p for b in bakes for p in b.parts)  # (every owner's curves in one pass)
+    actions = action_groups.write_all(bakes, lambda b, t_: write(b, t_, dense), t, progress, len(groups), total)
     return Smoothed(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],
