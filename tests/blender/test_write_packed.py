@@ -1,7 +1,8 @@
 """Results written in one packed pass (issue 27): Smooth Motion's dense curves of every owner
-packed into one array per operator (`bake.pack_dense`), their digests from the arrays written,
-Revert's edit check reading each result's keys into one packed array per attribute
-(`bake._packed_digests`); the digest counts a BEZIER key's handles.
+packed into one array per operator (`bake.pack_dense`), their digests from the arrays written
+(none read back), Revert's edit check reading each result curve's keys once
+(`bake._read_digests`); the digest counts a BEZIER key's handles (a handle edit on a Reduce
+Keys result was not seen, and Revert threw the edited result away).
 
 `test_written_keys_of_every_operator` fingerprints every curve of every action (keys, handles,
 handle types, interpolations, easings, groups, modifiers, the recorded digest) after Smooth

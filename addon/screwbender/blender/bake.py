@@ -560,7 +560,7 @@ _COUNT_PREFIX: dict[int, int] = {}
 def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None, handles: bool = True) -> str:
     """A digest of the keys of `action` for slot `identifier`: every curve's data path, index,
     key frames, values and interpolations, and with `handles` the handles of a curve with a
-    BEZIER key (:func:`curve_digest`), read in one packed pass (:func:`_packed_digests`), but
+    BEZIER key (:func:`curve_digest`), read once each (:func:`_read_digests`), but
     for the curves whose :func:`curve_digest` is `known` per (data path, index): those just
     written. A key moved, added or deleted, its interpolation changed, a BEZIER key's handle
     moved, a curve added or removed, changes it. Without `handles`: the digest written before
@@ -570,7 +570,7 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     subs = [known.get((path, index)) if known else None for path, index, _, _ in listed]
     read = [fcurve for (*_, fcurve), sub in zip(listed, subs) if sub is None]
     if read:
-        digests = iter(_packed_digests([fc.keyframe_points for fc in read], handles))
+        digests = iter(_read_digests([fc.keyframe_points for fc in read], handles))
         subs = [next(digests) if sub is None else sub for sub in subs]
     digest = zlib.crc32(b"keys:")
     for (path, index, _, _), sub in zip(listed, subs):
@@ -578,34 +578,31 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     return f"{DIGEST_HANDLES if handles else 'crc32:'}{digest:08x}"
 
 
-def _packed_digests(collections: list, handles: bool = True) -> list[int]:
-    """:func:`curve_digest` of the keys of each of `collections` (`keyframe_points`): their
-    frames, values and interpolations (and with `handles`, for the curves with a BEZIER key,
-    both handles) read into one packed array per attribute (one `foreach_get` per attribute
-    and non-empty curve, no buffer per curve), each curve's CRC-32 summed over its slices."""
-    counts = [len(points) for points in collections]
-    offsets = [0]
-    for n in counts:
-        offsets.append(offsets[-1] + n)
-    co = np.empty(2 * offsets[-1], dtype=np.float32)
-    kinds = np.empty(offsets[-1], dtype=np.uint8)
+def _read_digests(collections: list, handles: bool = True) -> list[int]:
+    """:func:`curve_digest` of the keys of each of `collections` (`keyframe_points`): one
+    `foreach_get` per attribute and curve (frames and values, interpolations; with `handles`
+    both handles of a curve with a BEZIER key) into buffers shared by the curves of one key
+    count (a packed array and its slices measured slower: 18.5 against 14.8 ms for 4,500
+    curves), each curve's CRC-32 summed over them in place."""
     out = []
-    for points, n, lo in zip(collections, counts, offsets):
-        if n:
-            bulk.get(points, "co", co[2 * lo : 2 * (lo + n)])
-            bulk.get(points, "interpolation", kinds[lo : lo + n])
-        out.append(zlib.crc32(kinds[lo : lo + n], zlib.crc32(co[2 * lo : 2 * (lo + n)], _count_prefix(n))))
-    if handles and offsets[-1]:
-        bezier = kinds == _BEZIER
-        starts = np.array(offsets[:-1])[np.array(counts) > 0]
-        with_bezier = np.zeros(len(collections), dtype=bool)
-        with_bezier[np.array(counts) > 0] = np.add.reduceat(bezier, starts) > 0
-        for c in np.flatnonzero(with_bezier).tolist():
-            points, n, lo = collections[c], counts[c], offsets[c]
-            pair = np.empty((2, 2 * n), dtype=np.float32)
-            bulk.get(points, "handle_left", pair[0])
-            bulk.get(points, "handle_right", pair[1])
-            out[c] = zlib.crc32(pair[1], zlib.crc32(pair[0], out[c]))
+    buffers: dict[int, tuple] = {}  # per key count: (co, interpolation, left, right), reused
+    bezier = bytes([_BEZIER])
+    for points in collections:
+        n = len(points)
+        arrays = buffers.get(n)
+        if arrays is None:
+            arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8), None, None)
+        co, kinds = arrays[0], arrays[1]
+        bulk.get(points, "co", co)
+        bulk.get(points, "interpolation", kinds)
+        digest = zlib.crc32(kinds, zlib.crc32(co, _count_prefix(n)))
+        if handles and bezier in kinds.tobytes():
+            if arrays[2] is None:
+                arrays = buffers[n] = (co, kinds, np.empty(2 * n, dtype=np.float32), np.empty(2 * n, dtype=np.float32))
+            bulk.get(points, "handle_left", arrays[2])
+            bulk.get(points, "handle_right", arrays[3])
+            digest = zlib.crc32(arrays[3], zlib.crc32(arrays[2], digest))
+        out.append(digest)
     return out
 
 
