@@ -106,6 +106,9 @@ class Baked:
     #: Blender's playback of the source at `frames` where the bake played it already
     #: (:attr:`sampling.Sampled.played`; NaN rows elsewhere), for the departure measure.
     played: np.ndarray | None = None
+    #: :meth:`columns` per property, made once (the report, the removal of the curves
+    #: replaced and the packing of the written ones each ask).
+    _columns: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -114,12 +117,16 @@ class Baked:
 
     def columns(self, prop: str) -> list[tuple[int, int]]:
         """(column of `values[prop]`, array index) of every curve of `prop` the bake writes."""
+        found = self._columns.get(prop)
+        if found is not None:
+            return found
         if prop == "scale":
             indices = [i for i, keyed in enumerate(self.motion.scale_axes.tolist()) if keyed]
         else:
             indices = range(self.values[prop].shape[1])
         unkeyed = self.unkeyed
-        return [(c, i) for c, i in enumerate(indices) if not unkeyed or (prop, i) not in unkeyed]
+        found = self._columns[prop] = [(c, i) for c, i in enumerate(indices) if not unkeyed or (prop, i) not in unkeyed]
+        return found
 
     @property
     def written(self) -> list[tuple[str, int]]:
@@ -390,98 +397,102 @@ def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion
 
 
 @dataclass
-class _Curve:
-    """One dense baked curve, ready to write (:func:`pack_dense`): `co` the (2 K,) float32
-    frames and values as Blender stores them (a view into the operator's packed array),
-    `interpolation` the keys' interpolations as a tuple of Blender's enum values (shared by
-    the curves of one owner), `digest` its :func:`curve_digest`."""
+class _Dense:
+    """One owner's dense baked curves, ready to write (:func:`pack_dense`)."""
 
-    prop: str
-    index: int
+    #: (property, its (column, array index) pairs written: :meth:`Baked.columns`), in order.
+    props: list[tuple[str, list[tuple[int, int]]]]
+    #: One row per curve, in that order: its frames and values interleaved, float32 as
+    #: Blender stores them (rows of the operator's one packed array).
     co: np.ndarray
+    #: The keys' interpolations as a tuple of Blender's enum values (what `foreach_set` takes
+    #: fastest for an enum) and as bytes (for the digest), shared by the owner's curves.
     interpolation: tuple
-    digest: int
+    kinds: bytes
 
 
-def pack_dense(parts: Iterable[Baked]) -> dict[int, list[_Curve]]:
-    """Every dense curve the bakes `parts` write (not those of a Frame Range joined to the
+def pack_dense(parts: Iterable[Baked]) -> dict[int, _Dense]:
+    """The dense curves the bakes `parts` write (not those of a Frame Range joined to the
     source keys, nor reduced ones), per `id(part)`: the frames and values of all of them in
-    one float32 array (two numpy assignments per owner, none per curve), the interpolations
-    and their bytes once per owner, each curve's :func:`curve_digest` from these arrays (what
-    Blender stores: no read back)."""
-    todo = []  # (part, [(prop, index, values column)])
+    one float32 array (one numpy assignment per owner and property, none per curve), the
+    interpolations once per owner."""
+    todo = []
     total = 0
     for part in parts:
         if part.reduced is not None or part.join is not None:
             continue
-        written = [(prop, index, part.values[prop][:, column]) for prop in part.values for column, index in part.columns(prop)]
-        todo.append((part, written))
-        total += len(written) * len(part.frames)
-    co = np.empty((total, 2), dtype=np.float32)  # Blender stores keys as float32
-    out: dict[int, list[_Curve]] = {}
+        props = [(prop, columns) for prop in part.values if (columns := part.columns(prop))]
+        count = sum(len(columns) for _, columns in props)
+        todo.append((part, props, count))
+        total += 2 * count * len(part.frames)
+    co = np.empty(total, dtype=np.float32)  # Blender stores keys as float32
+    out: dict[int, _Dense] = {}
     lo = 0
-    for part, written in todo:
-        n, c = len(part.frames), len(written)
-        block = co[lo : lo + n * c].reshape(c, n, 2)
-        lo += n * c
-        block[:, :, 0] = part.frames
-        if c:
-            block[:, :, 1] = np.stack([values for *_, values in written])
+    for part, props, count in todo:
+        n = len(part.frames)
+        rows = co[lo : lo + 2 * count * n].reshape(count, 2 * n)
+        lo += 2 * count * n
+        pairs = rows.reshape(count, n, 2)
+        pairs[:, :, 0] = part.frames
+        row = 0
+        for prop, columns in props:
+            values = part.values[prop]
+            if len(columns) < values.shape[1]:  # channels left unkeyed are not written
+                values = values[:, [c for c, _ in columns]]
+            pairs[row : row + len(columns), :, 1] = values.T
+            row += len(columns)
         constant = part.constant
         if constant is None or not constant.any():
-            interpolation = _linear(n)
-            kinds = np.full(n, _LINEAR, dtype=np.uint8)
+            interpolation, kinds = _linear(n)
         else:
             kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
-            # A tuple of Python ints: foreach_set takes it several times faster than a numpy
-            # array for an enum property (measured in Blender 4.2 and 5.0).
-            interpolation = tuple(kinds.tolist())
-        prefix = _count_prefix(n)
-        out[id(part)] = [
-            _Curve(prop, index, row.ravel(), interpolation, zlib.crc32(kinds, zlib.crc32(row, prefix)))
-            for (prop, index, _), row in zip(written, block)
-        ]
+            interpolation, kinds = tuple(kinds.tolist()), kinds.tobytes()
+        out[id(part)] = _Dense(props, rows, interpolation, kinds)
     return out
 
 
-_LINEARS: dict[int, tuple] = {}
+_LINEARS: dict[int, tuple[tuple, bytes]] = {}
 
 
-def _linear(n: int) -> tuple:
-    """(LINEAR,) * n, made once per key count."""
+def _linear(n: int) -> tuple[tuple, bytes]:
+    """(LINEAR,) * n and its bytes, made once per key count."""
     found = _LINEARS.get(n)
     if found is None:
-        found = _LINEARS[n] = (_LINEAR,) * n
+        found = _LINEARS[n] = ((_LINEAR,) * n, bytes([_LINEAR]) * n)
     return found
 
 
-def _write_dense(bag, part: Baked, curves: list[_Curve], digests: dict | None, groups: dict) -> None:
-    """The dense curves `curves` of `part` (:func:`pack_dense`) into `bag`, in the owner's
-    F-curve group, each with a Cycles modifier when the bake repeats (or the modes of
+def _write_dense(bag, part: Baked, dense: _Dense, digests: dict | None, groups: dict) -> None:
+    """The dense curves of `part` (:func:`pack_dense`) into `bag`, in the owner's F-curve
+    group, each with a Cycles modifier when the bake repeats (or the modes of
     `part.cycle_modes`) and the source curve's other modifiers copied on top; `digests` gets
-    each curve's digest per (path, index). Per curve only the Blender calls: the curve, its
-    keys, one `foreach_set` per written attribute."""
-    owner, stacks, cycle_modes = part.owner, part.motion.modifiers, part.cycle_modes
-    group = owner.group
-    paths = {prop: owner.path(prop) for prop in part.values}
-    for curve in curves:
-        prop, index = curve.prop, curve.index
-        path = paths[prop]
-        fcurve = channels.new_fcurve(bag, path, index, group, groups)
-        points = fcurve.keyframe_points
-        points.add(len(curve.interpolation))
-        bulk.put(points, "co", curve.co)
-        bulk.put(points, "interpolation", curve.interpolation)
-        if digests is not None:
-            digests[path, index] = curve.digest
-        if part.cyclic:
-            fcurve.modifiers.new("CYCLES")
-        elif cycle_modes and (prop, index) in cycle_modes:
-            before, after = cycle_modes[prop, index]
-            modifier = fcurve.modifiers.new("CYCLES")
-            modifier.mode_before, modifier.mode_after = before, after
-        if stacks and (prop, index) in stacks:
-            modifiers.copy_onto(stacks[prop, index], fcurve)
+    each curve's :func:`curve_digest` per (path, index), from the arrays written (no read
+    back). Per curve only the Blender calls: the curve, its keys, one `foreach_set` per
+    written attribute."""
+    owner, stacks, cycle_modes, cyclic = part.owner, part.motion.modifiers, part.cycle_modes, part.cyclic
+    group, interpolation, kinds = owner.group, dense.interpolation, dense.kinds
+    n = len(interpolation)
+    prefix = _count_prefix(n)
+    rows = iter(dense.co)
+    for prop, columns in dense.props:
+        path = owner.path(prop)
+        for _, index in columns:
+            co = next(rows)
+            fcurve = channels.new_fcurve(bag, path, index, group, groups)
+            points = fcurve.keyframe_points
+            points.add(n)
+            bulk.put(points, "co", co)
+            bulk.put(points, "interpolation", interpolation)
+            if digests is not None:
+                digests[path, index] = zlib.crc32(kinds, zlib.crc32(co, prefix))
+            if cyclic:
+                fcurve.modifiers.new("CYCLES")
+            elif cycle_modes and (prop, index) in cycle_modes:
+                before, after = cycle_modes[prop, index]
+                modifier = fcurve.modifiers.new("CYCLES")
+                modifier.mode_before, modifier.mode_after = before, after
+            if stacks and (prop, index) in stacks:
+                modifiers.copy_onto(stacks[prop, index], fcurve)
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
@@ -571,7 +582,7 @@ def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = 
     read = [fcurve for (*_, fcurve), sub in zip(listed, subs) if sub is None]
     if read:
         digests = iter(_read_digests([fc.keyframe_points for fc in read], handles))
-        subs = [next(digests) if sub is None else sub for sub in subs]
+        subs = [sub if sub is not None else next(digests) for sub in subs] if known else list(digests)
     digest = zlib.crc32(b"keys:")
     for (path, index, _, _), sub in zip(listed, subs):
         digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
@@ -585,23 +596,23 @@ def _read_digests(collections: list, handles: bool = True) -> list[int]:
     count (a packed array and its slices measured slower: 18.5 against 14.8 ms for 4,500
     curves), each curve's CRC-32 summed over them in place."""
     out = []
-    buffers: dict[int, tuple] = {}  # per key count: (co, interpolation, left, right), reused
+    buffers: dict[int, tuple] = {}  # per key count: (co, interpolation, prefix, left, right), reused
     bezier = bytes([_BEZIER])
     for points in collections:
         n = len(points)
         arrays = buffers.get(n)
         if arrays is None:
-            arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8), None, None)
+            arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8), _count_prefix(n), None, None)
         co, kinds = arrays[0], arrays[1]
         bulk.get(points, "co", co)
         bulk.get(points, "interpolation", kinds)
-        digest = zlib.crc32(kinds, zlib.crc32(co, _count_prefix(n)))
+        digest = zlib.crc32(kinds, zlib.crc32(co, arrays[2]))
         if handles and bezier in kinds.tobytes():
-            if arrays[2] is None:
-                arrays = buffers[n] = (co, kinds, np.empty(2 * n, dtype=np.float32), np.empty(2 * n, dtype=np.float32))
-            bulk.get(points, "handle_left", arrays[2])
-            bulk.get(points, "handle_right", arrays[3])
-            digest = zlib.crc32(arrays[3], zlib.crc32(arrays[2], digest))
+            if arrays[3] is None:
+                arrays = buffers[n] = (*arrays[:3], np.empty(2 * n, dtype=np.float32), np.empty(2 * n, dtype=np.float32))
+            bulk.get(points, "handle_left", arrays[3])
+            bulk.get(points, "handle_right", arrays[4])
+            digest = zlib.crc32(arrays[4], zlib.crc32(arrays[3], digest))
         out.append(digest)
     return out
 
@@ -646,7 +657,7 @@ def source_action(
     return found[0], found[1], False
 
 
-def write(bake: ActionBake, t: transaction.Transaction, dense: dict[int, list[_Curve]] | None = None) -> bpy.types.Action:
+def write(bake: ActionBake, t: transaction.Transaction, dense: dict[int, _Dense] | None = None) -> bpy.types.Action:
     """Gives the objects of `bake` a copy of their current action whose transform curves of
     the smoothed owners are the baked ones (every other curve as it was); see
     :func:`new_result`. `dense`: :func:`pack_dense` of the operator's bakes (made here for
@@ -917,7 +928,7 @@ def _bake_groups(
         departed = _departure_note(owner, motion, part, options)
         if departed is not None:
             read.notes.append(departed)
-        for prop, index in part.written:
+        for prop, index in part.written if read.unread else ():
             what = read.unread.get((owner.path(prop), index))
             if what is not None:
                 read.notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
