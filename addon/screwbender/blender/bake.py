@@ -44,6 +44,7 @@ WRITTEN_KEY = "screwbender_written"
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
 _BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
+_BEZIER_BYTE = bytes([_BEZIER])
 #: The start of a :func:`keys_digest` that covers the handles of curves with a BEZIER key; a
 #: digest written before it ("crc32:", keys and interpolations only) is compared as it was made.
 DIGEST_HANDLES = "crc32h:"
@@ -555,10 +556,10 @@ def curve_digest(
     count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
     of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
     # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
-    interpolation = np.ascontiguousarray(interpolation, dtype=np.uint8)
-    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), _count_prefix(len(interpolation)))
-    digest = zlib.crc32(interpolation, digest)
-    if handle_left is not None and (interpolation == _BEZIER).any():
+    kinds = np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes()
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), _count_prefix(len(kinds)))
+    digest = zlib.crc32(kinds, digest)
+    if handle_left is not None and _BEZIER_BYTE in kinds:
         digest = zlib.crc32(np.ascontiguousarray(handle_left, dtype=np.float32), digest)
         digest = zlib.crc32(np.ascontiguousarray(handle_right, dtype=np.float32), digest)
     return digest
@@ -597,7 +598,6 @@ def _read_digests(collections: list, handles: bool = True) -> list[int]:
     curves), each curve's CRC-32 summed over them in place."""
     out = []
     buffers: dict[int, tuple] = {}  # per key count: (co, interpolation, prefix, left, right), reused
-    bezier = bytes([_BEZIER])
     for points in collections:
         n = len(points)
         arrays = buffers.get(n)
@@ -607,7 +607,7 @@ def _read_digests(collections: list, handles: bool = True) -> list[int]:
         bulk.get(points, "co", co)
         bulk.get(points, "interpolation", kinds)
         digest = zlib.crc32(kinds, zlib.crc32(co, arrays[2]))
-        if handles and bezier in kinds.tobytes():
+        if handles and _BEZIER_BYTE in kinds.tobytes():
             if arrays[3] is None:
                 arrays = buffers[n] = (*arrays[:3], np.empty(2 * n, dtype=np.float32), np.empty(2 * n, dtype=np.float32))
             bulk.get(points, "handle_left", arrays[3])
