@@ -62,7 +62,8 @@ def fingerprint() -> dict:
 def scene() -> list:
     """test_smooth_batch's varied scene (every rotation mode, scale keyed or not, a hold, a
     cycle, linked duplicates), a non-transform curve on one object, a Noise modifier on
-    another's curve, and a rig of three bones; all selected, the rig last."""
+    another's curve, an object keyed off the whole frames (first: the others' frames differ
+    from its), and a rig of three bones; all selected, the rig last."""
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     objects = varied_scene("")
     extra = objects[0]
@@ -71,6 +72,10 @@ def scene() -> list:
         extra["weight"] = value
         extra.keyframe_insert('["weight"]', frame=frame)
     h.fcurves(objects[1])[0].modifiers.new("NOISE").strength = 0.5
+    late = h.new_object("Late")  # keys off the whole frames, from frame 6.5: a grid of its own
+    rng = np.random.default_rng(11)
+    h.key_poses(late, [6.5, 9.25, 15, 21.5, 30], h.rigid(rng.uniform(-2, 2, (5, 3)), np.stack([np.eye(3)] * 5)))
+    objects.insert(0, late)
     rig = bh.armature()
     rig.name = "Rig"
     for n, bone in enumerate(("Upper", "Fore", "Hand")):
