@@ -191,7 +191,9 @@ def counting_bulk(monkeypatch) -> dict:
 def test_smooth_and_revert_touch_each_curve_once_per_attribute(monkeypatch):
     """Smooth Motion of 12 objects writes each baked curve's keys with one `foreach_set` per
     attribute written (co, interpolation) and reads none back for its digest; Revert reads
-    each result curve's co and interpolation once (linear keys: no handles)."""
+    each result curve's co and interpolation once (linear keys: no handles). (The floor per
+    curve, which main already kept: this test passes on main too; it fails when a read or a
+    write per curve is added.)"""
     bpy.ops.wm.read_homefile(use_empty=True, use_factory_startup=True)
     objects = [keyed(f"Count{i}", seed=i, scale=i % 2 == 0) for i in range(12)]
     h.select_only(*objects)
@@ -204,8 +206,9 @@ def test_smooth_and_revert_touch_each_curve_once_per_attribute(monkeypatch):
     print(f"{curves} curves; smooth {smoothed}; revert {counts}")
     puts = {attr: n for (kind, attr), n in smoothed.items() if kind == "put"}
     assert puts == {"co": curves, "interpolation": curves}
-    reads_after_keys = {attr: n for (kind, attr), n in smoothed.items() if kind == "get" and attr == "interpolation"}
-    assert reads_after_keys.get("interpolation", 0) <= curves  # (keys.read's own, none for the digest)
+    # the source curves' keys read once (keys.read), the results' never: a digest read back
+    # would read each result curve's co and interpolation again (2 x curves)
+    assert smoothed.get(("get", "co"), 0) <= curves and smoothed.get(("get", "interpolation"), 0) <= curves
     assert counts == {("get", "co"): curves, ("get", "interpolation"): curves}
 
 
