@@ -43,6 +43,11 @@ WRITTEN_KEY = "screwbender_written"
 
 _LINEAR = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["LINEAR"].value
 _CONSTANT = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["CONSTANT"].value
+_BEZIER = bpy.types.Keyframe.bl_rna.properties["interpolation"].enum_items["BEZIER"].value
+_BEZIER_BYTE = bytes([_BEZIER])
+#: The start of a :func:`keys_digest` that covers the handles of curves with a BEZIER key; a
+#: digest written before it ("crc32:", keys and interpolations only) is compared as it was made.
+DIGEST_HANDLES = "crc32h:"
 
 
 def options_from(settings, scene: bpy.types.Scene) -> Options:
@@ -102,6 +107,9 @@ class Baked:
     #: Blender's playback of the source at `frames` where the bake played it already
     #: (:attr:`sampling.Sampled.played`; NaN rows elsewhere), for the departure measure.
     played: np.ndarray | None = None
+    #: :meth:`columns` per property, made once (the report, the removal of the curves
+    #: replaced and the packing of the written ones each ask).
+    _columns: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     @property
     def obj(self) -> bpy.types.Object:
@@ -110,12 +118,16 @@ class Baked:
 
     def columns(self, prop: str) -> list[tuple[int, int]]:
         """(column of `values[prop]`, array index) of every curve of `prop` the bake writes."""
+        found = self._columns.get(prop)
+        if found is not None:
+            return found
         if prop == "scale":
             indices = [i for i, keyed in enumerate(self.motion.scale_axes.tolist()) if keyed]
         else:
             indices = range(self.values[prop].shape[1])
         unkeyed = self.unkeyed
-        return [(c, i) for c, i in enumerate(indices) if not unkeyed or (prop, i) not in unkeyed]
+        found = self._columns[prop] = [(c, i) for c, i in enumerate(indices) if not unkeyed or (prop, i) not in unkeyed]
+        return found
 
     @property
     def written(self) -> list[tuple[str, int]]:
@@ -385,59 +397,103 @@ def _left_unkeyed(owner: owners.Owner, source_curves: list, values: dict, motion
     return frozenset(out)
 
 
-def _write_curves(
-    bag,
-    path: str,
-    frames: np.ndarray,
-    values: np.ndarray,
-    cyclic: bool,
-    indices: list[int] | np.ndarray | None = None,
-    group: str = channels.TRANSFORM_GROUP,
-    constant: np.ndarray | None = None,
-    cycle_modes: dict | None = None,
-    prop: str = "",
-    stacks: dict | None = None,
-    digests: dict | None = None,
-) -> None:
-    """One dense linear F-curve per column of `values` (array index `indices[column]`, by
-    default the column), keyed at `frames`, in F-curve group `group`; keys where `constant`
-    is set are CONSTANT (a held span that pops at its end). `cycle_modes` gives the Cycles
-    modifier (before, after) per (`prop`, index) of a motion baked over one extended cycle;
-    `stacks` the source curve's other F-curve modifiers per (`prop`, index), copied on top;
-    `digests` gets each written curve's :func:`curve_digest` per (path, index), from the arrays
-    written (no read back)."""
-    co = np.empty((len(frames), 2), dtype=np.float32)  # Blender stores keys as float32
-    co[:, 0] = frames
-    # A tuple of Python ints: foreach_set takes it several times faster than a numpy array
-    # for an enum property (measured in Blender 4.2 and 5.0).
-    if constant is None or not constant.any():
-        interpolation = (_LINEAR,) * len(frames)
-        kinds = np.full(len(frames), _LINEAR, dtype=np.uint8)
-    else:
-        kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
-        interpolation = tuple(kinds.tolist())
-    if digests is not None:  # (:func:`curve_digest` of each curve, its shared parts hashed once)
-        prefix = zlib.crc32(f"{len(frames)}:".encode())
-        kinds = kinds.tobytes()
-    for column in range(values.shape[1]):
-        index = int(indices[column]) if indices is not None else column
-        fcurve = channels.new_fcurve(bag, path, index, group)
-        points = fcurve.keyframe_points
-        points.add(len(frames))
-        co[:, 1] = values[:, column]
-        bulk.put(points, "co", co.ravel())
-        bulk.put(points, "interpolation", interpolation)
-        if digests is not None:
-            # (C-contiguous float32: summed in place, the bytes tobytes() gives)
-            digests[path, index] = zlib.crc32(kinds, zlib.crc32(co, prefix))
-        if cyclic:
-            fcurve.modifiers.new("CYCLES")
-        elif cycle_modes and (prop, index) in cycle_modes:
-            before, after = cycle_modes[prop, index]
-            modifier = fcurve.modifiers.new("CYCLES")
-            modifier.mode_before, modifier.mode_after = before, after
-        if stacks and (prop, index) in stacks:
-            modifiers.copy_onto(stacks[prop, index], fcurve)
+@dataclass
+class _Dense:
+    """One owner's dense baked curves, ready to write (:func:`pack_dense`)."""
+
+    #: (property, its (column, array index) pairs written: :meth:`Baked.columns`), in order.
+    props: list[tuple[str, list[tuple[int, int]]]]
+    #: One row per curve, in that order: its frames and values interleaved, float32 as
+    #: Blender stores them (rows of the operator's one packed array).
+    co: np.ndarray
+    #: The keys' interpolations as a tuple of Blender's enum values (what `foreach_set` takes
+    #: fastest for an enum) and as bytes (for the digest), shared by the owner's curves.
+    interpolation: tuple
+    kinds: bytes
+
+
+def pack_dense(parts: Iterable[Baked]) -> dict[int, _Dense]:
+    """The dense curves the bakes `parts` write (not those of a Frame Range joined to the
+    source keys, nor reduced ones), per `id(part)`: the frames and values of all of them in
+    one float32 array (one numpy assignment per owner and property, none per curve), the
+    interpolations once per owner."""
+    todo = []
+    total = 0
+    for part in parts:
+        if part.reduced is not None or part.join is not None:
+            continue
+        props = [(prop, columns) for prop in part.values if (columns := part.columns(prop))]
+        count = sum(len(columns) for _, columns in props)
+        todo.append((part, props, count))
+        total += 2 * count * len(part.frames)
+    co = np.empty(total, dtype=np.float32)  # Blender stores keys as float32
+    out: dict[int, _Dense] = {}
+    lo = 0
+    for part, props, count in todo:
+        n = len(part.frames)
+        rows = co[lo : lo + 2 * count * n].reshape(count, 2 * n)
+        lo += 2 * count * n
+        pairs = rows.reshape(count, n, 2)
+        pairs[:, :, 0] = part.frames
+        row = 0
+        for prop, columns in props:
+            values = part.values[prop]
+            if len(columns) < values.shape[1]:  # channels left unkeyed are not written
+                values = values[:, [c for c, _ in columns]]
+            pairs[row : row + len(columns), :, 1] = values.T
+            row += len(columns)
+        constant = part.constant
+        if constant is None or not constant.any():
+            interpolation, kinds = _linear(n)
+        else:
+            kinds = np.where(constant, _CONSTANT, _LINEAR).astype(np.uint8)
+            interpolation, kinds = tuple(kinds.tolist()), kinds.tobytes()
+        out[id(part)] = _Dense(props, rows, interpolation, kinds)
+    return out
+
+
+_LINEARS: dict[int, tuple[tuple, bytes]] = {}
+
+
+def _linear(n: int) -> tuple[tuple, bytes]:
+    """(LINEAR,) * n and its bytes, made once per key count."""
+    found = _LINEARS.get(n)
+    if found is None:
+        found = _LINEARS[n] = ((_LINEAR,) * n, bytes([_LINEAR]) * n)
+    return found
+
+
+def _write_dense(bag, part: Baked, dense: _Dense, digests: dict | None, groups: dict) -> None:
+    """The dense curves of `part` (:func:`pack_dense`) into `bag`, in the owner's F-curve
+    group, each with a Cycles modifier when the bake repeats (or the modes of
+    `part.cycle_modes`) and the source curve's other modifiers copied on top; `digests` gets
+    each curve's :func:`curve_digest` per (path, index), from the arrays written (no read
+    back). Per curve only the Blender calls: the curve, its keys, one `foreach_set` per
+    written attribute."""
+    owner, stacks, cycle_modes, cyclic = part.owner, part.motion.modifiers, part.cycle_modes, part.cyclic
+    group, interpolation, kinds = owner.group, dense.interpolation, dense.kinds
+    n = len(interpolation)
+    prefix = _count_prefix(n)
+    rows = iter(dense.co)
+    for prop, columns in dense.props:
+        path = owner.path(prop)
+        for _, index in columns:
+            co = next(rows)
+            fcurve = channels.new_fcurve(bag, path, index, group, groups)
+            points = fcurve.keyframe_points
+            points.add(n)
+            bulk.put(points, "co", co)
+            bulk.put(points, "interpolation", interpolation)
+            if digests is not None:
+                digests[path, index] = zlib.crc32(kinds, zlib.crc32(co, prefix))
+            if cyclic:
+                fcurve.modifiers.new("CYCLES")
+            elif cycle_modes and (prop, index) in cycle_modes:
+                before, after = cycle_modes[prop, index]
+                modifier = fcurve.modifiers.new("CYCLES")
+                modifier.mode_before, modifier.mode_after = before, after
+            if stacks and (prop, index) in stacks:
+                modifiers.copy_onto(stacks[prop, index], fcurve)
     # Keys are sorted, unique and linear: no fcurve.update() needed (as in Blender's baker).
 
 
@@ -490,53 +546,90 @@ def new_result(
     return result
 
 
-def curve_digest(co: np.ndarray, interpolation: np.ndarray) -> int:
+def curve_digest(
+    co: np.ndarray, interpolation: np.ndarray, handle_left: np.ndarray | None = None, handle_right: np.ndarray | None = None
+) -> int:
     """A checksum of one curve's keys: (K, 2) or (2K,) float32 frames and values, (K,) uint8
-    interpolations (Blender's enum values, as `foreach_get` gives them). CRC-32 of the key
+    interpolations (Blender's enum values, as `foreach_get` gives them) and, given, the
+    float32 handles, which count when a key is BEZIER (the only interpolation that plays
+    them: a handle edit there changes the motion; :data:`DIGEST_HANDLES`). CRC-32 of the key
     count and the arrays' bytes: not cryptographic, what a re-run needs is to notice a change
     of the keys it wrote (any one changed byte changes a CRC), at 0.6 of SHA-256's cost."""
     # (the arrays' bytes summed in place: no copy when they are float32 / uint8 already)
-    n = len(interpolation)
-    prefix = _COUNT_PREFIX.get(n)
-    if prefix is None:
-        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
-    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), prefix)
-    return zlib.crc32(np.ascontiguousarray(interpolation, dtype=np.uint8), digest)
+    kinds = np.ascontiguousarray(interpolation, dtype=np.uint8).tobytes()
+    digest = zlib.crc32(np.ascontiguousarray(co, dtype=np.float32), _count_prefix(len(kinds)))
+    digest = zlib.crc32(kinds, digest)
+    if handle_left is not None and _BEZIER_BYTE in kinds:
+        digest = zlib.crc32(np.ascontiguousarray(handle_left, dtype=np.float32), digest)
+        digest = zlib.crc32(np.ascontiguousarray(handle_right, dtype=np.float32), digest)
+    return digest
 
 
 #: :func:`curve_digest`'s CRC-32 of "<key count>:" per key count (the curves of a scene share a few).
 _COUNT_PREFIX: dict[int, int] = {}
 
 
-def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None) -> str:
+def keys_digest(action: bpy.types.Action, identifier: str, known: dict | None = None, handles: bool = True) -> str:
     """A digest of the keys of `action` for slot `identifier`: every curve's data path, index,
-    key frames, values and interpolations (one `foreach_get` each, but for the curves whose
-    :func:`curve_digest` is `known` per (data path, index): those just written). A key moved,
-    added or deleted, its interpolation changed, a curve added or removed, changes it."""
-    digest = zlib.crc32(b"keys:")
+    key frames, values and interpolations, and with `handles` the handles of a curve with a
+    BEZIER key (:func:`curve_digest`), read once each (:func:`_read_digests`), but
+    for the curves whose :func:`curve_digest` is `known` per (data path, index): those just
+    written. A key moved, added or deleted, its interpolation changed, a BEZIER key's handle
+    moved, a curve added or removed, changes it. Without `handles`: the digest written before
+    handles counted ("crc32:"), to compare with one of those."""
     # (each curve's path and index read once: Revert checks every curve of every result)
     listed = sorted((fc.data_path, fc.array_index, i, fc) for i, fc in enumerate(channels.action_fcurves(action, identifier)))
-    buffers: dict[int, tuple[np.ndarray, np.ndarray]] = {}  # per key count: (co, interpolation), reused
-    for path, index, _, fcurve in listed:
-        sub = known.get((path, index)) if known else None
-        if sub is None:
-            points = fcurve.keyframe_points
-            n = len(points)
-            arrays = buffers.get(n)
-            if arrays is None:
-                arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8))
-            bulk.get(points, "co", arrays[0])
-            bulk.get(points, "interpolation", arrays[1])
-            sub = curve_digest(*arrays)
+    subs = [known.get((path, index)) if known else None for path, index, _, _ in listed]
+    read = [fcurve for (*_, fcurve), sub in zip(listed, subs) if sub is None]
+    if read:
+        digests = iter(_read_digests([fc.keyframe_points for fc in read], handles))
+        subs = [sub if sub is not None else next(digests) for sub in subs] if known else list(digests)
+    digest = zlib.crc32(b"keys:")
+    for (path, index, _, _), sub in zip(listed, subs):
         digest = zlib.crc32(f"{path}[{index}]:{sub}|".encode(), digest)
-    return f"crc32:{digest:08x}"
+    return f"{DIGEST_HANDLES if handles else 'crc32:'}{digest:08x}"
+
+
+def _read_digests(collections: list, handles: bool = True) -> list[int]:
+    """:func:`curve_digest` of the keys of each of `collections` (`keyframe_points`): one
+    `foreach_get` per attribute and curve (frames and values, interpolations; with `handles`
+    both handles of a curve with a BEZIER key) into buffers shared by the curves of one key
+    count (a packed array and its slices measured slower: 18.5 against 14.8 ms for 4,500
+    curves), each curve's CRC-32 summed over them in place."""
+    out = []
+    buffers: dict[int, tuple] = {}  # per key count: (co, interpolation, prefix, left, right), reused
+    for points in collections:
+        n = len(points)
+        arrays = buffers.get(n)
+        if arrays is None:
+            arrays = buffers[n] = (np.empty(2 * n, dtype=np.float32), np.empty(n, dtype=np.uint8), _count_prefix(n), None, None)
+        co, kinds = arrays[0], arrays[1]
+        bulk.get(points, "co", co)
+        bulk.get(points, "interpolation", kinds)
+        digest = zlib.crc32(kinds, zlib.crc32(co, arrays[2]))
+        if handles and _BEZIER_BYTE in kinds.tobytes():
+            if arrays[3] is None:
+                arrays = buffers[n] = (*arrays[:3], np.empty(2 * n, dtype=np.float32), np.empty(2 * n, dtype=np.float32))
+            bulk.get(points, "handle_left", arrays[3])
+            bulk.get(points, "handle_right", arrays[4])
+            digest = zlib.crc32(arrays[4], zlib.crc32(arrays[3], digest))
+        out.append(digest)
+    return out
+
+
+def _count_prefix(n: int) -> int:
+    """The CRC-32 of "<n>:", the start of :func:`curve_digest` of n keys (cached)."""
+    prefix = _COUNT_PREFIX.get(n)
+    if prefix is None:
+        prefix = _COUNT_PREFIX[n] = zlib.crc32(f"{n}:".encode())
+    return prefix
 
 
 def was_edited(action: bpy.types.Action, identifier: str) -> bool:
     """Whether the keys of `action` (a result, slot `identifier`) changed after it was
     written (False for a result written before digests were kept: nothing to compare)."""
     written = action.get(WRITTEN_KEY)
-    return isinstance(written, str) and written != keys_digest(action, identifier)
+    return isinstance(written, str) and written != keys_digest(action, identifier, handles=written.startswith(DIGEST_HANDLES))
 
 
 def original_of(action: bpy.types.Action, made_by: str) -> tuple[bpy.types.Action, str] | None:
@@ -564,10 +657,13 @@ def source_action(
     return found[0], found[1], False
 
 
-def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
+def write(bake: ActionBake, t: transaction.Transaction, dense: dict[int, _Dense] | None = None) -> bpy.types.Action:
     """Gives the objects of `bake` a copy of their current action whose transform curves of
     the smoothed owners are the baked ones (every other curve as it was); see
-    :func:`new_result`."""
+    :func:`new_result`. `dense`: :func:`pack_dense` of the operator's bakes (made here for
+    this bake alone when not given)."""
+    if dense is None:
+        dense = pack_dense(bake.parts)
 
     def replace_curves(bag) -> None:
         # The curves the bake writes replace those of the same (data path, index); every other
@@ -577,6 +673,7 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
             replaced |= {(part.owner.path(prop), index) for part in bake.parts for prop, index in part.unkeyed}
         for fcurve in [fc for fc in channels.fcurves(bag) if (fc.data_path, fc.array_index) in replaced]:
             channels.remove_fcurve(bag, fcurve)
+        groups: dict = {}  # (the F-curve groups made or found, once per action)
         for part in bake.parts:
             if part.reduced is not None:
                 from . import reduce
@@ -590,19 +687,13 @@ def write(bake: ActionBake, t: transaction.Transaction) -> bpy.types.Action:
                     if stack and fcurve is not None and (prop, index) in part.reduced.curves:
                         modifiers.copy_onto(stack, fcurve)
                 continue
-            for prop, values in part.values.items():
-                columns = part.columns(prop)
-                if not columns:
-                    continue
-                if part.join is not None:
-                    _write_joined(bag, part, prop, columns)
-                    continue
-                if len(columns) < values.shape[1]:  # channels left unkeyed are not written
-                    values = values[:, [c for c, _ in columns]]
-                _write_curves(
-                    bag, part.owner.path(prop), part.frames, values, part.cyclic, [i for _, i in columns],
-                    part.owner.group, part.constant, part.cycle_modes, prop, part.motion.modifiers, digests,
-                )
+            if part.join is not None:  # a Frame Range narrower than the keys: joined to them
+                for prop in part.values:
+                    columns = part.columns(prop)
+                    if columns:
+                        _write_joined(bag, part, prop, columns)
+                continue
+            _write_dense(bag, part, dense[id(part)], digests, groups)
 
     digests: dict = {}
     return new_result(bake.objects, bake.source, bake.current, bake.identifier, t, replace_curves, digests=digests)
@@ -837,7 +928,7 @@ def _bake_groups(
         departed = _departure_note(owner, motion, part, options)
         if departed is not None:
             read.notes.append(departed)
-        for prop, index in part.written:
+        for prop, index in part.written if read.unread else ():
             what = read.unread.get((owner.path(prop), index))
             if what is not None:
                 read.notes.append(f"{owner.name}: {what} curve {prop}[{index}] replaced by the baked one")
@@ -950,7 +1041,8 @@ def smooth(
         from . import reduce
 
         notes.append(reduce.reduce_bakes(bakes, options.key_distance, options.key_angle))
-    actions = action_groups.write_all(bakes, write, t, progress, len(groups), total)
+    dense = pack_dense(p for b in bakes for p in b.parts)  # (every owner's curves in one pass)
+    actions = action_groups.write_all(bakes, lambda b, t_: write(b, t_, dense), t, progress, len(groups), total)
     return Smoothed(
         actions=actions,
         objects=[obj for b in bakes for obj in b.objects],

@@ -163,10 +163,14 @@ def ensure_group(bag: Any, name: str) -> bpy.types.ActionGroup:
     return group if group is not None else bag.groups.new(name)
 
 
-def new_fcurve(bag: Any, data_path: str, index: int, group: str = TRANSFORM_GROUP) -> bpy.types.FCurve:
+def new_fcurve(
+    bag: Any, data_path: str, index: int, group: str = TRANSFORM_GROUP, groups: dict | None = None
+) -> bpy.types.FCurve:
     """Creates an F-curve in `bag` (an action or a channelbag), in F-curve group `group`.
 
-    The group is made when missing; `group=""` puts the curve in no group.
+    The group is made when missing; `group=""` puts the curve in no group. `groups`, when
+    given, keeps the groups of `bag` found or made, per name, for the next curves (4.4 and
+    4.5 look a group up by name per curve otherwise; the other versions take the name).
     """
     if isinstance(bag, bpy.types.Action):  # legacy (4.2), or the 4.4/4.5 proxy
         return bag.fcurves.new(data_path, index=index, action_group=group)
@@ -174,7 +178,12 @@ def new_fcurve(bag: Any, data_path: str, index: int, group: str = TRANSFORM_GROU
         return bag.fcurves.new(data_path, index=index, group_name=group)
     fcurve = bag.fcurves.new(data_path, index=index)  # 4.4 and 4.5
     if group:
-        fcurve.group = ensure_group(bag, group)
+        found = groups.get(group) if groups is not None else None
+        if found is None:
+            found = ensure_group(bag, group)
+            if groups is not None:
+                groups[group] = found
+        fcurve.group = found
     return fcurve
 
 

@@ -437,12 +437,14 @@ def write_curve(
     points.add(n)
     co = np.asarray(curve.co, dtype=np.float32).ravel()
     interpolation = _enum("interpolation")[curve.interpolation]
+    left = np.asarray(curve.handle_left, dtype=np.float32).ravel()
+    right = np.asarray(curve.handle_right, dtype=np.float32).ravel()
     bulk.put(points, "co", co)
-    bulk.put(points, "handle_left", np.asarray(curve.handle_left, dtype=np.float32).ravel())
-    bulk.put(points, "handle_right", np.asarray(curve.handle_right, dtype=np.float32).ravel())
+    bulk.put(points, "handle_left", left)
+    bulk.put(points, "handle_right", right)
     bulk.put(points, "interpolation", tuple(interpolation.tolist()))
     if digests is not None:
-        digests[path, index] = bake.curve_digest(co, interpolation.astype(np.uint8))
+        digests[path, index] = bake.curve_digest(co, interpolation.astype(np.uint8), left, right)
     if np.any(curve.easing != 0):
         bulk.put(points, "easing", tuple(_enum("easing")[curve.easing].tolist()))
     types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
