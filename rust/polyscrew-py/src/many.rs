@@ -18,11 +18,10 @@ use crate::args::{
     self, float_array, int_list, sequence, str_arg, AnglesNearMany, ChannelsMany, Choice, Function,
     Most, PartialMovesMany, SampleMany,
 };
-use crate::arrays::{
-    poses_to_array, read_keys, read_poses, read_spec, read_vec3s, read_vector, vector_len,
-};
+use crate::arrays::{poses_to_array, read_keys, read_spec, read_vec3s, read_vector, vector_len};
 use crate::errors::{check_budget, invalid, shape_err, to_py_err};
 use crate::intent::{playback_arg, PyPlayback};
+use crate::motion::{moved_poses, MovedPoses};
 
 /// The most parts one call takes (a list of that many entries is refused before it is read).
 const MAX_PARTS: usize = 1 << 32;
@@ -107,9 +106,6 @@ fn angles_near_many<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// The poses of [`partial_moves_many`] and which were cut short.
-type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
-
 /// partial_moves_many(
 ///     source: ArrayLike, target: ArrayLike, counts: ArrayLike, pivots: ArrayLike,
 ///     max_angles: ArrayLike, max_distances: ArrayLike
@@ -146,49 +142,24 @@ fn partial_moves_many<'py>(
             return Err(shape_err(F, what, &format!("({s},)"), bounds.shape()));
         }
     }
-    let source = float_array(F, "source", source)?;
-    let target = float_array(F, "target", target)?;
-    for (what, poses) in [("source", &source), ("target", &target)] {
-        if !matches!(poses.shape(), [_, 4, 4]) {
-            return Err(shape_err(F, what, "(N, 4, 4)", poses.shape()));
-        }
-    }
-    let n = source.shape()[0];
-    check_budget(
-        F,
-        source.copy()
-            + target.copy()
-            + pivots.copy()
-            + Footprint::of::<Pose>(n.saturating_mul(3))
-            + Footprint::of::<bool>(n)
-            + Footprint::of::<[f64; 16]>(n),
-        "the partial moves",
-        polyscrew::motion::channels::CHANNELS_HINT,
-    )?;
-    let (source, target, pivots) = (source.read()?, target.read()?, pivots.read()?);
-    let (max_angles, max_distances) = (max_angles.read()?, max_distances.read()?);
-    let (sv, tv, pv) = (source.as_array(), target.as_array(), pivots.as_array());
-    let (av, dv) = (max_angles.as_array(), max_distances.as_array());
-    let (poses, cut) = py.detach(|| -> PyResult<(numpy::ndarray::Array3<f64>, Vec<bool>)> {
-        let source = read_poses(F, "source", &sv)?;
-        let target = read_poses(F, "target", &tv)?;
-        let pivots = read_vec3s(F, "pivots", &pv)?;
-        let angles = read_vector(F, "max_angles", &av)?;
-        let distances = read_vector(F, "max_distances", &dv)?;
-        let runs: Vec<MoveRun> = counts
-            .iter()
-            .zip(pivots.iter().zip(angles.iter().zip(&distances)))
-            .map(|(&len, (&pivot, (&angle, &distance)))| MoveRun {
-                len,
-                pivot,
-                bounds: MoveBounds { angle, distance },
-            })
-            .collect();
-        let (poses, cut) =
-            core_partial_moves_many(&source, &target, &runs).map_err(|e| to_py_err(F, e))?;
-        Ok((poses_to_array(&poses).map_err(|e| to_py_err(F, e))?, cut))
-    })?;
-    Ok((poses.into_pyarray(py), cut.into_pyarray(py)))
+    let extra = pivots.copy() + max_angles.copy() + max_distances.copy();
+    let (pivots, max_angles, max_distances) =
+        (pivots.read()?, max_angles.read()?, max_distances.read()?);
+    let pivots = read_vec3s(F, "pivots", &pivots.as_array())?;
+    let angles = read_vector(F, "max_angles", &max_angles.as_array())?;
+    let distances = read_vector(F, "max_distances", &max_distances.as_array())?;
+    let runs: Vec<MoveRun> = counts
+        .iter()
+        .zip(pivots.iter().zip(angles.iter().zip(&distances)))
+        .map(|(&len, (&pivot, (&angle, &distance)))| MoveRun {
+            len,
+            pivot,
+            bounds: MoveBounds { angle, distance },
+        })
+        .collect();
+    moved_poses(py, F, source, target, extra, move |source, target| {
+        core_partial_moves_many(source, target, &runs)
+    })
 }
 
 /// sample_many(

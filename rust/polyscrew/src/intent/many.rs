@@ -26,7 +26,7 @@ pub struct AngleRun {
     pub len: usize,
 }
 
-/// The lengths of `runs` added up, or [`Error::LengthMismatch`] when they are not `total`.
+/// Nothing when `lens` add up to `total`, else [`Error::LengthMismatch`] (`what`).
 fn check_total(lens: impl Iterator<Item = usize>, total: usize, what: &'static str) -> Result<()> {
     let mut sum = 0usize;
     for len in lens {
@@ -104,22 +104,16 @@ pub struct MoveRun {
 /// pivot and bounds: the poses and which were cut short, in order.
 ///
 /// # Errors
-/// [`Error::LengthMismatch`] when `target` is not as long as `source` or the runs do not
-/// add up to it, [`Error::In`] (`"part"`) for what [`partial_moves`] refuses in a run,
+/// [`Error::LengthMismatch`] when the runs do not add up to `source` or to `target`,
+/// [`Error::In`] (`"part"`) for what [`partial_moves`] refuses in a run,
 /// [`Error::Memory`] over the memory budget.
 pub fn partial_moves_many(
     source: &[Pose],
     target: &[Pose],
     runs: &[MoveRun],
 ) -> Result<(Vec<Pose>, Vec<bool>)> {
-    if source.len() != target.len() {
-        return Err(Error::LengthMismatch {
-            what: "target poses",
-            expected: source.len(),
-            got: target.len(),
-        });
-    }
     check_total(runs.iter().map(|r| r.len), source.len(), "counts")?;
+    check_total(runs.iter().map(|r| r.len), target.len(), "target poses")?;
     Footprint::of::<Pose>(source.len())
         .and::<bool>(source.len())
         .check("moved poses", CHANNELS_HINT)?;
