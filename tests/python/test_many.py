@@ -10,6 +10,7 @@ import numpy as np
 import polyscrew
 import pytest
 from scipy.spatial.transform import Rotation
+
 from test_intent import MODES, playback, random_curves, rotation_path, width
 
 
