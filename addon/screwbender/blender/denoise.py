@@ -364,13 +364,8 @@ class CurveEdit:
     co: np.ndarray
     left: np.ndarray
     right: np.ndarray
-    #: (K,) the keys smoothed, and those outside the frame range (their handles kept).
-    edit: np.ndarray
+    #: (K,) the keys outside the frame range (their handles kept).
     outside: np.ndarray
-    #: The smoothed values of the keys `edit` (float64).
-    target: np.ndarray
-    #: (mode, channel) of a rotation curve, whose targets are wrapped near the keys' values.
-    angle: tuple[str, int] | None = None
 
 
 def plan_edits(parts: list[Cleaned], shown: dict) -> None:
@@ -379,15 +374,17 @@ def plan_edits(parts: list[Cleaned], shown: dict) -> None:
     written: every key at a key frame of the motion gets its original key back (value and
     handles, from `originals`), and the smoothed keys (in the range, not held) the smoothed
     value at their frame, their handles moving with them. Reads only (nothing is written):
-    what `keys.read` read, and on a rerun the keys of the curves of the earlier result. The
-    comparisons of every curve's keys with its motion's key frames are one numpy pass, the
-    rotation targets one `polyscrew.angles_near_many` call, the moves one pass over the
-    packed keys of all parts."""
-    pending = []  # (part, curve, prop, co, left, right)
-    for c in parts:
-        c.edits = []
+    what `keys.read` read, and on a rerun the keys of the curves of the earlier result.
+
+    Every curve's keys of every part are packed into one array: their comparison with their
+    motion's key frames (a capture's keys are its key frames), their rows, targets and moves
+    are each one numpy pass over it, the rotation targets one `polyscrew.angles_near_many`
+    call; only curves not keyed on their motion's key frames look for their rows alone."""
+    curves = []  # (part index, curve, column of the owner's values, rotation?, co, left, right)
+    for o, c in enumerate(parts):
         motion, owner = c.motion, c.owner
         path = keys.rotation_path(motion.rotation_mode)
+        first = {path: 3, "location": 0}  # the owner's values: location x, y, z then the rotation channels
         width = {path: c.near.shape[1], "location": 3 if motion.located else 0}
         originals = {(fc.data_path, fc.array_index): fc for fc in c.originals}
         # What keys.read read (one foreach_get per property and curve): the original keys, and on
@@ -404,7 +401,7 @@ def plan_edits(parts: list[Cleaned], shown: dict) -> None:
             if originals or was is None:  # a rerun: the result is a copy of an earlier result
                 co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
             else:
-                co, left, right = (a.copy() for a in was)
+                co, left, right = was  # (copied when packed below)
             source = originals.get((fc.data_path, fc.array_index))
             if source is not None and source != fc and len(source.keyframe_points):
                 # The original keys back (this curve is a copy of an earlier result).
@@ -416,64 +413,63 @@ def plan_edits(parts: list[Cleaned], shown: dict) -> None:
                 co[hit, 1] = was[0][index, 1]
                 left[hit] = was[1][index]
                 right[hit] = was[2][index]
-            pending.append((c, fc, prop, co, left, right))
-    if not pending:
+            curves.append((o, fc, first[prop] + fc.array_index, prop == path, co, left, right))
+    for c in parts:
+        c.edits = []
+    if not curves:
         return
-    # Which curves are keyed on their motion's key frames (a capture): one comparison of all keys.
-    sizes = np.array([len(co) for _, _, _, co, _, _ in pending])
-    fits = np.array([len(c.motion.frames) == len(co) for c, _, _, co, _, _ in pending])
-    at = np.concatenate([co[:, 0] for _, _, _, co, _, _ in pending])
-    frames = np.concatenate([c.motion.frames if fit else np.full(len(co), np.nan)
-                             for (c, _, _, co, _, _), fit in zip(pending, fits)])
+    # Every part's key frames as rows of one table: which are smoothed, which in the range, and
+    # the values the smoothed keys take (location, then the rotation channels, :func:`near_rotations`).
+    counts = [len(c.motion.frames) for c in parts]
+    base = np.cumsum([0] + counts[:-1])
+    smoothed = np.zeros(sum(counts), dtype=bool)
+    in_range = np.zeros(sum(counts), dtype=bool)
+    values = np.zeros((sum(counts), 7))
+    for c, b in zip(parts, base.tolist()):
+        smoothed[b + c.rows[~c.held]] = True
+        in_range[b + c.rows] = True
+        values[b + c.rows, :3] = c.poses[:, :3, 3]
+        values[b + c.rows, 3 : 3 + c.near.shape[1]] = c.near
+    # The keys of every curve packed (copies of what was read).
+    co = np.concatenate([k[4] for k in curves])
+    left = np.concatenate([k[5] for k in curves])
+    right = np.concatenate([k[6] for k in curves])
+    sizes = np.array([len(k[4]) for k in curves])
     starts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
-    same = np.logical_and.reduceat(at == frames, starts) & fits
-    edits = []
-    for (c, fc, prop, co, left, right), keyed in zip(pending, same):
-        motion = c.motion
-        count = len(motion.frames)
-        if keyed:
-            row, near = np.arange(count), np.ones(count, dtype=bool)
-        else:
-            row, near = nearest_rows(motion.frames, co[:, 0])
-        smoothed = np.zeros(count, dtype=bool)
-        smoothed[c.rows[~c.held]] = True
-        in_range = np.zeros(count, dtype=bool)
-        in_range[c.rows] = True
-        edit = near & smoothed[row]
-        position = np.searchsorted(c.rows, row[edit])  # (the smoothed rows are among c.rows)
-        i = fc.array_index
-        if prop == "location":
-            target = c.poses[position, i, 3]
-            angle = None
-        else:  # each smoothed key written like the original key value (:func:`near_rotations`)
-            target = c.near[position, i]
-            angle = (motion.rotation_mode, i)
-        e = CurveEdit(fc.data_path, i, co, left, right, edit, ~(near & in_range[row]), target, angle)
-        c.edits.append(e)
-        edits.append(e)
-    # An angle within half a turn of the key's own original value: one call for every rotation curve.
-    turned = [e for e in edits if e.angle is not None]
-    if turned:
-        wrapped = polyscrew.angles_near_many(
-            np.concatenate([e.target for e in turned]), np.concatenate([e.co[e.edit, 1] for e in turned]),
-            [e.angle[0] for e in turned], np.array([e.angle[1] for e in turned], dtype=np.int64),
-            np.array([len(e.target) for e in turned], dtype=np.int64),
+    part_of = np.array([k[0] for k in curves])
+    # Which curves are keyed on their motion's key frames (a capture): one comparison of all keys.
+    fits = np.array(counts)[part_of] == sizes
+    frames = np.concatenate([parts[o].motion.frames if fit else np.full(size, np.nan)
+                             for o, fit, size in zip(part_of.tolist(), fits.tolist(), sizes.tolist())])
+    same = np.logical_and.reduceat(co[:, 0] == frames, starts) & fits
+    row = np.arange(len(co)) - np.repeat(starts, sizes)  # (a capture's keys are its rows)
+    near = np.ones(len(co), dtype=bool)
+    for k in np.flatnonzero(~same).tolist():  # keys on other frames: the nearest key frame of each
+        lo, hi = starts[k], starts[k] + sizes[k]
+        row[lo:hi], near[lo:hi] = nearest_rows(parts[part_of[k]].motion.frames, co[lo:hi, 0])
+    row += np.repeat(base[part_of], sizes)
+    edit = near & smoothed[row]
+    outside = ~(near & in_range[row])
+    target = values[row[edit], np.repeat([k[2] for k in curves], sizes)[edit]]
+    # Each rotation key's target within half a turn of the key's own original value: one call.
+    turned = np.flatnonzero([k[3] for k in curves])
+    if len(turned):
+        edited = np.concatenate(([0], np.cumsum(edit)))
+        per_curve = edited[starts + sizes] - edited[starts]
+        rotation = np.repeat([k[3] for k in curves], sizes)[edit]
+        target[rotation] = polyscrew.angles_near_many(
+            target[rotation], co[edit, 1][rotation], [parts[part_of[k]].motion.rotation_mode for k in turned.tolist()],
+            np.array([curves[k][1].array_index for k in turned.tolist()], dtype=np.int64), per_curve[turned],
         )
-        for e, target in zip(turned, np.split(wrapped, np.cumsum([len(e.target) for e in turned])[:-1])):
-            e.target = target
-    # The moves of every smoothed key, their handles with them: one pass over the packed keys.
-    co = np.concatenate([e.co for e in edits])
-    left = np.concatenate([e.left for e in edits])
-    right = np.concatenate([e.right for e in edits])
-    edit = np.concatenate([e.edit for e in edits])
-    target = np.concatenate([e.target for e in edits])
+    # The smoothed keys moved, their handles with them.
     delta = (target - co[edit, 1]).astype(np.float32)
     left[edit, 1] += delta
     right[edit, 1] += delta
     co[edit, 1] = target  # exact, not the sum
-    bounds = np.cumsum([len(e.co) for e in edits])[:-1]
-    for e, a, b, d in zip(edits, np.split(co, bounds), np.split(left, bounds), np.split(right, bounds)):
-        e.co, e.left, e.right = a, b, d
+    bounds = starts[1:]
+    for k, a, b, d, out in zip(curves, np.split(co, bounds), np.split(left, bounds), np.split(right, bounds),
+                               np.split(outside, bounds)):
+        parts[k[0]].edits.append(CurveEdit(k[1].data_path, k[1].array_index, a, b, d, out))
 
 
 def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
