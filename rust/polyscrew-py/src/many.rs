@@ -21,7 +21,7 @@ use crate::args::{
 use crate::arrays::{poses_to_array, read_keys, read_spec, read_vec3s, read_vector, vector_len};
 use crate::errors::{check_budget, invalid, shape_err, to_py_err};
 use crate::intent::{playback_arg, PyPlayback};
-use crate::motion::{moved_poses, MovedPoses};
+use crate::motion::{moved_poses, wrapped_angles, MovedPoses};
 
 /// The most parts one call takes (a list of that many entries is refused before it is read).
 const MAX_PARTS: usize = 1 << 32;
@@ -86,24 +86,9 @@ fn angles_near_many<'py>(
             Ok(AngleRun { mode, channel, len })
         })
         .collect::<PyResult<Vec<_>>>()?;
-    let values = float_array(F, "values", values)?;
-    let reference = float_array(F, "reference", reference)?;
-    let n = vector_len(F, "values", &values)?;
-    vector_len(F, "reference", &reference)?;
-    check_budget(
-        F,
-        values.copy() + reference.copy() + Footprint::of::<f64>(n).times(3),
-        "the angles",
-        polyscrew::motion::channels::CHANNELS_HINT,
-    )?;
-    let (values, reference) = (values.read()?, reference.read()?);
-    let (vv, rv) = (values.as_array(), reference.as_array());
-    let out = py.detach(|| -> PyResult<Vec<f64>> {
-        let values = read_vector(F, "values", &vv)?;
-        let reference = read_vector(F, "reference", &rv)?;
-        core_angles_near_many(&values, &reference, &runs).map_err(|e| to_py_err(F, e))
-    })?;
-    Ok(out.into_pyarray(py))
+    wrapped_angles(py, F, values, reference, move |values, reference| {
+        core_angles_near_many(values, reference, &runs)
+    })
 }
 
 /// partial_moves_many(

@@ -791,12 +791,26 @@ fn angles_near<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     const F: &str = AnglesNear::NAME;
     let (mode, channel) = (mode.0, args::int_in(F, "channel", channel, 0, 3)?);
-    let values = float_array(F, "values", values)?;
-    let reference = float_array(F, "reference", reference)?;
-    let n = vector_len(F, "values", &values)?;
-    vector_len(F, "reference", &reference)?;
+    wrapped_angles(py, F, values, reference, move |values, reference| {
+        core_angles_near(values, reference, mode, channel as usize)
+    })
+}
+
+/// The shared body of `angles_near` and `angles_near_many`: reads `values` and `reference`
+/// ((N,) each), checks the budget, and runs `near` on them with the GIL released.
+pub(crate) fn wrapped_angles<'py>(
+    py: Python<'py>,
+    function: &'static str,
+    values: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    near: impl FnOnce(&[f64], &[f64]) -> Result<Vec<f64>, Error> + Send,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let values = float_array(function, "values", values)?;
+    let reference = float_array(function, "reference", reference)?;
+    let n = vector_len(function, "values", &values)?;
+    vector_len(function, "reference", &reference)?;
     check_budget(
-        F,
+        function,
         values.copy() + reference.copy() + Footprint::of::<f64>(n).times(3),
         "the angles",
         polyscrew::motion::channels::CHANNELS_HINT,
@@ -804,9 +818,9 @@ fn angles_near<'py>(
     let (values, reference) = (values.read()?, reference.read()?);
     let (vv, rv) = (values.as_array(), reference.as_array());
     let out = py.detach(|| -> PyResult<Vec<f64>> {
-        let values = read_vector(F, "values", &vv)?;
-        let reference = read_vector(F, "reference", &rv)?;
-        core_angles_near(&values, &reference, mode, channel as usize).map_err(|e| to_py_err(F, e))
+        let values = read_vector(function, "values", &vv)?;
+        let reference = read_vector(function, "reference", &rv)?;
+        near(&values, &reference).map_err(|e| to_py_err(function, e))
     })?;
     Ok(out.into_pyarray(py))
 }
