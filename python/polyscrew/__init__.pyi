@@ -1218,3 +1218,40 @@ def reduce_keys(
 HANDLE_TYPES: tuple[HandleTypeName, ...]
 """Blender's ``Keyframe.handle_left_type`` / ``handle_right_type`` identifiers; a key's code
 in ``reduce_keys``' ``"handle_type"`` is its index here."""
+
+def angles_near_many(
+    values: ArrayLike, reference: ArrayLike, modes: Sequence[RotationModeName],
+    channels: ArrayLike, counts: ArrayLike
+) -> FloatArray:
+    """``angles_near`` of many curves in one call: ``values`` and ``reference`` (N,) are the
+    curves' values one after the other, curve ``i`` the next ``counts[i]`` of them, of rotation
+    channel ``channels[i]`` in ``modes[i]``; the result is, to the bit, each curve's
+    ``angles_near(values_i, reference_i, modes[i], channels[i])`` one after the other.
+    """
+
+def partial_moves_many(
+    source: ArrayLike, target: ArrayLike, counts: ArrayLike, pivots: ArrayLike,
+    max_angles: ArrayLike, max_distances: ArrayLike
+) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+    """``partial_moves`` of many owners in one call: ``source`` and ``target`` (N, 4, 4) are the
+    owners' poses one after the other, owner ``i`` the next ``counts[i]`` of them, with its
+    pivot ``pivots[i]`` ((S, 3)) and bounds ``max_angles[i]``, ``max_distances[i]`` ((S,));
+    the result is, to the bit, each owner's ``partial_moves`` one after the other.
+    """
+
+def sample_many(
+    poses: ArrayLike, key_times: ArrayLike, times: ArrayLike, scheme: SchemeName = "jarek",
+    levels: int = 4, timing: TimeMapName = "smooth"
+) -> FloatArray:
+    """``sample`` of many owners keyed at the same ``key_times`` (K,), at the same ``times``
+    (T,), in one call: ``poses`` (O * K, 4, 4) are the owners' keys one after the other; the
+    result (O * T, 4, 4) is, to the bit, each owner's ``sample(poses_i, key_times, times,
+    scheme, levels, timing=timing)`` one after the other (open motions).
+    """
+
+def channels_many(
+    playbacks: Sequence[Playback], frames: ArrayLike
+) -> list[tuple[FloatArray, FloatArray, FloatArray]]:
+    """``Playback.channels`` of many playbacks at the same ``frames`` (T,) in one call: per
+    playback, to the bit, its location (T, 3), rotation (T, 3 or 4) and scale (T, 3).
+    """

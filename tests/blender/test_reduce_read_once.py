@@ -25,16 +25,21 @@ DISTANCE, ANGLE = 0.001, math.radians(0.5)
 @contextlib.contextmanager
 def counting_calls():
     """Counts `polyscrew.reduce_keys` and `polyscrew.evaluate_fcurves` calls of the Reduce
-    Keys module and the playbacks of the dense motion (`Source.channels`)."""
+    Keys module and the playbacks of the dense motion (`Source.channels`, and each playback
+    of a `polyscrew.channels_many` call, which plays many owners in one call)."""
     reduce = addon_module("blender.reduce")
     intent = addon_module("pure.intent")
     calls = {"reduce_keys": 0, "evaluate_fcurves": 0, "channels": 0}
-    originals = {name: getattr(reduce.polyscrew, name) for name in ("reduce_keys", "evaluate_fcurves")}
+    names = ("reduce_keys", "evaluate_fcurves", "channels_many")
+    originals = {name: getattr(reduce.polyscrew, name) for name in names}
     channels = intent.Source.channels
 
     def counted(name):
         def call(*args, **kwargs):
-            calls[name] += 1
+            if name == "channels_many":
+                calls["channels"] += len(args[0])
+            else:
+                calls[name] += 1
             return originals[name](*args, **kwargs)
 
         return call

@@ -30,7 +30,7 @@ import bpy
 import numpy as np
 import polyscrew
 
-from ..pure import denoise_data
+from ..pure import denoise_data, intent
 from ..pure.reports import Outcome
 from . import action_groups, bake, bulk, channels, feature, keys, owners, preview, transaction
 from .keys import SmoothError
@@ -92,6 +92,8 @@ class Cleaned:
     #: The rotation channels written at the keys `rows` (len(rows), k), like the original key
     #: values (:func:`near_rotations`, one `polyscrew` call for all owners of a mode).
     near: np.ndarray | None = None
+    #: The keys to write, per curve (:func:`plan_edits`).
+    edits: list = field(default_factory=list)
 
 
 @dataclass
@@ -201,6 +203,20 @@ def _part(owner: owners.Owner, fcurves: list, read: dict) -> tuple[list, object]
     return None if part is None else (played, part)
 
 
+def play_at_keys(motions: list[keys.KeyedMotion]) -> dict[int, dict[str, np.ndarray]]:
+    """The channels of each motion's source at its key frames (per `id(motion)`), as Blender
+    plays them: one `polyscrew.channels_many` call per set of key frames (motions keyed on
+    the same frames, a capture, are one call)."""
+    by_frames: dict[bytes, list[keys.KeyedMotion]] = {}
+    for motion in motions:
+        by_frames.setdefault(motion.frames.tobytes(), []).append(motion)
+    out = {}
+    for chosen in by_frames.values():
+        for motion, played in zip(chosen, intent.channels_many([m.source for m in chosen], chosen[0].frames)):
+            out[id(motion)] = played
+    return out
+
+
 def near_rotations(parts: list[Cleaned]) -> None:
     """Sets each part's `near`: its smoothed rotations as channels of its mode, each written
     like the original key value at its frame (its quaternion sign, its Euler twin and whole
@@ -210,9 +226,10 @@ def near_rotations(parts: list[Cleaned]) -> None:
     by_mode: dict[str, list[Cleaned]] = {}
     for c in parts:
         by_mode.setdefault(c.motion.rotation_mode, []).append(c)
+    played = play_at_keys([c.motion for c in parts if _played_at_keys(c.motion)])
     for mode, chosen in by_mode.items():
         poses = np.concatenate([c.poses for c in chosen])
-        reference = np.concatenate([_original_rotation(c.motion)[c.rows] for c in chosen])
+        reference = np.concatenate([_original_rotation(c.motion, played.get(id(c.motion)))[c.rows] for c in chosen])
         near = polyscrew.rotation_channels_near(poses, mode, reference)
         bounds = np.cumsum([0] + [len(c.rows) for c in chosen]).tolist()
         for c, lo, hi in zip(chosen, bounds[:-1], bounds[1:]):
@@ -228,7 +245,7 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
         owner, motion, rows, held, _ = item
         key = (motion.frames[rows].tobytes(), held.tobytes())
         batches.setdefault(key, []).append(item)
-    out = []
+    out, sparse = [], []
     for items in batches.values():
         _, motion, rows, held, _ = items[0]
         times = motion.frames[rows]
@@ -261,10 +278,15 @@ def clean(prepared: list[tuple[owners.Owner, keys.KeyedMotion, np.ndarray, np.nd
             if spacing > denoise_data.SPARSE_SPACING:  # sparse: no key moves more than the noise
                 c.sparse_spacing = spacing
                 c.refused = denoise_data.blocked(owner.name, spacing, c.rotation_noise, c.translation_noise, stack[b])
-                c.poses, c.limited = denoise_data.limit_moves(
-                    stack[b], c.poses, c.pivot, np.sqrt(3.0) * c.rotation_noise, np.sqrt(3.0) * c.translation_noise
-                )
+                sparse.append((c, stack[b]))
             out.append(c)
+    if sparse:  # every sparse owner's keys drawn back in one call
+        moved, limited = denoise_data.limit_moves(
+            [source for _, source in sparse], [c.poses for c, _ in sparse], [c.pivot for c, _ in sparse],
+            [np.sqrt(3.0) * c.rotation_noise for c, _ in sparse], [np.sqrt(3.0) * c.translation_noise for c, _ in sparse],
+        )
+        for (c, _), poses, count in zip(sparse, moved, limited):
+            c.poses, c.limited = poses, count
     return out
 
 
@@ -291,102 +313,180 @@ def data_notes(c: Cleaned) -> list[str]:
 
 
 
-def _rows(frames: np.ndarray, at: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`nearest_rows`, at once when the keys `at` are the key frames `frames` themselves
-    (a curve keyed on every key frame: a capture)."""
-    if len(at) == len(frames) and np.array_equal(at, frames):
-        return np.arange(len(frames)), np.ones(len(frames), dtype=bool)
-    return nearest_rows(frames, at)
-
-
-def _original_rotation(motion: keys.KeyedMotion) -> np.ndarray:
-    """The original rotation channel values at every key frame of `motion` (K, k)."""
+def _original_rotation(motion: keys.KeyedMotion, played: dict | None = None) -> np.ndarray:
+    """The original rotation channel values at every key frame of `motion` (K, k); `played`:
+    the channels of `motion.source` at its key frames, when :func:`near_rotations` played
+    them (None: this motion needs no playback)."""
     mode = motion.rotation_mode
     if motion.source is not None:
+        if played is not None:
+            return np.asarray(played[keys.rotation_path(mode)], dtype=np.float64)
         path = keys.rotation_path(mode)
         read, static = read_keys(motion), motion.source.static[path]
-        cycles = dict(zip(motion.source.columns, motion.source.packed.cycles))
         out = np.empty((len(motion.frames), len(static)))
         for i in range(len(static)):
             points = read.get((path, i))
-            if points is None:
-                out[:, i] = static[i]  # unkeyed: its own value
-            elif cycles[path, i] is None and len(points[0]) == len(motion.frames) and np.array_equal(points[0][:, 0], motion.frames):
-                out[:, i] = points[0][:, 1]  # keyed on every key frame: Blender plays its key values there
-            else:
-                return np.asarray(motion.source.channels(motion.frames)[path], dtype=np.float64)
+            out[:, i] = static[i] if points is None else points[0][:, 1]
         return out
     # Curves the add-on cannot evaluate: continuity from the first key's values.
     return polyscrew.rotation_channels(motion.poses, mode, previous=keys.continued(mode, motion.first_rotation))
 
 
-def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
-    """Writes the owner's location and rotation keys among `fcurves` (not muted): every key
-    at a key frame of the motion gets its original key back (value and handles, from
-    `cleaned.originals`), and the smoothed keys (in the range, not held) the smoothed value at
-    their frame, their handles moving with them."""
-    motion, owner = cleaned.motion, cleaned.owner
-    mode = motion.rotation_mode
-    path = keys.rotation_path(mode)
-    smoothed_rows = cleaned.rows[~cleaned.held]
-    smoothed = np.zeros(len(motion.frames), dtype=bool)
-    smoothed[smoothed_rows] = True
-    in_range = np.zeros(len(motion.frames), dtype=bool)
-    in_range[cleaned.rows] = True
-    if cleaned.near is None:
-        near_rotations([cleaned])
-    rotation = np.zeros((len(motion.frames), cleaned.near.shape[1]))
-    # Each smoothed key written like the original key value (:func:`near_rotations`).
-    rotation[cleaned.rows] = cleaned.near
-    values = {path: rotation}
-    if motion.located:
-        location = np.zeros((len(motion.frames), 3))
-        location[cleaned.rows] = cleaned.poses[:, :3, 3]
-        values["location"] = location
-    originals = {(fc.data_path, fc.array_index): fc for fc in cleaned.originals}
-    # What keys.read read (one foreach_get per property and curve): the original keys, and on
-    # a first run also those of the result's curves (a copy of them): nothing is read again.
+def _played_at_keys(motion: keys.KeyedMotion) -> bool:
+    """Whether the original rotation of `motion` at its key frames needs its playback: some
+    rotation curve is cyclic or not keyed on every key frame (else its key values are what
+    Blender plays there)."""
+    if motion.source is None:
+        return False
+    path = keys.rotation_path(motion.rotation_mode)
     read = read_keys(motion)
-    for fc in fcurves:
-        prop = owner.prop_of(fc.data_path)
-        if fc.mute or prop not in values or fc.array_index >= values[prop].shape[1] or not len(fc.keyframe_points):
+    cycles = dict(zip(motion.source.columns, motion.source.packed.cycles))
+    for i in range(len(motion.source.static[path])):
+        points = read.get((path, i))
+        if points is None:
             continue
+        if cycles[path, i] is not None or not _same_frames(points[0][:, 0], motion.frames):
+            return True
+    return False
+
+
+def _same_frames(a: np.ndarray, b: np.ndarray) -> bool:
+    return len(a) == len(b) and np.array_equal(a, b)
+
+
+@dataclass
+class CurveEdit:
+    """One curve's keys as Remove Noise writes them, prepared before anything is written."""
+
+    data_path: str
+    index: int
+    #: The keys (K, 2) float32: co and both handles, as written.
+    co: np.ndarray
+    left: np.ndarray
+    right: np.ndarray
+    #: (K,) the keys outside the frame range (their handles kept).
+    outside: np.ndarray
+
+
+def plan_edits(parts: list[Cleaned], shown: dict) -> None:
+    """Sets each part's `edits`: the keys of its location and rotation curves among `shown`
+    (per (object pointer, bone): the curves the result copies, not muted) as they will be
+    written: every key at a key frame of the motion gets its original key back (value and
+    handles, from `originals`), and the smoothed keys (in the range, not held) the smoothed
+    value at their frame, their handles moving with them. Reads only (nothing is written):
+    what `keys.read` read, and on a rerun the keys of the curves of the earlier result.
+
+    Every curve's keys of every part are packed into one array: their comparison with their
+    motion's key frames (a capture's keys are its key frames), their rows, targets and moves
+    are each one numpy pass over it, the rotation targets one `polyscrew.angles_near_many`
+    call; only curves not keyed on their motion's key frames look for their rows alone."""
+    curves = []  # (part index, curve, column of the owner's values, rotation?, co, left, right)
+    for o, c in enumerate(parts):
+        motion, owner = c.motion, c.owner
+        path = keys.rotation_path(motion.rotation_mode)
+        first = {path: 3, "location": 0}  # the owner's values: location x, y, z then the rotation channels
+        width = {path: c.near.shape[1], "location": 3 if motion.located else 0}
+        originals = {(fc.data_path, fc.array_index): fc for fc in c.originals}
+        # What keys.read read (one foreach_get per property and curve): the original keys, and on
+        # a first run also those of the result's curves (a copy of them): nothing is read again.
+        read = read_keys(motion)
+        for fc in shown.get((owner.obj.as_pointer(), owner.bone), []):
+            prop = owner.prop_of(fc.data_path)
+            if fc.mute or fc.array_index >= width.get(prop, 0) or not len(fc.keyframe_points):
+                continue
+            points = fc.keyframe_points
+            was = read.get((prop, fc.array_index))
+            if was is None or len(was[0]) != len(points):
+                was = None
+            if originals or was is None:  # a rerun: the result is a copy of an earlier result
+                co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
+            else:
+                co, left, right = was  # (copied when packed below)
+            source = originals.get((fc.data_path, fc.array_index))
+            if source is not None and source != fc and len(source.keyframe_points):
+                # The original keys back (this curve is a copy of an earlier result).
+                if was is None or len(was[0]) != len(source.keyframe_points):
+                    was = (_points(source), _points(source, "handle_left"), _points(source, "handle_right"))
+                order = np.argsort(was[0][:, 0], kind="stable")
+                index, hit = nearest_rows(was[0][order, 0], co[:, 0])
+                index = order[index[hit]]
+                co[hit, 1] = was[0][index, 1]
+                left[hit] = was[1][index]
+                right[hit] = was[2][index]
+            curves.append((o, fc, first[prop] + fc.array_index, prop == path, co, left, right))
+    for c in parts:
+        c.edits = []
+    if not curves:
+        return
+    # Every part's key frames as rows of one table: which are smoothed, which in the range, and
+    # the values the smoothed keys take (location, then the rotation channels, :func:`near_rotations`).
+    counts = [len(c.motion.frames) for c in parts]
+    base = np.cumsum([0] + counts[:-1])
+    smoothed = np.zeros(sum(counts), dtype=bool)
+    in_range = np.zeros(sum(counts), dtype=bool)
+    values = np.zeros((sum(counts), 7))
+    for c, b in zip(parts, base.tolist()):
+        smoothed[b + c.rows[~c.held]] = True
+        in_range[b + c.rows] = True
+        values[b + c.rows, :3] = c.poses[:, :3, 3]
+        values[b + c.rows, 3 : 3 + c.near.shape[1]] = c.near
+    # The keys of every curve packed (copies of what was read).
+    co = np.concatenate([k[4] for k in curves])
+    left = np.concatenate([k[5] for k in curves])
+    right = np.concatenate([k[6] for k in curves])
+    sizes = np.array([len(k[4]) for k in curves])
+    starts = np.concatenate(([0], np.cumsum(sizes)[:-1]))
+    part_of = np.array([k[0] for k in curves])
+    # Which curves are keyed on their motion's key frames (a capture): one comparison of all keys.
+    fits = np.array(counts)[part_of] == sizes
+    frames = np.concatenate([parts[o].motion.frames if fit else np.full(size, np.nan)
+                             for o, fit, size in zip(part_of.tolist(), fits.tolist(), sizes.tolist())])
+    same = np.logical_and.reduceat(co[:, 0] == frames, starts) & fits
+    row = np.arange(len(co)) - np.repeat(starts, sizes)  # (a capture's keys are its rows)
+    near = np.ones(len(co), dtype=bool)
+    for k in np.flatnonzero(~same).tolist():  # keys on other frames: the nearest key frame of each
+        lo, hi = starts[k], starts[k] + sizes[k]
+        row[lo:hi], near[lo:hi] = nearest_rows(parts[part_of[k]].motion.frames, co[lo:hi, 0])
+    row += np.repeat(base[part_of], sizes)
+    edit = near & smoothed[row]
+    outside = ~(near & in_range[row])
+    target = values[row[edit], np.repeat([k[2] for k in curves], sizes)[edit]]
+    # Each rotation key's target within half a turn of the key's own original value: one call.
+    turned = np.flatnonzero([k[3] for k in curves])
+    if len(turned):
+        edited = np.concatenate(([0], np.cumsum(edit)))
+        per_curve = edited[starts + sizes] - edited[starts]
+        rotation = np.repeat([k[3] for k in curves], sizes)[edit]
+        target[rotation] = polyscrew.angles_near_many(
+            target[rotation], co[edit, 1][rotation], [parts[part_of[k]].motion.rotation_mode for k in turned.tolist()],
+            np.array([curves[k][1].array_index for k in turned.tolist()], dtype=np.int64), per_curve[turned],
+        )
+    # The smoothed keys moved, their handles with them.
+    delta = (target - co[edit, 1]).astype(np.float32)
+    left[edit, 1] += delta
+    right[edit, 1] += delta
+    co[edit, 1] = target  # exact, not the sum
+    bounds = starts[1:]
+    for k, a, b, d, out in zip(curves, np.split(co, bounds), np.split(left, bounds), np.split(right, bounds),
+                               np.split(outside, bounds)):
+        parts[k[0]].edits.append(CurveEdit(k[1].data_path, k[1].array_index, a, b, d, out))
+
+
+def _edit_keys(fcurves: list, cleaned: Cleaned) -> None:
+    """Writes the owner's keys prepared by :func:`plan_edits` into its curves among `fcurves`
+    (the result's copies of the curves planned): the keys, the handles unless `fc.update()`
+    makes them, and outside the frame range the handles they had."""
+    by_path = {(fc.data_path, fc.array_index): fc for fc in fcurves}
+    for e in cleaned.edits:
+        fc = by_path[e.data_path, e.index]
         points = fc.keyframe_points
-        was = read.get((prop, fc.array_index))
-        if was is None or len(was[0]) != len(points):
-            was = None
-        if originals or was is None:  # a rerun: the result is a copy of an earlier result
-            co, left, right = _points(fc), _points(fc, "handle_left"), _points(fc, "handle_right")
-        else:
-            co, left, right = (a.copy() for a in was)
-        source = originals.get((fc.data_path, fc.array_index))
-        if source is not None and source != fc and len(source.keyframe_points):
-            # The original keys back (this curve is a copy of an earlier result).
-            if was is None or len(was[0]) != len(source.keyframe_points):
-                was = (_points(source), _points(source, "handle_left"), _points(source, "handle_right"))
-            order = np.argsort(was[0][:, 0], kind="stable")
-            index, hit = nearest_rows(was[0][order, 0], co[:, 0])
-            index = order[index[hit]]
-            co[hit, 1] = was[0][index, 1]
-            left[hit] = was[1][index]
-            right[hit] = was[2][index]
-        row, near = _rows(motion.frames, co[:, 0])
-        edit = near & smoothed[row]
-        target = values[prop][row[edit], fc.array_index]
-        if prop == path:  # an angle within half a turn of the key's own original value
-            target = polyscrew.angles_near(target, co[edit, 1], mode, fc.array_index)
-        delta = (target - co[edit, 1]).astype(np.float32)
-        left[edit, 1] += delta
-        right[edit, 1] += delta
-        co[edit, 1] = target  # exact, not the sum
-        bulk.put(points, "co", co.ravel())
+        bulk.put(points, "co", e.co.ravel())
         if not _automatic_handles(points):  # (else `fc.update()` makes them from the keys)
-            bulk.put(points, "handle_left", left.ravel())
-            bulk.put(points, "handle_right", right.ravel())
+            bulk.put(points, "handle_left", e.left.ravel())
+            bulk.put(points, "handle_right", e.right.ravel())
         fc.update()
-        outside = ~(near & in_range[row])
-        if outside.any():  # (else no handle can have changed outside the range)
-            _keep_handles_outside(fc, outside, left, right)
+        if e.outside.any():  # (else no handle can have changed outside the range)
+            _keep_handles_outside(fc, e.outside, e.left, e.right)
 
 
 _FREE = bpy.types.Keyframe.bl_rna.properties["handle_left_type"].enum_items["FREE"].value
@@ -438,7 +538,7 @@ def remove_noise(
     anything is written, and the writing is all or nothing."""
     groups, refused = action_groups.by_action(selection)
     skipped = [message for _, message in refused]
-    prepared, plans, notes, rerun = [], [], [], []
+    prepared, plans, notes, rerun, shown_of = [], [], [], [], {}
     sharers: dict[tuple[int, str], list[str]] = {}
     # Every group's users in one pass over the scene's objects (one pass per group grew as
     # groups x objects), and every owner's transform curves read in one pass.
@@ -480,6 +580,7 @@ def remove_noise(
             # the curves of the original keys, to write them back on a rerun (a first run edits a copy of them)
             prepared.append((owner, motion, rows, held, by_owner.get(owner.bone, []) if source is not current else []))
             first_of[owner.bone, owner.rotation_mode] = owner
+            shown_of[owner.obj.as_pointer(), owner.bone] = shown.get(owner.bone, [])
             done.append(owner)
             if motion.kept:
                 notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
@@ -497,6 +598,7 @@ def remove_noise(
             skipped.append(c.refused)
             del cleaned[key]
     near_rotations(list(cleaned.values()))
+    plan_edits(list(cleaned.values()), shown_of)
     plans = [
         (objects, source, current, identifier, kept)
         for objects, source, current, identifier, done in plans

@@ -40,6 +40,7 @@ import bpy
 import numpy as np
 import polyscrew
 
+from ..pure import intent
 from ..pure.reduce_plan import (  # noqa: F401  (re-exported: reduce.Options, reduce.KEY_MODES, ...)
     DEFAULT_ANGLE,
     DEFAULT_DISTANCE_M,
@@ -144,22 +145,34 @@ def solve(
     except (ValueError, TypeError, MemoryError) as err:
         names = ", ".join(it.owner.name for it in items[:3]) + (" ..." if len(items) > 3 else "")
         raise SmoothError(f"{names}: {err}") from err
-    offsets_ = np.asarray(r["offsets"])
+    offsets_ = np.asarray(r["offsets"]).tolist()
     owner_of = np.asarray(r["owner"])
     wanted = [set(it.written) for it in items]
     curves: list[dict] = [{} for _ in items]
+    codes = {name: np.asarray(r[name]) for name in ("co", "handle_left", "handle_right", "interpolation", "easing",
+                                                     "handle_type")}
+    # Every curve as Blender takes it, converted once for all curves (not once per curve).
+    interpolation = _enum("interpolation")[codes["interpolation"]]
+    easing = _enum("easing")[codes["easing"]]
+    eased_before = np.concatenate(([0], np.cumsum(codes["easing"] != 0)))  # (per curve: any eased key)
+    eased = (eased_before[offsets_[1:]] - eased_before[offsets_[:-1]]) > 0
+    blender = {
+        "co": codes["co"].astype(np.float32),
+        "handle_left": codes["handle_left"].astype(np.float32),
+        "handle_right": codes["handle_right"].astype(np.float32),
+        "interpolation_bytes": interpolation.astype(np.uint8),
+        "interpolation": interpolation.tolist(),
+        "easing": easing.tolist(),
+        "handle_type": _enum("handle_left_type")[codes["handle_type"]].tolist(),
+    }
     for c, (b, path, index) in enumerate(zip(owner_of.tolist(), r["path"], np.asarray(r["index"]).tolist())):
         if (path, index) not in wanted[b]:
             continue
-        lo, hi = int(offsets_[c]), int(offsets_[c + 1])
-        curves[b][path, index] = Curve(
-            co=np.asarray(r["co"])[lo:hi],
-            handle_left=np.asarray(r["handle_left"])[lo:hi],
-            handle_right=np.asarray(r["handle_right"])[lo:hi],
-            interpolation=np.asarray(r["interpolation"])[lo:hi],
-            easing=np.asarray(r["easing"])[lo:hi],
-            handle_type=np.asarray(r["handle_type"])[lo:hi],
-        )
+        lo, hi = offsets_[c], offsets_[c + 1]
+        part = {name: values[lo:hi] for name, values in codes.items()}
+        written = {name: values[lo:hi] for name, values in blender.items()}
+        written["eased"] = bool(eased[c])
+        curves[b][path, index] = Curve(**part, written=written)
     return [
         Reduced(
             item=it, curves=curves[b], keys=int(r["keys"][b]),
@@ -172,60 +185,77 @@ def solve(
 # Reading ---------------------------------------------------------------------------------
 
 
-def _item(owner: owners.Owner, motion: keys.KeyedMotion, frames: np.ndarray) -> Item:
-    """The owner's dense motion at `frames` as Blender plays its curves, and its playback at
-    the probes of every span (one `Playback` call for both)."""
-    source = motion.source
-    mode = motion.rotation_mode
-    rot_path = keys.rotation_path(mode)
+def _items(members: list[tuple[owners.Owner, keys.KeyedMotion]], frames: np.ndarray) -> list[Item]:
+    """Each owner's dense motion at `frames` as Blender plays its curves, and its playback at
+    the probes of every span: one `polyscrew.channels_many` call for every owner (frames and
+    probes together), one `rotation_matrices` call per rotation mode. Raises SmoothError for
+    the first owner whose playback is not finite or whose keyed scale is not positive."""
     n = len(frames)
     probes = _probe_times(frames)
     before_end = frames[1:] - np.minimum(1e-3, 0.01 * np.diff(frames))
-    played = source.channels(np.concatenate([frames, probes, before_end]))
-    location = played["location"] if motion.located else np.zeros_like(played["location"])
-    rotation = played[rot_path]
-    scale = played["scale"]
-    for label, values in (("location", location), (rot_path, rotation), ("scale", scale)):
-        if not np.all(np.isfinite(values)):
-            raise SmoothError(f"{owner.name}: {label} is not finite between the keys: skipped")
-    scale_axes = motion.scale_axes
-    if np.any((scale <= 0.0) & scale_axes):
-        raise SmoothError(f"{owner.name}: keyed scale reaches zero or below: Reduce Keys needs a positive scale: skipped")
-    # Steps: the channels hold the first frame's values exactly through the span (at the
-    # probes and just before its end) and jump at its end (a CONSTANT pop).
-    stacked = np.concatenate([location, rotation, scale], axis=1)
-    at, inside = stacked[:n], stacked[n:].reshape(len(PROBES) + 1, n - 1, -1)
-    steps = np.all(inside == at[None, :-1], axis=(0, 2)) & np.any(at[1:] != at[:-1], axis=1)
-    # Linear spans: the channels at the probes on the straight line between the frames
-    chord = np.stack([at[:-1] + f * (at[1:] - at[:-1]) for f in PROBES])
-    linear = np.all(np.abs(inside[: len(PROBES)] - chord) <= 1e-6 * (1.0 + np.abs(chord)), axis=(0, 2))
-    columns = set(source.columns)
-    located = motion.located and any(p == "location" for p, _ in columns)
-    rotated = any(p == rot_path for p, _ in columns)
-    size = keys.rotation_width(mode)
-    written = [("location", i) for i in range(3)] if located else []
-    written += [(rot_path, i) for i in range(size)] if rotated else []
-    written += [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
-    poses = keys.compose(location, keys.rotation_matrices(rotation, mode))
-    scales = np.where(scale_axes, scale, 1.0)
-    m = n + len(probes)
-    return Item(
-        owner=owner,
-        mode=mode,
-        poses=poses[:n],
-        scales=scales[:n],
-        channels=np.array([located, rotated, bool(scale_axes.any())]),
-        constant=steps,
-        start=_pad4(rotation[0]),
-        radius=body_radius(owner),
-        written=written,
-        keys_before=len(motion.frames),
-        cyclic=motion.cyclic,
-        probe_poses=poses[n:m],
-        probe_scales=scales[n:m],
-        linear=linear,
-        whole=int(np.sum(np.abs(frames - np.round(frames)) < keys.FRAME_TOLERANCE)),
-    )
+    times = np.concatenate([frames, probes, before_end])
+    played_all = intent.channels_many([motion.source for _, motion in members], times)
+    read = []
+    for (owner, motion), played in zip(members, played_all):
+        rot_path = keys.rotation_path(motion.rotation_mode)
+        location = played["location"] if motion.located else np.zeros_like(played["location"])
+        rotation, scale = played[rot_path], played["scale"]
+        for label, values in (("location", location), (rot_path, rotation), ("scale", scale)):
+            if not np.all(np.isfinite(values)):
+                raise SmoothError(f"{owner.name}: {label} is not finite between the keys: skipped")
+        if np.any((scale <= 0.0) & motion.scale_axes):
+            raise SmoothError(f"{owner.name}: keyed scale reaches zero or below: Reduce Keys needs a positive scale: skipped")
+        read.append((location, rotation, scale))
+    # The rotation matrices of every owner of a mode in one call (row by row: the same values).
+    matrices: list = [None] * len(members)
+    by_mode: dict[str, list[int]] = {}
+    for k, (_, motion) in enumerate(members):
+        by_mode.setdefault(motion.rotation_mode, []).append(k)
+    for mode, chosen in by_mode.items():
+        stacked = keys.rotation_matrices(np.concatenate([read[k][1] for k in chosen]), mode)
+        for k, m in zip(chosen, np.split(stacked, len(chosen))):
+            matrices[k] = m
+    out = []
+    for (owner, motion), (location, rotation, scale), rotations in zip(members, read, matrices):
+        mode = motion.rotation_mode
+        rot_path = keys.rotation_path(mode)
+        # Steps: the channels hold the first frame's values exactly through the span (at the
+        # probes and just before its end) and jump at its end (a CONSTANT pop).
+        stacked = np.concatenate([location, rotation, scale], axis=1)
+        at, inside = stacked[:n], stacked[n:].reshape(len(PROBES) + 1, n - 1, -1)
+        steps = np.all(inside == at[None, :-1], axis=(0, 2)) & np.any(at[1:] != at[:-1], axis=1)
+        # Linear spans: the channels at the probes on the straight line between the frames
+        chord = np.stack([at[:-1] + f * (at[1:] - at[:-1]) for f in PROBES])
+        linear = np.all(np.abs(inside[: len(PROBES)] - chord) <= 1e-6 * (1.0 + np.abs(chord)), axis=(0, 2))
+        columns = set(motion.source.columns)
+        located = motion.located and any(p == "location" for p, _ in columns)
+        rotated = any(p == rot_path for p, _ in columns)
+        size = keys.rotation_width(mode)
+        scale_axes = motion.scale_axes
+        written = [("location", i) for i in range(3)] if located else []
+        written += [(rot_path, i) for i in range(size)] if rotated else []
+        written += [("scale", int(i)) for i in np.flatnonzero(scale_axes)]
+        poses = keys.compose(location, rotations)
+        scales = np.where(scale_axes, scale, 1.0)
+        m = n + len(probes)
+        out.append(Item(
+            owner=owner,
+            mode=mode,
+            poses=poses[:n],
+            scales=scales[:n],
+            channels=np.array([located, rotated, bool(scale_axes.any())]),
+            constant=steps,
+            start=_pad4(rotation[0]),
+            radius=body_radius(owner),
+            written=written,
+            keys_before=len(motion.frames),
+            cyclic=motion.cyclic,
+            probe_poses=poses[n:m],
+            probe_scales=scales[n:m],
+            linear=linear,
+            whole=int(np.sum(np.abs(frames - np.round(frames)) < keys.FRAME_TOLERANCE)),
+        ))
+    return out
 
 
 def _with_probes(items: list[Item], frames: np.ndarray, flagged: np.ndarray) -> tuple[np.ndarray, list[Item]]:
@@ -250,7 +280,7 @@ def _with_probes(items: list[Item], frames: np.ndarray, flagged: np.ndarray) -> 
 def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per span between dense frames: how far Blender's playback of the dense keys at the
     probes departs from the core's reference there (the screw between the frames, one
-    `polyscrew.sample` call per owner, levels 0, linear timing), over all owners, in world
+    `polyscrew.sample_many` call for all owners, levels 0, linear timing), over all owners, in world
     space along the chains: (distance, angle) as the core measures them, `|dt| + 2 r sin(a/2)`
     (+ `r |ds|` with scale) and `a`."""
     probes = _probe_times(frames)
@@ -259,9 +289,13 @@ def departure(items: list[Item], frames: np.ndarray) -> tuple[np.ndarray, np.nda
     world_ref, world_play = {}, {}
     dist = np.zeros(spans)
     ang = np.zeros(spans)
+    # every owner's screws between its frames at the probes, in one call
+    refs = polyscrew.sample_many(
+        np.concatenate([it.poses for it in items]), frames, probes, levels=0, timing="linear"
+    ).reshape(len(items), len(probes), 4, 4)
     for i in _chain_order(parents, len(items)):
         it = items[i]
-        ref = polyscrew.sample(it.poses, frames, probes, levels=0, timing="linear")
+        ref = refs[i]
         play = it.probe_poses
         if parents is not None and parents[i] >= 0:
             j = int(parents[i])
@@ -315,7 +349,7 @@ def batches(pairs: list[tuple[owners.Owner, keys.KeyedMotion]], options: Options
         grouped.setdefault(frames.tobytes(), (frames, []))[1].append((owner, motion))
     out = []
     for frames, members in grouped.values():
-        items = _located_children([_item(o, m, frames) for o, m in members], members)
+        items = _located_children(_items(members, frames), members)
         steps = np.any([it.constant for it in items], axis=0)
         between, margin = "screw", (0.0, 0.0)
         if np.all(np.all([it.linear for it in items], axis=0) | steps):
@@ -432,22 +466,20 @@ def write_curve(
     else:
         snapshot = [("CYCLES", {"mode_before": cycle[0], "mode_after": cycle[1]})] if cycle else []
     fc = channels.new_fcurve(bag, path, index, group)
-    n = len(curve.co)
+    written = curve.written  # (prepared by :func:`solve` for every curve at once)
     points = fc.keyframe_points
-    points.add(n)
-    co = np.asarray(curve.co, dtype=np.float32).ravel()
-    interpolation = _enum("interpolation")[curve.interpolation]
-    left = np.asarray(curve.handle_left, dtype=np.float32).ravel()
-    right = np.asarray(curve.handle_right, dtype=np.float32).ravel()
+    points.add(len(curve.co))
+    co = written["co"].ravel()
     bulk.put(points, "co", co)
+    left, right = written["handle_left"].ravel(), written["handle_right"].ravel()
     bulk.put(points, "handle_left", left)
     bulk.put(points, "handle_right", right)
-    bulk.put(points, "interpolation", tuple(interpolation.tolist()))
+    bulk.put(points, "interpolation", tuple(written["interpolation"]))
     if digests is not None:
-        digests[path, index] = bake.curve_digest(co, interpolation.astype(np.uint8), left, right)
-    if np.any(curve.easing != 0):
-        bulk.put(points, "easing", tuple(_enum("easing")[curve.easing].tolist()))
-    types = tuple(_enum("handle_left_type")[curve.handle_type].tolist())
+        digests[path, index] = bake.curve_digest(co, written["interpolation_bytes"], left, right)
+    if written["eased"]:
+        bulk.put(points, "easing", tuple(written["easing"]))
+    types = tuple(written["handle_type"])
     bulk.put(points, "handle_left_type", types)
     bulk.put(points, "handle_right_type", types)
     for name, value in kept.items():

@@ -92,12 +92,20 @@ def blocked(name: str, spacing: float, rotation_noise: float, translation_noise:
 
 
 def limit_moves(
-    source: np.ndarray, smoothed: np.ndarray, pivot: np.ndarray, rotation_bound: float, translation_bound: float
-) -> tuple[np.ndarray, int]:
-    """`smoothed` (n, 4, 4) with every pose that moved from `source` by more than the bounds
-    (a rotation angle, radians; a distance of the pivot point) drawn back towards its source
-    pose by the fraction a that brings both within them: the rotation by a of its turn
-    (about the same axis), the pivot a of the way along its straight move. Returns the poses
-    and how many were drawn back (one `polyscrew.partial_moves` call)."""
-    poses, limited = polyscrew.partial_moves(source, smoothed, pivot, rotation_bound, translation_bound)
-    return poses, int(limited.sum())
+    sources: list[np.ndarray], smoothed: list[np.ndarray], pivots: list[np.ndarray], rotation_bounds: list[float],
+    translation_bounds: list[float],
+) -> tuple[list[np.ndarray], list[int]]:
+    """Per owner: its `smoothed` poses (n, 4, 4) with every pose that moved from its `sources`
+    pose by more than its bounds (a rotation angle, radians; a distance of its pivot point)
+    drawn back towards its source pose by the fraction a that brings both within them: the
+    rotation by a of its turn (about the same axis), the pivot a of the way along its straight
+    move. Returns each owner's poses and how many were drawn back (one
+    `polyscrew.partial_moves_many` call for all owners: each owner's `partial_moves`, bit for
+    bit)."""
+    counts = np.array([len(p) for p in smoothed], dtype=np.int64)
+    poses, cut = polyscrew.partial_moves_many(
+        np.concatenate(sources), np.concatenate(smoothed), counts, np.array(pivots, dtype=np.float64).reshape(-1, 3),
+        np.array(rotation_bounds, dtype=np.float64), np.array(translation_bounds, dtype=np.float64),
+    )
+    bounds = np.cumsum(counts)[:-1]
+    return np.split(poses, bounds), [int(c.sum()) for c in np.split(cut, bounds)]

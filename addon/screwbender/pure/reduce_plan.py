@@ -97,6 +97,10 @@ class Curve:
     interpolation: np.ndarray
     easing: np.ndarray
     handle_type: np.ndarray
+    #: The curve as Blender takes it (what `foreach_set` writes: flat float32 keys and
+    #: handles, Blender's enum values), prepared for every curve of a call at once by the
+    #: Blender layer; None until then.
+    written: dict | None = None
 
 
 @dataclass

@@ -214,6 +214,10 @@ functions!(
     AnalyseTurns = "analyse_turns",
     ReduceKeys = "reduce_keys",
     SampleOwners = "sample_owners",
+    AnglesNearMany = "angles_near_many",
+    PartialMovesMany = "partial_moves_many",
+    SampleMany = "sample_many",
+    ChannelsMany = "channels_many",
 );
 
 /// The name of `obj`'s type, for messages.

@@ -16,6 +16,7 @@ mod errors;
 mod fcurve;
 mod feature;
 mod intent;
+mod many;
 mod motion;
 mod reduce;
 mod sweep;
@@ -124,5 +125,6 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     batch::register(m)?;
     denoise::register(m)?;
     reduce::register(m)?;
+    many::register(m)?;
     Ok(())
 }

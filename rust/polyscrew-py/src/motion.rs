@@ -791,12 +791,26 @@ fn angles_near<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     const F: &str = AnglesNear::NAME;
     let (mode, channel) = (mode.0, args::int_in(F, "channel", channel, 0, 3)?);
-    let values = float_array(F, "values", values)?;
-    let reference = float_array(F, "reference", reference)?;
-    let n = vector_len(F, "values", &values)?;
-    vector_len(F, "reference", &reference)?;
+    wrapped_angles(py, F, values, reference, move |values, reference| {
+        core_angles_near(values, reference, mode, channel as usize)
+    })
+}
+
+/// The shared body of `angles_near` and `angles_near_many`: reads `values` and `reference`
+/// ((N,) each), checks the budget, and runs `near` on them with the GIL released.
+pub(crate) fn wrapped_angles<'py>(
+    py: Python<'py>,
+    function: &'static str,
+    values: &Bound<'py, PyAny>,
+    reference: &Bound<'py, PyAny>,
+    near: impl FnOnce(&[f64], &[f64]) -> Result<Vec<f64>, Error> + Send,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let values = float_array(function, "values", values)?;
+    let reference = float_array(function, "reference", reference)?;
+    let n = vector_len(function, "values", &values)?;
+    vector_len(function, "reference", &reference)?;
     check_budget(
-        F,
+        function,
         values.copy() + reference.copy() + Footprint::of::<f64>(n).times(3),
         "the angles",
         polyscrew::motion::channels::CHANNELS_HINT,
@@ -804,9 +818,9 @@ fn angles_near<'py>(
     let (values, reference) = (values.read()?, reference.read()?);
     let (vv, rv) = (values.as_array(), reference.as_array());
     let out = py.detach(|| -> PyResult<Vec<f64>> {
-        let values = read_vector(F, "values", &vv)?;
-        let reference = read_vector(F, "reference", &rv)?;
-        core_angles_near(&values, &reference, mode, channel as usize).map_err(|e| to_py_err(F, e))
+        let values = read_vector(function, "values", &vv)?;
+        let reference = read_vector(function, "reference", &rv)?;
+        near(&values, &reference).map_err(|e| to_py_err(function, e))
     })?;
     Ok(out.into_pyarray(py))
 }
@@ -885,7 +899,51 @@ fn direction_steps<'py>(
 }
 
 /// The poses of [`partial_moves`] and which were cut short.
-type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
+pub(crate) type MovedPoses<'py> = (Bound<'py, PyArray3<f64>>, Bound<'py, PyArray1<bool>>);
+
+/// The shared body of `partial_moves` and `partial_moves_many`: reads `source` and `target`
+/// ((N, 4, 4) each), checks the budget (`extra`: the caller's other arguments read), and
+/// runs `moves` on the poses with the GIL released.
+pub(crate) fn moved_poses<'py>(
+    py: Python<'py>,
+    function: &'static str,
+    source: &Bound<'py, PyAny>,
+    target: &Bound<'py, PyAny>,
+    extra: Footprint,
+    moves: impl FnOnce(&[Pose], &[Pose]) -> Result<(Vec<Pose>, Vec<bool>), Error> + Send,
+) -> PyResult<MovedPoses<'py>> {
+    let source = float_array(function, "source", source)?;
+    let target = float_array(function, "target", target)?;
+    for (what, poses) in [("source", &source), ("target", &target)] {
+        if !matches!(poses.shape(), [_, 4, 4]) {
+            return Err(shape_err(function, what, "(N, 4, 4)", poses.shape()));
+        }
+    }
+    let n = source.shape()[0];
+    check_budget(
+        function,
+        source.copy()
+            + target.copy()
+            + extra
+            + Footprint::of::<Pose>(n.saturating_mul(3))
+            + Footprint::of::<bool>(n)
+            + Footprint::of::<[f64; 16]>(n),
+        "the partial moves",
+        polyscrew::motion::channels::CHANNELS_HINT,
+    )?;
+    let (source, target) = (source.read()?, target.read()?);
+    let (sv, tv) = (source.as_array(), target.as_array());
+    let (poses, cut) = py.detach(|| -> PyResult<(Array3<f64>, Vec<bool>)> {
+        let source = read_poses(function, "source", &sv)?;
+        let target = read_poses(function, "target", &tv)?;
+        let (poses, cut) = moves(&source, &target).map_err(|e| to_py_err(function, e))?;
+        Ok((
+            poses_to_array(&poses).map_err(|e| to_py_err(function, e))?,
+            cut,
+        ))
+    })?;
+    Ok((poses.into_pyarray(py), cut.into_pyarray(py)))
+}
 
 /// partial_moves(
 ///     source: ArrayLike, target: ArrayLike, pivot: ArrayLike, max_angle: float,
@@ -913,40 +971,17 @@ fn partial_moves<'py>(
         angle: args::float_scalar(F, "max_angle", max_angle)?,
         distance: args::float_scalar(F, "max_distance", max_distance)?,
     };
-    let source = float_array(F, "source", source)?;
-    let target = float_array(F, "target", target)?;
     let pivot = float_array(F, "pivot", pivot)?;
     if pivot.shape() != [3] {
         return Err(shape_err(F, "pivot", "(3,)", pivot.shape()));
     }
-    for (what, poses) in [("source", &source), ("target", &target)] {
-        if !matches!(poses.shape(), [_, 4, 4]) {
-            return Err(shape_err(F, what, "(N, 4, 4)", poses.shape()));
-        }
-    }
-    let n = source.shape()[0];
-    check_budget(
-        F,
-        source.copy()
-            + target.copy()
-            + pivot.copy()
-            + Footprint::of::<Pose>(n.saturating_mul(3))
-            + Footprint::of::<bool>(n)
-            + Footprint::of::<[f64; 16]>(n),
-        "the partial moves",
-        polyscrew::motion::channels::CHANNELS_HINT,
-    )?;
-    let (source, target, pivot) = (source.read()?, target.read()?, pivot.read()?);
-    let (sv, tv, pv) = (source.as_array(), target.as_array(), pivot.as_array());
-    let (poses, cut) = py.detach(|| -> PyResult<(Array3<f64>, Vec<bool>)> {
-        let source = read_poses(F, "source", &sv)?;
-        let target = read_poses(F, "target", &tv)?;
-        let p = DVec3::new(pv[0], pv[1], pv[2]);
-        let (poses, cut) =
-            core_partial_moves(&source, &target, p, bounds).map_err(|e| to_py_err(F, e))?;
-        Ok((poses_to_array(&poses).map_err(|e| to_py_err(F, e))?, cut))
-    })?;
-    Ok((poses.into_pyarray(py), cut.into_pyarray(py)))
+    let extra = pivot.copy();
+    let pivot = pivot.read()?;
+    let pv = pivot.as_array();
+    let p = DVec3::new(pv[0], pv[1], pv[2]);
+    moved_poses(py, F, source, target, extra, move |source, target| {
+        core_partial_moves(source, target, p, bounds)
+    })
 }
 
 /// memory_budget() -> int

@@ -43,6 +43,7 @@ pub mod batch;
 pub mod departure;
 pub(crate) mod interp;
 pub mod limits;
+pub mod many;
 pub mod pace;
 pub mod playback;
 pub mod spans;
@@ -60,6 +61,9 @@ pub use batch::{
 };
 pub use departure::{
     departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
+};
+pub use many::{
+    angles_near_many, channels_many, partial_moves_many, sample_many, AngleRun, MoveRun,
 };
 pub use pace::{
     keys_parameters, keys_parameters_played, pace_parameters, screw_pace_poses, timed_frames,
