@@ -17,6 +17,7 @@ mod fcurve;
 mod feature;
 mod intent;
 mod motion;
+mod read;
 mod reduce;
 mod sweep;
 
@@ -122,6 +123,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fcurve::register(m)?;
     intent::register(m)?;
     batch::register(m)?;
+    read::register(m)?;
     denoise::register(m)?;
     reduce::register(m)?;
     Ok(())
