@@ -1036,10 +1036,10 @@ def read_owners(
     amplitude: ArrayLike | None = None,
     period: ArrayLike | None = None,
     cycles: Sequence[Mapping[str, Any] | None] | None = None,
-) -> tuple[list[Playback | None], FloatArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray, tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, npt.NDArray[np.bool_], FloatArray, IntArray], IntArray]:
+) -> tuple[list[Playback | None], FloatArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray, tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, npt.NDArray[np.bool_], FloatArray, IntArray, FloatArray, FloatArray, FloatArray], IntArray]:
     """Many owners' keys read in one call: for each owner, exactly what ``Playback``, then
-    ``Playback.channels`` at its key frames, ``rotation_matrices`` and ``analyse_turns``
-    give, one after the other.
+    ``Playback.channels`` at its key frames, ``rotation_matrices``, ``analyse_turns`` and
+    ``Playback.channels`` at the frames it inserts give, one after the other.
 
     The curves of every owner are packed together as ``evaluate_fcurves`` takes them (the
     same keyword arguments), curve ``c`` driving ``channels[c]``; owner ``o`` plays curves
@@ -1056,8 +1056,9 @@ def read_owners(
     concatenated (F,) with ``counts`` (O,) of them each; the channels there, location (F, 3),
     rotation (F, 4: NaN in the last column for a 3-wide mode) and scale (F, 3); the rigid key
     poses (F, 4, 4); ``spans``, ``analyse_turns``' held, pops, turn and flips of the analysed
-    owners' spans one after the other (K - 1 each), its inserted frames concatenated, and
-    how many of those each owner has (O,); and a status per owner (int64): 1 read and
+    owners' spans one after the other (K - 1 each), its inserted frames concatenated, how
+    many of those each owner has (O,), and the channels at them (location (M, 3), rotation
+    (M, 4) padded as above, scale (M, 3)); and a status per owner (int64): 1 read and
     analysed, 0 read, -1 refused (nothing of it in the arrays: read it alone to learn why:
     bad curves, fewer than two key frames, a key row not finite, a keyed scale not positive,
     what ``analyse_turns`` refuses). GIL released. Raises ValueError for arrays that do not

@@ -1,8 +1,9 @@
 """Many owners' keys read in one call (issue 27): `polyscrew.read_owners` gives, to the bit,
 what `keys.read` computes owner by owner from its packed curves: `Playback(...)`, the union of
 the curves' key frames (`keyed._union`), `Playback.channels` there (or the key values of a
-capture, `key_values`), `keyed.compose(location, keyed.rotation_matrices(rotation, mode))`
-and `analyse_turns` under every Turns choice. Random owners in all 8 rotation modes: holds
+capture, `key_values`), `keyed.compose(location, keyed.rotation_matrices(rotation, mode))`,
+`analyse_turns` under every Turns choice and `Playback.channels` at the frames it inserts.
+Random owners in all 8 rotation modes: holds
 and pops (CONSTANT keys), spins over half a turn, Euler wraps, quaternion sign flips and
 non-normalised quaternions, scale keyed on some axes, connected bones (no location), owners
 sharing curves with other values, and owners the core refuses (a NaN key, keys out of time
@@ -134,6 +135,8 @@ def alone(owner: dict):
     if owner["turns"] is not None:
         try:
             spans = polyscrew.analyse_turns(playback, frames, owner["turns"])
+            if len(spans[3]):  # (keys.read plays the frames added to spins)
+                spans += (playback.channels(spans[3]),)
         except ValueError:
             return None
     return playback, frames, location, rotation, scale, poses, spans
@@ -179,7 +182,7 @@ def test_read_owners_is_each_owner_read_alone_to_the_bit():
         shared[o] = (o * 7) % 160
         owners.append(twin)
     playbacks, frames, counts, location, rotation, scale, poses, spans, status = batch(owners, shared)
-    held, pops, turn, flips, inserted, inserted_counts = spans
+    held, pops, turn, flips, inserted, inserted_counts, at_location, at_rotation, at_scale = spans
     key_at = np.concatenate(([0], np.cumsum(counts)))
     span_at = np.concatenate(([0], np.cumsum(np.where(status == 1, np.maximum(counts - 1, 0), 0))))
     inserted_at = np.concatenate(([0], np.cumsum(inserted_counts)))
@@ -206,6 +209,11 @@ def test_read_owners_is_each_owner_read_alone_to_the_bit():
             mine = (held[s0:s1], pops[s0:s1], turn[s0:s1], inserted[i0:i1], flips[s0:s1])
             for name, a, b in zip(("held", "pops", "turn", "inserted", "flips"), mine, want_spans):
                 assert same(a, b), f"owner {o} ({owner['mode']}, {owner['turns']}): {name} differs"
+            played = (at_location[i0:i1], at_rotation[i0:i1, :w], at_scale[i0:i1])
+            if len(want_spans[3]):
+                for name, a, b in zip(("location", "rotation", "scale"), played, want_spans[5]):
+                    assert same(a, b), f"owner {o}: the playback's {name} at the inserted frames differs"
+            assert all(len(p) == len(want_spans[3]) for p in played)
             seen["spins"] += int(len(want_spans[3]) > 0)
             seen["flips"] += int(want_spans[4].any())
             seen["holds"] += int(want_spans[0].any())

@@ -38,6 +38,9 @@ type Out<'py> = (
         Bound<'py, PyArray1<bool>>,
         Bound<'py, PyArray1<f64>>,
         Bound<'py, PyArray1<i64>>,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray2<f64>>,
+        Bound<'py, PyArray2<f64>>,
     ),
     Bound<'py, PyArray1<i64>>,
 );
@@ -88,11 +91,11 @@ fn names<T: Named>(
 ///     amplitude: ArrayLike | None = None,
 ///     period: ArrayLike | None = None,
 ///     cycles: Sequence[Mapping[str, Any] | None] | None = None,
-/// ) -> tuple[list[Playback | None], FloatArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray, tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, npt.NDArray[np.bool_], FloatArray, IntArray], IntArray]
+/// ) -> tuple[list[Playback | None], FloatArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray, tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, npt.NDArray[np.bool_], FloatArray, IntArray, FloatArray, FloatArray, FloatArray], IntArray]
 ///
 /// Many owners' keys read in one call: for each owner, exactly what ``Playback``, then
-/// ``Playback.channels`` at its key frames, ``rotation_matrices`` and ``analyse_turns``
-/// give, one after the other.
+/// ``Playback.channels`` at its key frames, ``rotation_matrices``, ``analyse_turns`` and
+/// ``Playback.channels`` at the frames it inserts give, one after the other.
 ///
 /// The curves of every owner are packed together as ``evaluate_fcurves`` takes them (the
 /// same keyword arguments), curve ``c`` driving ``channels[c]``; owner ``o`` plays curves
@@ -109,8 +112,9 @@ fn names<T: Named>(
 /// concatenated (F,) with ``counts`` (O,) of them each; the channels there, location (F, 3),
 /// rotation (F, 4: NaN in the last column for a 3-wide mode) and scale (F, 3); the rigid key
 /// poses (F, 4, 4); ``spans``, ``analyse_turns``' held, pops, turn and flips of the analysed
-/// owners' spans one after the other (K - 1 each), its inserted frames concatenated, and
-/// how many of those each owner has (O,); and a status per owner (int64): 1 read and
+/// owners' spans one after the other (K - 1 each), its inserted frames concatenated, how
+/// many of those each owner has (O,), and the channels at them (location (M, 3), rotation
+/// (M, 4) padded as above, scale (M, 3)); and a status per owner (int64): 1 read and
 /// analysed, 0 read, -1 refused (nothing of it in the arrays: read it alone to learn why:
 /// bad curves, fewer than two key frames, a key row not finite, a keyed scale not positive,
 /// what ``analyse_turns`` refuses). GIL released. Raises ValueError for arrays that do not
@@ -307,7 +311,8 @@ fn read_owners<'py>(
         }
     }
     let (frames, counts, location, rotation, scale, poses) = arrays;
-    let (held, pops, turn, flips, inserted, inserted_counts) = spans;
+    let (held, pops, turn, flips, inserted, inserted_counts, played) = spans;
+    let (inserted_location, inserted_rotation, inserted_scale) = played;
     Ok((
         playbacks,
         frames.into_pyarray(py),
@@ -323,6 +328,9 @@ fn read_owners<'py>(
             flips.into_pyarray(py),
             inserted.into_pyarray(py),
             inserted_counts.into_pyarray(py),
+            inserted_location.into_pyarray(py),
+            inserted_rotation.into_pyarray(py),
+            inserted_scale.into_pyarray(py),
         ),
         Array1::from_vec(status).into_pyarray(py),
     ))
@@ -337,7 +345,8 @@ type Arrays = (
     Array2<f64>,
     Array3<f64>,
 );
-/// Held, pops, turn, flips, inserted, inserted counts.
+/// Held, pops, turn, flips, inserted, inserted counts, and the inserted frames' location,
+/// rotation and scale.
 type SpanArrays = (
     Array1<bool>,
     Array1<bool>,
@@ -345,31 +354,39 @@ type SpanArrays = (
     Array1<bool>,
     Array1<f64>,
     Array1<i64>,
+    (Array2<f64>, Array2<f64>, Array2<f64>),
 );
+
+/// Channel rows of `mode` (`6 + width` each) split into location, rotation (padded to 4
+/// with NaN) and scale, appended to `out`.
+fn split_rows(rows: &[f64], mode: RotationMode, out: &mut [Vec<f64>; 3]) {
+    let w = mode.width();
+    for row in rows.chunks_exact(6 + w) {
+        out[0].extend_from_slice(&row[..3]);
+        out[1].extend_from_slice(&row[3..3 + w]);
+        out[1].extend(std::iter::repeat_n(f64::NAN, 4 - w));
+        out[2].extend_from_slice(&row[3 + w..]);
+    }
+}
 
 /// The owners' reads concatenated (refused owners: nothing).
 fn concatenated(reads: &[Option<OwnerRead>], modes: &[RotationMode]) -> (Arrays, SpanArrays) {
     let (mut frames, mut counts) = (Vec::new(), Vec::with_capacity(reads.len()));
-    let (mut location, mut rotation, mut scale, mut poses) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut keyed: [Vec<f64>; 3] = Default::default();
+    let mut played: [Vec<f64>; 3] = Default::default();
+    let mut poses = Vec::new();
     let (mut held, mut pops, mut turn, mut flips, mut inserted) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut inserted_counts = Vec::with_capacity(reads.len());
-    for (read, mode) in reads.iter().zip(modes) {
+    for (read, &mode) in reads.iter().zip(modes) {
         let Some(read) = read else {
             counts.push(0);
             inserted_counts.push(0);
             continue;
         };
-        let w = mode.width();
         frames.extend_from_slice(&read.frames);
         counts.push(read.frames.len() as i64);
-        for row in read.rows.chunks_exact(6 + w) {
-            location.extend_from_slice(&row[..3]);
-            rotation.extend_from_slice(&row[3..3 + w]);
-            rotation.extend(std::iter::repeat_n(f64::NAN, 4 - w));
-            scale.extend_from_slice(&row[3 + w..]);
-        }
+        split_rows(&read.rows, mode, &mut keyed);
         poses.extend(read.poses.iter().flatten());
         match &read.spans {
             Some(s) => {
@@ -379,20 +396,24 @@ fn concatenated(reads: &[Option<OwnerRead>], modes: &[RotationMode]) -> (Arrays,
                 flips.extend_from_slice(&s.flips);
                 inserted.extend_from_slice(&s.inserted);
                 inserted_counts.push(s.inserted.len() as i64);
+                split_rows(&read.inserted_rows, mode, &mut played);
             }
             None => inserted_counts.push(0),
         }
     }
-    let f = frames.len();
-    let rows =
-        |v: Vec<f64>, w: usize| Array2::from_shape_vec((f, w), v).expect("a row per key frame");
+    let (f, m) = (frames.len(), inserted.len());
+    let rows = |v: Vec<f64>, n: usize, w: usize| {
+        Array2::from_shape_vec((n, w), v).expect("a row per frame")
+    };
+    let [location, rotation, scale] = keyed;
+    let [at_location, at_rotation, at_scale] = played;
     (
         (
             Array1::from_vec(frames),
             Array1::from_vec(counts),
-            rows(location, 3),
-            rows(rotation, 4),
-            rows(scale, 3),
+            rows(location, f, 3),
+            rows(rotation, f, 4),
+            rows(scale, f, 3),
             Array3::from_shape_vec((f, 4, 4), poses).expect("a pose per key frame"),
         ),
         (
@@ -402,6 +423,11 @@ fn concatenated(reads: &[Option<OwnerRead>], modes: &[RotationMode]) -> (Arrays,
             Array1::from_vec(flips),
             Array1::from_vec(inserted),
             Array1::from_vec(inserted_counts),
+            (
+                rows(at_location, m, 3),
+                rows(at_rotation, m, 4),
+                rows(at_scale, m, 3),
+            ),
         ),
     )
 }

@@ -6,9 +6,10 @@
 //! frames, two closer than [`KEY_FRAME_TOLERANCE`] being one), its channel rows there (played,
 //! or with `key_values` the curves' key values when every curve is keyed on every key frame),
 //! its rigid **key poses** `T R` ([`rotation_matrix`]), and, when asked, what
-//! [`analyse_turns`] says of its spans. This is, to the bit, `Playback(...)`,
-//! `Playback.channels(frames)`, `rotation_matrices` and `analyse_turns` called one after the
-//! other for each owner, as `keys.read` calls them.
+//! [`analyse_turns`] says of its spans, with the channel rows at the frames it inserts into
+//! spins. This is, to the bit, `Playback(...)`, `Playback.channels(frames)`,
+//! `rotation_matrices`, `analyse_turns` and `Playback.channels(inserted)` called one after
+//! the other for each owner, as `keys.read` calls them.
 
 use std::ops::Range;
 
@@ -60,6 +61,9 @@ pub struct OwnerRead {
     pub poses: Vec<[f64; 16]>,
     /// [`analyse_turns`] of the key frames, when asked.
     pub spans: Option<Spans>,
+    /// The channel rows at the spans' inserted frames (`Playback::channels` of them; empty
+    /// when none is inserted).
+    pub inserted_rows: Vec<f64>,
 }
 
 /// The curves `range` of `packed` (checked: [`PackedCurves::check_lengths`]) as a packed
@@ -216,12 +220,17 @@ fn read_owner(packed: &PackedCurves<'_>, owner: &OwnerKeys<'_>) -> Result<OwnerR
         .turns
         .map(|turns| analyse_turns(&playback, &frames, turns))
         .transpose()?;
+    let inserted_rows = match &spans {
+        Some(s) if !s.inserted.is_empty() => playback.channels(&s.inserted)?,
+        _ => Vec::new(),
+    };
     Ok(OwnerRead {
         playback,
         frames,
         rows,
         poses,
         spans,
+        inserted_rows,
     })
 }
 
@@ -356,6 +365,10 @@ mod tests {
         assert_eq!(first.rows, alone.channels(&first.frames).unwrap());
         let spans = analyse_turns(&alone, &first.frames, Turns::Auto).unwrap();
         assert_eq!(first.spans.as_ref().unwrap().inserted, spans.inserted);
+        assert_eq!(
+            first.inserted_rows,
+            alone.channels(&spans.inserted).unwrap()
+        );
         assert!(
             !spans.inserted.is_empty(),
             "3 radians a span: a spin: {spans:?}"
