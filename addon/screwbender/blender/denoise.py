@@ -32,7 +32,7 @@ import polyscrew
 
 from ..pure import denoise_data
 from ..pure.reports import Outcome
-from . import action_groups, bake, bulk, channels, feature, keys, owners, preview, transaction
+from . import action_groups, bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).
@@ -157,19 +157,16 @@ def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.
 
 def prepare(
     owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None,
-    read: dict | None = None, cache: dict | None = None, motion: keys.KeyedMotion | SmoothError | None = None,
+    motion: keys.KeyedMotion | SmoothError | None = None,
 ) -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
     """The owner's key poses (no analysis), the rows to smooth and which of them are held.
     `fcurves` hold the keys read; `shown` (default `fcurves`) the keys the user sees and
-    selects (the earlier result, on a rerun from the original keys); `read`: the keys of many
-    owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
-    `keys.read`'s, kept for one run (an object's checks made once for all its bones).
-    `motion`: the owner's keys read already (:func:`read_request`'s, by :func:`keys.read_many`;
-    a :class:`SmoothError` is raised)."""
+    selects (the earlier result, on a rerun from the original keys). `motion`: the owner's
+    keys read already, as :func:`read_request` asks (:func:`keys.read_many` reads every
+    owner's together; a :class:`SmoothError` is raised); None: read here."""
     if motion is None:
-        motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
-                           packed=None if read is None else _part(owner, fcurves, read), cache=cache, key_values=True)
-    elif isinstance(motion, SmoothError):
+        motion = keys.read_many([read_request(owner, fcurves, action, slot)])[0]
+    if isinstance(motion, SmoothError):
         raise motion
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
@@ -192,24 +189,6 @@ def read_request(owner: owners.Owner, fcurves: list, action=None, slot: str = ""
     """How :func:`prepare` reads `owner`'s keys (its curves `fcurves`, of `action`'s slot
     `slot` when not the active action): no analysis, a capture from its key values."""
     return keys.Request(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False, key_values=True)
-
-
-def read_together(pairs: list[tuple[owners.Owner, list]]) -> dict:
-    """The transform curves of every owner of `pairs` ((owner, its curves)) read in one
-    `curves.read` call, each curve once (:func:`preview.read_together`): per owner's played
-    curves, their part of the packed keys (empty when some curve cannot be packed: each owner
-    then reads its own, which says why)."""
-    read: dict = {}
-    preview.read_together(pairs, read)
-    return read
-
-
-def _part(owner: owners.Owner, fcurves: list, read: dict) -> tuple[list, object] | None:
-    """(the owner's played transform curves, their packed keys) from :func:`read_together`'s
-    `read`, for `keys.read(packed=...)`; None when they were not read there."""
-    played = preview.played_curves(owner, fcurves)
-    part = read.get(tuple(fc.as_pointer() for fc in played))
-    return None if part is None else (played, part)
 
 
 def near_rotations(parts: list[Cleaned]) -> None:
