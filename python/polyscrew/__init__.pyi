@@ -1016,6 +1016,58 @@ def sample_owners(
     fit together.
     """
 
+def read_owners(
+    curves: ArrayLike,
+    channels: Sequence[tuple[str, int]],
+    unkeyed: ArrayLike,
+    modes: Sequence[RotationModeName],
+    *,
+    located: ArrayLike | None = None,
+    key_values: ArrayLike | None = None,
+    turns: Sequence[Literal["AUTO", "BLENDER", "SHORTEST"] | None] | None = None,
+    offsets: ArrayLike,
+    co: ArrayLike,
+    handle_left: ArrayLike,
+    handle_right: ArrayLike,
+    interpolation: ArrayLike,
+    easing: ArrayLike,
+    extrapolation: ExtrapolationName | Sequence[ExtrapolationName] | None = None,
+    back: ArrayLike | None = None,
+    amplitude: ArrayLike | None = None,
+    period: ArrayLike | None = None,
+    cycles: Sequence[Mapping[str, Any] | None] | None = None,
+) -> tuple[list[Playback | None], FloatArray, IntArray, FloatArray, FloatArray, FloatArray, FloatArray, tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, npt.NDArray[np.bool_], FloatArray, IntArray, FloatArray, FloatArray, FloatArray], IntArray]:
+    """Many owners' keys read in one call: for each owner, exactly what ``Playback``, then
+    ``Playback.channels`` at its key frames, ``rotation_matrices``, ``analyse_turns`` and
+    ``Playback.channels`` at the frames it inserts give, one after the other.
+
+    The curves of every owner are packed together as ``evaluate_fcurves`` takes them (the
+    same keyword arguments), curve ``c`` driving ``channels[c]``; owner ``o`` plays curves
+    ``curves[o, 0]`` to ``curves[o, 0] + curves[o, 1]`` (``curves`` (O, 2); owners may share
+    curves), in rotation mode ``modes[o]``, with its own values ``unkeyed[o]`` (O, 10):
+    location, rotation (3 Euler angles and one number unused, or 4) and scale. Per owner,
+    optional: ``located`` (default 1: a bone connected to its parent has 0), ``key_values``
+    (1: when every curve is keyed on every key frame, its key values are the channels there,
+    not played), ``turns`` (None: not analysed).
+
+    Returns ``(playbacks, frames, counts, location, rotation, scale, poses, spans,
+    status)``: per owner its ``Playback`` (None when refused); its key frames (the union of
+    its curves' key frames, a frame within ``KEY_FRAME_TOLERANCE`` of the one before dropped)
+    concatenated (F,) with ``counts`` (O,) of them each; the channels there, location (F, 3),
+    rotation (F, 4: NaN in the last column for a 3-wide mode) and scale (F, 3); the rigid key
+    poses (F, 4, 4); ``spans``, ``analyse_turns``' held, pops, turn and flips of the analysed
+    owners' spans one after the other (K - 1 each), its inserted frames concatenated, how
+    many of those each owner has (O,), and the channels at them (location (M, 3), rotation
+    (M, 4) padded as above, scale (M, 3)); and a status per owner (int64): 1 read and
+    analysed, 0 read, -1 refused (nothing of it in the arrays: read it alone to learn why:
+    bad curves, fewer than two key frames, a key row not finite, a keyed scale not positive,
+    what ``analyse_turns`` refuses). GIL released. Raises ValueError for arrays that do not
+    fit together.
+    """
+
+KEY_FRAME_TOLERANCE: float
+"""Two key frames of an owner closer than this (frames) are one (``read_owners``; 1e-4)."""
+
 class Denoised:
     """The result of ``denoise``: the smooth poses and what was chosen on the way.
 

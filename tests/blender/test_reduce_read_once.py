@@ -17,6 +17,7 @@ from scipy.spatial.transform import Rotation
 import bake_helpers as h
 import bone_helpers as bh
 from conftest import addon_module
+from playback_rows import playing_rows
 from test_reduce_keys import check_within, play, sample_times, transform_keys
 
 DISTANCE, ANGLE = 0.001, math.radians(0.5)
@@ -115,24 +116,26 @@ def test_a_capture_read_from_its_key_values_reduces_to_the_same_keys(sb):
             noisy_keys(ob, frames, mode, rng)
             objects.append(ob)
         sets.append(objects)
-    read = keys.read
+    read = keys.read_many
 
-    def played_read(*args, **kwargs):
-        kwargs["key_values"] = False
-        return read(*args, **kwargs)
+    def played_read(requests, *args, **kwargs):
+        for request in requests:
+            request.key_values = False
+        return read(requests, *args, **kwargs)
 
     plays = []
     for objects, forced in zip(sets, (True, False)):
         h.select_only(*objects)
         if forced:
-            keys.read = played_read
+            keys.read_many = played_read
         try:
-            with counting_calls() as calls:  # (tolerances above the noise: keys are dropped)
+            with counting_calls() as calls, playing_rows() as played:  # (tolerances above the noise: keys are dropped)
                 assert bpy.ops.screwbender.reduce_keys(distance=0.05, angle=math.radians(5.0)) == {"FINISHED"}
         finally:
-            keys.read = read
-        plays.append(calls["channels"])
-    assert plays == [2 * len(modes), len(modes)], plays  # (the forced path played the key frames too)
+            keys.read_many = read
+        plays.append((calls["channels"], played["rows"]))
+    # the forced path played the key frames too: each owner's once more
+    assert plays[0][1] - plays[1][1] == len(modes) * len(frames), plays
 
     def written(ob):
         """Every curve's keys, handles and interpolations as Blender holds them."""

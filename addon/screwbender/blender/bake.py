@@ -21,6 +21,7 @@ from __future__ import annotations
 import zlib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import bpy
 import numpy as np
@@ -822,41 +823,77 @@ class _GroupRead:
     notes: list[str]
 
 
-def _read_group(group: _Group, options: Options) -> _GroupRead:
-    """Reads the owners that share one action (and slot): one bake for the whole group when
-    every object has the same key poses for every owner, else one per object (`units`)."""
+def _read_groups(groups: list[_Group], options: Options) -> list[_GroupRead]:
+    """Reads the owners of every group (the owners that share one action and slot): every
+    owner of every group in one :func:`keys.read_many` call (one read of all their curves, one
+    polyscrew call), then per group one bake for the whole group when every object has the
+    same key poses for every owner, else one per object (`units`)."""
+    heads, requests = [], []
+    for group in groups:
+        head = _group_head(group, options)
+        heads.append((head, len(requests)))
+        requests += [
+            keys.Request(
+                owners.Owner(obj, bone), options.closed, action=head.read_from, slot=head.source_slot,
+                extend_to=options.frame_range, fcurves=head.by_owner.get(bone, []), turns=options.turns,
+            )
+            for bone in group.bones
+            for obj in group.objects
+        ]
+    got = keys.read_many(requests, cache={})  # (objects sharing curves read them once)
+    ends = [start for _, start in heads[1:]] + [len(requests)]
+    return [_read_group(group, head, got[start:end]) for group, (head, start), end in zip(groups, heads, ends)]
+
+
+class _Head(NamedTuple):
+    """What the bake of a group reads from (:func:`_group_head`)."""
+
+    current: bpy.types.Action
+    identifier: str
+    source: bpy.types.Action
+    source_slot: str
+    #: Whether the current action is a result edited since it was made.
+    edited: bool
+    #: The action the keys are read from (None: the current one).
+    read_from: bpy.types.Action | None
+    by_owner: dict
+    #: The curves of `read_from` (or the current action) listed.
+    listed: list
+
+
+def _group_head(group: _Group, options: Options) -> _Head:
+    """What the bake of `group` reads from."""
     first = group.objects[0]
     current = first.animation_data.action
     identifier = channels.slot_identifier(first)
     source, source_slot, edited = source_action(current, identifier, "smooth", options.smooth_result)
+    read_from = None if source is current else source
+    # The objects share the action: its curves grouped by owner once (not scanned per bone).
+    listed = channels.object_fcurves(first) if read_from is None else channels.action_fcurves(read_from, source_slot)
+    return _Head(current, identifier, source, source_slot, edited, read_from, owners.curves_by_owner(listed), listed)
+
+
+def _read_group(group: _Group, head: _Head, got: list) -> _GroupRead:
+    """One group read from `head` and `got`, the key motions (or errors) of its owners, bone
+    after bone and for each bone object after object."""
+    current, identifier, source, read_from, by_owner, listed = (
+        head.current, head.identifier, head.source, head.read_from, head.by_owner, head.listed
+    )
     notes = []
-    if edited:
+    if head.edited:
         notes.append(
             f"{_names([o.name for o in group.objects])}: '{current.name}' was edited after Smooth Motion made it "
             "(keys moved, added or deleted): smoothed the edited keys and kept them (Revert returns to "
             "them, a second Revert to the original)"
         )
-    read_from = None if source is current else source
     motions: dict[str, list[keys.KeyedMotion]] = {}
     skipped = []
-    # The objects share the action: its curves grouped by owner once (not scanned per bone).
-    listed = channels.object_fcurves(first) if read_from is None else channels.action_fcurves(read_from, source_slot)
-    by_owner = owners.curves_by_owner(listed)
-    read_once: dict = {}  # the objects share the curves: each read once (keys.read's cache)
+    motion = iter(got)
     for bone in group.bones:
-        row = []
-        for obj in group.objects:
-            owner = owners.Owner(obj, bone)
-            try:
-                row.append(
-                    keys.read(
-                        owner, options.closed, action=read_from, slot=source_slot, extend_to=options.frame_range,
-                        fcurves=by_owner.get(bone, []), turns=options.turns, cache=read_once,
-                    )
-                )
-            except SmoothError as err:
-                skipped.append((owner, str(err)))
-                break
+        row = [next(motion) for _ in group.objects]
+        refused = next(((obj, m) for obj, m in zip(group.objects, row) if isinstance(m, SmoothError)), None)
+        if refused is not None:  # the bone is skipped, with the first refusal's message
+            skipped.append((owners.Owner(refused[0], bone), str(refused[1])))
         else:
             motions[bone] = row
     read = _GroupRead(group, source, current, identifier, motions, [], by_owner, {}, skipped, notes)
@@ -893,7 +930,7 @@ def _bake_groups(
     call per rotation mode), then each group's action bakes made, its skipped owners with
     their messages and its notes told in the order one group after another would give them.
     `progress(done, total)` as each group is done."""
-    reads = [_read_group(group, options) for group in groups]
+    reads = _read_groups(groups, options)
     # (read, objects, owner, motion, plan or the error refusing it) per owner, in order
     planned = []
     for read in reads:

@@ -32,7 +32,7 @@ import polyscrew
 
 from ..pure import denoise_data, intent
 from ..pure.reports import Outcome
-from . import action_groups, bake, bulk, channels, feature, keys, owners, preview, transaction
+from . import action_groups, bake, bulk, channels, feature, keys, owners, transaction
 from .keys import SmoothError
 
 #: The fewest keys in the frame range Remove Noise smooths (a third difference needs four).
@@ -159,15 +159,17 @@ def _rows_in(frames: np.ndarray, frame_range: tuple[float, float] | None) -> np.
 
 def prepare(
     owner: owners.Owner, fcurves: list, options: Options, action=None, slot: str = "", shown: list | None = None,
-    read: dict | None = None, cache: dict | None = None,
+    motion: keys.KeyedMotion | SmoothError | None = None,
 ) -> tuple[keys.KeyedMotion, np.ndarray, np.ndarray]:
     """The owner's key poses (no analysis), the rows to smooth and which of them are held.
     `fcurves` hold the keys read; `shown` (default `fcurves`) the keys the user sees and
-    selects (the earlier result, on a rerun from the original keys); `read`: the keys of many
-    owners read together (:func:`read_together`), used when they hold this owner's; `cache`:
-    `keys.read`'s, kept for one run (an object's checks made once for all its bones)."""
-    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False,
-                       packed=None if read is None else _part(owner, fcurves, read), cache=cache, key_values=True)
+    selects (the earlier result, on a rerun from the original keys). `motion`: the owner's
+    keys read already, as :func:`read_request` asks (:func:`keys.read_many` reads every
+    owner's together; a :class:`SmoothError` is raised); None: read here."""
+    if motion is None:
+        motion = keys.read_many([read_request(owner, fcurves, action, slot)])[0]
+    if isinstance(motion, SmoothError):
+        raise motion
     rows = _rows_in(motion.frames, options.frame_range)
     if len(rows) < MIN_KEYS:
         raise SmoothError(
@@ -185,22 +187,10 @@ def prepare(
     return motion, rows, held
 
 
-def read_together(pairs: list[tuple[owners.Owner, list]]) -> dict:
-    """The transform curves of every owner of `pairs` ((owner, its curves)) read in one
-    `curves.read` call, each curve once (:func:`preview.read_together`): per owner's played
-    curves, their part of the packed keys (empty when some curve cannot be packed: each owner
-    then reads its own, which says why)."""
-    read: dict = {}
-    preview.read_together(pairs, read)
-    return read
-
-
-def _part(owner: owners.Owner, fcurves: list, read: dict) -> tuple[list, object] | None:
-    """(the owner's played transform curves, their packed keys) from :func:`read_together`'s
-    `read`, for `keys.read(packed=...)`; None when they were not read there."""
-    played = preview.played_curves(owner, fcurves)
-    part = read.get(tuple(fc.as_pointer() for fc in played))
-    return None if part is None else (played, part)
+def read_request(owner: owners.Owner, fcurves: list, action=None, slot: str = "") -> keys.Request:
+    """How :func:`prepare` reads `owner`'s keys (its curves `fcurves`, of `action`'s slot
+    `slot` when not the active action): no analysis, a capture from its key values."""
+    return keys.Request(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False, key_values=True)
 
 
 def play_at_keys(motions: list[keys.KeyedMotion]) -> dict[int, dict[str, np.ndarray]]:
@@ -543,7 +533,7 @@ def remove_noise(
     # Every group's users in one pass over the scene's objects (one pass per group grew as
     # groups x objects), and every owner's transform curves read in one pass.
     users_all = bake.users_by_slot({group.action.as_pointer() for group in groups})
-    listed_groups, pairs = [], []
+    listed_groups, requests = [], []
     for group in groups:
         current, identifier = group.action, group.identifier
         # (an edited result is denoised from the original keys again, as before)
@@ -552,8 +542,12 @@ def remove_noise(
         # The keys the user sees and selects: those of the action shown (an earlier result).
         shown = by_owner if source is current else owners.curves_by_owner(channels.action_fcurves(current, identifier))
         listed_groups.append((source, slot, by_owner, shown))
-        pairs.extend((owner, by_owner.get(owner.bone, [])) for owner in group.members if owner.exists())
-    read, cache = read_together(pairs), {}
+        requests += [
+            read_request(owner, by_owner.get(owner.bone, []), None if source is current else source, slot)
+            for owner in {(o.obj.as_pointer(), o.bone): o for o in group.members}.values()
+        ]
+    # every owner's keys in one keys.read_many call (one read of all their curves, one polyscrew call)
+    motions = iter(keys.read_many(requests))
     for i, group in enumerate(groups):
         members = group.members
         first = members[0].obj
@@ -565,6 +559,7 @@ def remove_noise(
         # once, their names reported with the first's (they get the result action too).
         first_of: dict[tuple[str, str], owners.Owner] = {}
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
+            read = next(motions)
             twin = first_of.get((owner.bone, owner.rotation_mode))
             if twin is not None:
                 sharers.setdefault((twin.obj.as_pointer(), twin.bone), []).append(owner.name)
@@ -572,8 +567,7 @@ def remove_noise(
             try:
                 motion, rows, held = prepare(owner, by_owner.get(owner.bone, []), options,
                                              action=None if source is current else source, slot=slot,
-                                             shown=shown.get(owner.bone, []), read=read,
-                                             cache=cache)
+                                             shown=shown.get(owner.bone, []), motion=read)
             except SmoothError as err:
                 skipped.append(str(err))
                 continue

@@ -89,14 +89,7 @@ def _current_values(target, curves: dict, path: str, size: int, frame: float) ->
 def _transform_curves(owner: owners.Owner, listed: list) -> list:
     """The curves :func:`keys.read` reads for `owner` among `listed`, in its order (keyed
     transform curves, not muted; no location for a connected bone)."""
-    paths = keys.transform_paths(owner.rotation_mode)
-    located = not owner.bone or not owner.obj.data.bones[owner.bone].use_connect
-    found = {}
-    for fc in listed:
-        prop = owner.prop_of(fc.data_path)
-        if prop in paths and not fc.mute and len(fc.keyframe_points) > 0 and (located or prop != "location"):
-            found[prop, fc.array_index] = fc
-    return list(found.values())
+    return list(keys.keyed_curves(owner, listed)[0].values())
 
 
 def _key_codes(point) -> tuple[int, int]:
@@ -265,21 +258,28 @@ def insert_keys(
     return out
 
 
-def _read_before(owner: owners.Owner, listed: list, frame: float, options: bake.Options, known: dict) -> _Keying:
-    """The keys of `owner` before the insertion (each curve packed once: `known`)."""
-    chosen = _transform_curves(owner, listed)
-    pointers = tuple(fc.as_pointer() for fc in chosen)
-    packed = known.get(pointers)
-    if packed is None and chosen:
-        try:
-            packed = curves.read(chosen, keys_only=True)
-        except curves.UnsupportedCurve:
-            packed = None  # keys.read says why, and reads the keys alone
-    before = keys.read(
-        owner, options.closed, fcurves=listed, turns=options.turns,
-        packed=(chosen, packed) if packed is not None else None,
-    )
-    return _Keying(owner, listed, chosen, packed, before, check_frames(before, frame))
+def _read_before(
+    requests: list[tuple[owners.Owner, list]], frame: float, options: bake.Options, known: dict
+) -> list[_Keying | SmoothError]:
+    """The keys of every owner of `requests` ((owner, its curves)) before the insertion, in
+    one :func:`keys.read_many` call (each curve packed once: `known` holds the curves packed
+    before, by their pointers)."""
+    chosen = [_transform_curves(owner, listed) for owner, listed in requests]
+    given = [known.get(tuple(fc.as_pointer() for fc in c)) for c in chosen]
+    read = keys.read_many([
+        keys.Request(owner, options.closed, fcurves=listed, turns=options.turns, packed=(c, g) if g is not None else None)
+        for (owner, listed), c, g in zip(requests, chosen, given)
+    ])
+    out = []
+    for (owner, listed), c, before in zip(requests, chosen, read):
+        if isinstance(before, SmoothError):
+            out.append(before)
+            continue
+        source = before.source
+        same = source is not None and source.columns == [(owner.prop_of(fc.data_path), fc.array_index) for fc in c]
+        packed = source.packed if same else None  # (None: keys.read read the key values alone)
+        out.append(_Keying(owner, listed, c, packed, before, check_frames(before, frame)))
+    return out
 
 
 def _insert_round(
@@ -291,11 +291,11 @@ def _insert_round(
     out: list[InsertResult | SmoothError | None] = [None] * len(requests)
     done: list[_Keying | None] = [None] * len(requests)
     work: list[tuple[int, _Keying]] = []
-    for i, (owner, listed) in enumerate(requests):
-        try:
-            work.append((i, _read_before(owner, list(listed), frame, options, known)))
-        except SmoothError as err:
-            out[i] = err
+    for i, keying in enumerate(_read_before([(owner, list(listed)) for owner, listed in requests], frame, options, known)):
+        if isinstance(keying, SmoothError):
+            out[i] = keying
+        else:
+            work.append((i, keying))
     before = bake.sample_poses_many([(k.owner, k.before, k.frames) for _, k in work], options)
     sampled = []
     for (i, keying), got in zip(work, before):
@@ -310,14 +310,15 @@ def _insert_round(
             opened.append(keying.one)
             _insert(keying, poses, scales, frame)
         reread = []
-        for i, keying, _ in sampled:
-            try:
-                after = keys.read(
-                    keying.owner, options.closed, fcurves=keying.listed, turns=options.turns, packed=keying.given
-                )
+        read = keys.read_many([
+            keys.Request(keying.owner, options.closed, fcurves=keying.listed, turns=options.turns, packed=keying.given)
+            for _, keying, _ in sampled
+        ])
+        for (i, keying, _), after in zip(sampled, read):
+            if isinstance(after, SmoothError):
+                out[i] = after
+            else:
                 reread.append((i, keying, after))
-            except SmoothError as err:
-                out[i] = err
         after = bake.sample_poses_many([(k.owner, a, k.frames) for _, k, a in reread], options)
         poses_after = {i: got for (i, _, _), got in zip(reread, after)}
         for i, keying, (poses, _) in sampled:

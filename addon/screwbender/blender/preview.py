@@ -448,27 +448,47 @@ class PreviewCache:
         when the caller has grouped them (:func:`owners.curves_by_owner`). `memo`: the keys
         read so far in this refresh (:func:`key_hash`): each curve is read once.
         """
-        owner = owners.as_owner(owner)
-        digest, live, read = key_hash(owner, options, frame, auto_key, fcurves, memo)
-        key = cache_key(owner)
-        entry = self.entries.get(key)
-        if entry is not None and entry.digest == digest:
-            return entry, False
-        name = owner.name
-        try:
-            motion = keys.read(
-                owner, options.smooth.closed, extend_to=options.smooth.frame_range, fcurves=fcurves,
-                turns=options.smooth.turns, packed=read,
-            )
-            if live is not None:
-                motion = with_live_key(motion, live)
-            entry = PreviewEntry(digest, compute(motion, options, owner))
-        except (SmoothError, ValueError) as err:
-            message = str(err)
-            entry = PreviewEntry(digest, None, message if message.startswith(name) else f"{name}: {message}")
-        self.entries[key] = entry
-        self.recomputed[name] = self.recomputed.get(name, 0) + 1
-        return entry, True
+        return self.refresh_many([(owners.as_owner(owner), fcurves)], options, frame, auto_key, memo)[0]
+
+    def refresh_many(
+        self,
+        pairs: list[tuple[owners.Owner, list | None]],
+        options: PreviewOptions,
+        frame: float | None = None,
+        auto_key: bool = False,
+        memo: dict | None = None,
+    ) -> list[tuple[PreviewEntry, bool]]:
+        """:meth:`refresh` of every (owner, its curves or None) of `pairs`: the owners whose
+        hash changed are read together (:func:`keys.read_many`: one read of their curves, one
+        polyscrew call), then each recomputed."""
+        memo = {} if memo is None else memo
+        hashed = [(owner, fcurves, *key_hash(owner, options, frame, auto_key, fcurves, memo)) for owner, fcurves in pairs]
+        stale, seen = [], set()
+        for owner, fcurves, digest, live, read in hashed:
+            entry, key = self.entries.get(cache_key(owner)), cache_key(owner)
+            if key not in seen and (entry is None or entry.digest != digest):
+                stale.append((owner, fcurves, digest, live, read))
+            seen.add(key)
+        smooth = options.smooth
+        motions = keys.read_many([
+            keys.Request(owner, smooth.closed, extend_to=smooth.frame_range, fcurves=fcurves, turns=smooth.turns, packed=read)
+            for owner, fcurves, _, _, read in stale
+        ])
+        for (owner, _, digest, live, _), motion in zip(stale, motions):
+            name = owner.name
+            try:
+                if isinstance(motion, SmoothError):
+                    raise motion
+                if live is not None:
+                    motion = with_live_key(motion, live)
+                entry = PreviewEntry(digest, compute(motion, options, owner))
+            except (SmoothError, ValueError) as err:
+                message = str(err)
+                entry = PreviewEntry(digest, None, message if message.startswith(name) else f"{name}: {message}")
+            self.entries[cache_key(owner)] = entry
+            self.recomputed[name] = self.recomputed.get(name, 0) + 1
+        recomputed = {cache_key(owner) for owner, *_ in stale}
+        return [(self.entries[cache_key(o)], cache_key(o) in recomputed) for o, *_ in hashed]
 
     def forget(self, keep: set | None = None) -> None:
         """Drops every entry (or every entry whose :func:`cache_key` is not in `keep`)."""

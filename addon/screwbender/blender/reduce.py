@@ -315,10 +315,24 @@ def read_motion(owner: owners.Owner, fcurves: list, action=None, slot: str = "")
     """The owner's keys, read once (no analysis; a capture's key poses from its key values,
     which is what Blender plays at its key frames); refuses curves Blender plays in a way the
     add-on cannot evaluate (the reduced keys must match Blender's playback)."""
-    motion = keys.read(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False, key_values=True)
-    if motion.source is None:
-        raise SmoothError(f"{owner.name}: {'; '.join(motion.kept)}; Reduce Keys needs Blender's playback: skipped")
-    return motion
+    got = read_motions([(owner, fcurves, action, slot)])[0]
+    if isinstance(got, SmoothError):
+        raise got
+    return got
+
+
+def read_motions(items: list[tuple[owners.Owner, list, object, str]]) -> list[keys.KeyedMotion | SmoothError]:
+    """:func:`read_motion` of every (owner, its curves, the action read or None, its slot) of
+    `items` in one :func:`keys.read_many` call: its motion, or the error refusing it."""
+    got = keys.read_many([
+        keys.Request(owner, "OFF", action=action, slot=slot, fcurves=fcurves, analyse=False, key_values=True)
+        for owner, fcurves, action, slot in items
+    ])
+    return [
+        SmoothError(f"{owner.name}: {'; '.join(m.kept)}; Reduce Keys needs Blender's playback: skipped")
+        if isinstance(m, keys.KeyedMotion) and m.source is None else m
+        for (owner, *_), m in zip(items, got)
+    ]
 
 
 def _located_children(items: list[Item], members: list) -> list[Item]:
@@ -563,21 +577,29 @@ def reduce_keys(
     # Every group's users in one pass over the scene's objects (`bake.users_of` per group grew
     # as groups x objects: Reduce Keys of many objects grew as objects^1.29).
     users = bake.users_by_slot({group.action.as_pointer() for group in groups})
+    sources, wanted = [], []
     for group in groups:
-        members = group.members
-        first = members[0].obj
         current, identifier = group.action, group.identifier
         source, slot, was_edited = bake.source_action(current, identifier, "reduce", options.reduce_result)
         if was_edited:
             # the animator changed the result: the edit is the new source, never thrown away
             edited.append(f"'{current.name}'")
         by_owner = owners.curves_by_owner(channels.action_fcurves(source, slot))
+        sources.append(source)
+        wanted += [
+            (owner, by_owner.get(owner.bone, []), None if source is current else source, slot)
+            for owner in {(o.obj.as_pointer(), o.bone): o for o in group.members}.values()
+        ]
+    motions = iter(read_motions(wanted))  # every owner's keys in one read and one polyscrew call
+    for group, source in zip(groups, sources):
+        members = group.members
+        first = members[0].obj
+        current, identifier = group.action, group.identifier
         done = []
         for owner in {(o.obj.as_pointer(), o.bone): o for o in members}.values():
-            try:
-                motion = read_motion(owner, by_owner.get(owner.bone, []), None if source is current else source, slot)
-            except SmoothError as err:
-                skipped.append(str(err))
+            motion = next(motions)
+            if isinstance(motion, SmoothError):
+                skipped.append(str(motion))
                 continue
             pairs.append((owner, motion))
             done.append(owner)
@@ -700,7 +722,11 @@ def reduce_bag(bag, members: list[owners.Owner], distance: float, angle: float) 
     action, just written) replaced by their reduction (one `polyscrew.reduce_keys` call).
     Raises SmoothError (the caller's transaction undoes everything)."""
     by_owner = owners.curves_by_owner(channels.fcurves(bag))
-    pairs = [(o, read_motion(o, by_owner.get(o.bone, []))) for o in members]
+    motions = read_motions([(o, by_owner.get(o.bone, []), None, "") for o in members])
+    refused = next((m for m in motions if isinstance(m, SmoothError)), None)
+    if refused is not None:
+        raise refused
+    pairs = list(zip(members, motions))
     options = Options(distance=distance, angle=angle)
     results = [r for batch in batches(pairs, options) for r in solve_batch(batch, options)]
     for result in results:

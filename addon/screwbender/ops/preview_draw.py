@@ -212,16 +212,15 @@ def refresh(scene: bpy.types.Scene) -> bool:
     changed; returns whether any was recomputed. Forgets owners no longer previewed."""
     options = preview_options(scene)
     objects = enabled_objects(scene)
-    changed = False
     frame = current_frame(scene)
     auto = auto_keying(scene)
     keep = set()
     memo: dict = {}  # the keys read in this refresh: each curve read once (shared actions too)
     pairs = [pair for obj in objects for pair in owners_with_curves(obj, scene)]
     preview.read_together(pairs, memo)  # every owner's curves in one pass
-    for owner, curves in pairs:
-        changed = CACHE.refresh(owner, options, frame, auto, curves, memo)[1] or changed
+    for owner, _ in pairs:
         keep.add(preview.cache_key(owner))
+    changed = any(recomputed for _, recomputed in CACHE.refresh_many(pairs, options, frame, auto, memo))
     CACHE.forget(keep)
     for uid in [u for u in _gpu_batches if u not in keep]:
         del _gpu_batches[uid]

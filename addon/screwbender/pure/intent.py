@@ -52,7 +52,7 @@ Nothing here writes Blender data.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 
 import numpy as np
 import polyscrew
@@ -153,12 +153,21 @@ class Source:
     #: The curves, channels and static values in the core (raises ValueError for curves
     #: `polyscrew` refuses).
     playback: polyscrew.Playback = field(init=False, repr=False)
+    #: The playback of these curves and values when it is made already (`polyscrew.read_owners`).
+    made: InitVar[polyscrew.Playback | None] = None
 
-    def __post_init__(self) -> None:
-        unkeyed = np.concatenate([self.static["location"], self.static[self.rotation_path], self.static["scale"]])
+    def __post_init__(self, made: polyscrew.Playback | None) -> None:
+        if made is not None:
+            self.playback = made
+            return
         self.playback = polyscrew.Playback(
-            channels=self.columns, unkeyed=unkeyed, mode=self.mode, located=self.located, **self.packed.arguments()
+            channels=self.columns, unkeyed=self.unkeyed(), mode=self.mode, located=self.located,
+            **self.packed.arguments(),
         )
+
+    def unkeyed(self) -> np.ndarray:
+        """The owner's own values of all its channels: location, rotation, scale."""
+        return np.concatenate([self.static["location"], self.static[self.rotation_path], self.static["scale"]])
 
     def channels(self, frames: np.ndarray) -> dict[str, np.ndarray]:
         """location (T, 3), rotation (T, k) and scale (T, 3) at `frames`, as Blender plays them."""

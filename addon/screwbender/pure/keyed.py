@@ -20,8 +20,9 @@ from . import intent
 #: `polyscrew.ROTATION_MODES`: name -> (property, width)).
 ROTATION_PATHS = {mode: prop for mode, (prop, _) in polyscrew.ROTATION_MODES.items()}
 
-#: Two key frames closer than this (in frames) are the same frame.
-FRAME_TOLERANCE = 1e-4
+#: Two key frames closer than this (in frames) are the same frame (the core's,
+#: `polyscrew.KEY_FRAME_TOLERANCE`).
+FRAME_TOLERANCE = polyscrew.KEY_FRAME_TOLERANCE
 
 #: A last key whose pose and scale differ from the first by less than this (per matrix entry,
 #: relative to the motion's size) repeats the first pose: it closes a cyclic motion's period.
@@ -187,6 +188,7 @@ def key_motion(
     size: float,
     stacked: dict,
     keyed: frozenset,
+    spans: tuple | None = None,
 ) -> KeyedMotion:
     """The key motion of the owner `name` from what the Blender layer read (`keys.read`): the
     channels and rigid `poses` at the key `frames`, its curves as Blender plays them (`source`,
@@ -200,7 +202,9 @@ def key_motion(
     `kept`/`removed`/`causes`; a closed motion's closing key becomes its period, and a cycle with
     holds is tiled over neighbouring periods as an open motion. Raises :class:`SmoothError`.
     `owner`, `size`, `stacked` (the modifiers kept per curve) and `keyed` are carried into the
-    result as they are.
+    result as they are. `spans`: what `intent.analyse_turns(source, frames, turns)` returns
+    and `source.channels` at its inserted frames, when the caller has them already
+    (`polyscrew.read_owners`; never for an extended cycle, whose frames change here).
     """
     paths = transform_paths(mode)
     bake_range = None
@@ -233,7 +237,11 @@ def key_motion(
     if mode == "QUATERNION" and np.abs(np.linalg.norm(rotation, axis=1) - 1.0).max() > 1e-3:
         causes.append("non-normalised quaternion keys: Blender's playback interpolates their components")
     if source is not None and analyse:
-        held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
+        if spans is None:
+            held, pops, turn, inserted, flips = intent.analyse_turns(source, frames, turns)
+            at_inserted = None
+        else:
+            held, pops, turn, inserted, flips, at_inserted = spans
         followed = ~held & ((~flips & (mode != "QUATERNION")) if turns == "AUTO" else (turns == "BLENDER"))
         # Shortest: typed turns whose short screw turns less far than Blender's playback
         shortened = np.zeros(len(held), dtype=bool)
@@ -264,7 +272,7 @@ def key_motion(
             causes.append("spins taken the short way")
         if len(inserted):
             spins = int(np.sum((turn > intent.WIND_LIMIT) & followed))
-            played = source.channels(inserted)
+            played = source.channels(inserted) if at_inserted is None else at_inserted
             order = np.argsort(np.concatenate([frames, inserted]), kind="stable")
             parent = np.clip(np.searchsorted(frames, np.concatenate([frames, inserted])[order][:-1], side="right") - 1, 0, len(frames) - 2)
             frames = np.concatenate([frames, inserted])[order]

@@ -218,6 +218,7 @@ functions!(
     PartialMovesMany = "partial_moves_many",
     SampleMany = "sample_many",
     ChannelsMany = "channels_many",
+    ReadOwners = "read_owners",
 );
 
 /// The name of `obj`'s type, for messages.
@@ -654,4 +655,29 @@ impl<'a, 'py, F: Function, T: Named> FromPyObject<'a, 'py> for Choice<F, T> {
             .map(Self::of)
             .map_err(|e| crate::errors::to_py_err(F::NAME, e))
     }
+}
+
+/// An optional per-owner flag of `function` (nonzero: set), `owners` long, `default` for
+/// every owner when not given (or None).
+pub fn per_owner_flags(
+    function: &'static str,
+    what: &'static str,
+    obj: Option<&Bound<'_, PyAny>>,
+    owners: usize,
+    default: bool,
+) -> PyResult<Vec<bool>> {
+    let Some(obj) = obj.filter(|o| !o.is_none()) else {
+        return Ok(vec![default; owners]);
+    };
+    let arg = int_array(function, what, obj)?;
+    if arg.shape() != [owners] {
+        return Err(crate::errors::shape_err(
+            function,
+            what,
+            &format!("({owners},)"),
+            arg.shape(),
+        ));
+    }
+    let array = arg.read()?;
+    Ok(array.as_array().iter().map(|&v| v != 0).collect())
 }

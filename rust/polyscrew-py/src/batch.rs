@@ -56,18 +56,9 @@ fn per_owner(
     Ok(array.as_array().iter().copied().collect())
 }
 
-/// An optional per-owner flag (0 or 1), `owners` long.
+/// An optional per-owner flag (0 or 1), `owners` long (false when not given).
 fn flags(what: &'static str, obj: Option<&Bound<'_, PyAny>>, owners: usize) -> PyResult<Vec<bool>> {
-    const F: &str = SampleOwners::NAME;
-    let Some(obj) = obj.filter(|o| !o.is_none()) else {
-        return Ok(vec![false; owners]);
-    };
-    let arg = int_array(F, what, obj)?;
-    if arg.shape() != [owners] {
-        return Err(shape_err(F, what, &format!("({owners},)"), arg.shape()));
-    }
-    let array = arg.read()?;
-    Ok(array.as_array().iter().map(|&v| v != 0).collect())
+    args::per_owner_flags(SampleOwners::NAME, what, obj, owners, false)
 }
 
 /// An `(N, columns)` integer table.

@@ -18,6 +18,7 @@ mod feature;
 mod intent;
 mod many;
 mod motion;
+mod read;
 mod reduce;
 mod sweep;
 
@@ -123,6 +124,7 @@ fn _polyscrew(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fcurve::register(m)?;
     intent::register(m)?;
     batch::register(m)?;
+    read::register(m)?;
     denoise::register(m)?;
     reduce::register(m)?;
     many::register(m)?;

@@ -53,7 +53,7 @@ impl PackedCurves<'_> {
     }
 
     /// Checks every length against `C` and `K` (the last offset).
-    fn check_lengths(&self) -> Result<usize> {
+    pub(crate) fn check_lengths(&self) -> Result<usize> {
         if self.offsets.is_empty() {
             return Err(Error::Count {
                 what: "offsets (one per curve, plus one)",

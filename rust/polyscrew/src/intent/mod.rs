@@ -46,6 +46,7 @@ pub mod limits;
 pub mod many;
 pub mod pace;
 pub mod playback;
+pub mod read;
 pub mod spans;
 pub mod turns;
 
@@ -70,6 +71,7 @@ pub use pace::{
     travel, KeysTiming, PaceSource, Timed, DENSE_PACE_SAMPLES, PACE_SAMPLES,
 };
 pub use playback::{rotation_matrices, rotation_matrix, Channel, Playback};
+pub use read::{key_frame_union, read_owners, OwnerKeys, OwnerRead, KEY_FRAME_TOLERANCE};
 pub use spans::{
     analyse_spans, analyse_turns, Spans, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES,
     SPAN_SAMPLES, WIND_LIMIT, WIND_STEP,
