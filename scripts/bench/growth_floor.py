@@ -28,12 +28,13 @@ and lists, per measurement, the functions whose own time grows most above linear
 smallest size to the largest (cProfile does not see RNA property reads: they count in their
 Python caller).
 
-Run after scripts/build_extension.sh (SCREWBENDER_EXTENSION_ZIP picks another build, for an
-A/B of two trees run side by side):
-    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/growth_floor.py --family objects \\
-        --sizes 20,100,500,2000 --ops revert
+Without --family it runs CASES (Revert on 20, 100, 500, 2,000 objects x 50 frames; the three
+operators on rigs of 20, 100, 300 bones x 250 frames; --quick: small sizes, one run, seconds).
+Run after scripts/build_extension.sh (scripts/bench.sh, part `measure`, runs it so;
+SCREWBENDER_EXTENSION_ZIP picks another build, for an A/B of two trees run side by side):
+    PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/growth_floor.py [--quick]
     PYTHONPATH=.venv/bpy/5.0 .venv/bin/python scripts/bench/growth_floor.py --family rig \\
-        --sizes 20,100,300 --frames 250 --keys 10 --ops revert,smooth,insert_key
+        --sizes 20,100,300 --frames 250 --keys 10 --ops revert,smooth,insert_key --profile
 """
 
 from __future__ import annotations
@@ -159,35 +160,31 @@ def one_repetition(stage: bf.Stage, ops: list[str], frames: int, measure) -> Non
         stage.clean()
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--family", default="objects", choices=("objects", "rig"))
-    parser.add_argument("--sizes", default="20,100,500", help="owner counts, comma-separated")
-    parser.add_argument("--frames", type=int, default=50)
-    parser.add_argument("--keys", type=int, default=2)
-    parser.add_argument("--runs", type=int, default=3, help="interleaved repetitions per size (medians)")
-    parser.add_argument("--ops", default="revert,smooth,insert_key")
-    parser.add_argument("--profile", action="store_true", help="also one cProfile'd call of each per size")
-    parser.add_argument("--top", type=int, default=8, help="with --profile: functions listed per measurement")
-    args = parser.parse_args()
-    bpy.utils.register_class(BENCH_OT_growth_floor)
-    sizes, ops = [int(s) for s in args.sizes.split(",")], args.ops.split(",")
+#: The default cases: (family, sizes, frames, keys, operators).
+CASES = (
+    ("objects", (20, 100, 500, 2000), 50, 2, ("revert",)),
+    ("rig", (20, 100, 300), 250, 10, ("revert", "smooth", "insert_key")),
+)
+QUICK_CASES = (("objects", (2, 6), 20, 2, ("revert",)), ("rig", (2, 6), 30, 3, ("revert", "smooth", "insert_key")))
+
+
+def run_case(family: str, sizes: list[int], frames: int, keys: int, ops: list[str], runs: int, profile: bool,
+             top: int) -> None:
     medians: dict[int, dict[str, tuple[float, float]]] = {}
     profiles: dict[int, dict[str, dict[str, float]]] = {}
     for n in sizes:
-        stage = bf.Stage(bf.build(args.family, n, args.frames, args.keys))
+        stage = bf.Stage(bf.build(family, n, frames, keys))
         times: dict[str, list[tuple[float, float]]] = {}
-        one_repetition(stage, ops, args.frames, lambda name, fn: fn())  # warm-up
-        for _ in range(args.runs):
-            one_repetition(stage, ops, args.frames, lambda name, fn: times.setdefault(name, []).append(cpu_wall(fn)))
+        one_repetition(stage, ops, frames, lambda name, fn: fn())  # warm-up
+        for _ in range(runs):
+            one_repetition(stage, ops, frames, lambda name, fn: times.setdefault(name, []).append(cpu_wall(fn)))
         medians[n] = {k: (statistics.median(c for c, _ in v), statistics.median(w for _, w in v)) for k, v in times.items()}
-        print(f"{n} {args.family}: " + "; ".join(f"{k} {1e3 * c:.2f} ms CPU, {1e3 * w:.2f} ms wall"
-                                                  for k, (c, w) in medians[n].items()), flush=True)
-        if args.profile:
+        if profile:
             profiles[n] = {}
-            one_repetition(stage, ops, args.frames, lambda name, fn: profiles[n].__setitem__(name, own_times(fn)))
-    print(f"CPU medians of {args.runs} interleaved runs (ms) at {', '.join(map(str, sizes))} {args.family}; "
-          "exponent p fitted over all sizes (CPU, wall) and between neighbouring sizes (CPU):")
+            one_repetition(stage, ops, frames, lambda name, fn, n=n: profiles[n].__setitem__(name, own_times(fn)))
+    print(f"Blender {bpy.app.version_string}, {family} x {frames} frames: CPU medians of {runs} interleaved run(s) (ms) "
+          f"at {', '.join(map(str, sizes))} owners; exponent p fitted over all sizes (CPU, wall) and between "
+          "neighbouring sizes (CPU):")
     for name in medians[sizes[0]]:
         cpu = [medians[n][name][0] for n in sizes]
         wall = [medians[n][name][1] for n in sizes]
@@ -196,16 +193,36 @@ def main() -> None:
         pairs = [math.log(max(b, 1e-9) / max(a, 1e-9)) / math.log(m / n)
                  for (n, a), (m, b) in zip(zip(sizes, cpu), zip(sizes[1:], cpu[1:]))]
         print(f"  {name:28s} {' '.join(f'{1e3 * t:9.2f}' for t in cpu)}   p {p_cpu:.2f} CPU, {p_wall:.2f} wall;"
-              f" pairs {' '.join(f'{p:.2f}' for p in pairs)}")
-    if args.profile:
+              f" pairs {' '.join(f'{p:.2f}' for p in pairs)}", flush=True)
+    if profile:
         first, last = sizes[0], sizes[-1]
         for name in profiles[first]:
             a, b = profiles[first][name], profiles[last].get(name, {})
             excess = sorted(((b.get(f, 0.0) - last / first * a.get(f, 0.0), f) for f in set(a) | set(b)), reverse=True)
             print(f"{name}: own time above linear from {first} to {last} (ms: excess, at {first}, at {last}):")
-            for extra, f in excess[: args.top]:
+            for extra, f in excess[:top]:
                 print(f"  {1e3 * extra:8.2f} {1e3 * a.get(f, 0.0):8.2f} {1e3 * b.get(f, 0.0):8.2f}  {f}")
 
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--family", choices=("objects", "rig"), help="one case (default: CASES)")
+    parser.add_argument("--sizes", default="20,100,500", help="with --family: owner counts, comma-separated")
+    parser.add_argument("--frames", type=int, default=50)
+    parser.add_argument("--keys", type=int, default=2)
+    parser.add_argument("--runs", type=int, default=3, help="interleaved repetitions per size (medians)")
+    parser.add_argument("--ops", default="revert,smooth,insert_key", help="with --family")
+    parser.add_argument("--profile", action="store_true", help="also one cProfile'd call of each per size")
+    parser.add_argument("--top", type=int, default=8, help="with --profile: functions listed per measurement")
+    parser.add_argument("--quick", action="store_true", help="QUICK_CASES, one run (seconds)")
+    args = parser.parse_args()
+    bpy.utils.register_class(BENCH_OT_growth_floor)
+    if args.family:
+        cases = [(args.family, [int(s) for s in args.sizes.split(",")], args.frames, args.keys, args.ops.split(","))]
+    else:
+        cases = QUICK_CASES if args.quick else CASES
+    for family, sizes, frames, keys, ops in cases:
+        run_case(family, list(sizes), frames, keys, list(ops), 1 if args.quick else args.runs, args.profile, args.top)
 
 if __name__ == "__main__":
     main()
