@@ -184,10 +184,13 @@ def run_case(family: str, sizes: list[int], frames: int, keys: int, ops: list[st
             one_repetition(stage, ops, frames, lambda name, fn, n=n: profiles[n].__setitem__(name, own_times(fn)))
     print(f"Blender {bpy.app.version_string}, {family} x {frames} frames: CPU medians of {runs} interleaved run(s) (ms) "
           f"at {', '.join(map(str, sizes))} owners; exponent p fitted over all sizes (CPU, wall) and between "
-          "neighbouring sizes (CPU):")
+          "neighbouring sizes (CPU); one size: CPU and wall:")
     for name in medians[sizes[0]]:
         cpu = [medians[n][name][0] for n in sizes]
         wall = [medians[n][name][1] for n in sizes]
+        if len(sizes) < 2:  # one size: its times (CPU, wall), no exponent
+            print(f"  {name:28s} {1e3 * cpu[0]:9.2f} CPU, {1e3 * wall[0]:9.2f} wall", flush=True)
+            continue
         p_cpu = bench_report.growth_exponent(sizes, [max(t, 1e-9) for t in cpu])[0]
         p_wall = bench_report.growth_exponent(sizes, [max(t, 1e-9) for t in wall])[0]
         pairs = [math.log(max(b, 1e-9) / max(a, 1e-9)) / math.log(m / n)
