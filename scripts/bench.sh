@@ -21,7 +21,8 @@
 #   - the measurements the docs quote (part "measure"): what Smooth Motion keeps of the
 #     animator's intent (measure_intent.py), how far each scheme strays from the keys
 #     (measure_schemes.py), where a bake's time goes (profile_bake.py), each writing operator
-#     against its floor, profiled (profile_floor.py, docs/performance.md), the live preview's
+#     against its floor, profiled (profile_floor.py, docs/performance.md), Revert, Smooth Motion
+#     and Insert Key against owners beside Blender-only floors (growth_floor.py), the live preview's
 #     recompute (bench_preview.py), Build Swept Region on a 100,000-triangle mesh
 #     (bench_sweep_blender.py), the closed swept boundary against the open sweep
 #     (bench_sweep_closed.py), key fractions of reduce_keys (measure_reduce.py), memory
@@ -292,6 +293,7 @@ else
   measure measure_schemes "$pylib:$bpy_dir"
   measure profile_bake "$pylib:$bpy_dir" "${profile_args[@]}"
   measure profile_floor "$pylib:$bpy_dir" "${floor_profile_args[@]}"
+  measure growth_floor "$pylib:$bpy_dir" "${floor_profile_args[@]}"
   measure bench_preview "$pylib:$bpy_dir" "${preview_args[@]}"
   measure bench_sweep_blender "$pylib:$bpy_dir"
   measure bench_sweep_closed "$pylib"

@@ -880,6 +880,7 @@ class Report:
         ("measure_schemes", "how far each subdivision scheme strays from the key poses (the Scheme tooltips)"),
         ("profile_bake", "where Smooth Motion's time goes on many objects, and Blender's own read and write calls"),
         ("profile_floor", "each writing operator against its floor, profiled (issue 27; docs/performance.md)"),
+        ("growth_floor", "Revert, Smooth Motion and Insert Key against owners beside Blender-only floors (issue 27, item 4)"),
         ("bench_preview", "the live preview's recompute (issue 8: 50 keys, 5 levels, 64 instances)"),
         ("bench_sweep_blender", "Build Swept Region on a 100,000-triangle mesh against stroboscopic instancing"),
         ("bench_sweep_closed", "the closed boundary of the swept region against the open sweep on issue 29's cases"),

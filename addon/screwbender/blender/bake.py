@@ -772,22 +772,23 @@ def _action_groups(selection: Iterable) -> tuple[list[_Group], list]:
     """The owners grouped by the action and slot that animates them (linked duplicates share
     one), in the order given; owners without an action are refused here."""
     found, skipped = action_groups.by_action(selection)
-    groups: dict[tuple, _Group] = {}
+    # Per (action pointer, slot): its objects by pointer and its bones, each once, in order (dicts:
+    # a list's `in` per owner grew as owners squared, a rig's bones or many linked duplicates).
+    members: dict[tuple, tuple[dict[int, bpy.types.Object], dict[str, None]]] = {}
     for by_action in found:
-        group = groups[by_action.action.as_pointer(), by_action.identifier] = _Group([], [])
+        objects, bones = members[by_action.action.as_pointer(), by_action.identifier] = {}, {}
         for owner in by_action.members:
-            if owner.obj not in group.objects:
-                group.objects.append(owner.obj)
-            if owner.bone not in group.bones:
-                group.bones.append(owner.bone)
+            objects.setdefault(owner.obj.as_pointer(), owner.obj)
+            bones.setdefault(owner.bone, None)
     # Every object the action animates through that slot keeps sharing it, selected or not
     # (one pass over the scene's objects for all the actions).
-    users = users_by_slot({pointer for pointer, _ in groups})
-    for key, group in groups.items():
+    users = users_by_slot({pointer for pointer, _ in members})
+    groups = []
+    for key, (objects, bones) in members.items():
         for obj in users.get(key, ()):
-            if obj not in group.objects:
-                group.objects.append(obj)
-    return list(groups.values()), skipped
+            objects.setdefault(obj.as_pointer(), obj)
+        groups.append(_Group(list(objects.values()), list(bones)))
+    return groups, skipped
 
 
 def users_by_slot(pointers: set[int]) -> dict[tuple[int, str], list[bpy.types.Object]]:
