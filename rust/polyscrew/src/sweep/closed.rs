@@ -120,7 +120,7 @@ const SLABS_PER_THREAD: usize = 4;
 pub const MAX_POSES: usize = 1 << 20;
 
 /// How to ask [`sweep_closed`] for less.
-const CELL_HINT: &str = "use a larger cell";
+const CELL_HINT: &str = "use a larger tolerance (or cell)";
 
 /// Bytes per world-grid point: its value (4) and the pose that gave it (4).
 const WORLD_BYTES_PER_POINT: usize = 8;
@@ -497,7 +497,7 @@ pub(super) fn body_distance_grid(
 }
 
 /// How to ask the closed sweep for less memory.
-pub const CLOSED_HINT: &str = "use a larger cell, fewer poses or a smaller motion";
+pub const CLOSED_HINT: &str = "use a larger tolerance (or cell), fewer poses or a smaller motion";
 
 /// Distance from `p` to the triangle `(a, b, c)` (Ericson, *Real-Time Collision Detection*,
 /// 5.1.5: the closest point by Voronoi regions).
@@ -783,22 +783,24 @@ fn contoured(
     evaluation: Evaluation,
 ) -> Result<ClosedMesh> {
     let band = BAND_CELLS * cell;
-    let field = BodyField::new(body, cell / BODY_SUBCELLS, band, threads)?;
     let Plan {
         motion,
         boxes,
         grid,
     } = Plan::new(body, poses, cell)?;
+    let Grid { origin, n, .. } = grid;
+    let count = n[0] * n[1] * n[2];
+    // Both grids checked before either is sampled: an oversized request costs no work.
+    let [bx, by, bz] = BodyField::dims(body, cell / BODY_SUBCELLS, band).1;
+    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
+        + Footprint::of::<f32>(bx.saturating_mul(by).saturating_mul(bz)))
+    .check("the region's distance grid", CLOSED_HINT)?;
+    let field = BodyField::new(body, cell / BODY_SUBCELLS, band, threads)?;
     let to_body: Vec<DAffine3> = motion
         .poses
         .iter()
         .map(|p| p.inverse().to_affine())
         .collect();
-    let Grid { origin, n, .. } = grid;
-    let count = n[0] * n[1] * n[2];
-    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
-        + Footprint::of::<f32>(field.values.len()))
-    .check("the region's distance grid", CLOSED_HINT)?;
     let mut g: Vec<f32> = try_vec(count, "the region's distance grid")?;
     g.resize(count, band as f32);
     let mut arg: Vec<u32> = try_vec(count, "the region's distance grid")?;
