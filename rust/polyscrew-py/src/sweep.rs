@@ -8,10 +8,11 @@ use pyo3::types::{PyDict, PyTuple};
 use glam::DVec3;
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::sweep::closed::{
-    closed_work, sweep_closed_mesh, ClosedOptions, CELL_PER_TOLERANCE, CLOSED_HINT, MAX_THREADS,
+    closed_work_mesh, sweep_closed_mesh, ClosedOptions, CELL_PER_TOLERANCE, CLOSED_HINT,
+    MAX_THREADS,
 };
 use polyscrew::sweep::{
-    body_footprint, sweep_mesh, Accuracy, Body, SweepOptions, DEFAULT_CELL_REL,
+    body_footprint, sweep_mesh, Accuracy, SweepOptions, DEFAULT_CELL_REL,
     DEFAULT_CLOSED_TOLERANCE_REL, DEFAULT_TOLERANCE_REL, MAX_STEPS, SWEEP_HINT,
 };
 use polyscrew::{Error, Pose};
@@ -301,17 +302,7 @@ fn sweep_closed_work<'py>(
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
         let t = read_triangles(F, "triangles", ta)?;
         let p = read_poses(F, "poses", pa)?;
-        if p.len() < 2 {
-            return Err(to_py_err(
-                F,
-                Error::TooFew {
-                    got: p.len(),
-                    need: 2,
-                },
-            ));
-        }
-        let body = Body::new(&v, &t).map_err(|e| to_py_err(F, e))?;
-        closed_work(&body, &p, &options).map_err(|e| to_py_err(F, e))
+        closed_work_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))
     })?;
     let dict = PyDict::new(py);
     dict.set_item("cell", work.cell)?;

@@ -272,14 +272,9 @@ impl BodyField {
         let mut values: Vec<f32> = try_vec(count, "the body's distance grid")?;
         values.resize(count, band as f32);
         let [nx, ny, nz] = n;
-        let point =
-            |i: usize, j: usize, k: usize| origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-        let range = |lo: f64, hi: f64, o: f64, m: usize| -> (usize, usize) {
-            let a = ((lo - o) / h).floor().max(0.0) as usize;
-            let b = (((hi - o) / h).ceil().max(0.0) as usize).min(m - 1);
-            (a, b)
-        };
         let grid = Grid { origin, cell: h, n };
+        let point = |i, j, k| grid.point(i, j, k);
+        let range = |lo, hi, axis| grid.span(lo, hi, axis);
         let roundoff = ROUNDOFF_REL * (lo.abs().max(hi.abs()).max_element() + band + h);
         // Slabs of whole layers, a few per thread.
         let per = nz.div_ceil(thread_count(threads) * SLABS_PER_THREAD);
@@ -297,8 +292,8 @@ impl BodyField {
             let [a, b, c] = t.map(|i| verts[i as usize]);
             let tlo = a.min(b).min(c);
             let thi = a.max(b).max(c);
-            let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
-            let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
+            let (i0, i1) = range(tlo.x, thi.x, 0);
+            let (j0, j1) = range(tlo.y, thi.y, 1);
             let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
             if det == 0.0 {
                 continue;
@@ -365,7 +360,7 @@ fn unsigned_distances(
     k0: usize,
     slab: &mut [f32],
 ) {
-    let Grid { origin, cell: h, n } = grid;
+    let n = grid.n;
     let [nx, ny, nz] = n;
     let layers = slab.len() / (nx * ny);
     if layers == 0 {
@@ -373,24 +368,19 @@ fn unsigned_distances(
     }
     let (ka, kb) = (k0, (k0 + layers - 1).min(nz - 1));
     let verts = body.vertices();
-    let point =
-        |i: usize, j: usize, k: usize| origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-    let range = |lo: f64, hi: f64, o: f64, m: usize| -> (usize, usize) {
-        let a = ((lo - o) / h).floor().max(0.0) as usize;
-        let b = (((hi - o) / h).ceil().max(0.0) as usize).min(m - 1);
-        (a, b)
-    };
+    let point = |i, j, k| grid.point(i, j, k);
+    let range = |lo, hi, axis| grid.span(lo, hi, axis);
     for t in body.triangles() {
         let [a, b, c] = t.map(|i| verts[i as usize]);
         let tlo = a.min(b).min(c) - DVec3::splat(band);
         let thi = a.max(b).max(c) + DVec3::splat(band);
-        let (k0, k1) = range(tlo.z, thi.z, origin.z, nz);
+        let (k0, k1) = range(tlo.z, thi.z, 2);
         let (k0, k1) = (k0.max(ka), k1.min(kb));
         if k0 > k1 {
             continue;
         }
-        let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
-        let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
+        let (i0, i1) = range(tlo.x, thi.x, 0);
+        let (j0, j1) = range(tlo.y, thi.y, 1);
         let normal = (b - a).cross(c - a).normalize_or_zero();
         let centre = (a + b + c) / 3.0;
         let radius = centre
@@ -419,7 +409,7 @@ fn unsigned_distances(
                 if xlo > xhi {
                     continue;
                 }
-                let (a0, a1) = range(xlo, xhi, origin.x, nx);
+                let (a0, a1) = range(xlo, xhi, 0);
                 for i in a0.max(i0)..=a1.min(i1) {
                     let p = point(i, j, k);
                     let slot = &mut slab[((k - ka) * ny + j) * nx + i];
@@ -839,6 +829,24 @@ struct Grid {
     origin: DVec3,
     cell: f64,
     n: [usize; 3],
+}
+
+impl Grid {
+    /// Point `(i, j, k)`.
+    #[inline]
+    fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.cell
+    }
+
+    /// The indices along `axis` of the points from the last at or below `lo` to the first at
+    /// or above `hi`, clamped to the grid.
+    #[inline]
+    fn span(&self, lo: f64, hi: f64, axis: usize) -> (usize, usize) {
+        let (o, m) = (self.origin[axis], self.n[axis]);
+        let a = ((lo - o) / self.cell).floor().max(0.0) as usize;
+        let b = (((hi - o) / self.cell).ceil().max(0.0) as usize).min(m - 1);
+        (a, b)
+    }
 }
 
 /// Lowers `g` (and records the pose in `arg`) at the grid points `i0..=i1` of row `(jj, k)`
@@ -1306,6 +1314,25 @@ fn push_oriented(out: &mut ClosedMesh, t: [u32; 3], outward: DVec3) {
     } else {
         out.triangles.push(t);
     }
+}
+
+/// [`Body::new`] then [`closed_work`].
+///
+/// # Errors
+/// Those of [`Body::new`] and [`closed_work`].
+pub fn closed_work_mesh(
+    vertices: &[DVec3],
+    triangles: &[[i64; 3]],
+    poses: &[Pose],
+    options: &ClosedOptions,
+) -> Result<ClosedWork> {
+    if poses.len() < 2 {
+        return Err(Error::TooFew {
+            got: poses.len(),
+            need: 2,
+        });
+    }
+    closed_work(&Body::new(vertices, triangles)?, poses, options)
 }
 
 /// [`Body::new`] then [`sweep_closed`].
