@@ -668,7 +668,9 @@ def compute_all(
             try:
                 work = polyscrew.sweep_closed_work(verts * scale, tris, poses, **grid)
             except ValueError as err:
-                raise SweepError(f"{obj.name}: {err}") from err
+                # An open mesh has no inside: say where the open sweep is.
+                hint = "; Closed Volume needs a closed mesh: turn it off for the open sweep" if "not closed" in str(err) else ""
+                raise SweepError(f"{obj.name}: {err}{hint}") from err
             refusal = sweep_report.closed_refusal(work)
             if refusal is not None:
                 raise SweepError(f"{obj.name}: {refusal}")

@@ -15,10 +15,10 @@ from dataclasses import dataclass
 import numpy as np
 
 #: The most world-grid points a closed boundary may sample from the operator: at the rate
-#: measured on issue 29's cases (docs/sweep.md: about 1.5 CPU seconds per million grid
-#: points at the default tolerance, most of it the narrow band and the refinement) a
-#: minute and a half to three minutes on one core; beyond it the call would run for minutes
-#: with Blender frozen. The memory budget (1 GiB: 8 bytes per grid point) refuses more anyway.
+#: measured on issue 29's three cases at the default tolerance (docs/sweep.md: 0.6 to 0.8 CPU
+#: seconds per million grid points, 20 to 66 million of them) about a minute to a minute and a
+#: half of CPU; beyond it the call would run for minutes with Blender waiting. The memory
+#: budget (1 GiB: 8 bytes per grid point, 4 per body-grid point) refuses more anyway.
 MAX_CLOSED_GRID_POINTS = 100_000_000
 #: The most dense poses a closed boundary may sample from the operator (the longest default
 #: case, the smoothed torus, samples 1,230).
