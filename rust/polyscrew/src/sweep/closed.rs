@@ -1316,6 +1316,18 @@ fn push_oriented(out: &mut ClosedMesh, t: [u32; 3], outward: DVec3) {
     }
 }
 
+/// The body of `vertices` and `triangles` for a motion through `poses` (two or more: checked
+/// first, so that too few poses is that error whatever the mesh).
+fn body_for(vertices: &[DVec3], triangles: &[[i64; 3]], poses: &[Pose]) -> Result<Body> {
+    if poses.len() < 2 {
+        return Err(Error::TooFew {
+            got: poses.len(),
+            need: 2,
+        });
+    }
+    Body::new(vertices, triangles)
+}
+
 /// [`Body::new`] then [`closed_work`].
 ///
 /// # Errors
@@ -1326,13 +1338,7 @@ pub fn closed_work_mesh(
     poses: &[Pose],
     options: &ClosedOptions,
 ) -> Result<ClosedWork> {
-    if poses.len() < 2 {
-        return Err(Error::TooFew {
-            got: poses.len(),
-            need: 2,
-        });
-    }
-    closed_work(&Body::new(vertices, triangles)?, poses, options)
+    closed_work(&body_for(vertices, triangles, poses)?, poses, options)
 }
 
 /// [`Body::new`] then [`sweep_closed`].
@@ -1345,12 +1351,5 @@ pub fn sweep_closed_mesh(
     poses: &[Pose],
     options: &ClosedOptions,
 ) -> Result<ClosedMesh> {
-    if poses.len() < 2 {
-        return Err(Error::TooFew {
-            got: poses.len(),
-            need: 2,
-        });
-    }
-    let body = Body::new(vertices, triangles)?;
-    sweep_closed(&body, poses, options)
+    sweep_closed(&body_for(vertices, triangles, poses)?, poses, options)
 }
