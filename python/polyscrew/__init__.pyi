@@ -557,7 +557,7 @@ def sweep_closed(
     info: Literal[False] = False,
     *,
     tolerance: float | None = None,
-    threads: int = 0,
+    threads: int | None = None,
 ) -> tuple[FloatArray, IntArray]: ...
 @overload
 def sweep_closed(
@@ -568,7 +568,7 @@ def sweep_closed(
     *,
     info: Literal[True],
     tolerance: float | None = None,
-    threads: int = 0,
+    threads: int | None = None,
 ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]:
     """The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
     one closed, consistently oriented, self-intersection-free triangle mesh, every vertex within

@@ -173,7 +173,7 @@ fn sweep<'py>(
 ///     info: Literal[False] = False,
 ///     *,
 ///     tolerance: float | None = None,
-///     threads: int = 0,
+///     threads: int | None = None,
 /// ) -> tuple[FloatArray, IntArray]
 /// sweep_closed(
 ///     vertices: ArrayLike,
@@ -183,7 +183,7 @@ fn sweep<'py>(
 ///     *,
 ///     info: Literal[True],
 ///     tolerance: float | None = None,
-///     threads: int = 0,
+///     threads: int | None = None,
 /// ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]
 ///
 /// The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
