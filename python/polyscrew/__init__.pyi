@@ -544,6 +544,8 @@ def sweep(
 class ClosedSweepInfo(TypedDict):
     cell: float
     error_bound: float
+    tolerance: float
+    attempts: int
     poses: int
 
 @overload
@@ -553,6 +555,9 @@ def sweep_closed(
     poses: ArrayLike,
     cell: float | None = None,
     info: Literal[False] = False,
+    *,
+    tolerance: float | None = None,
+    threads: int | None = None,
 ) -> tuple[FloatArray, IntArray]: ...
 @overload
 def sweep_closed(
@@ -562,29 +567,63 @@ def sweep_closed(
     cell: float | None = None,
     *,
     info: Literal[True],
+    tolerance: float | None = None,
+    threads: int | None = None,
 ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]:
     """The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
-    one closed, consistently oriented, self-intersection-free triangle mesh.
+    one closed, consistently oriented, self-intersection-free triangle mesh, every vertex within
+    ``tolerance`` of the swept boundary.
 
     ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame (closed:
     every edge in two faces); ``poses`` (N >= 2, 4, 4) its world poses, one screw per span.
     The region's signed distance (the minimum over the motion of the body's, the body's
-    sampled on a grid six times finer than ``cell``, the motion sampled so that no point
-    moves more than a cell between samples) is contoured on a grid of spacing ``cell`` by
-    marching tetrahedra, and every vertex moved along its grid edge to the zero of the
-    distance refined between the samples. ``cell=None``: ``DEFAULT_CLOSED_CELL`` (1.5 %) of
-    the body's extent (its bounding box's diagonal). Slower than ``sweep`` (seconds, not
-    milliseconds) and many more triangles: for meshes that must be closed.
+    sampled on a grid six times finer than the cell, the motion sampled so that no point
+    moves more than a cell between samples) is contoured on a grid by marching tetrahedra, and
+    every vertex moved along its grid edge to the zero of the distance refined between the
+    samples. ``tolerance`` (a length; None: ``DEFAULT_CLOSED_TOLERANCE`` (0.5 %) of the body's
+    extent, its bounding box's diagonal) sets the cell: ``CLOSED_CELL_PER_TOLERANCE`` times
+    it, contoured again at a cell where the bound cannot exceed it if the first one's does.
+    ``cell`` (scripts) fixes the cell instead; not both. ``threads``: the body's distance
+    grid and the region's field are computed on this many threads (0: all the machine has;
+    at most 64);
+    the mesh is the same, bit for bit. Slower than ``sweep`` (seconds, not milliseconds) and
+    many more triangles: for meshes that must be closed (``sweep_closed_work`` tells the work
+    before).
 
     Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
     triangles counter-clockwise seen from outside, every edge in exactly two; with
     ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
-    boundary: the distance left at a vertex plus the body grid's interpolation bound) and
-    ``poses`` (the dense poses sampled).
+    boundary: the distance left at a vertex plus the body grid's interpolation bound; at most
+    ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2)
+    and ``poses`` (the dense poses sampled).
 
     Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
-    that is not positive or below 1/1000 of the body's extent, or grids over the memory
-    budget.
+    or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
+    extent), both of them, or grids over the memory budget.
+    """
+
+class ClosedSweepWork(TypedDict):
+    cell: float
+    tolerance: float
+    poses: int
+    grid_points: int
+    body_points: int
+
+def sweep_closed_work(
+    vertices: ArrayLike,
+    triangles: ArrayLike,
+    poses: ArrayLike,
+    cell: float | None = None,
+    *,
+    tolerance: float | None = None,
+) -> ClosedSweepWork:
+    """What ``sweep_closed`` with the same arguments will sample, without sampling it (the
+    arguments checked as it checks them; the dense poses counted, milliseconds): ``cell`` and
+    ``tolerance`` (of its first attempt), ``poses`` (dense poses), ``grid_points`` (the world
+    grid over the instances' boxes) and ``body_points`` (the body's fine distance grid). For a
+    caller to refuse work that would run for minutes before it starts.
+
+    Raises ``ValueError`` as ``sweep_closed`` does (but for the memory budget of its grids).
     """
 
 MAX_STEPS: int
@@ -594,7 +633,13 @@ DEFAULT_SWEEP_TOLERANCE: float
 """The default tolerance of ``sweep``, as a fraction of the body's bounding radius (0.002)."""
 
 DEFAULT_CLOSED_CELL: float
-"""The default cell of ``sweep_closed``, as a fraction of the body's extent (0.015)."""
+"""The cell of ``sweep_closed`` before it took a tolerance, as a fraction of the body's extent (0.015)."""
+
+DEFAULT_CLOSED_TOLERANCE: float
+"""The default tolerance of ``sweep_closed``, as a fraction of the body's extent, its bounding box's diagonal (0.005)."""
+
+CLOSED_CELL_PER_TOLERANCE: float
+"""The first cell of ``sweep_closed`` as a multiple of its tolerance (1.25)."""
 
 CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
 ParametrizationName = Literal["uniform", "centripetal"]

@@ -532,7 +532,7 @@ def one_repetition(stage: Stage, family: str, frames: int, record: Record, sweep
             stage.clean()
         if sweep:
             stage.fresh()
-            if run_op(record, "sweep", lambda: ops.sweep(), objects):
+            if run_op(record, "sweep", lambda: ops.sweep(closed=False), objects):
                 made = made_meshes(stage)
                 stage.clean()
                 stage.fresh()

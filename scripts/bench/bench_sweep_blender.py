@@ -58,7 +58,7 @@ def main() -> None:
         o.select_set(o is obj)
     bpy.context.view_layer.objects.active = obj
     start = time.perf_counter()
-    assert bpy.ops.screwbender.sweep(steps=STEPS, caps=True) == {"FINISHED"}
+    assert bpy.ops.screwbender.sweep(steps=STEPS, caps=True, closed=False) == {"FINISHED"}
     operator_s = time.perf_counter() - start
     region = bpy.context.view_layer.objects.active
     out_tris = swept.triangle_count(region.data)

@@ -242,7 +242,7 @@ def main() -> None:
     import polyscrew
 
     result: dict = {"quick": quick, "poses": args.poses, "ref_cell": ref_cell, "spacing": spacing,
-                    "default_cell": polyscrew.DEFAULT_CLOSED_CELL, "cases": [], "notes": [],
+                    "default_tolerance": polyscrew.DEFAULT_CLOSED_TOLERANCE, "cases": [], "notes": [],
                     "versions": {"python": platform.python_version(), "numpy": np.__version__}}
     for name in ("gpytoolbox", "sweep3d", "scikit-image", "scipy"):
         result["versions"][name] = package_version(name)
@@ -297,7 +297,8 @@ def main() -> None:
                      f"{100 * row['hausdorff']:.3f} %" if len(mt) else ""), flush=True)
 
         cpu, wall, (cv, ct, info) = timed(lambda: polyscrew.sweep_closed(v, t, poses, info=True))
-        record("ours: sweep_closed", f"default cell {info['cell']:.4f}", cpu, wall, cv, ct, ours=True)
+        record("ours: sweep_closed", f"default tolerance {info['tolerance']:.4f}, cell {info['cell']:.4f}", cpu, wall,
+               cv, ct, ours=True)
         cpu, wall, (ov, ot) = timed(lambda: polyscrew.sweep(v, t, poses), repeat=5)
         record("ours: sweep (open)", "default steps, median of 5", cpu, wall, ov, ot)
         for eps in gpy_eps:

@@ -39,7 +39,7 @@ def sweep(obj: bpy.types.Object) -> tuple[bpy.types.Object, float]:
     obj.select_set(True)
     bpy.context.view_layer.objects.active = obj
     start = time.perf_counter()
-    result = bpy.ops.screwbender.sweep(steps=1, caps=True)
+    result = bpy.ops.screwbender.sweep(steps=1, caps=True, closed=False)
     seconds = time.perf_counter() - start
     if result != {"FINISHED"}:
         sys.exit(f"60_sweep: Build Swept Region failed on {obj.name}")

@@ -187,7 +187,7 @@ def test_build_swept_region_into_an_unlinked_collection(sb):
     a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
     h.select_only(a, b)
     with fail_on_call("blender.swept", "mesh_from_arrays", 2) as calls:
-        check_unchanged(lambda: bpy.ops.screwbender.sweep())
+        check_unchanged(lambda: bpy.ops.screwbender.sweep(closed=False))
     assert calls["n"] == 2
     assert addon_module("blender.swept").COLLECTION not in bpy.context.scene.collection.children
 
@@ -196,14 +196,14 @@ def test_build_swept_region(sb):
     a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
     h.select_only(a, b)
     with fail_on_call("blender.swept", "mesh_from_arrays", 2) as calls:
-        check_unchanged(lambda: bpy.ops.screwbender.sweep())
+        check_unchanged(lambda: bpy.ops.screwbender.sweep(closed=False))
     assert calls["n"] == 2
 
 
 def test_check_clearance(sb):
     a, b = keyed("A", scale=False), keyed("B", offset=3.0, scale=False)
     h.select_only(a)
-    assert bpy.ops.screwbender.sweep() == {"FINISHED"}
+    assert bpy.ops.screwbender.sweep(closed=False) == {"FINISHED"}  # open meshes: the open sweep
     region = bpy.context.view_layer.objects.active
     h.select_only(region, b)
     with fail_on_call("blender.swept", "select_faces", 2) as calls:

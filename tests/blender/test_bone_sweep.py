@@ -256,4 +256,4 @@ def test_a_mirror_before_the_armature_modifier_is_allowed():
     mirror = prop.modifiers.new("Mirror", "MIRROR")
     while prop.modifiers[0] != mirror:
         bpy.ops.object.modifier_move_up(modifier="Mirror")
-    assert bpy.ops.screwbender.sweep(steps=2) == {"FINISHED"}
+    assert bpy.ops.screwbender.sweep(steps=2, closed=False) == {"FINISHED"}

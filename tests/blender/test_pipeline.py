@@ -57,7 +57,7 @@ def test_every_writing_operator_runs_through_the_pipeline(runs):
     assert bpy.ops.screwbender.denoise() == {"FINISHED"}
     bpy.context.scene.frame_set(17)
     assert bpy.ops.screwbender.insert_key() == {"FINISHED"}
-    assert bpy.ops.screwbender.sweep(steps=2) == {"FINISHED"}
+    assert bpy.ops.screwbender.sweep(steps=2, closed=False) == {"FINISHED"}
     region = bpy.context.view_layer.objects.active
     h.select_only(region, other)
     bpy.context.view_layer.objects.active = region

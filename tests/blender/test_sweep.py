@@ -227,7 +227,7 @@ def test_sweeps_the_smoothed_motion_at_its_baked_keys():
     swept = addon_module("blender.swept")
     frames = swept.motion_frames(body, scene)
     np.testing.assert_allclose(frames, np.arange(1, 30.25, 0.5))
-    assert bpy.ops.screwbender.sweep(steps=2) == {"FINISHED"}
+    assert bpy.ops.screwbender.sweep(steps=2, closed=False) == {"FINISHED"}
     (region,) = swept_objects()
     # Every baked pose's box corners lie on the region's vertices' bounding box or inside.
     v = np.array([tuple(p.co) for p in region.data.vertices])

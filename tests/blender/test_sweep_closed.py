@@ -1,4 +1,4 @@
-"""Build Swept Region with Closed Volume: the region's closed boundary (issue 29, items 2 and 3).
+"""Build Swept Region with Closed Volume: the region's closed boundary (issue 29, items 1 to 3).
 
 Independent references: Blender's own mesh checks (`bmesh`: every edge manifold and
 contiguous, the volume; `BVHTree.overlap` of the mesh with itself for self-intersections,
@@ -15,10 +15,22 @@ import bmesh
 import bpy
 import numpy as np
 import pytest
+from mathutils import Matrix
 from mathutils.bvhtree import BVHTree
 
 import bake_helpers as h
-from test_sweep_tolerance import Motion, cube, long_screw, played_poses, region_arrays, sd_box, smoothed, swept_region
+from screws import screw_matrix
+from test_sweep_tolerance import (
+    Motion,
+    cube,
+    key,
+    long_screw,
+    played_poses,
+    region_arrays,
+    sd_box,
+    smoothed,
+    swept_region,
+)
 
 
 def region_sd(motion, points, half, per_span=1024, fine=32, levels=2):
@@ -72,9 +84,10 @@ def blender_checks(region, v, t):
     return closed, volume, int((shared == 0).sum()), int((shared > 0).sum())
 
 
-#: The smoothed motion's region at the default cell is 840,000 triangles: a coarser cell keeps
-#: the test's time down (the default cell is checked on the long screw).
-CELLS = {"long_screw": 0.0, "smoothed": 0.06}
+#: The smoothed motion's region at the former default cell (1.5 % of the diagonal) is 840,000
+#: triangles: a coarser cell keeps the test's time down (that cell is checked on the long
+#: screw; the operator's default, a tolerance, on a short motion below).
+CELLS = {"long_screw": 0.015 * np.sqrt(3.0), "smoothed": 0.06}
 
 
 @pytest.mark.parametrize("motion", ["long_screw", "smoothed"])
@@ -86,8 +99,7 @@ def test_closed_volume_is_the_closed_boundary_within_its_bound(motion):
     assert bpy.ops.screwbender.sweep(closed=True, cell=CELLS[motion]) == {"FINISHED"}
     region = swept_region()
     cell, bound = region["screwbender_cell"], region["screwbender_error_bound"]
-    # 0: 1.5 % of the unit cube's diagonal
-    assert cell == pytest.approx(CELLS[motion] or 0.015 * np.sqrt(3.0), rel=1e-6)
+    assert cell == pytest.approx(CELLS[motion], rel=1e-6)
     assert 0.0 < bound < cell
     v, t = region_arrays(region)
     closed, volume, overlaps, touching = blender_checks(region, v, t)
@@ -135,6 +147,57 @@ def test_an_open_mesh_is_refused_with_nothing_created():
     long_screw(obj)
     h.select_only(obj)
     before = len(bpy.data.objects), len(bpy.data.meshes)
-    with pytest.raises(RuntimeError, match="not closed"):
+    with pytest.raises(RuntimeError, match="not closed.*turn it off for the open sweep"):
         bpy.ops.screwbender.sweep(closed=True)
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+
+
+def short_motion(obj):
+    """The unit cube slid by 0.6 and turned by 40 degrees over frames 1 to 2."""
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 2
+    key(obj, 1, Matrix.Identity(4))
+    key(obj, 2, Matrix(screw_matrix((0.2, 0.3, 1.0), (0.4, -0.2, 0.0), np.radians(40.0), 0.6).tolist()))
+    return [1.0, 2.0]
+
+
+def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance():
+    """The operator with no options: Closed Volume, the tolerance 0.5 % of the object's
+    bounding-box diagonal, the bound reported within it, closed, no two triangles crossing,
+    every sampled vertex within the bound of the region's boundary."""
+    body = cube()
+    poses = played_poses(body, short_motion(body))
+    h.select_only(body)
+    assert bpy.ops.screwbender.sweep() == {"FINISHED"}
+    region = swept_region()
+    tol, bound, cell = (region[k] for k in ("screwbender_tolerance", "screwbender_error_bound", "screwbender_cell"))
+    assert tol == pytest.approx(0.005 * np.sqrt(3.0), rel=1e-6)
+    assert 0.0 < bound <= tol
+    assert cell == pytest.approx(1.25 * tol, rel=1e-6) or cell < tol
+    v, t = region_arrays(region)
+    closed, volume, overlaps, touching = blender_checks(region, v, t)
+    pts = v[np.random.default_rng(0).choice(len(v), min(len(v), 1500), replace=False)]
+    worst = np.abs(region_sd(Motion(poses), pts, 0.5)).max()
+    print(f"\ndefaults: {len(t)} triangles, tolerance {tol:.4f}, bound {bound:.4f}, cell {cell:.4f}, worst vertex "
+          f"{worst:.2e}, volume {volume:.4f}, intersecting pairs {overlaps} (and {touching} sharing a corner)")
+    assert closed
+    assert overlaps == 0
+    assert worst <= bound + 1e-6  # float32 vertices
+    assert region["screwbender_volume"] == pytest.approx(volume, rel=1e-5)
+    assert volume > 1.0
+
+
+def test_heavy_closed_work_is_refused_before_it_starts_with_nothing_created():
+    """A tolerance that would sample over MAX_CLOSED_GRID_POINTS grid points is refused before
+    any sampling (in milliseconds, not minutes), saying what to change; the open sweep is one
+    option away."""
+    body = cube()
+    long_screw(body)
+    h.select_only(body)
+    before = len(bpy.data.objects), len(bpy.data.meshes)
+    with pytest.raises(RuntimeError, match="raise the Tolerance.*Closed Volume off") as error:
+        bpy.ops.screwbender.sweep(tolerance=0.0025)
+    print(f"\n{error.value}")
+    assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
+    h.select_only(body)
+    assert bpy.ops.screwbender.sweep(tolerance=0.0025, closed=False) == {"FINISHED"}

@@ -90,7 +90,7 @@ KEYS = np.array([np.eye(4), screw_matrix((0.2, 1, 0.3), (1, 0, 0), 1.1, 0.4),
 SMOOTH = polyscrew.subdivide(KEYS, "four_point", levels=3, closed=False)
 
 #: name: (vertices, triangles, signed distance, poses, the body's own error, the cell as a
-#: fraction of the body's extent: None for the default). The L-prism at the default cell (1.5 %)
+#: fraction of the body's extent: None for the former default, 1.5 %). The L-prism at the default cell (1.5 %)
 #: is 0.64 % short in volume (its many sharp creases are cut by the flat faces): 1 % holds 0.5 %.
 CASES = {
     "cube, 120-degree screw with slide": (CUBE_V, CUBE_T, cube_sd, LONG, 0.0, None),
@@ -193,9 +193,12 @@ def test_closed_boundary_is_closed_exact_and_holds_the_volume(name):
     v, t, sd, poses, body_error, cell_rel = CASES[name]
     extent = np.linalg.norm(v.max(axis=0) - v.min(axis=0))
     start = time.process_time()
-    cv, ct, info = polyscrew.sweep_closed(v, t, poses, cell=None if cell_rel is None else cell_rel * extent, info=True)
+    # The cell given (None: the former default, 1.5 %; the tolerance's default is checked in
+    # test_sweep_closed_tolerance.py and tests/blender/test_sweep_closed.py).
+    cell = (cell_rel or polyscrew.DEFAULT_CLOSED_CELL) * extent
+    cv, ct, info = polyscrew.sweep_closed(v, t, poses, cell=cell, info=True)
     cpu = time.process_time() - start
-    assert info["cell"] == pytest.approx((cell_rel or polyscrew.DEFAULT_CLOSED_CELL) * extent)
+    assert info["cell"] == cell and info["tolerance"] == 0.0 and info["attempts"] == 1
     assert cv.dtype == np.float64 and ct.dtype == np.int64 and ct.min() >= 0 and ct.max() < len(cv)
     assert is_closed_oriented(ct), name
     # Every vertex on the boundary: the region's signed distance at it within the bound.

@@ -12,8 +12,11 @@ The pipeline, per object (Rossignac-Kim, "Swept volumes"):
 3. `polyscrew.sweep` builds the swept mesh (each pair of samples is one screw), each screw in
    the fewest steps that keep the swept surfaces within a tolerance of the exact ones (by
    default 0.2 % of the body's bounding radius);
-   or, with Closed Volume, `polyscrew.sweep_closed` builds the region's boundary as a closed,
-   consistently oriented, self-intersection-free mesh (slower: seconds, many more triangles);
+   or, with Closed Volume (Build Swept Region's default), `polyscrew.sweep_closed` builds the
+   region's boundary as a closed, consistently oriented, self-intersection-free mesh, every
+   vertex within a tolerance (by default 0.5 % of the body's bounding-box diagonal; slower:
+   seconds, many more triangles), its work told first (`polyscrew.sweep_closed_work`) and
+   refused when it would run for minutes (:func:`sweep_report.closed_refusal`);
 4. :func:`create_object` writes it into a new object of the "Swept Regions" collection.
 
 Steps 1 to 3 run for every object before anything is created, so a refusal leaves the scene
@@ -33,6 +36,7 @@ import polyscrew
 from mathutils import Matrix, Vector
 from mathutils.bvhtree import BVHTree
 
+from ..pure import sweep_report
 from . import bake, bulk, channels, curves, keys, owners, transaction
 
 #: Name of the collection that receives swept regions.
@@ -61,8 +65,10 @@ class Swept:
     tolerance: float = 0.0
     error_bound: float = 0.0
     #: The grid cell of a closed boundary (`polyscrew.sweep_closed`; 0 for the open sweep):
-    #: every vertex then within `error_bound` of the exact swept boundary.
+    #: every vertex then within `error_bound` of the exact swept boundary; `attempts`: the
+    #: grids it contoured (2 when the first cell's bound exceeded the tolerance).
     cell: float = 0.0
+    attempts: int = 0
 
 
 def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
@@ -612,8 +618,10 @@ def compute(
     fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
     bounding radius; 0: exactly `steps`). `read`: a dict kept over one run of several objects
     (the key frames read so far: each curve is read once, :func:`_key_frames`). `closed`: the
-    region's closed boundary instead (`polyscrew.sweep_closed`, grid `cell` in world units;
-    None: 1.5 % of the body's extent; `steps`, `caps` and `tolerance` do not apply)."""
+    region's closed boundary instead (`polyscrew.sweep_closed`: every vertex within `tolerance`,
+    None: 0.5 % of the body's extent, or a fixed grid `cell` in world units; `steps` and `caps`
+    do not apply), refused before any is computed when one would sample more than
+    :func:`sweep_report.closed_refusal` allows."""
     return compute_all([obj], context, steps, caps, tolerance, read, closed, cell)[0]
 
 
@@ -653,13 +661,27 @@ def compute_all(
             raise SweepError(f"{obj.name}: the frame range has a single frame; a motion needs two poses")
         items.append((obj, frames, driver))
     posed = world_poses_all(items, scene, read, plan=plan)
+    # A closed boundary's grid: a cell given, else the tolerance's (None: the default).
+    grid = {"cell": cell} if cell is not None else {"tolerance": tolerance}
+    if closed:  # every object's work told before any is computed
+        for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
+            try:
+                work = polyscrew.sweep_closed_work(verts * scale, tris, poses, **grid)
+            except ValueError as err:
+                # An open mesh has no inside: say where the open sweep is.
+                hint = "; Closed Volume needs a closed mesh: turn it off for the open sweep" if "not closed" in str(err) else ""
+                raise SweepError(f"{obj.name}: {err}{hint}") from err
+            refusal = sweep_report.closed_refusal(work)
+            if refusal is not None:
+                raise SweepError(f"{obj.name}: {refusal}")
     out = []
     for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
         start = time.perf_counter()
         try:
             if closed:
-                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, cell=cell, info=True)
-                out.append(Swept(obj, v, t, poses, time.perf_counter() - start, 0.0, info["error_bound"], info["cell"]))
+                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, **grid)
+                out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
+                                 info["error_bound"], info["cell"], info["attempts"]))
                 continue
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:

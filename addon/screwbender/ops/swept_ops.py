@@ -27,8 +27,9 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         soft_max=0.1,
         precision=4,
         subtype="DISTANCE",
-        description="Largest distance of the swept surfaces from the exact ones: each span between two "
-        "sampled poses takes the fewest steps within it (0: 0.2 % of the object's bounding radius)",
+        description="Largest distance of the result from the exact swept boundary. Closed Volume: every "
+        "vertex within it (0: 0.5 % of the object's bounding box diagonal; smaller is slower and heavier). "
+        "Open sweep: every swept surface within it (0: 0.2 % of the object's bounding radius)",
     )
     steps: IntProperty(
         name="Minimum Steps",
@@ -37,17 +38,17 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         max=256,
         soft_max=32,
         options={"HIDDEN", "SKIP_SAVE"},
-        description="Least number of steps per span (scripts; the tolerance adds more where needed)",
+        description="Least number of steps per span of the open sweep (scripts; the tolerance adds more where needed)",
     )
     caps: BoolProperty(
-        name="Caps", default=True, description="Include the object at the first and last pose"
+        name="Caps", default=True, description="Include the object at the first and last pose (open sweep)"
     )
     closed: BoolProperty(
         name="Closed Volume",
-        default=False,
+        default=True,
         description="Build the region's boundary as a closed, consistently oriented, self-intersection-free "
-        "mesh (for booleans, printing, volume, clearance). Slower than the open preview (seconds, not "
-        "milliseconds) and many more triangles",
+        "mesh (for booleans, printing, volume, clearance): seconds, many triangles. Off: the open sweep, the "
+        "live preview's fast superset (milliseconds; not closed)",
     )
     cell: FloatProperty(
         name="Cell Size",
@@ -56,8 +57,9 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         soft_max=1.0,
         precision=4,
         subtype="DISTANCE",
-        description="Grid cell of the closed boundary (smaller is more accurate, slower and heavier; "
-        "0: 1.5 % of the object's bounding box diagonal)",
+        options={"HIDDEN", "SKIP_SAVE"},
+        description="Scripts: a fixed grid cell for the closed boundary instead of one derived from the "
+        "tolerance (0: from the tolerance)",
     )
     voxel_size: FloatProperty(
         name="Voxel Size",
@@ -82,12 +84,11 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     def draw(self, context: bpy.types.Context) -> None:
         layout = self.layout
         layout.use_property_split = True
-        layout.prop(self, "tolerance")
-        layout.prop(self, "caps")
         layout.prop(self, "closed")
+        layout.prop(self, "tolerance")
         row = layout.row()
-        row.enabled = self.closed
-        row.prop(self, "cell")
+        row.enabled = not self.closed
+        row.prop(self, "caps")
 
     def execute(self, context: bpy.types.Context) -> set[str]:
         objects = sorted((o for o in context.selected_objects if o.type == "MESH"), key=lambda o: o.name)
@@ -130,7 +131,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                     len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
                     max(s.error_bound for s in computed), sum(m.area for m in found),
                     None if any(v is None for v in volumes) else sum(volumes),
-                    cell=max(s.cell for s in computed),
+                    cell=max(s.cell for s in computed), attempts=max(s.attempts for s in computed),
                 ),
             )
             return {"FINISHED"}

@@ -3,7 +3,9 @@
 
 - :func:`measures`: the surface area and, for a closed mesh, the enclosed volume (the
   divergence theorem: the sum over triangles of ``a . (b x c) / 6``);
-- :func:`summary`: the operator's one-line report.
+- :func:`summary`: the operator's one-line report;
+- :func:`closed_refusal`: whether a closed boundary's work (`polyscrew.sweep_closed_work`,
+  told before the call) is too much to run inside Blender, and what to change.
 """
 
 from __future__ import annotations
@@ -11,6 +13,30 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+#: The most world-grid points a closed boundary may sample from the operator: at the rate
+#: measured on issue 29's three cases at the default tolerance (docs/sweep.md: 0.6 to 0.8 CPU
+#: seconds per million grid points, 20 to 66 million of them) about a minute to a minute and a
+#: half of CPU; beyond it the call would run for minutes with Blender waiting. The memory
+#: budget (1 GiB: 8 bytes per grid point, 4 per body-grid point) refuses more anyway.
+MAX_CLOSED_GRID_POINTS = 100_000_000
+#: The most dense poses a closed boundary may sample from the operator (the longest default
+#: case, the smoothed torus, samples 1,230).
+MAX_CLOSED_POSES = 20_000
+
+
+def closed_refusal(work: dict) -> str | None:
+    """None when the closed boundary's work (`polyscrew.sweep_closed_work`'s dict: ``cell``,
+    ``tolerance``, ``poses``, ``grid_points``) is within :data:`MAX_CLOSED_GRID_POINTS` and
+    :data:`MAX_CLOSED_POSES`; otherwise why not and what to change (a coarser tolerance, or
+    the open sweep, which takes milliseconds)."""
+    grid, poses = int(work["grid_points"]), int(work["poses"])
+    if grid <= MAX_CLOSED_GRID_POINTS and poses <= MAX_CLOSED_POSES:
+        return None
+    asked = f"tolerance {work['tolerance']:.3g}" if work["tolerance"] > 0.0 else f"cell {work['cell']:.3g}"
+    return (f"Closed Volume at {asked} would sample {grid:,} grid points over {poses:,} poses (at most "
+            f"{MAX_CLOSED_GRID_POINTS:,} and {MAX_CLOSED_POSES:,}: minutes of work); raise the Tolerance (the "
+            f"work grows as its cube), shorten the frame range, or turn Closed Volume off for the open sweep")
 
 
 @dataclass
@@ -54,14 +80,20 @@ def measures(vertices: np.ndarray, triangles: np.ndarray) -> Measures:
 
 
 def summary(objects: int, triangles: int, seconds: float, sweep_ms: float, tolerance: float, bound: float,
-            area: float, volume: float | None, cell: float = 0.0) -> str:
+            area: float, volume: float | None, cell: float = 0.0, attempts: int = 1) -> str:
     """``Swept 1 object(s): 6536 triangles in 0.05 s (sweep 2.1 ms); tolerance 0.00173 (met
     within 0.00164); area 12.3; volume 5.08`` (volume only for a closed result). A closed
-    boundary (`cell` > 0) names its cell and the bound its vertices meet: ``closed boundary,
-    cell 0.026 (vertices within 0.016 of the swept boundary)``."""
+    boundary (`cell` > 0) names the tolerance its vertices meet (when it was given one) and its
+    cell: ``closed boundary, tolerance 0.00866 (vertices within 0.0061 of the swept boundary;
+    cell 0.0108)``, and a second grid when the first did not meet the tolerance."""
     text = f"Swept {objects} object(s): {triangles} triangles in {seconds:.2f} s (sweep {sweep_ms:.1f} ms)"
     if cell > 0.0:
-        text += f"; closed boundary, cell {cell:.3g} (vertices within {bound:.3g} of the swept boundary)"
+        grids = f", {attempts} grids" if attempts > 1 else ""
+        if tolerance > 0.0:
+            text += (f"; closed boundary, tolerance {tolerance:.3g} (vertices within {bound:.3g} of the swept "
+                     f"boundary; cell {cell:.3g}{grids})")
+        else:
+            text += f"; closed boundary, cell {cell:.3g} (vertices within {bound:.3g} of the swept boundary)"
     elif tolerance > 0.0:
         text += f"; tolerance {tolerance:.3g} (met within {bound:.3g})"
     text += f"; area {area:.6g}"

@@ -7,10 +7,13 @@ use pyo3::types::{PyDict, PyTuple};
 
 use glam::DVec3;
 use polyscrew::memory::{try_vec, Footprint};
-use polyscrew::sweep::closed::{sweep_closed_mesh, ClosedOptions, CLOSED_HINT};
+use polyscrew::sweep::closed::{
+    closed_work_mesh, sweep_closed_mesh, ClosedOptions, CELL_PER_TOLERANCE, CLOSED_HINT,
+    MAX_THREADS,
+};
 use polyscrew::sweep::{
-    body_footprint, sweep_mesh, Accuracy, SweepOptions, DEFAULT_CELL_REL, DEFAULT_TOLERANCE_REL,
-    MAX_STEPS, SWEEP_HINT,
+    body_footprint, sweep_mesh, Accuracy, SweepOptions, DEFAULT_CELL_REL,
+    DEFAULT_CLOSED_TOLERANCE_REL, DEFAULT_TOLERANCE_REL, MAX_STEPS, SWEEP_HINT,
 };
 use polyscrew::{Error, Pose};
 
@@ -159,6 +162,8 @@ fn sweep<'py>(
 // stub: class ClosedSweepInfo(TypedDict):
 // stub:     cell: float
 // stub:     error_bound: float
+// stub:     tolerance: float
+// stub:     attempts: int
 // stub:     poses: int
 /// sweep_closed(
 ///     vertices: ArrayLike,
@@ -166,6 +171,9 @@ fn sweep<'py>(
 ///     poses: ArrayLike,
 ///     cell: float | None = None,
 ///     info: Literal[False] = False,
+///     *,
+///     tolerance: float | None = None,
+///     threads: int | None = None,
 /// ) -> tuple[FloatArray, IntArray]
 /// sweep_closed(
 ///     vertices: ArrayLike,
@@ -174,32 +182,43 @@ fn sweep<'py>(
 ///     cell: float | None = None,
 ///     *,
 ///     info: Literal[True],
+///     tolerance: float | None = None,
+///     threads: int | None = None,
 /// ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]
 ///
 /// The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
-/// one closed, consistently oriented, self-intersection-free triangle mesh.
+/// one closed, consistently oriented, self-intersection-free triangle mesh, every vertex within
+/// ``tolerance`` of the swept boundary.
 ///
 /// ``vertices`` (V, 3) and ``triangles`` (T, 3) are the body in its local frame (closed:
 /// every edge in two faces); ``poses`` (N >= 2, 4, 4) its world poses, one screw per span.
 /// The region's signed distance (the minimum over the motion of the body's, the body's
-/// sampled on a grid six times finer than ``cell``, the motion sampled so that no point
-/// moves more than a cell between samples) is contoured on a grid of spacing ``cell`` by
-/// marching tetrahedra, and every vertex moved along its grid edge to the zero of the
-/// distance refined between the samples. ``cell=None``: ``DEFAULT_CLOSED_CELL`` (1.5 %) of
-/// the body's extent (its bounding box's diagonal). Slower than ``sweep`` (seconds, not
-/// milliseconds) and many more triangles: for meshes that must be closed.
+/// sampled on a grid six times finer than the cell, the motion sampled so that no point
+/// moves more than a cell between samples) is contoured on a grid by marching tetrahedra, and
+/// every vertex moved along its grid edge to the zero of the distance refined between the
+/// samples. ``tolerance`` (a length; None: ``DEFAULT_CLOSED_TOLERANCE`` (0.5 %) of the body's
+/// extent, its bounding box's diagonal) sets the cell: ``CLOSED_CELL_PER_TOLERANCE`` times
+/// it, contoured again at a cell where the bound cannot exceed it if the first one's does.
+/// ``cell`` (scripts) fixes the cell instead; not both. ``threads``: the body's distance
+/// grid and the region's field are computed on this many threads (0: all the machine has;
+/// at most 64);
+/// the mesh is the same, bit for bit. Slower than ``sweep`` (seconds, not milliseconds) and
+/// many more triangles: for meshes that must be closed (``sweep_closed_work`` tells the work
+/// before).
 ///
 /// Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
 /// triangles counter-clockwise seen from outside, every edge in exactly two; with
 /// ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
-/// boundary: the distance left at a vertex plus the body grid's interpolation bound) and
-/// ``poses`` (the dense poses sampled).
+/// boundary: the distance left at a vertex plus the body grid's interpolation bound; at most
+/// ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2)
+/// and ``poses`` (the dense poses sampled).
 ///
 /// Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
-/// that is not positive or below 1/1000 of the body's extent, or grids over the memory
-/// budget.
+/// or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
+/// extent), both of them, or grids over the memory budget.
 #[pyfunction]
-#[pyo3(signature = (vertices, triangles, poses, cell = None, info = false))]
+#[pyo3(signature = (vertices, triangles, poses, cell = None, info = false, *, tolerance = None, threads = None))]
+#[allow(clippy::too_many_arguments)]
 fn sweep_closed<'py>(
     py: Python<'py>,
     vertices: &Bound<'py, PyAny>,
@@ -207,15 +226,16 @@ fn sweep_closed<'py>(
     poses: &Bound<'py, PyAny>,
     cell: Option<&Bound<'py, PyAny>>,
     #[pyo3(from_py_with = info_arg)] info: bool,
+    tolerance: Option<&Bound<'py, PyAny>>,
+    threads: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     const F: &str = "sweep_closed";
-    let cell = args::optional_float(F, "cell", cell)?;
+    let options = closed_options(F, cell, tolerance, threads)?;
     let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
-    let options = ClosedOptions { cell };
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
-    type Closed = (Array2<f64>, Array2<i64>, [f64; 2], usize);
-    let (vo, to, figures, count) = py.detach(|| -> PyResult<Closed> {
+    type Closed = (Array2<f64>, Array2<i64>, [f64; 3], [usize; 2]);
+    let (vo, to, figures, counts) = py.detach(|| -> PyResult<Closed> {
         let (va, ta, pa) = &views;
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
         let t = read_triangles(F, "triangles", ta)?;
@@ -223,7 +243,8 @@ fn sweep_closed<'py>(
         let out = sweep_closed_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))?;
         drop((v, t, p));
         let (vo, to) = mesh_arrays(F, &out.vertices, &out.triangles)?;
-        Ok((vo, to, [out.cell, out.error_bound], out.poses))
+        let figures = [out.cell, out.error_bound, out.tolerance];
+        Ok((vo, to, figures, [out.attempts, out.poses]))
     })?;
     let (vo, to) = (vo.into_pyarray(py), to.into_pyarray(py));
     if !info {
@@ -232,8 +253,84 @@ fn sweep_closed<'py>(
     let dict = PyDict::new(py);
     dict.set_item("cell", figures[0])?;
     dict.set_item("error_bound", figures[1])?;
-    dict.set_item("poses", count)?;
+    dict.set_item("tolerance", figures[2])?;
+    dict.set_item("attempts", counts[0])?;
+    dict.set_item("poses", counts[1])?;
     PyTuple::new(py, [vo.into_any(), to.into_any(), dict.into_any()])
+}
+
+// stub:
+// stub: class ClosedSweepWork(TypedDict):
+// stub:     cell: float
+// stub:     tolerance: float
+// stub:     poses: int
+// stub:     grid_points: int
+// stub:     body_points: int
+/// sweep_closed_work(
+///     vertices: ArrayLike,
+///     triangles: ArrayLike,
+///     poses: ArrayLike,
+///     cell: float | None = None,
+///     *,
+///     tolerance: float | None = None,
+/// ) -> ClosedSweepWork
+///
+/// What ``sweep_closed`` with the same arguments will sample, without sampling it (the
+/// arguments checked as it checks them; the dense poses counted, milliseconds): ``cell`` and
+/// ``tolerance`` (of its first attempt), ``poses`` (dense poses), ``grid_points`` (the world
+/// grid over the instances' boxes) and ``body_points`` (the body's fine distance grid). For a
+/// caller to refuse work that would run for minutes before it starts.
+///
+/// Raises ``ValueError`` as ``sweep_closed`` does (but for the memory budget of its grids).
+#[pyfunction]
+#[pyo3(signature = (vertices, triangles, poses, cell = None, *, tolerance = None))]
+fn sweep_closed_work<'py>(
+    py: Python<'py>,
+    vertices: &Bound<'py, PyAny>,
+    triangles: &Bound<'py, PyAny>,
+    poses: &Bound<'py, PyAny>,
+    cell: Option<&Bound<'py, PyAny>>,
+    tolerance: Option<&Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    const F: &str = "sweep_closed_work";
+    let options = closed_options(F, cell, tolerance, None)?;
+    let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
+    let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
+    let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
+    let work = py.detach(|| -> PyResult<_> {
+        let (va, ta, pa) = &views;
+        let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
+        let t = read_triangles(F, "triangles", ta)?;
+        let p = read_poses(F, "poses", pa)?;
+        closed_work_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))
+    })?;
+    let dict = PyDict::new(py);
+    dict.set_item("cell", work.cell)?;
+    dict.set_item("tolerance", work.tolerance)?;
+    dict.set_item("poses", work.poses)?;
+    dict.set_item("grid_points", work.grid_points)?;
+    dict.set_item("body_points", work.body_points)?;
+    Ok(dict)
+}
+
+/// The options of `sweep_closed` and `sweep_closed_work`.
+fn closed_options(
+    function: &'static str,
+    cell: Option<&Bound<'_, PyAny>>,
+    tolerance: Option<&Bound<'_, PyAny>>,
+    threads: Option<&Bound<'_, PyAny>>,
+) -> PyResult<ClosedOptions> {
+    let threads = match threads {
+        Some(t) if !t.is_none() => {
+            args::int_in(function, "threads", t, 0, MAX_THREADS as i64)? as usize
+        }
+        _ => 0,
+    };
+    Ok(ClosedOptions {
+        cell: args::optional_float(function, "cell", cell)?,
+        tolerance: args::optional_float(function, "tolerance", tolerance)?,
+        threads,
+    })
 }
 
 /// The `vertices`, `triangles` and `poses` (two or more) of a sweep, their copies, the poses
@@ -297,6 +394,7 @@ fn info_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sweep, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_closed, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_closed_work, m)?)?;
     // stub:
     // stub: MAX_STEPS: int
     // stub: """The largest accepted number of sweep steps per screw (4096)."""
@@ -307,7 +405,15 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_SWEEP_TOLERANCE", DEFAULT_TOLERANCE_REL)?;
     // stub:
     // stub: DEFAULT_CLOSED_CELL: float
-    // stub: """The default cell of ``sweep_closed``, as a fraction of the body's extent (0.015)."""
+    // stub: """The cell of ``sweep_closed`` before it took a tolerance, as a fraction of the body's extent (0.015)."""
     m.add("DEFAULT_CLOSED_CELL", DEFAULT_CELL_REL)?;
+    // stub:
+    // stub: DEFAULT_CLOSED_TOLERANCE: float
+    // stub: """The default tolerance of ``sweep_closed``, as a fraction of the body's extent, its bounding box's diagonal (0.005)."""
+    m.add("DEFAULT_CLOSED_TOLERANCE", DEFAULT_CLOSED_TOLERANCE_REL)?;
+    // stub:
+    // stub: CLOSED_CELL_PER_TOLERANCE: float
+    // stub: """The first cell of ``sweep_closed`` as a multiple of its tolerance (1.25)."""
+    m.add("CLOSED_CELL_PER_TOLERANCE", CELL_PER_TOLERANCE)?;
     Ok(())
 }

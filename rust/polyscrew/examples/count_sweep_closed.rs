@@ -8,24 +8,36 @@
 //! The file: a line `vertices triangles poses`, then one line per vertex (`x y z`), per
 //! triangle (`a b c`) and per pose (its 4 x 4 matrix, rows one after the other). Prints the
 //! closed mesh's counts, its bound, a digest of its vertices' bits and triangles (equal meshes,
-//! equal digests) and the thread's CPU time.
+//! equal digests) and the process's CPU time (all threads) and wall time. `CELL` 0 or none:
+//! the default tolerance; `THREADS` 0 or none: the machine's.
 use glam::DVec3;
 use polyscrew::sweep::{sweep_closed_mesh, ClosedOptions};
 use polyscrew::Pose;
 
-/// The thread's CPU time in seconds (Linux `/proc/thread-self/schedstat`), if readable.
+/// The process's CPU time in seconds, all threads (Linux `/proc/self/stat`: user and system
+/// time in clock ticks, 100 a second), if readable.
 fn cpu_seconds() -> Option<f64> {
-    let s = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    Some(s.split_whitespace().next()?.parse::<f64>().ok()? * 1e-9)
+    let s = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The fields after the command's closing parenthesis: utime and stime are the 12th and 13th.
+    let rest = &s[s.rfind(')')? + 2..];
+    let mut fields = rest.split_whitespace().skip(11);
+    let user: f64 = fields.next()?.parse().ok()?;
+    let system: f64 = fields.next()?.parse().ok()?;
+    Some((user + system) / 100.0)
 }
 
 fn main() {
     let path = std::env::args()
         .nth(1)
-        .expect("usage: count_sweep_closed CASE.txt [CELL]");
+        .expect("usage: count_sweep_closed CASE.txt [CELL [THREADS]]");
+    // A cell of 0 (or none): the default tolerance.
     let cell = std::env::args()
         .nth(2)
-        .map(|c| c.parse::<f64>().expect("a cell"));
+        .map(|c| c.parse::<f64>().expect("a cell"))
+        .filter(|&c| c > 0.0);
+    let threads = std::env::args()
+        .nth(3)
+        .map_or(0, |t| t.parse::<usize>().expect("a thread count"));
     let text = std::fs::read_to_string(&path).expect("a readable case file");
     let mut lines = text.lines();
     let numbers = |line: &str| -> Vec<f64> {
@@ -52,9 +64,15 @@ fn main() {
         })
         .collect();
     let before = cpu_seconds();
-    let out = sweep_closed_mesh(&vertices, &triangles, &poses, &ClosedOptions { cell })
-        .expect("the closed sweep");
+    let wall = std::time::Instant::now();
+    let options = ClosedOptions {
+        cell,
+        threads,
+        ..ClosedOptions::default()
+    };
+    let out = sweep_closed_mesh(&vertices, &triangles, &poses, &options).expect("the closed sweep");
     let cpu = cpu_seconds().zip(before).map(|(a, b)| a - b);
+    let wall = wall.elapsed().as_secs_f64();
     // FNV-1a over the vertices' bits and the triangles: equal meshes, equal digests.
     let digest = out
         .vertices
@@ -65,11 +83,12 @@ fn main() {
             (h ^ x).wrapping_mul(0x0100_0000_01b3)
         });
     println!(
-        "{path}: {} vertices, {} triangles, cell {:.4}, bound {:.3e}, {} poses, digest {digest:016x}, CPU {:.3} s",
+        "{path}: {} vertices, {} triangles, cell {:.4}, bound {:.3e}, {} attempt(s), {} poses, digest {digest:016x}, CPU {:.3} s, wall {wall:.3} s",
         out.vertices.len(),
         out.triangles.len(),
         out.cell,
         out.error_bound,
+        out.attempts,
         out.poses,
         cpu.unwrap_or(f64::NAN)
     );

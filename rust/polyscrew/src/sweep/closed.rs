@@ -39,9 +39,32 @@ use crate::memory::{try_vec, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::screw::Screw;
 
-/// The default cell of [`sweep_closed`] as a fraction of the body's extent (the diagonal of
-/// its bounding box): 1.5 %.
+/// The default cell of [`sweep_closed`] with neither a cell nor a tolerance given, before
+/// issue 29 item 1 (kept for scripts that name it), as a fraction of the body's extent (the
+/// diagonal of its bounding box): 1.5 %. [`sweep_closed`]'s default is now
+/// [`DEFAULT_CLOSED_TOLERANCE_REL`].
 pub const DEFAULT_CELL_REL: f64 = 0.015;
+
+/// The default tolerance of [`sweep_closed`] as a fraction of the body's extent (the diagonal
+/// of its bounding box, the "size" of `scripts/bench/sweep_measures.py`): 0.5 %, issue 29's
+/// goal.
+pub const DEFAULT_CLOSED_TOLERANCE_REL: f64 = 0.005;
+
+/// The first cell tried for a tolerance, as a multiple of it. The reported bound is at most
+/// `(1 + sqrt(3) / (2 BODY_SUBCELLS)) cell` (see [`guaranteed_cell`]) but, measured on issue
+/// 29's cases, it is `0.38` to `0.69` cells (cube, L-prism, torus at 0.9 % to 1.5 % of the
+/// extent): a cell of `1.25` tolerances meets the tolerance in one attempt there (`0.86`
+/// a bound above `0.8` cells would exceed it).
+pub const CELL_PER_TOLERANCE: f64 = 1.25;
+
+/// The cell at which the reported bound is within `tolerance` whatever the body and the
+/// motion: the bound is the residual left at a vertex, at most one cell (a vertex stays on
+/// its grid edge, and the residual is capped there), plus the body grid's trilinear bound
+/// `sqrt(3) / 2 cell / BODY_SUBCELLS`; so `tolerance / (1 + sqrt(3) / (2 BODY_SUBCELLS))`.
+/// [`sweep_closed`] falls back on it when the first cell's bound exceeds the tolerance.
+pub fn guaranteed_cell(tolerance: f64) -> f64 {
+    tolerance / (1.0 + 0.5 * 3f64.sqrt() / BODY_SUBCELLS)
+}
 
 /// The body's distance grid is this many times finer than the world grid.
 pub const BODY_SUBCELLS: f64 = 6.0;
@@ -86,11 +109,18 @@ pub const EDGE_MARGIN: f64 = 0.02;
 /// A cell below `extent / MAX_CELLS_PER_EXTENT` (the body's extent) is refused.
 pub const MAX_CELLS_PER_EXTENT: f64 = 1000.0;
 
+/// Most threads [`ClosedOptions::threads`] starts.
+pub const MAX_THREADS: usize = 64;
+
+/// Slabs of layers per thread in the body grid's parallel step (dealt in turn, so that the
+/// threads' shares even out where the work is uneven along z).
+const SLABS_PER_THREAD: usize = 4;
+
 /// Most dense poses [`sweep_closed`] takes.
 pub const MAX_POSES: usize = 1 << 20;
 
 /// How to ask [`sweep_closed`] for less.
-const CELL_HINT: &str = "use a larger cell";
+const CELL_HINT: &str = "use a larger tolerance (or cell)";
 
 /// Bytes per world-grid point: its value (4) and the pose that gave it (4).
 const WORLD_BYTES_PER_POINT: usize = 8;
@@ -103,9 +133,18 @@ const GRID_JITTER: [f64; 3] = [0.313_725_49, 0.271_826_3, 0.141_4];
 /// Options of [`sweep_closed`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ClosedOptions {
-    /// The world grid's cell (body units, `> 0`); `None`: [`DEFAULT_CELL_REL`] of the body's
-    /// extent.
+    /// The world grid's cell (body units, `> 0`), for scripts that fix it; `None`: derived
+    /// from `tolerance`. Not both.
     pub cell: Option<f64>,
+    /// The largest distance, reported as `error_bound`, of a vertex from the swept boundary
+    /// (body units, `> 0`); `None` (and no `cell`): [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
+    /// body's extent. The cell is [`CELL_PER_TOLERANCE`] times it, and
+    /// [`guaranteed_cell`] if that cell's bound exceeds it (a second attempt).
+    pub tolerance: Option<f64>,
+    /// Threads for the body's distance grids and the region's field (steps 1 and 2); `0`:
+    /// [`std::thread::available_parallelism`]; at most [`MAX_THREADS`]. The mesh is the same,
+    /// bit for bit, whatever the count.
+    pub threads: usize,
 }
 
 /// The closed boundary and what it took.
@@ -121,8 +160,29 @@ pub struct ClosedMesh {
     /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex
     /// plus the body grid's interpolation bound `sqrt(3) h_b / 2`.
     pub error_bound: f64,
+    /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
+    pub tolerance: f64,
+    /// Grids contoured: 1, or 2 when the first cell's bound exceeded the tolerance.
+    pub attempts: usize,
     /// Dense poses sampled.
     pub poses: usize,
+}
+
+/// What [`sweep_closed`] will sample, known before it runs ([`closed_work`]): enough to
+/// refuse a call that would run for minutes.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ClosedWork {
+    /// The cell of the first attempt.
+    pub cell: f64,
+    /// The tolerance (0 when a cell was given).
+    pub tolerance: f64,
+    /// Dense poses.
+    pub poses: usize,
+    /// Points of the world grid (the instances' boxes; the field is evaluated in its narrow
+    /// band, every point is contoured).
+    pub grid_points: usize,
+    /// Points of the body's fine distance grid.
+    pub body_points: usize,
 }
 
 /// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
@@ -178,14 +238,14 @@ impl BodyField {
         (self.values[(k * ny + j) * nx + i] as f64, node.distance(p))
     }
 
-    /// Samples `body`'s signed distance (see the module documentation).
-    fn new(body: &Body, h: f64, band: f64) -> Result<Self> {
+    /// The grid's origin and points per axis for spacing `h` and band `band`: the body's box
+    /// grown by the band and two spacings, its origin off any round position, so grid columns
+    /// do not run along the body's edges (ray parity counts each face crossed once).
+    fn dims(body: &Body, h: f64, band: f64) -> (DVec3, [usize; 3]) {
         let verts = body.vertices();
         let (lo, hi) = verts
             .iter()
             .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        // An origin off any round position, so grid columns do not run along the body's
-        // edges (ray parity counts each face crossed once).
         let jitter = DVec3::from_array(GRID_JITTER) * h;
         let origin = lo - DVec3::splat(band + 2.0 * h) - jitter;
         let size = hi + DVec3::splat(band + 2.0 * h) - origin;
@@ -194,86 +254,46 @@ impl BodyField {
             (size.y / h).ceil() as usize + 1,
             (size.z / h).ceil() as usize + 1,
         ];
+        (origin, n)
+    }
+
+    /// Samples `body`'s signed distance (see the module documentation) on the grid of
+    /// [`BodyField::dims`], the unsigned distances spread over `threads` threads by slabs of
+    /// the grid along z (each point's value is the same whatever thread computes it: the
+    /// least over the triangles).
+    fn new(body: &Body, h: f64, band: f64, threads: usize) -> Result<Self> {
+        let verts = body.vertices();
+        let (lo, hi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let (origin, n) = Self::dims(body, h, band);
         let count = n[0].saturating_mul(n[1]).saturating_mul(n[2]);
         Footprint::of::<f32>(count).check("the body's distance grid", CLOSED_HINT)?;
         let mut values: Vec<f32> = try_vec(count, "the body's distance grid")?;
         values.resize(count, band as f32);
         let [nx, ny, nz] = n;
-        let point =
-            |i: usize, j: usize, k: usize| origin + DVec3::new(i as f64, j as f64, k as f64) * h;
-        let range = |lo: f64, hi: f64, o: f64, m: usize| -> (usize, usize) {
-            let a = ((lo - o) / h).floor().max(0.0) as usize;
-            let b = (((hi - o) / h).ceil().max(0.0) as usize).min(m - 1);
-            (a, b)
-        };
-        // Unsigned distances within the band. A point keeps the least distance, rounded once
-        // to f32 (rounding is monotone), so the order of the triangles does not matter, and a
-        // triangle is skipped at a point where a lower bound of its distance (to its plane, to
-        // its bounding sphere) is already above the point's least distance by more than
-        // round-off: it could not lower it. The values are those of testing every triangle.
+        let grid = Grid { origin, cell: h, n };
+        let point = |i, j, k| grid.point(i, j, k);
+        let range = |lo, hi, axis| grid.span(lo, hi, axis);
         let roundoff = ROUNDOFF_REL * (lo.abs().max(hi.abs()).max_element() + band + h);
-        for t in body.triangles() {
-            let [a, b, c] = t.map(|i| verts[i as usize]);
-            let tlo = a.min(b).min(c) - DVec3::splat(band);
-            let thi = a.max(b).max(c) + DVec3::splat(band);
-            let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
-            let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
-            let (k0, k1) = range(tlo.z, thi.z, origin.z, nz);
-            let normal = (b - a).cross(c - a).normalize_or_zero();
-            let centre = (a + b + c) / 3.0;
-            let radius = centre
-                .distance(a)
-                .max(centre.distance(b))
-                .max(centre.distance(c));
-            // Along a row, the points within `band` of the plane and of the sphere (both
-            // bounds a point's test below would also reject beyond) are an interval.
-            let far = band + roundoff;
-            for k in k0..=k1 {
-                for j in j0..=j1 {
-                    let p0 = point(0, j, k);
-                    let (dy, dz) = (p0.y - centre.y, p0.z - centre.z);
-                    let rest = (radius + far).powi(2) - dy * dy - dz * dz;
-                    if rest < 0.0 {
-                        continue;
-                    }
-                    let half = rest.sqrt();
-                    let (mut xlo, mut xhi) = (centre.x - half, centre.x + half);
-                    if normal.x != 0.0 {
-                        let off = normal.dot(p0 - a) - normal.x * p0.x;
-                        let (u, w) = ((-far - off) / normal.x, (far - off) / normal.x);
-                        xlo = xlo.max(u.min(w));
-                        xhi = xhi.min(u.max(w));
-                    }
-                    if xlo > xhi {
-                        continue;
-                    }
-                    let (a0, a1) = range(xlo, xhi, origin.x, nx);
-                    for i in a0.max(i0)..=a1.min(i1) {
-                        let p = point(i, j, k);
-                        let slot = &mut values[(k * ny + j) * nx + i];
-                        let least = *slot as f64 + roundoff;
-                        let reach = least + radius;
-                        if normal.dot(p - a).abs() > least
-                            || p.distance_squared(centre) > reach * reach
-                        {
-                            continue;
-                        }
-                        let d = point_triangle_distance(p, a, b, c);
-                        if d < *slot as f64 {
-                            *slot = d as f32;
-                        }
-                    }
-                }
-            }
-        }
+        // Slabs of whole layers, a few per thread.
+        let per = nz.div_ceil(thread_count(threads) * SLABS_PER_THREAD);
+        let slabs: Vec<(usize, &mut [f32])> = values
+            .chunks_mut(per * nx * ny)
+            .enumerate()
+            .map(|(s, slab)| (s * per, slab))
+            .collect();
+        in_parts(slabs, threads, "the body's distance grid", |(k0, slab)| {
+            unsigned_distances(body, grid, band, roundoff, k0, slab);
+        })?;
         // Signs: crossings of each column (x_i, y_j) along z.
         let mut crossings: Vec<(usize, f64)> = Vec::new();
         for t in body.triangles() {
             let [a, b, c] = t.map(|i| verts[i as usize]);
             let tlo = a.min(b).min(c);
             let thi = a.max(b).max(c);
-            let (i0, i1) = range(tlo.x, thi.x, origin.x, nx);
-            let (j0, j1) = range(tlo.y, thi.y, origin.y, ny);
+            let (i0, i1) = range(tlo.x, thi.x, 0);
+            let (j0, j1) = range(tlo.y, thi.y, 1);
             let det = (b.x - a.x) * (c.y - a.y) - (c.x - a.x) * (b.y - a.y);
             if det == 0.0 {
                 continue;
@@ -324,6 +344,136 @@ impl BodyField {
     }
 }
 
+/// The body's unsigned distances within `band` at the grid points of the layers `k0..` held
+/// by `slab` (whole layers of `grid`, initialised to `band`).
+///
+/// A point keeps the least distance, rounded once to f32 (rounding is monotone), so the order
+/// of the triangles does not matter, and a triangle is skipped at a point where a lower bound
+/// of its distance (to its plane, to its bounding sphere) is already above the point's least
+/// distance by more than `roundoff`: it could not lower it. The values are those of testing
+/// every triangle.
+fn unsigned_distances(
+    body: &Body,
+    grid: Grid,
+    band: f64,
+    roundoff: f64,
+    k0: usize,
+    slab: &mut [f32],
+) {
+    let n = grid.n;
+    let [nx, ny, nz] = n;
+    let layers = slab.len() / (nx * ny);
+    if layers == 0 {
+        return;
+    }
+    let (ka, kb) = (k0, (k0 + layers - 1).min(nz - 1));
+    let verts = body.vertices();
+    let point = |i, j, k| grid.point(i, j, k);
+    let range = |lo, hi, axis| grid.span(lo, hi, axis);
+    for t in body.triangles() {
+        let [a, b, c] = t.map(|i| verts[i as usize]);
+        let tlo = a.min(b).min(c) - DVec3::splat(band);
+        let thi = a.max(b).max(c) + DVec3::splat(band);
+        let (k0, k1) = range(tlo.z, thi.z, 2);
+        let (k0, k1) = (k0.max(ka), k1.min(kb));
+        if k0 > k1 {
+            continue;
+        }
+        let (i0, i1) = range(tlo.x, thi.x, 0);
+        let (j0, j1) = range(tlo.y, thi.y, 1);
+        let normal = (b - a).cross(c - a).normalize_or_zero();
+        let centre = (a + b + c) / 3.0;
+        let radius = centre
+            .distance(a)
+            .max(centre.distance(b))
+            .max(centre.distance(c));
+        // Along a row, the points within `band` of the plane and of the sphere (both
+        // bounds a point's test below would also reject beyond) are an interval.
+        let far = band + roundoff;
+        for k in k0..=k1 {
+            for j in j0..=j1 {
+                let p0 = point(0, j, k);
+                let (dy, dz) = (p0.y - centre.y, p0.z - centre.z);
+                let rest = (radius + far).powi(2) - dy * dy - dz * dz;
+                if rest < 0.0 {
+                    continue;
+                }
+                let half = rest.sqrt();
+                let (mut xlo, mut xhi) = (centre.x - half, centre.x + half);
+                if normal.x != 0.0 {
+                    let off = normal.dot(p0 - a) - normal.x * p0.x;
+                    let (u, w) = ((-far - off) / normal.x, (far - off) / normal.x);
+                    xlo = xlo.max(u.min(w));
+                    xhi = xhi.min(u.max(w));
+                }
+                if xlo > xhi {
+                    continue;
+                }
+                let (a0, a1) = range(xlo, xhi, 0);
+                for i in a0.max(i0)..=a1.min(i1) {
+                    let p = point(i, j, k);
+                    let slot = &mut slab[((k - ka) * ny + j) * nx + i];
+                    let least = *slot as f64 + roundoff;
+                    let reach = least + radius;
+                    if normal.dot(p - a).abs() > least || p.distance_squared(centre) > reach * reach
+                    {
+                        continue;
+                    }
+                    let d = point_triangle_distance(p, a, b, c);
+                    if d < *slot as f64 {
+                        *slot = d as f32;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The threads to use for `threads`: 0, the machine's ([`std::thread::available_parallelism`]);
+/// otherwise that many, at most [`MAX_THREADS`] (more than the machine has gains nothing, but
+/// gives the tests uneven shares to check on any machine).
+fn thread_count(threads: usize) -> usize {
+    if threads == 0 {
+        std::thread::available_parallelism().map_or(1, |p| p.get())
+    } else {
+        threads.min(MAX_THREADS)
+    }
+}
+
+/// Runs `work(part)` on every part of `parts`, spread over [`thread_count`]`(threads)`
+/// threads, the parts dealt in turn (so that uneven parts even out). Each part is its own
+/// slice of the output, so the result does not depend on the count.
+///
+/// # Errors
+/// [`Error::Worker`] (`what`) if a thread failed (a bug: the work does not panic on data).
+fn in_parts<P: Send>(
+    parts: Vec<P>,
+    threads: usize,
+    what: &'static str,
+    work: impl Fn(P) + Sync,
+) -> Result<()> {
+    let threads = thread_count(threads).min(parts.len());
+    if threads <= 1 {
+        parts.into_iter().for_each(work);
+        return Ok(());
+    }
+    let mut dealt: Vec<Vec<P>> = (0..threads).map(|_| Vec::new()).collect();
+    for (s, part) in parts.into_iter().enumerate() {
+        dealt[s % threads].push(part);
+    }
+    let work = &work;
+    let joined = std::thread::scope(|scope| {
+        let handles: Vec<_> = dealt
+            .into_iter()
+            .map(|mine| scope.spawn(move || mine.into_iter().for_each(work)))
+            .collect();
+        handles.into_iter().map(|h| h.join()).collect::<Vec<_>>()
+    });
+    joined
+        .into_iter()
+        .try_for_each(|r| r.map_err(|_| Error::Worker { what }))
+}
+
 /// The body's distance grid of spacing `h` and band `band`: its origin, points per axis and
 /// values (for the tests).
 #[cfg(test)]
@@ -332,12 +482,12 @@ pub(super) fn body_distance_grid(
     h: f64,
     band: f64,
 ) -> Result<(DVec3, [usize; 3], Vec<f32>)> {
-    let field = BodyField::new(body, h, band)?;
+    let field = BodyField::new(body, h, band, 0)?;
     Ok((field.origin, field.n, field.values))
 }
 
 /// How to ask the closed sweep for less memory.
-pub const CLOSED_HINT: &str = "use a larger cell, fewer poses or a smaller motion";
+pub const CLOSED_HINT: &str = "use a larger tolerance (or cell), fewer poses or a smaller motion";
 
 /// Distance from `p` to the triangle `(a, b, c)` (Ericson, *Real-Time Collision Detection*,
 /// 5.1.5: the closest point by Voronoi regions).
@@ -426,16 +576,41 @@ impl DenseMotion {
 
 /// The boundary of the region swept by the closed `body` along the polyscrew through `poses`
 /// as a closed, consistently oriented, self-intersection-free triangle mesh (see the module
-/// documentation).
+/// documentation), every vertex within `error_bound` of the swept boundary.
+///
+/// With a tolerance (`options.tolerance`, by default [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
+/// body's extent) the cell is [`CELL_PER_TOLERANCE`] times it; if the bound reported there
+/// exceeds the tolerance, the grid is contoured again at [`guaranteed_cell`], where it cannot
+/// (`attempts` 2). With `options.cell`, that cell, once.
 ///
 /// # Errors
 /// - [`Error::TooFew`] for fewer than 2 poses; [`Error::BadPose`] for a pose out of range;
 /// - [`Error::Value`] (`"body"`) for a body that is not closed (no inside);
-/// - [`Error::Value`] (`"cell"`) for a cell that is not finite and positive, below
-///   `extent /` [`MAX_CELLS_PER_EXTENT`], or a motion needing more than [`MAX_POSES`] poses;
+/// - [`Error::Value`] (`"cell"`, `"tolerance"`) for a cell or tolerance that is not finite
+///   and positive, a cell below `extent /` [`MAX_CELLS_PER_EXTENT`] (a tolerance whose
+///   [`guaranteed_cell`] is), or a motion needing more than [`MAX_POSES`] poses;
+/// - [`Error::Conflict`] (`"cell"`) for both a cell and a tolerance;
 /// - [`Error::Memory`] for grids or a mesh over the memory budget.
 pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedMesh> {
     sweep_closed_with(body, poses, options, Evaluation::NarrowBand)
+}
+
+/// What [`sweep_closed`] will sample (its first attempt), without sampling it: the checks of
+/// [`sweep_closed`] on the arguments, the cell, the dense poses and the grids' sizes.
+///
+/// # Errors
+/// Those of [`sweep_closed`] but the memory budget's.
+pub fn closed_work(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedWork> {
+    let (cell, tolerance) = first_cell(body, poses, options)?;
+    let plan = Plan::new(body, poses, cell)?;
+    let count = |n: [usize; 3]| n[0].saturating_mul(n[1]).saturating_mul(n[2]);
+    Ok(ClosedWork {
+        cell,
+        tolerance,
+        poses: plan.motion.poses.len(),
+        grid_points: count(plan.grid.n),
+        body_points: count(BodyField::dims(body, cell / BODY_SUBCELLS, BAND_CELLS * cell).1),
+    })
 }
 
 /// Where the region's field is evaluated on the world grid.
@@ -448,13 +623,8 @@ pub(super) enum Evaluation {
     Dense,
 }
 
-/// [`sweep_closed`] with the world grid's evaluation chosen.
-pub(super) fn sweep_closed_with(
-    body: &Body,
-    poses: &[Pose],
-    options: &ClosedOptions,
-    evaluation: Evaluation,
-) -> Result<ClosedMesh> {
+/// The checks of [`sweep_closed`] and its first cell, with the tolerance (0 for a given cell).
+fn first_cell(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<(f64, f64)> {
     if poses.len() < 2 {
         return Err(Error::TooFew {
             got: poses.len(),
@@ -473,86 +643,171 @@ pub(super) fn sweep_closed_with(
         });
     }
     let extent = body.extent();
-    let cell = options.cell.unwrap_or(DEFAULT_CELL_REL * extent);
-    if !(cell.is_finite() && cell > 0.0 && cell * MAX_CELLS_PER_EXTENT >= extent) {
-        return Err(Error::Value {
+    let smallest = extent / MAX_CELLS_PER_EXTENT;
+    let at_least = |what: &'static str, value: f64, min: f64| Error::Value {
+        what,
+        at: None,
+        value,
+        expected: Expected::AtLeast {
+            min,
+            limit: MAX_CELLS_PER_EXTENT as usize,
+            counted: "cells across the body's extent",
+        },
+    };
+    match (options.cell, options.tolerance) {
+        (Some(_), Some(_)) => Err(Error::Conflict {
             what: "cell",
-            at: None,
-            value: cell,
-            expected: Expected::AtLeast {
-                min: extent / MAX_CELLS_PER_EXTENT,
-                limit: MAX_CELLS_PER_EXTENT as usize,
-                counted: "cells across the body's extent",
-            },
-        });
+            reason: "give a cell or a tolerance, not both".to_string(),
+        }),
+        (Some(cell), None) => {
+            if !(cell.is_finite() && cell > 0.0 && cell * MAX_CELLS_PER_EXTENT >= extent) {
+                return Err(at_least("cell", cell, smallest));
+            }
+            Ok((cell, 0.0))
+        }
+        (None, tolerance) => {
+            let tolerance = tolerance.unwrap_or(DEFAULT_CLOSED_TOLERANCE_REL * extent);
+            let least = smallest / guaranteed_cell(1.0);
+            if !(tolerance.is_finite() && tolerance > 0.0 && tolerance >= least) {
+                return Err(at_least("tolerance", tolerance, least));
+            }
+            Ok((CELL_PER_TOLERANCE * tolerance, tolerance))
+        }
     }
+}
+
+/// [`sweep_closed`] with the world grid's evaluation chosen.
+pub(super) fn sweep_closed_with(
+    body: &Body,
+    poses: &[Pose],
+    options: &ClosedOptions,
+    evaluation: Evaluation,
+) -> Result<ClosedMesh> {
+    let (cell, tolerance) = first_cell(body, poses, options)?;
+    let mut out = contoured(body, poses, cell, options.threads, evaluation)?;
+    out.attempts = 1;
+    if tolerance > 0.0 && out.error_bound > tolerance {
+        out = contoured(
+            body,
+            poses,
+            guaranteed_cell(tolerance),
+            options.threads,
+            evaluation,
+        )?;
+        out.attempts = 2;
+    }
+    out.tolerance = tolerance;
+    Ok(out)
+}
+
+/// The dense motion and the world grid of one cell.
+struct Plan {
+    motion: DenseMotion,
+    /// Each instance's box (the body's box grown by the band), world frame.
+    boxes: Vec<(DVec3, DVec3)>,
+    grid: Grid,
+}
+
+impl Plan {
+    /// The motion sampled for `cell`, and the world grid: the union of the instances' boxes
+    /// (the body's box grown by the band), plus two cells, so the outer layer is outside
+    /// every instance.
+    fn new(body: &Body, poses: &[Pose], cell: f64) -> Result<Self> {
+        let band = BAND_CELLS * cell;
+        let motion = DenseMotion::new(body, poses, cell)?;
+        let verts = body.vertices();
+        let (blo, bhi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let (blo, bhi) = (blo - DVec3::splat(band), bhi + DVec3::splat(band));
+        let boxes: Vec<(DVec3, DVec3)> = motion
+            .poses
+            .iter()
+            .map(|p| {
+                (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| {
+                    let q = p.transform_point3(DVec3::new(
+                        if c & 1 == 0 { blo.x } else { bhi.x },
+                        if c & 2 == 0 { blo.y } else { bhi.y },
+                        if c & 4 == 0 { blo.z } else { bhi.z },
+                    ));
+                    (lo.min(q), hi.max(q))
+                })
+            })
+            .collect();
+        let (wlo, whi) = boxes.iter().fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
+        );
+        let origin = wlo - DVec3::splat(2.0 * cell);
+        let size = whi + DVec3::splat(2.0 * cell) - origin;
+        let dims = [
+            (size.x / cell).ceil() + 1.0,
+            (size.y / cell).ceil() + 1.0,
+            (size.z / cell).ceil() + 1.0,
+        ];
+        let total = dims[0] * dims[1] * dims[2];
+        if total > (usize::MAX / WORLD_BYTES_PER_POINT) as f64 {
+            return Err(Error::Limit {
+                what: "cell",
+                counted: "grid points",
+                count: total.min(usize::MAX as f64) as usize,
+                limit: usize::MAX / WORLD_BYTES_PER_POINT,
+                hint: CELL_HINT,
+            });
+        }
+        let n = dims.map(|d| d as usize);
+        Ok(Self {
+            motion,
+            boxes,
+            grid: Grid { origin, cell, n },
+        })
+    }
+}
+
+/// The region's boundary contoured at `cell` (steps 1 to 4 of the module documentation).
+fn contoured(
+    body: &Body,
+    poses: &[Pose],
+    cell: f64,
+    threads: usize,
+    evaluation: Evaluation,
+) -> Result<ClosedMesh> {
     let band = BAND_CELLS * cell;
-    let field = BodyField::new(body, cell / BODY_SUBCELLS, band)?;
-    let motion = DenseMotion::new(body, poses, cell)?;
+    let Plan {
+        motion,
+        boxes,
+        grid,
+    } = Plan::new(body, poses, cell)?;
+    let Grid { origin, n, .. } = grid;
+    let count = n[0] * n[1] * n[2];
+    // Both grids checked before either is sampled: an oversized request costs no work.
+    let [bx, by, bz] = BodyField::dims(body, cell / BODY_SUBCELLS, band).1;
+    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
+        + Footprint::of::<f32>(bx.saturating_mul(by).saturating_mul(bz)))
+    .check("the region's distance grid", CLOSED_HINT)?;
+    let field = BodyField::new(body, cell / BODY_SUBCELLS, band, threads)?;
     let to_body: Vec<DAffine3> = motion
         .poses
         .iter()
         .map(|p| p.inverse().to_affine())
         .collect();
-    // The world grid: the union of the instances' boxes (the body's box grown by the band),
-    // plus two cells, so the outer layer is outside every instance.
-    let verts = body.vertices();
-    let (blo, bhi) = verts
-        .iter()
-        .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let (blo, bhi) = (blo - DVec3::splat(band), bhi + DVec3::splat(band));
-    let boxes: Vec<(DVec3, DVec3)> = motion
-        .poses
-        .iter()
-        .map(|p| {
-            (0..8).fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(lo, hi), c| {
-                let q = p.transform_point3(DVec3::new(
-                    if c & 1 == 0 { blo.x } else { bhi.x },
-                    if c & 2 == 0 { blo.y } else { bhi.y },
-                    if c & 4 == 0 { blo.z } else { bhi.z },
-                ));
-                (lo.min(q), hi.max(q))
-            })
-        })
-        .collect();
-    let (wlo, whi) = boxes.iter().fold(
-        (DVec3::INFINITY, DVec3::NEG_INFINITY),
-        |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
-    );
-    let origin = wlo - DVec3::splat(2.0 * cell);
-    let size = whi + DVec3::splat(2.0 * cell) - origin;
-    let dims = [
-        (size.x / cell).ceil() + 1.0,
-        (size.y / cell).ceil() + 1.0,
-        (size.z / cell).ceil() + 1.0,
-    ];
-    let total = dims[0] * dims[1] * dims[2];
-    if total > (usize::MAX / WORLD_BYTES_PER_POINT) as f64 {
-        return Err(Error::Limit {
-            what: "cell",
-            counted: "grid points",
-            count: total.min(usize::MAX as f64) as usize,
-            limit: usize::MAX / WORLD_BYTES_PER_POINT,
-            hint: CELL_HINT,
-        });
-    }
-    let n = dims.map(|d| d as usize);
-    let [nx, ny, nz] = n;
-    let count = nx * ny * nz;
-    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
-        + Footprint::of::<f32>(field.values.len()))
-    .check("the region's distance grid", CLOSED_HINT)?;
     let mut g: Vec<f32> = try_vec(count, "the region's distance grid")?;
     g.resize(count, band as f32);
     let mut arg: Vec<u32> = try_vec(count, "the region's distance grid")?;
     arg.resize(count, u32::MAX);
-    let grid = Grid { origin, cell, n };
     match evaluation {
         Evaluation::NarrowBand => {
-            let coarse = BodyField::new(body, cell, COARSE_BAND_CELLS * cell)?;
+            let coarse = BodyField::new(body, cell, COARSE_BAND_CELLS * cell, threads)?;
             narrow_band(
-                &field, &coarse, body, &motion, &to_body, grid, &mut g, &mut arg,
-            );
+                &field,
+                &coarse,
+                body,
+                &motion,
+                &to_body,
+                grid,
+                (&mut g, &mut arg),
+                threads,
+            )?;
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
@@ -576,9 +831,28 @@ struct Grid {
     n: [usize; 3],
 }
 
+impl Grid {
+    /// Point `(i, j, k)`.
+    #[inline]
+    fn point(&self, i: usize, j: usize, k: usize) -> DVec3 {
+        self.origin + DVec3::new(i as f64, j as f64, k as f64) * self.cell
+    }
+
+    /// The indices along `axis` of the points from the last at or below `lo` to the first at
+    /// or above `hi`, clamped to the grid.
+    #[inline]
+    fn span(&self, lo: f64, hi: f64, axis: usize) -> (usize, usize) {
+        let (o, m) = (self.origin[axis], self.n[axis]);
+        let a = ((lo - o) / self.cell).floor().max(0.0) as usize;
+        let b = (((hi - o) / self.cell).ceil().max(0.0) as usize).min(m - 1);
+        (a, b)
+    }
+}
+
 /// Lowers `g` (and records the pose in `arg`) at the grid points `i0..=i1` of row `(jj, k)`
 /// by the body's field read through `inv` (world -> body), as long as a point is not already
-/// at the field's floor, at the points `i` that `read(i)` allows.
+/// at the field's floor, at the points `i` that `read(i)` allows. `g` and `arg` hold the grid
+/// from its point `base` on.
 #[allow(clippy::too_many_arguments)]
 #[inline]
 fn lower_row(
@@ -587,13 +861,12 @@ fn lower_row(
     pose: u32,
     grid: Grid,
     [i0, i1, jj, k]: [usize; 4],
-    g: &mut [f32],
-    arg: &mut [u32],
+    (g, arg, base): (&mut [f32], &mut [u32], usize),
     read: impl Fn(usize) -> bool,
 ) {
     let Grid { origin, cell, n } = grid;
     let deep = -(field.band as f32);
-    let row = (k * n[1] + jj) * n[0];
+    let row = (k * n[1] + jj) * n[0] - base;
     let dx = inv.matrix3.x_axis * cell;
     let mut p = inv.transform_point3(origin + DVec3::new(i0 as f64, jj as f64, k as f64) * cell);
     for i in i0..=i1 {
@@ -629,9 +902,8 @@ fn dense(
         let k1 = (((hi.z - origin.z) / cell).ceil() as usize).min(nz - 1);
         for k in k0..=k1 {
             for jj in j0..=j1 {
-                lower_row(field, inv, j as u32, grid, [i0, i1, jj, k], g, arg, |_| {
-                    true
-                });
+                let at = (&mut *g, &mut *arg, 0);
+                lower_row(field, inv, j as u32, grid, [i0, i1, jj, k], at, |_| true);
             }
         }
     }
@@ -665,7 +937,7 @@ fn dense(
 /// `g(y)` nor be the first pose reaching it. A pose whose bounding sphere stays `B_c + sqrt(3)`
 /// cells off `c` is not read at all (its `f_j` is the clamp `b` there, which never lowers
 /// `g`). The poses kept are read in the dense order, so the minimum and the pose giving it are
-/// those of the dense grid.
+/// those of the dense grid. The layers of blocks are dealt to `threads` threads.
 #[allow(clippy::too_many_arguments)]
 fn narrow_band(
     field: &BodyField,
@@ -674,11 +946,10 @@ fn narrow_band(
     motion: &DenseMotion,
     to_body: &[DAffine3],
     grid: Grid,
-    g: &mut [f32],
-    arg: &mut [u32],
-) {
-    let Grid { origin, cell, n } = grid;
-    let [nx, ny, nz] = n;
+    (g, arg): (&mut [f32], &mut [u32]),
+    threads: usize,
+) -> Result<()> {
+    let n = grid.n;
     let root3 = 3f64.sqrt();
     let verts = body.vertices();
     let (lo, hi) = verts
@@ -689,27 +960,78 @@ fn narrow_band(
         .iter()
         .map(|&v| v.distance(centre))
         .fold(0.0, f64::max);
-    let centres: Vec<DVec3> = motion
-        .poses
-        .iter()
-        .map(|p| p.transform_point3(centre))
+    let band = Band {
+        field,
+        coarse,
+        to_body,
+        centres: motion
+            .poses
+            .iter()
+            .map(|p| p.transform_point3(centre))
+            .collect(),
+        sphere: radius + coarse.band + root3 * coarse.h,
+        grid,
+    };
+    // Layers of blocks (`BLOCK_POINTS` grid layers each) dealt to the threads: a block
+    // writes only its own points, each the same whatever thread computes it.
+    let layer = BLOCK_POINTS * n[0] * n[1];
+    let parts: Vec<_> = g
+        .chunks_mut(layer)
+        .zip(arg.chunks_mut(layer))
+        .enumerate()
         .collect();
-    let rho = root3 * (BLOCK_POINTS as f64 + 1.0) / 2.0 * cell;
-    // The farthest a block's own point is from its centre.
-    let r_max = root3 * (BLOCK_POINTS as f64 - 1.0) / 2.0 * cell;
-    let fine_err = root3 * field.h + BLOCK_SLACK_CELLS * cell;
-    let reach = rho + fine_err;
-    let sphere = radius + coarse.band + root3 * coarse.h;
-    let b = field.band;
-    let deep = -(b as f32);
-    let blocks = n.map(|m| m.div_ceil(BLOCK_POINTS));
-    // The least value of `f_j` at a block point `r` from the centre (`low` = `v_j - delta_j`),
-    // and the most `g` can be there (`up` = `min_j (v_j + delta_j)`).
-    let floor = |low: f64, r: f64| (low - r).min(b) - fine_err;
-    let ceiling = |up: f64, r: f64| (up + r).max(-b).min(b) + fine_err;
-    let mut near: Vec<(u32, f64)> = Vec::new();
-    let mut dist = [0.0f64; BLOCK_POINTS * BLOCK_POINTS * BLOCK_POINTS];
-    for bk in 0..blocks[2] {
+    in_parts(
+        parts,
+        threads,
+        "the region's distance grid",
+        |(bk, (g, arg))| {
+            band.layer(bk, g, arg);
+        },
+    )
+}
+
+/// What the narrow band's blocks read (see [`narrow_band`]).
+struct Band<'a> {
+    field: &'a BodyField,
+    coarse: &'a BodyField,
+    to_body: &'a [DAffine3],
+    /// The centre of the body's box at every pose (world frame).
+    centres: Vec<DVec3>,
+    /// A pose whose instance's centre is farther than this from a block's centre is not read.
+    sphere: f64,
+    grid: Grid,
+}
+
+impl Band<'_> {
+    /// The blocks of layer `bk` (grid layers `bk * BLOCK_POINTS..`), `g` and `arg` holding
+    /// that layer's points.
+    fn layer(&self, bk: usize, g: &mut [f32], arg: &mut [u32]) {
+        let Self {
+            field,
+            coarse,
+            to_body,
+            sphere,
+            grid,
+            ..
+        } = *self;
+        let Grid { origin, cell, n } = grid;
+        let [nx, ny, nz] = n;
+        let base = bk * BLOCK_POINTS * nx * ny;
+        let root3 = 3f64.sqrt();
+        let rho = root3 * (BLOCK_POINTS as f64 + 1.0) / 2.0 * cell;
+        // The farthest a block's own point is from its centre.
+        let r_max = root3 * (BLOCK_POINTS as f64 - 1.0) / 2.0 * cell;
+        let fine_err = root3 * field.h + BLOCK_SLACK_CELLS * cell;
+        let reach = rho + fine_err;
+        let b = field.band;
+        let deep = -(b as f32);
+        let blocks = n.map(|m| m.div_ceil(BLOCK_POINTS));
+        // The least value of `f_j` at a block point `r` from the centre (`low` = `v_j - delta_j`),
+        // and the most `g` can be there (`up` = `min_j (v_j + delta_j)`).
+        let floor = |low: f64, r: f64| (low - r).min(b) - fine_err;
+        let ceiling = |up: f64, r: f64| (up + r).max(-b).min(b) + fine_err;
+        let mut near: Vec<(u32, f64)> = Vec::new();
+        let mut dist = [0.0f64; BLOCK_POINTS * BLOCK_POINTS * BLOCK_POINTS];
         let (k0, k1) = (bk * BLOCK_POINTS, ((bk + 1) * BLOCK_POINTS).min(nz) - 1);
         for bj in 0..blocks[1] {
             let (j0, j1) = (bj * BLOCK_POINTS, ((bj + 1) * BLOCK_POINTS).min(ny) - 1);
@@ -719,7 +1041,7 @@ fn narrow_band(
                 let c = origin + 0.5 * twice * cell;
                 near.clear();
                 let (mut low, mut up) = (coarse.band, coarse.band);
-                for (j, (w, inv)) in centres.iter().zip(to_body).enumerate() {
+                for (j, (w, inv)) in self.centres.iter().zip(to_body).enumerate() {
                     if c.distance_squared(*w) > sphere * sphere {
                         continue;
                     }
@@ -734,7 +1056,7 @@ fn narrow_band(
                 if up < -reach {
                     for k in k0..=k1 {
                         for jj in j0..=j1 {
-                            let row = (k * ny + jj) * nx;
+                            let row = (k * ny + jj) * nx - base;
                             g[row + i0..=row + i1].fill(deep);
                         }
                     }
@@ -764,7 +1086,8 @@ fn narrow_band(
                                 let r = dist[slot(i, jj, k)];
                                 floor(v, r) <= ceiling(up, r)
                             };
-                            lower_row(field, inv, j, grid, [i0, i1, jj, k], g, arg, read);
+                            let at = (&mut *g, &mut *arg, base);
+                            lower_row(field, inv, j, grid, [i0, i1, jj, k], at, read);
                         }
                     }
                 }
@@ -993,6 +1316,31 @@ fn push_oriented(out: &mut ClosedMesh, t: [u32; 3], outward: DVec3) {
     }
 }
 
+/// The body of `vertices` and `triangles` for a motion through `poses` (two or more: checked
+/// first, so that too few poses is that error whatever the mesh).
+fn body_for(vertices: &[DVec3], triangles: &[[i64; 3]], poses: &[Pose]) -> Result<Body> {
+    if poses.len() < 2 {
+        return Err(Error::TooFew {
+            got: poses.len(),
+            need: 2,
+        });
+    }
+    Body::new(vertices, triangles)
+}
+
+/// [`Body::new`] then [`closed_work`].
+///
+/// # Errors
+/// Those of [`Body::new`] and [`closed_work`].
+pub fn closed_work_mesh(
+    vertices: &[DVec3],
+    triangles: &[[i64; 3]],
+    poses: &[Pose],
+    options: &ClosedOptions,
+) -> Result<ClosedWork> {
+    closed_work(&body_for(vertices, triangles, poses)?, poses, options)
+}
+
 /// [`Body::new`] then [`sweep_closed`].
 ///
 /// # Errors
@@ -1003,12 +1351,5 @@ pub fn sweep_closed_mesh(
     poses: &[Pose],
     options: &ClosedOptions,
 ) -> Result<ClosedMesh> {
-    if poses.len() < 2 {
-        return Err(Error::TooFew {
-            got: poses.len(),
-            need: 2,
-        });
-    }
-    let body = Body::new(vertices, triangles)?;
-    sweep_closed(&body, poses, options)
+    sweep_closed(&body_for(vertices, triangles, poses)?, poses, options)
 }

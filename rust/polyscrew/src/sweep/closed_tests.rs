@@ -39,7 +39,7 @@ fn sd_mesh(body: &Body, p: DVec3) -> f64 {
 }
 
 /// Every directed edge once and its reverse once: closed and consistently oriented.
-fn is_closed_oriented(t: &[[u32; 3]]) -> bool {
+pub(super) fn is_closed_oriented(t: &[[u32; 3]]) -> bool {
     let mut count: HashMap<(u32, u32), u32> = HashMap::new();
     for tri in t {
         for e in 0..3 {
@@ -135,10 +135,11 @@ const CELL_REL: f64 = 0.04;
 fn options(body: &Body) -> ClosedOptions {
     ClosedOptions {
         cell: Some(CELL_REL * body.extent()),
+        ..ClosedOptions::default()
     }
 }
 
-fn cases() -> Vec<(&'static str, Body, Vec<Pose>)> {
+pub(super) fn cases() -> Vec<(&'static str, Body, Vec<Pose>)> {
     let (cv, ct) = cuboid(DVec3::ONE);
     let cube = Body::new(&cv, &ct).unwrap();
     let (lv, lt) = l_prism(0.5);
@@ -207,7 +208,7 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
 
 /// A case's region signed distance at `x`: the exact motion (`min_over_motion`), the body's
 /// exact signed distance (closed form for the cube, `sd_mesh` otherwise).
-fn region_sd(name: &str, body: &Body, poses: &[Pose], x: DVec3) -> f64 {
+pub(super) fn region_sd(name: &str, body: &Body, poses: &[Pose], x: DVec3) -> f64 {
     let is_cube = name.starts_with("cube");
     min_over_motion(poses, &|p: &Pose| {
         let q = p.inverse().transform_point3(x);
@@ -326,6 +327,7 @@ fn face_distances(
             &poses,
             &ClosedOptions {
                 cell: Some(cell_rel * extent),
+                ..ClosedOptions::default()
             },
         )
         .unwrap();

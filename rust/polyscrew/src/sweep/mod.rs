@@ -61,7 +61,10 @@ pub use body::{
     body_footprint, Body, Edge, EdgeKind, FLAT_REL, MAX_VERTEX_COORDINATE, NO_FACE, SWEEP_HINT,
     ZERO_AREA_REL,
 };
-pub use closed::{sweep_closed, sweep_closed_mesh, ClosedMesh, ClosedOptions, DEFAULT_CELL_REL};
+pub use closed::{
+    closed_work, sweep_closed, sweep_closed_mesh, ClosedMesh, ClosedOptions, ClosedWork,
+    DEFAULT_CELL_REL, DEFAULT_CLOSED_TOLERANCE_REL,
+};
 pub use generator::{
     Generator, Scratch, Segment, SegmentKind, Velocity, MOTIONLESS_REL, TANGENT_REL,
 };
@@ -444,6 +447,8 @@ pub fn sweep_mesh(
 
 #[cfg(test)]
 mod closed_tests;
+#[cfg(test)]
+mod closed_tolerance_tests;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]

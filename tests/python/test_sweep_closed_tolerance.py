@@ -1,0 +1,105 @@
+"""`polyscrew.sweep_closed` driven by a tolerance (issue 29, item 1 for the closed boundary).
+
+- the bound reported is within the tolerance asked for, on the cube (120-degree screw with a
+  slide), the L-prism (half turn) and the torus (smoothed polyscrew), the cell is the rule's,
+  and sampled vertices lie within the bound of the swept boundary by an independent reference
+  (the exact motion by scipy's `expm(logm)`, the body's exact signed distance:
+  test_sweep_closed.py's);
+- the default is 0.5 % of the body's extent (its bounding-box diagonal, the size of
+  `scripts/bench/sweep_measures.py`), told by `sweep_closed_work` before any sampling;
+- the mesh is the same, byte for byte, on one thread and on several;
+- a cell with a tolerance, or a bad tolerance, is refused; so is heavy work, by the add-on's
+  pure `sweep_report.closed_refusal`, with what to change.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import polyscrew
+import pytest
+
+from pure_layer import module
+from test_sweep_closed import CASES, dense, is_closed_oriented, region_sd
+
+sweep_report = module("sweep_report")  # the add-on's pure layer: no bpy
+
+#: The tests' tolerance: 1 % of the body's extent (the default, 0.5 %, takes 5 to 10 times as
+#: long; the Blender operator's test runs it on a short motion).
+TOLERANCE_REL = 0.01
+THREE = ["cube, 120-degree screw with slide", "L-prism, half turn", "torus, smoothed polyscrew"]
+
+
+def extent_of(v):
+    return float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+
+
+@pytest.mark.parametrize("name", THREE)
+def test_the_bound_reported_is_within_the_tolerance(name):
+    v, t, sd, poses, body_error, _ = CASES[name]
+    tolerance = TOLERANCE_REL * extent_of(v)
+    cv, ct, info = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True)
+    sample = cv[np.random.default_rng(1).choice(len(cv), min(len(cv), 600), replace=False)]
+    inv = np.linalg.inv(dense(poses, max(64, 8192 // (len(poses) - 1))))
+    worst = np.abs(region_sd(sample, inv, sd)).max()
+    print(f"\n{name}: tolerance {tolerance:.4f}, cell {info['cell']:.4f}, bound {info['error_bound']:.4f} "
+          f"({info['attempts']} grid(s)), worst vertex {worst:.4f}, {len(ct)} triangles")
+    assert info["tolerance"] == tolerance
+    assert info["error_bound"] <= tolerance
+    rule = polyscrew.CLOSED_CELL_PER_TOLERANCE * tolerance
+    assert info["cell"] == rule if info["attempts"] == 1 else info["cell"] < tolerance
+    assert worst <= info["error_bound"] + body_error
+    assert is_closed_oriented(ct)
+
+
+@pytest.mark.parametrize("name", THREE)
+def test_the_default_tolerance_is_half_a_percent_of_the_extent(name):
+    v, t, _, poses, _, _ = CASES[name]
+    extent = extent_of(v)
+    work = polyscrew.sweep_closed_work(v, t, poses)
+    assert polyscrew.DEFAULT_CLOSED_TOLERANCE == 0.005
+    assert work["tolerance"] == pytest.approx(0.005 * extent, rel=1e-12)
+    assert work["cell"] == pytest.approx(polyscrew.CLOSED_CELL_PER_TOLERANCE * work["tolerance"], rel=1e-12)
+    coarse = polyscrew.sweep_closed_work(v, t, poses, tolerance=2 * work["tolerance"])
+    assert coarse["grid_points"] * 6 < work["grid_points"] and coarse["poses"] < work["poses"]
+    # The operator runs every default case (none is refused).
+    assert sweep_report.closed_refusal(work) is None
+
+
+def test_several_threads_give_the_one_thread_mesh_byte_for_byte():
+    v, t, _, poses, _, _ = CASES["torus, smoothed polyscrew"]
+    tolerance = 0.03 * extent_of(v)
+    one = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, threads=1, info=True)
+    for threads in (2, 3, 0):
+        many = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, threads=threads, info=True)
+        assert many[0].tobytes() == one[0].tobytes() and many[1].tobytes() == one[1].tobytes(), threads
+        assert many[2] == one[2]
+
+
+def test_bad_tolerances_and_heavy_work_are_refused():
+    v, t, _, poses, _, _ = CASES["cube, 120-degree screw with slide"]
+    with pytest.raises(ValueError, match="not both"):
+        polyscrew.sweep_closed(v, t, poses, cell=0.05, tolerance=0.05)
+    for bad in (0.0, -1.0, float("nan"), float("inf"), 1e-6):
+        with pytest.raises(ValueError, match="tolerance"):
+            polyscrew.sweep_closed(v, t, poses, tolerance=bad)
+        with pytest.raises(ValueError, match="tolerance"):
+            polyscrew.sweep_closed_work(v, t, poses, tolerance=bad)
+    with pytest.raises(ValueError, match="threads"):
+        polyscrew.sweep_closed(v, t, poses, tolerance=0.1, threads=-1)
+    # A tolerance 0.15 % of the extent (above the least accepted, 0.11 %): about 37 times the
+    # default's grid, refused before anything is sampled, with what to change.
+    heavy = polyscrew.sweep_closed_work(v, t, poses, tolerance=0.0015 * extent_of(v))
+    message = sweep_report.closed_refusal(heavy)
+    assert heavy["grid_points"] > sweep_report.MAX_CLOSED_GRID_POINTS
+    assert message is not None and "raise the Tolerance" in message and "Closed Volume off" in message
+    many_poses = dict(heavy, grid_points=1, poses=sweep_report.MAX_CLOSED_POSES + 1)
+    assert sweep_report.closed_refusal(many_poses) is not None
+    assert sweep_report.closed_refusal(dict(heavy, grid_points=1, poses=1)) is None
+
+
+def test_the_report_names_the_closed_tolerance_and_what_met_it():
+    text = sweep_report.summary(1, 1000, 1.0, 900.0, 0.00866, 0.0061, 12.3, 5.08, cell=0.0108)
+    assert "closed boundary, tolerance 0.00866 (vertices within 0.0061 of the swept boundary; cell 0.0108)" in text
+    assert "2 grids" in sweep_report.summary(1, 1000, 1.0, 900.0, 0.00866, 0.0061, 12.3, 5.08, cell=0.009, attempts=2)
+    # A cell given by a script: no tolerance to name.
+    assert "closed boundary, cell 0.05 (vertices" in sweep_report.summary(1, 10, 0.1, 1.0, 0.0, 0.01, 1.0, 1.0, cell=0.05)
