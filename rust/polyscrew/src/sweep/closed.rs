@@ -21,7 +21,12 @@
 //!    tetrahedron's edges;
 //! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
 //!    the motion (the body at 8 poses per sample interval on each side of the sample that
-//!    gave the minimum at the edge's ends), kept strictly inside the edge.
+//!    gave the minimum at the edge's ends), kept strictly inside the edge: regula falsi on
+//!    trilinear reads, then secant steps on the body's exact signed distance (`exact.rs`),
+//!    read only at the poses whose trilinear read can give the minimum; the value left is
+//!    checked against every refined pose of the motion (an interval is skipped when a bound
+//!    shows it above that value), and the steps are redone over all of them when a pose
+//!    elsewhere is lower. The reported bound is the largest exact `|g|` left at a vertex.
 //!
 //! Why it is closed and intersection-free: the surface pieces of a tetrahedron lie inside it
 //! and meet the pieces of its neighbours exactly on their shared faces (a vertex is owned by
@@ -33,6 +38,7 @@
 
 use glam::{DAffine3, DVec3};
 
+use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
 use crate::error::{Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
@@ -74,8 +80,15 @@ const ROUNDOFF_REL: f64 = 1e-9;
 /// Poses per sample interval at which a vertex's refinement evaluates the body.
 pub const REFINE_POSES: usize = 8;
 
-/// Regula falsi steps of a vertex's refinement along its edge.
+/// Regula falsi steps of a vertex's refinement along its edge (trilinear reads).
 pub const REFINE_ITERATIONS: usize = 5;
+
+/// Secant steps of a vertex's refinement on the body's exact distance, after the regula
+/// falsi steps.
+pub const EXACT_ITERATIONS: usize = 3;
+
+/// The exact distance's triangle lists are kept per cube of side `cell /` this.
+pub const EXACT_LISTS_PER_CELL: f64 = 2.0;
 
 /// A vertex is kept at least this fraction of its edge from either end: where the zero set
 /// passes through a grid point, the triangles around it stay far above round-off (and the
@@ -118,20 +131,21 @@ pub struct ClosedMesh {
     /// The world grid's cell.
     pub cell: f64,
     /// A bound on the distance of every vertex from the exact swept boundary (of the
-    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex
-    /// plus the body grid's interpolation bound `sqrt(3) h_b / 2`.
+    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex,
+    /// `g` read with the body's exact distance.
     pub error_bound: f64,
     /// Dense poses sampled.
     pub poses: usize,
 }
 
 /// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
-struct BodyField {
+pub(super) struct BodyField {
     origin: DVec3,
     h: f64,
     n: [usize; 3],
     values: Vec<f32>,
-    band: f64,
+    /// Values are clamped to `+-band`.
+    pub(super) band: f64,
 }
 
 impl BodyField {
@@ -165,17 +179,27 @@ impl BodyField {
     /// above the band).
     #[inline]
     fn nearest(&self, p: DVec3) -> (f64, f64) {
+        let (v, node) = self.nearest_node(p);
+        (v, node.distance(p))
+    }
+
+    /// The value at the grid point nearest `p`, and that point; outside the grid `band` and
+    /// `p` itself (the distance there is above the band).
+    #[inline]
+    pub(super) fn nearest_node(&self, p: DVec3) -> (f64, DVec3) {
         let u = ((p - self.origin) / self.h).round();
         let [nx, ny, nz] = self.n;
         if !(u.x >= 0.0 && u.y >= 0.0 && u.z >= 0.0) {
-            return (self.band, 0.0);
+            return (self.band, p);
         }
         let (i, j, k) = (u.x as usize, u.y as usize, u.z as usize);
         if i >= nx || j >= ny || k >= nz {
-            return (self.band, 0.0);
+            return (self.band, p);
         }
-        let node = self.origin + u * self.h;
-        (self.values[(k * ny + j) * nx + i] as f64, node.distance(p))
+        (
+            self.values[(k * ny + j) * nx + i] as f64,
+            self.origin + u * self.h,
+        )
     }
 
     /// Samples `body`'s signed distance (see the module documentation).
@@ -336,45 +360,38 @@ pub(super) fn body_distance_grid(
     Ok((field.origin, field.n, field.values))
 }
 
+/// The body's exact signed distance as the closed sweep builds it for a cell (`band`,
+/// spacings as [`sweep_closed`] takes them): a reader of `(distance, gradient)` (for the
+/// tests).
+#[cfg(test)]
+pub(super) fn exact_distance(
+    body: &Body,
+    cell: f64,
+) -> Result<impl Fn(DVec3) -> (f64, Option<DVec3>) + '_> {
+    let field = BodyField::new(body, cell / BODY_SUBCELLS, BAND_CELLS * cell)?;
+    let exact = exact_field(body, &field, cell)?;
+    Ok(move |p| exact.at(p))
+}
+
+/// The exact distance's lists over the body grid's box.
+fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<ExactField<'a>> {
+    let last = DVec3::new(field.n[0] as f64, field.n[1] as f64, field.n[2] as f64) - 1.0;
+    ExactField::new(
+        body,
+        field,
+        field.origin,
+        field.origin + last * field.h,
+        cell / EXACT_LISTS_PER_CELL,
+    )
+}
+
 /// How to ask the closed sweep for less memory.
 pub const CLOSED_HINT: &str = "use a larger cell, fewer poses or a smaller motion";
 
-/// Distance from `p` to the triangle `(a, b, c)` (Ericson, *Real-Time Collision Detection*,
-/// 5.1.5: the closest point by Voronoi regions).
+/// Distance from `p` to the triangle `(a, b, c)`: to its point nearest `p`
+/// ([`closest_on_triangle`]).
 pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.length();
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return bp.length();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (p - (a + v * ab)).length();
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return cp.length();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (p - (a + w * ac)).length();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + w * (c - b))).length();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (p - (a + ab * v + ac * w)).length()
+    (p - closest_on_triangle(p, a, b, c).0).length()
 }
 
 /// The dense motion: every pose (body -> world) and, for each interval between two, the
@@ -556,14 +573,14 @@ pub(super) fn sweep_closed_with(
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
-    let refine = Refiner::new(&field, &motion)?;
+    let exact = exact_field(body, &field, cell)?;
+    let refine = Refiner::new(&field, exact, &motion, body, cell)?;
     let mut out = ClosedMesh {
         cell,
         poses: motion.poses.len(),
         ..ClosedMesh::default()
     };
     contour(&g, &arg, n, origin, cell, &refine, &mut out)?;
-    out.error_bound += 0.5 * 3f64.sqrt() * field.h;
     Ok(out)
 }
 
@@ -773,16 +790,33 @@ fn narrow_band(
     }
 }
 
-/// Evaluates the region's field between the motion's samples.
+/// Evaluates the region's field between the motion's samples: by the body grid's trilinear
+/// reads, and by the body's exact distance for a vertex's last steps.
 struct Refiner<'a> {
     field: &'a BodyField,
+    exact: ExactField<'a>,
     /// World -> body at [`REFINE_POSES`] poses per sample interval (sample `j` at
     /// `j * REFINE_POSES`).
     fine: Vec<DAffine3>,
+    /// Twice the trilinear read's error bound and the float32 rounding of the grid's values:
+    /// a pose whose read is above the least read by more cannot give the exact minimum.
+    spread: f64,
+    /// The centre of the body's bounding sphere through each sample of the motion (world).
+    centres: Vec<DVec3>,
+    /// That sphere's radius.
+    radius: f64,
+    /// The most a body point moves between a sample and a refined pose of its intervals.
+    travel: f64,
 }
 
 impl<'a> Refiner<'a> {
-    fn new(field: &'a BodyField, motion: &DenseMotion) -> Result<Self> {
+    fn new(
+        field: &'a BodyField,
+        exact: ExactField<'a>,
+        motion: &DenseMotion,
+        body: &Body,
+        travel: f64,
+    ) -> Result<Self> {
         let count = motion.steps.len() * REFINE_POSES + 1;
         Footprint::of::<DAffine3>(count).check("the refined motion", CLOSED_HINT)?;
         let mut fine = try_vec(count, "the refined motion")?;
@@ -793,21 +827,51 @@ impl<'a> Refiner<'a> {
             }
         }
         fine.push(motion.poses[motion.poses.len() - 1].inverse().to_affine());
-        Ok(Self { field, fine })
+        let spread = 2.0 * (0.5 * 3f64.sqrt() * field.h + field.band * f32::EPSILON as f64)
+            + ROUNDOFF_REL * field.band;
+        let verts = body.vertices();
+        let (lo, hi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let centre = 0.5 * (lo + hi);
+        let radius = verts
+            .iter()
+            .map(|&v| v.distance(centre))
+            .fold(0.0, f64::max);
+        let centres = motion
+            .poses
+            .iter()
+            .map(|p| p.transform_point3(centre))
+            .collect();
+        Ok(Self {
+            field,
+            exact,
+            fine,
+            spread,
+            centres,
+            radius,
+            travel,
+        })
     }
 
-    /// `min d(P(s)^-1 x)` over the poses `P(s)` within one sample interval of sample `j`.
-    fn at(&self, x: DVec3, j: u32) -> f64 {
+    /// The refined poses within one sample interval of sample `j`.
+    fn span(&self, j: u32) -> std::ops::RangeInclusive<usize> {
         let j = j as usize;
         let lo = j.saturating_sub(1) * REFINE_POSES;
         let hi = ((j + 1) * REFINE_POSES).min(self.fine.len() - 1);
-        self.fine[lo..=hi]
+        lo..=hi
+    }
+
+    /// `min d(P(s)^-1 x)` over the poses `P(s)` within one sample interval of sample `j`
+    /// (trilinear reads).
+    fn at(&self, x: DVec3, j: u32) -> f64 {
+        self.fine[self.span(j)]
             .iter()
             .map(|a| self.field.at(a.transform_point3(x)))
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The region's field at `x` near the samples `js` (`u32::MAX`: none).
+    /// The region's field at `x` near the samples `js` (`u32::MAX`: none), trilinear reads.
     fn near(&self, x: DVec3, js: [u32; 2]) -> f64 {
         let a = if js[0] == u32::MAX {
             f64::INFINITY
@@ -818,6 +882,88 @@ impl<'a> Refiner<'a> {
             return a;
         }
         a.min(self.at(x, js[1]))
+    }
+
+    /// The poses [`Refiner::near`] reads at `js`, each once.
+    fn poses(&self, js: [u32; 2]) -> impl Iterator<Item = &DAffine3> {
+        let first = (js[0] != u32::MAX).then(|| self.span(js[0]));
+        let second = (js[1] != u32::MAX && js[1] != js[0]).then(|| self.span(js[1]));
+        let skip = first.clone();
+        first
+            .into_iter()
+            .flatten()
+            .chain(
+                second
+                    .into_iter()
+                    .flatten()
+                    .filter(move |i| !skip.as_ref().is_some_and(|r| r.contains(i))),
+            )
+            .map(|i| &self.fine[i])
+    }
+
+    /// The same minimum with the body's exact distance. Only the poses whose
+    /// trilinear read is within [`Refiner::spread`] of the least are read exactly: each read
+    /// is within half of it of the exact distance, so the others are above the minimum.
+    fn exact_near(&self, x: DVec3, js: [u32; 2]) -> f64 {
+        const MOST: usize = 2 * (2 * REFINE_POSES + 1);
+        let mut reads = [(0.0f64, DVec3::ZERO); MOST];
+        let mut count = 0;
+        let mut least = f64::INFINITY;
+        for a in self.poses(js) {
+            let y = a.transform_point3(x);
+            let read = self.field.at(y);
+            least = least.min(read);
+            reads[count] = (read, y);
+            count += 1;
+        }
+        reads[..count]
+            .iter()
+            .filter(|&&(read, _)| read <= least + self.spread)
+            .map(|&(_, y)| self.exact.at(y).0)
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+impl Refiner<'_> {
+    /// The exact minimum at `x` over every refined pose of the motion; `upper` is at least
+    /// that minimum (a value already
+    /// found). An interval between two samples is skipped when every pose in it is above
+    /// `upper`: a body point moves at most `travel` across the interval, so at most half of it
+    /// from the nearer sample, and a pose there is at least the nearer sample's distance to
+    /// the body's bounding sphere, and at least its trilinear read (less the read's error),
+    /// less `travel / 2`; a pose is read exactly only when its trilinear read, less its error,
+    /// is not above `upper`.
+    fn exact_all(&self, x: DVec3, mut upper: f64) -> f64 {
+        let half = 0.5 * self.spread;
+        let reach = self.radius + 0.5 * self.travel;
+        let mut best = f64::INFINITY;
+        // The sample before: its read, less the read's error (infinite: out of reach).
+        let mut before = f64::INFINITY;
+        for (i, c) in self.centres.iter().enumerate() {
+            let here = if c.distance(x) - reach > upper {
+                f64::INFINITY
+            } else {
+                self.field
+                    .at(self.fine[i * REFINE_POSES].transform_point3(x))
+                    - half
+            };
+            let low = before.min(here) - 0.5 * self.travel;
+            before = here;
+            if i == 0 || low > upper {
+                continue;
+            }
+            let first = (i - 1) * REFINE_POSES;
+            for a in &self.fine[first..=first + REFINE_POSES] {
+                let y = a.transform_point3(x);
+                if self.field.at(y) - half > upper {
+                    continue;
+                }
+                let d = self.exact.at(y).0;
+                best = best.min(d);
+                upper = upper.min(d);
+            }
+        }
+        best
     }
 }
 
@@ -885,8 +1031,41 @@ fn contour(
                 }
             }
         }
+        // Secant steps on the exact field from the trilinear root (the first along the
+        // trilinear bracket's slope), keeping the point where it is least: first near the
+        // samples `js`, then, if a pose elsewhere in the motion is lower there, over all.
+        let secant = |t: f64, slope: f64, exact: &dyn Fn(DVec3) -> f64| {
+            let (mut t0, mut g0) = (t, exact(lerp(t)));
+            let mut best = (g0, t0);
+            let mut slope = slope;
+            for _ in 0..EXACT_ITERATIONS {
+                if g0 == 0.0 || !(slope.is_finite() && slope != 0.0) {
+                    break;
+                }
+                let t1 = (t0 - g0 / slope).clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN);
+                if t1 == t0 {
+                    break;
+                }
+                let g1 = exact(lerp(t1));
+                if g1.abs() < best.0.abs() {
+                    best = (g1, t1);
+                }
+                slope = (g1 - g0) / (t1 - t0);
+                (t0, g0) = (t1, g1);
+            }
+            (best, slope)
+        };
+        let ((local, t), slope) = secant(t, (gb - ga) / (tb - ta), &|x| refine.exact_near(x, js));
+        let (g, t) = if refine.exact_all(lerp(t), local) < local {
+            secant(t, slope, &|x| {
+                refine.exact_all(x, refine.near(x, js) + refine.spread)
+            })
+            .0
+        } else {
+            (local, t)
+        };
         let x = lerp(t);
-        residual = residual.max(refine.near(x, js).abs().min(cell));
+        residual = residual.max(g.abs().min(cell));
         let v = out.vertices.len();
         if v >= u32::MAX as usize {
             return Err(Error::Limit {
