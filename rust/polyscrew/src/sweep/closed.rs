@@ -441,6 +441,28 @@ impl DenseMotion {
     }
 }
 
+impl DenseMotion {
+    /// The body's bounding sphere (about its box's centre) through every pose: the centres
+    /// (world) and the radius.
+    fn spheres(&self, body: &Body) -> (Vec<DVec3>, f64) {
+        let verts = body.vertices();
+        let (lo, hi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let centre = 0.5 * (lo + hi);
+        let radius = verts
+            .iter()
+            .map(|&v| v.distance(centre))
+            .fold(0.0, f64::max);
+        let centres = self
+            .poses
+            .iter()
+            .map(|p| p.transform_point3(centre))
+            .collect();
+        (centres, radius)
+    }
+}
+
 /// The boundary of the region swept by the closed `body` along the polyscrew through `poses`
 /// as a closed, consistently oriented, self-intersection-free triangle mesh (see the module
 /// documentation).
@@ -697,20 +719,7 @@ fn narrow_band(
     let Grid { origin, cell, n } = grid;
     let [nx, ny, nz] = n;
     let root3 = 3f64.sqrt();
-    let verts = body.vertices();
-    let (lo, hi) = verts
-        .iter()
-        .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let centre = 0.5 * (lo + hi);
-    let radius = verts
-        .iter()
-        .map(|&v| v.distance(centre))
-        .fold(0.0, f64::max);
-    let centres: Vec<DVec3> = motion
-        .poses
-        .iter()
-        .map(|p| p.transform_point3(centre))
-        .collect();
+    let (centres, radius) = motion.spheres(body);
     let rho = root3 * (BLOCK_POINTS as f64 + 1.0) / 2.0 * cell;
     // The farthest a block's own point is from its centre.
     let r_max = root3 * (BLOCK_POINTS as f64 - 1.0) / 2.0 * cell;
@@ -829,20 +838,7 @@ impl<'a> Refiner<'a> {
         fine.push(motion.poses[motion.poses.len() - 1].inverse().to_affine());
         let spread = 2.0 * (0.5 * 3f64.sqrt() * field.h + field.band * f32::EPSILON as f64)
             + ROUNDOFF_REL * field.band;
-        let verts = body.vertices();
-        let (lo, hi) = verts
-            .iter()
-            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-        let centre = 0.5 * (lo + hi);
-        let radius = verts
-            .iter()
-            .map(|&v| v.distance(centre))
-            .fold(0.0, f64::max);
-        let centres = motion
-            .poses
-            .iter()
-            .map(|p| p.transform_point3(centre))
-            .collect();
+        let (centres, radius) = motion.spheres(body);
         Ok(Self {
             field,
             exact,
@@ -901,26 +897,35 @@ impl<'a> Refiner<'a> {
             .map(|i| &self.fine[i])
     }
 
-    /// The same minimum with the body's exact distance. Only the poses whose
-    /// trilinear read is within [`Refiner::spread`] of the least are read exactly: each read
-    /// is within half of it of the exact distance, so the others are above the minimum.
+    /// The same minimum with the body's exact distance. Each trilinear read is within half
+    /// of [`Refiner::spread`] of the exact distance, so a pose whose read, less that, is
+    /// above an exact value already found cannot give the minimum and is not read exactly.
     fn exact_near(&self, x: DVec3, js: [u32; 2]) -> f64 {
         const MOST: usize = 2 * (2 * REFINE_POSES + 1);
         let mut reads = [(0.0f64, DVec3::ZERO); MOST];
         let mut count = 0;
-        let mut least = f64::INFINITY;
+        let mut first = 0;
         for a in self.poses(js) {
             let y = a.transform_point3(x);
-            let read = self.field.at(y);
-            least = least.min(read);
-            reads[count] = (read, y);
+            reads[count] = (self.field.at(y), y);
+            if reads[count].0 < reads[first].0 {
+                first = count;
+            }
             count += 1;
         }
-        reads[..count]
-            .iter()
-            .filter(|&&(read, _)| read <= least + self.spread)
-            .map(|&(_, y)| self.exact.at(y).0)
-            .fold(f64::INFINITY, f64::min)
+        if count == 0 {
+            return f64::INFINITY;
+        }
+        // The pose read least first: its exact value then rules out every pose whose read,
+        // less the read's error, is above it.
+        let half = 0.5 * self.spread;
+        let mut best = self.exact.at(reads[first].1).0;
+        for (k, &(read, y)) in reads[..count].iter().enumerate() {
+            if k != first && read - half <= best {
+                best = best.min(self.exact.at(y).0);
+            }
+        }
+        best
     }
 }
 
