@@ -389,7 +389,7 @@ fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<Exact
 pub const CLOSED_HINT: &str = "use a larger cell, fewer poses or a smaller motion";
 
 /// Distance from `p` to the triangle `(a, b, c)`: to its point nearest `p`
-/// ([`closest_on_triangle`]).
+/// (Ericson, *Real-Time Collision Detection*, 5.1.5: the closest point by Voronoi regions).
 pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
     (p - closest_on_triangle(p, a, b, c).0).length()
 }

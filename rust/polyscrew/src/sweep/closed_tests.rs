@@ -381,7 +381,8 @@ fn face_report(cell_rel: f64, triangles: [usize; 2]) -> Vec<(&'static str, f64, 
 /// body's exact distance), on the four cases at the tests' cell.
 ///
 /// Ignored: it fails on today's closed sweep, whose bound covers the vertices only (at this
-/// cell an L-prism face across a crease is 2.54 % of the extent off, over the bound's 2.39 %).
+/// cell faces across creases are up to 0.97 % (cube), 1.83 % (L-prism) and 2.86 % (smoothed
+/// cube) of the extent off, over bounds of 0.91, 1.06 and 1.26 %).
 /// It is the acceptance test of issue 29's face bound:
 /// `cargo test --release -- --ignored every_face_point`.
 #[test]
