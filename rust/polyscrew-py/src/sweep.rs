@@ -413,7 +413,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("DEFAULT_CLOSED_TOLERANCE", DEFAULT_CLOSED_TOLERANCE_REL)?;
     // stub:
     // stub: CLOSED_CELL_PER_TOLERANCE: float
-    // stub: """The first cell of ``sweep_closed`` as a multiple of its tolerance (1.25)."""
+    // stub: """The first cell of ``sweep_closed`` as a multiple of its tolerance (2)."""
     m.add("CLOSED_CELL_PER_TOLERANCE", CELL_PER_TOLERANCE)?;
     Ok(())
 }

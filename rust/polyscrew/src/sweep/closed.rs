@@ -21,7 +21,12 @@
 //!    tetrahedron's edges;
 //! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
 //!    the motion (the body at 8 poses per sample interval on each side of the sample that
-//!    gave the minimum at the edge's ends), kept strictly inside the edge.
+//!    gave the minimum at the edge's ends), kept strictly inside the edge: regula falsi on
+//!    trilinear reads, then secant steps on the body's exact signed distance (`exact.rs`),
+//!    read only at the poses whose trilinear read can give the minimum; the value left is
+//!    checked against every refined pose of the motion (an interval is skipped when a bound
+//!    shows it above that value), and the steps are redone over all of them when a pose
+//!    elsewhere is lower. The reported bound is the largest exact `|g|` left at a vertex.
 //!
 //! Why it is closed and intersection-free: the surface pieces of a tetrahedron lie inside it
 //! and meet the pieces of its neighbours exactly on their shared faces (a vertex is owned by
@@ -33,6 +38,7 @@
 
 use glam::{DAffine3, DVec3};
 
+use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
 use crate::error::{Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
@@ -50,20 +56,27 @@ pub const DEFAULT_CELL_REL: f64 = 0.015;
 /// goal.
 pub const DEFAULT_CLOSED_TOLERANCE_REL: f64 = 0.005;
 
-/// The first cell tried for a tolerance, as a multiple of it. The reported bound is at most
-/// `(1 + sqrt(3) / (2 BODY_SUBCELLS)) cell` (see [`guaranteed_cell`]) but, measured on issue
-/// 29's cases, it is `0.38` to `0.69` cells (cube, L-prism, torus at 0.9 % to 1.5 % of the
-/// extent): a cell of `1.25` tolerances meets the tolerance in one attempt there (`0.86`
-/// a bound above `0.8` cells would exceed it).
-pub const CELL_PER_TOLERANCE: f64 = 1.25;
+/// The first cell tried for a tolerance, as a multiple of it. The reported bound (the exact
+/// residual left at a vertex, capped at one cell, plus [`motion_gap`]: see [`guaranteed_cell`])
+/// is, measured on issue 29's cases since the refinement ends on the body's exact distance,
+/// `0.08` to `0.32` cells plus the gap's `0.0625` (cube, L-prism, torus, smoothed cube at 1.5 %
+/// and 4 % of the extent): a cell of `2` tolerances meets the tolerance in one attempt there (a
+/// bound above `0.5` cells would exceed it and take a second attempt at [`guaranteed_cell`]).
+pub const CELL_PER_TOLERANCE: f64 = 2.0;
 
 /// The cell at which the reported bound is within `tolerance` whatever the body and the
-/// motion: the bound is the residual left at a vertex, at most one cell (a vertex stays on
-/// its grid edge, and the residual is capped there), plus the body grid's trilinear bound
-/// `sqrt(3) / 2 cell / BODY_SUBCELLS`; so `tolerance / (1 + sqrt(3) / (2 BODY_SUBCELLS))`.
-/// [`sweep_closed`] falls back on it when the first cell's bound exceeds the tolerance.
+/// motion: the bound is the exact residual left at a vertex, at most one cell (a vertex stays
+/// on its grid edge, and the residual is capped there), plus [`motion_gap`]; so
+/// `tolerance / (1 + 1 / (2 REFINE_POSES))`. [`sweep_closed`] falls back on it when the first
+/// cell's bound exceeds the tolerance.
 pub fn guaranteed_cell(tolerance: f64) -> f64 {
-    tolerance / (1.0 + 0.5 * 3f64.sqrt() / BODY_SUBCELLS)
+    tolerance / (1.0 + motion_gap(1.0))
+}
+
+/// How far below the minimum over the poses the refinement reads the minimum over the whole
+/// continuous motion can be, at a cell of `cell`: `cell / (2 REFINE_POSES)` (see `contour`).
+fn motion_gap(cell: f64) -> f64 {
+    cell / (2.0 * REFINE_POSES as f64)
 }
 
 /// The body's distance grid is this many times finer than the world grid.
@@ -97,8 +110,15 @@ const ROUNDOFF_REL: f64 = 1e-9;
 /// Poses per sample interval at which a vertex's refinement evaluates the body.
 pub const REFINE_POSES: usize = 8;
 
-/// Regula falsi steps of a vertex's refinement along its edge.
+/// Regula falsi steps of a vertex's refinement along its edge (trilinear reads).
 pub const REFINE_ITERATIONS: usize = 5;
+
+/// Secant steps of a vertex's refinement on the body's exact distance, after the regula
+/// falsi steps.
+pub const EXACT_ITERATIONS: usize = 3;
+
+/// The exact distance's triangle lists are kept per cube of side `cell /` this.
+pub const EXACT_LISTS_PER_CELL: f64 = 2.0;
 
 /// A vertex is kept at least this fraction of its edge from either end: where the zero set
 /// passes through a grid point, the triangles around it stay far above round-off (and the
@@ -157,8 +177,8 @@ pub struct ClosedMesh {
     /// The world grid's cell.
     pub cell: f64,
     /// A bound on the distance of every vertex from the exact swept boundary (of the
-    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex
-    /// plus the body grid's interpolation bound `sqrt(3) h_b / 2`.
+    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex,
+    /// `g` read with the body's exact distance.
     pub error_bound: f64,
     /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
     pub tolerance: f64,
@@ -186,12 +206,13 @@ pub struct ClosedWork {
 }
 
 /// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
-struct BodyField {
+pub(super) struct BodyField {
     origin: DVec3,
     h: f64,
     n: [usize; 3],
     values: Vec<f32>,
-    band: f64,
+    /// Values are clamped to `+-band`.
+    pub(super) band: f64,
 }
 
 impl BodyField {
@@ -225,17 +246,27 @@ impl BodyField {
     /// above the band).
     #[inline]
     fn nearest(&self, p: DVec3) -> (f64, f64) {
+        let (v, node) = self.nearest_node(p);
+        (v, node.distance(p))
+    }
+
+    /// The value at the grid point nearest `p`, and that point; outside the grid `band` and
+    /// `p` itself (the distance there is above the band).
+    #[inline]
+    pub(super) fn nearest_node(&self, p: DVec3) -> (f64, DVec3) {
         let u = ((p - self.origin) / self.h).round();
         let [nx, ny, nz] = self.n;
         if !(u.x >= 0.0 && u.y >= 0.0 && u.z >= 0.0) {
-            return (self.band, 0.0);
+            return (self.band, p);
         }
         let (i, j, k) = (u.x as usize, u.y as usize, u.z as usize);
         if i >= nx || j >= ny || k >= nz {
-            return (self.band, 0.0);
+            return (self.band, p);
         }
-        let node = self.origin + u * self.h;
-        (self.values[(k * ny + j) * nx + i] as f64, node.distance(p))
+        (
+            self.values[(k * ny + j) * nx + i] as f64,
+            self.origin + u * self.h,
+        )
     }
 
     /// The grid's origin and points per axis for spacing `h` and band `band`: the body's box
@@ -486,45 +517,38 @@ pub(super) fn body_distance_grid(
     Ok((field.origin, field.n, field.values))
 }
 
+/// The body's exact signed distance as the closed sweep builds it for a cell (`band`,
+/// spacings as [`sweep_closed`] takes them): a reader of `(distance, gradient)` (for the
+/// tests).
+#[cfg(test)]
+pub(super) fn exact_distance(
+    body: &Body,
+    cell: f64,
+) -> Result<impl Fn(DVec3) -> (f64, Option<DVec3>) + '_> {
+    let field = BodyField::new(body, cell / BODY_SUBCELLS, BAND_CELLS * cell, 0)?;
+    let exact = exact_field(body, &field, cell)?;
+    Ok(move |p| exact.at(p))
+}
+
+/// The exact distance's lists over the body grid's box.
+fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<ExactField<'a>> {
+    let last = DVec3::new(field.n[0] as f64, field.n[1] as f64, field.n[2] as f64) - 1.0;
+    ExactField::new(
+        body,
+        field,
+        field.origin,
+        field.origin + last * field.h,
+        cell / EXACT_LISTS_PER_CELL,
+    )
+}
+
 /// How to ask the closed sweep for less memory.
 pub const CLOSED_HINT: &str = "use a larger tolerance (or cell), fewer poses or a smaller motion";
 
-/// Distance from `p` to the triangle `(a, b, c)` (Ericson, *Real-Time Collision Detection*,
-/// 5.1.5: the closest point by Voronoi regions).
+/// Distance from `p` to the triangle `(a, b, c)`: to its point nearest `p`
+/// (Ericson, *Real-Time Collision Detection*, 5.1.5: the closest point by Voronoi regions).
 pub fn point_triangle_distance(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let (ab, ac, ap) = (b - a, c - a, p - a);
-    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return ap.length();
-    }
-    let bp = p - b;
-    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
-    if d3 >= 0.0 && d4 <= d3 {
-        return bp.length();
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        let v = d1 / (d1 - d3);
-        return (p - (a + v * ab)).length();
-    }
-    let cp = p - c;
-    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
-    if d6 >= 0.0 && d5 <= d6 {
-        return cp.length();
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        let w = d2 / (d2 - d6);
-        return (p - (a + w * ac)).length();
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-        return (p - (b + w * (c - b))).length();
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let (v, w) = (vb * denom, vc * denom);
-    (p - (a + ab * v + ac * w)).length()
+    (p - closest_on_triangle(p, a, b, c).0).length()
 }
 
 /// The dense motion: every pose (body -> world) and, for each interval between two, the
@@ -571,6 +595,28 @@ impl DenseMotion {
             }
         }
         Ok(out)
+    }
+}
+
+impl DenseMotion {
+    /// The body's bounding sphere (about its box's centre) through every pose: the centres
+    /// (world) and the radius.
+    fn spheres(&self, body: &Body) -> (Vec<DVec3>, f64) {
+        let verts = body.vertices();
+        let (lo, hi) = verts
+            .iter()
+            .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        let centre = 0.5 * (lo + hi);
+        let radius = verts
+            .iter()
+            .map(|&v| v.distance(centre))
+            .fold(0.0, f64::max);
+        let centres = self
+            .poses
+            .iter()
+            .map(|p| p.transform_point3(centre))
+            .collect();
+        (centres, radius)
     }
 }
 
@@ -811,14 +857,14 @@ fn contoured(
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
-    let refine = Refiner::new(&field, &motion)?;
+    let exact = exact_field(body, &field, cell)?;
+    let refine = Refiner::new(&field, exact, &motion, body, cell)?;
     let mut out = ClosedMesh {
         cell,
         poses: motion.poses.len(),
         ..ClosedMesh::default()
     };
     contour(&g, &arg, n, origin, cell, &refine, &mut out)?;
-    out.error_bound += 0.5 * 3f64.sqrt() * field.h;
     Ok(out)
 }
 
@@ -951,24 +997,12 @@ fn narrow_band(
 ) -> Result<()> {
     let n = grid.n;
     let root3 = 3f64.sqrt();
-    let verts = body.vertices();
-    let (lo, hi) = verts
-        .iter()
-        .fold((verts[0], verts[0]), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let centre = 0.5 * (lo + hi);
-    let radius = verts
-        .iter()
-        .map(|&v| v.distance(centre))
-        .fold(0.0, f64::max);
+    let (centres, radius) = motion.spheres(body);
     let band = Band {
         field,
         coarse,
         to_body,
-        centres: motion
-            .poses
-            .iter()
-            .map(|p| p.transform_point3(centre))
-            .collect(),
+        centres,
         sphere: radius + coarse.band + root3 * coarse.h,
         grid,
     };
@@ -1096,16 +1130,33 @@ impl Band<'_> {
     }
 }
 
-/// Evaluates the region's field between the motion's samples.
+/// Evaluates the region's field between the motion's samples: by the body grid's trilinear
+/// reads, and by the body's exact distance for a vertex's last steps.
 struct Refiner<'a> {
     field: &'a BodyField,
+    exact: ExactField<'a>,
     /// World -> body at [`REFINE_POSES`] poses per sample interval (sample `j` at
     /// `j * REFINE_POSES`).
     fine: Vec<DAffine3>,
+    /// Twice the trilinear read's error bound and the float32 rounding of the grid's values:
+    /// a pose whose read is above the least read by more cannot give the exact minimum.
+    spread: f64,
+    /// The centre of the body's bounding sphere through each sample of the motion (world).
+    centres: Vec<DVec3>,
+    /// That sphere's radius.
+    radius: f64,
+    /// The most a body point moves between a sample and a refined pose of its intervals.
+    travel: f64,
 }
 
 impl<'a> Refiner<'a> {
-    fn new(field: &'a BodyField, motion: &DenseMotion) -> Result<Self> {
+    fn new(
+        field: &'a BodyField,
+        exact: ExactField<'a>,
+        motion: &DenseMotion,
+        body: &Body,
+        travel: f64,
+    ) -> Result<Self> {
         let count = motion.steps.len() * REFINE_POSES + 1;
         Footprint::of::<DAffine3>(count).check("the refined motion", CLOSED_HINT)?;
         let mut fine = try_vec(count, "the refined motion")?;
@@ -1116,21 +1167,38 @@ impl<'a> Refiner<'a> {
             }
         }
         fine.push(motion.poses[motion.poses.len() - 1].inverse().to_affine());
-        Ok(Self { field, fine })
+        let spread = 2.0 * (0.5 * 3f64.sqrt() * field.h + field.band * f32::EPSILON as f64)
+            + ROUNDOFF_REL * field.band;
+        let (centres, radius) = motion.spheres(body);
+        Ok(Self {
+            field,
+            exact,
+            fine,
+            spread,
+            centres,
+            radius,
+            travel,
+        })
     }
 
-    /// `min d(P(s)^-1 x)` over the poses `P(s)` within one sample interval of sample `j`.
-    fn at(&self, x: DVec3, j: u32) -> f64 {
+    /// The refined poses within one sample interval of sample `j`.
+    fn span(&self, j: u32) -> std::ops::RangeInclusive<usize> {
         let j = j as usize;
         let lo = j.saturating_sub(1) * REFINE_POSES;
         let hi = ((j + 1) * REFINE_POSES).min(self.fine.len() - 1);
-        self.fine[lo..=hi]
+        lo..=hi
+    }
+
+    /// `min d(P(s)^-1 x)` over the poses `P(s)` within one sample interval of sample `j`
+    /// (trilinear reads).
+    fn at(&self, x: DVec3, j: u32) -> f64 {
+        self.fine[self.span(j)]
             .iter()
             .map(|a| self.field.at(a.transform_point3(x)))
             .fold(f64::INFINITY, f64::min)
     }
 
-    /// The region's field at `x` near the samples `js` (`u32::MAX`: none).
+    /// The region's field at `x` near the samples `js` (`u32::MAX`: none), trilinear reads.
     fn near(&self, x: DVec3, js: [u32; 2]) -> f64 {
         let a = if js[0] == u32::MAX {
             f64::INFINITY
@@ -1141,6 +1209,97 @@ impl<'a> Refiner<'a> {
             return a;
         }
         a.min(self.at(x, js[1]))
+    }
+
+    /// The poses [`Refiner::near`] reads at `js`, each once.
+    fn poses(&self, js: [u32; 2]) -> impl Iterator<Item = &DAffine3> {
+        let first = (js[0] != u32::MAX).then(|| self.span(js[0]));
+        let second = (js[1] != u32::MAX && js[1] != js[0]).then(|| self.span(js[1]));
+        let skip = first.clone();
+        first
+            .into_iter()
+            .flatten()
+            .chain(
+                second
+                    .into_iter()
+                    .flatten()
+                    .filter(move |i| !skip.as_ref().is_some_and(|r| r.contains(i))),
+            )
+            .map(|i| &self.fine[i])
+    }
+
+    /// The same minimum with the body's exact distance. Each trilinear read is within half
+    /// of [`Refiner::spread`] of the exact distance, so a pose whose read, less that, is
+    /// above an exact value already found cannot give the minimum and is not read exactly.
+    fn exact_near(&self, x: DVec3, js: [u32; 2]) -> f64 {
+        const MOST: usize = 2 * (2 * REFINE_POSES + 1);
+        let mut reads = [(0.0f64, DVec3::ZERO); MOST];
+        let mut count = 0;
+        let mut first = 0;
+        for a in self.poses(js) {
+            let y = a.transform_point3(x);
+            reads[count] = (self.field.at(y), y);
+            if reads[count].0 < reads[first].0 {
+                first = count;
+            }
+            count += 1;
+        }
+        if count == 0 {
+            return f64::INFINITY;
+        }
+        // The pose read least first: its exact value then rules out every pose whose read,
+        // less the read's error, is above it.
+        let half = 0.5 * self.spread;
+        let mut best = self.exact.at(reads[first].1).0;
+        for (k, &(read, y)) in reads[..count].iter().enumerate() {
+            if k != first && read - half <= best {
+                best = best.min(self.exact.at(y).0);
+            }
+        }
+        best
+    }
+}
+
+impl Refiner<'_> {
+    /// The exact minimum at `x` over every refined pose of the motion; `upper` is at least
+    /// that minimum (a value already
+    /// found). An interval between two samples is skipped when every pose in it is above
+    /// `upper`: a body point moves at most `travel` across the interval, so at most half of it
+    /// from the nearer sample, and a pose there is at least the nearer sample's distance to
+    /// the body's bounding sphere, and at least its trilinear read (less the read's error),
+    /// less `travel / 2`; a pose is read exactly only when its trilinear read, less its error,
+    /// is not above `upper`.
+    fn exact_all(&self, x: DVec3, mut upper: f64) -> f64 {
+        let half = 0.5 * self.spread;
+        let reach = self.radius + 0.5 * self.travel;
+        let mut best = f64::INFINITY;
+        // The sample before: its read, less the read's error (infinite: out of reach).
+        let mut before = f64::INFINITY;
+        for (i, c) in self.centres.iter().enumerate() {
+            let here = if c.distance(x) - reach > upper {
+                f64::INFINITY
+            } else {
+                self.field
+                    .at(self.fine[i * REFINE_POSES].transform_point3(x))
+                    - half
+            };
+            let low = before.min(here) - 0.5 * self.travel;
+            before = here;
+            if i == 0 || low > upper {
+                continue;
+            }
+            let first = (i - 1) * REFINE_POSES;
+            for a in &self.fine[first..=first + REFINE_POSES] {
+                let y = a.transform_point3(x);
+                if self.field.at(y) - half > upper {
+                    continue;
+                }
+                let d = self.exact.at(y).0;
+                best = best.min(d);
+                upper = upper.min(d);
+            }
+        }
+        best
     }
 }
 
@@ -1208,8 +1367,41 @@ fn contour(
                 }
             }
         }
+        // Secant steps on the exact field from the trilinear root (the first along the
+        // trilinear bracket's slope), keeping the point where it is least: first near the
+        // samples `js`, then, if a pose elsewhere in the motion is lower there, over all.
+        let secant = |t: f64, slope: f64, exact: &dyn Fn(DVec3) -> f64| {
+            let (mut t0, mut g0) = (t, exact(lerp(t)));
+            let mut best = (g0, t0);
+            let mut slope = slope;
+            for _ in 0..EXACT_ITERATIONS {
+                if g0 == 0.0 || !(slope.is_finite() && slope != 0.0) {
+                    break;
+                }
+                let t1 = (t0 - g0 / slope).clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN);
+                if t1 == t0 {
+                    break;
+                }
+                let g1 = exact(lerp(t1));
+                if g1.abs() < best.0.abs() {
+                    best = (g1, t1);
+                }
+                slope = (g1 - g0) / (t1 - t0);
+                (t0, g0) = (t1, g1);
+            }
+            (best, slope)
+        };
+        let ((local, t), slope) = secant(t, (gb - ga) / (tb - ta), &|x| refine.exact_near(x, js));
+        let (g, t) = if refine.exact_all(lerp(t), local) < local {
+            secant(t, slope, &|x| {
+                refine.exact_all(x, refine.near(x, js) + refine.spread)
+            })
+            .0
+        } else {
+            (local, t)
+        };
         let x = lerp(t);
-        residual = residual.max(refine.near(x, js).abs().min(cell));
+        residual = residual.max(g.abs().min(cell));
         let v = out.vertices.len();
         if v >= u32::MAX as usize {
             return Err(Error::Limit {
@@ -1297,7 +1489,12 @@ fn contour(
             }
         }
     }
-    out.error_bound = residual;
+    // The refinement reads the body at REFINE_POSES poses per sample interval, over which no
+    // body point travels more than a cell (`DenseMotion::new`: the helix arc, linear in the
+    // screw's parameter), so every instant of the motion is within `cell / (2 REFINE_POSES)` of
+    // travel from a pose read: the continuous motion's minimum is at most that below the one
+    // found (the body's distance is 1-Lipschitz).
+    out.error_bound = residual + motion_gap(cell);
     Ok(())
 }
 

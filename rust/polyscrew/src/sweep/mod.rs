@@ -53,6 +53,7 @@
 
 pub mod body;
 pub mod closed;
+mod exact;
 pub mod generator;
 
 use glam::DVec3;

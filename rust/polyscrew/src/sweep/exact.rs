@@ -1,0 +1,276 @@
+//! The body's exact signed distance, for the last steps of the closed sweep's refinement
+//! (issue 29: the trilinear read of the body's grid was more than half the vertex bound).
+//!
+//! A uniform grid of triangle lists in the body frame: each list cell keeps only the
+//! triangles that can be nearest to one of its points, found from the body's distance grid
+//! (exact distances at its points, rounded once to float32): with `q` the grid point nearest
+//! the cell's centre, `D` its distance and `R` the farthest a point of the cell is from `q`,
+//! the triangle `T*` nearest a point `x` of the cell has
+//! `dist(q, T*) <= dist(x, T*) + |x - q| = d(x) + |x - q| <= D + 2 R`, so the triangles farther
+//! than that from `q` are left out. The sign is that of `(x - c) . n` with `c` the nearest
+//! point and `n` the angle-weighted pseudo-normal of the feature holding it (face, edge or
+//! vertex: Baerentzen and Aanaes 2005, "Signed distance computation using the angle weighted
+//! pseudonormal"), exact for a closed, consistently oriented mesh.
+//!
+//! A cell whose `q` is beyond the distance grid's band holds no list: its points are at
+//! least `band - R` from the surface, and read as `+-band` (the sign of the grid's value).
+
+use glam::DVec3;
+
+use super::closed::BodyField;
+use super::Body;
+use crate::error::Result;
+use crate::memory::try_vec;
+
+/// Which feature of a triangle holds its point nearest a query: the face, the edge from
+/// corner `k` to corner `k + 1` (mod 3), or corner `k`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Feature {
+    /// The triangle's interior.
+    Face,
+    /// The edge from corner `k` to corner `(k + 1) % 3`.
+    Edge(u8),
+    /// Corner `k`.
+    Vertex(u8),
+}
+
+/// The point of the triangle `(a, b, c)` nearest `p` and the feature holding it (Ericson,
+/// *Real-Time Collision Detection*, 5.1.5: the closest point by Voronoi regions).
+pub fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, Feature) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, Feature::Vertex(0));
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, Feature::Vertex(1));
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        let v = d1 / (d1 - d3);
+        return (a + v * ab, Feature::Edge(0));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, Feature::Vertex(2));
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        let w = d2 / (d2 - d6);
+        return (a + w * ac, Feature::Edge(2));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        let w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+        return (b + w * (c - b), Feature::Edge(1));
+    }
+    let denom = 1.0 / (va + vb + vc);
+    let (v, w) = (vb * denom, vc * denom);
+    (a + ab * v + ac * w, Feature::Face)
+}
+
+/// Round-off allowance of the lists' test, relative to the largest coordinate involved.
+const ROUNDOFF_REL: f64 = 1e-9;
+
+/// The body's exact signed distance near its surface (see the module documentation).
+pub(super) struct ExactField<'a> {
+    body: &'a Body,
+    /// Angle-weighted pseudo-normals of the body's vertices (unnormalized).
+    vertex_normals: Vec<DVec3>,
+    /// Pseudo-normals of the body's edges, by [`Body::edges`] index (unnormalized).
+    edge_normals: Vec<DVec3>,
+    origin: DVec3,
+    s: f64,
+    n: [usize; 3],
+    /// Per list cell: its triangles are `items[start[c]..start[c + 1]]`; a cell without a
+    /// list reads `far[c]`.
+    start: Vec<u32>,
+    items: Vec<u32>,
+    far: Vec<f32>,
+}
+
+impl<'a> ExactField<'a> {
+    /// Lists for cells of side `s` over the box `lo..hi` (body frame), from the body's
+    /// distance grid `grid` (exact distances within its band, rounded to float32).
+    pub(super) fn new(
+        body: &'a Body,
+        grid: &BodyField,
+        lo: DVec3,
+        hi: DVec3,
+        s: f64,
+    ) -> Result<Self> {
+        let verts = body.vertices();
+        let tris = body.triangles();
+        let normals = body.normals();
+        let mut vertex_normals = vec![DVec3::ZERO; verts.len()];
+        for (t, &nrm) in tris.iter().zip(normals) {
+            for k in 0..3 {
+                let p = verts[t[k] as usize];
+                let (u, w) = (
+                    verts[t[(k + 1) % 3] as usize] - p,
+                    verts[t[(k + 2) % 3] as usize] - p,
+                );
+                let angle = u.angle_between(w);
+                if angle.is_finite() {
+                    vertex_normals[t[k] as usize] += angle * nrm;
+                }
+            }
+        }
+        let edge_normals: Vec<DVec3> = body
+            .edges()
+            .iter()
+            .map(|e| {
+                e.faces
+                    .iter()
+                    .filter(|&&f| (f as usize) < normals.len())
+                    .map(|&f| normals[f as usize])
+                    .sum()
+            })
+            .collect();
+        let n = [
+            ((hi.x - lo.x) / s).ceil().max(1.0) as usize,
+            ((hi.y - lo.y) / s).ceil().max(1.0) as usize,
+            ((hi.z - lo.z) / s).ceil().max(1.0) as usize,
+        ];
+        let cells = n[0] * n[1] * n[2];
+        let band = grid.band;
+        let roundoff = ROUNDOFF_REL * (lo.abs().max(hi.abs()).max_element() + band + s);
+        // Each cell's test point `q`, and the reach of its list (`D + 2 R`), or NaN (far).
+        let mut far: Vec<f32> = try_vec(cells, "the exact distance's lists")?;
+        let mut reach: Vec<f64> = try_vec(cells, "the exact distance's lists")?;
+        let mut test: Vec<DVec3> = try_vec(cells, "the exact distance's lists")?;
+        let half = 0.5 * 3f64.sqrt() * s;
+        let mut widest: f64 = 0.0;
+        for k in 0..n[2] {
+            for j in 0..n[1] {
+                for i in 0..n[0] {
+                    let c = lo + (DVec3::new(i as f64, j as f64, k as f64) + 0.5) * s;
+                    let (v, q) = grid.nearest_node(c);
+                    let delta = q.distance(c);
+                    test.push(q);
+                    // The grid stores the clamp as the float32 of `band`.
+                    if v.abs() >= band as f32 as f64 {
+                        far.push(band.copysign(v) as f32);
+                        reach.push(f64::NAN);
+                    } else {
+                        let r = delta + half;
+                        // `D` is the float32 of the exact distance: within `D * 2^-24` of it.
+                        let rch = v.abs() * (1.0 + f32::EPSILON as f64) + 2.0 * r + roundoff;
+                        widest = widest.max(rch);
+                        far.push(f32::NAN);
+                        reach.push(rch);
+                    }
+                }
+            }
+        }
+        let index = |i: usize, j: usize, k: usize| (k * n[1] + j) * n[0] + i;
+        let range = |a: f64, b: f64, o: f64, m: usize| -> (usize, usize) {
+            let i0 = ((a - o) / s).floor().max(0.0) as usize;
+            let i1 = (((b - o) / s).floor().max(0.0) as usize).min(m - 1);
+            (i0, i1)
+        };
+        let mut pairs: Vec<(u32, u32)> = Vec::new();
+        for (ti, t) in tris.iter().enumerate() {
+            let [a, b, c] = t.map(|i| verts[i as usize]);
+            let grow = DVec3::splat(widest + half);
+            let (tlo, thi) = (a.min(b).min(c) - grow, a.max(b).max(c) + grow);
+            let (i0, i1) = range(tlo.x, thi.x, lo.x, n[0]);
+            let (j0, j1) = range(tlo.y, thi.y, lo.y, n[1]);
+            let (k0, k1) = range(tlo.z, thi.z, lo.z, n[2]);
+            for k in k0..=k1 {
+                for j in j0..=j1 {
+                    for i in i0..=i1 {
+                        let cell = index(i, j, k);
+                        let rch = reach[cell];
+                        if rch.is_nan() {
+                            continue;
+                        }
+                        let q = test[cell];
+                        let (x, _) = closest_on_triangle(q, a, b, c);
+                        if q.distance_squared(x) <= rch * rch {
+                            pairs.push((cell as u32, ti as u32));
+                        }
+                    }
+                }
+            }
+        }
+        pairs.sort_unstable();
+        let mut start: Vec<u32> = try_vec(cells + 1, "the exact distance's lists")?;
+        let mut items: Vec<u32> = try_vec(pairs.len(), "the exact distance's lists")?;
+        let mut next = 0;
+        for cell in 0..cells {
+            start.push(items.len() as u32);
+            while next < pairs.len() && pairs[next].0 as usize == cell {
+                items.push(pairs[next].1);
+                next += 1;
+            }
+        }
+        start.push(items.len() as u32);
+        Ok(Self {
+            body,
+            vertex_normals,
+            edge_normals,
+            origin: lo,
+            s,
+            n,
+            start,
+            items,
+            far,
+        })
+    }
+
+    /// The signed distance at `p` (body frame) and the outward unit gradient there (the
+    /// direction from the nearest point, or the pseudo-normal on the surface), or `None`
+    /// and `+-band` off the lists.
+    pub(super) fn at(&self, p: DVec3) -> (f64, Option<DVec3>) {
+        let u = (p - self.origin) / self.s;
+        let [nx, ny, nz] = self.n;
+        if !(u.x >= 0.0 && u.y >= 0.0 && u.z >= 0.0) {
+            return (f64::INFINITY, None);
+        }
+        let (i, j, k) = (u.x as usize, u.y as usize, u.z as usize);
+        if i >= nx || j >= ny || k >= nz {
+            return (f64::INFINITY, None);
+        }
+        let cell = (k * ny + j) * nx + i;
+        let (a, b) = (self.start[cell] as usize, self.start[cell + 1] as usize);
+        if a == b {
+            return (self.far[cell] as f64, None);
+        }
+        let verts = self.body.vertices();
+        let tris = self.body.triangles();
+        let mut best = (f64::INFINITY, DVec3::ZERO, 0u32, Feature::Face);
+        for &t in &self.items[a..b] {
+            let [va, vb, vc] = tris[t as usize].map(|i| verts[i as usize]);
+            let (x, feature) = closest_on_triangle(p, va, vb, vc);
+            let d2 = p.distance_squared(x);
+            if d2 < best.0 {
+                best = (d2, x, t, feature);
+            }
+        }
+        let (d2, x, t, feature) = best;
+        let pseudo = match feature {
+            Feature::Face => self.body.normals()[t as usize],
+            Feature::Edge(k) => {
+                self.edge_normals[self.body.face_edges()[t as usize][k as usize] as usize]
+            }
+            Feature::Vertex(k) => self.vertex_normals[tris[t as usize][k as usize] as usize],
+        };
+        let d = d2.sqrt();
+        let away = p - x;
+        let inside = away.dot(pseudo) < 0.0;
+        let gradient = if d > 0.0 {
+            if inside {
+                -away / d
+            } else {
+                away / d
+            }
+        } else {
+            pseudo.normalize_or_zero()
+        };
+        (if inside { -d } else { d }, Some(gradient))
+    }
+}
