@@ -214,6 +214,16 @@ def rotation_channels(
     ``ValueError``. At most ``MAX_ROTATIONS`` rotations per call.
     """
 
+def rotation_channels_each(
+    rotations: ArrayLike, mode: RotationModeName, previous: ArrayLike
+) -> FloatArray:
+    """Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), each continued from
+    its own row of ``previous`` ((N, 4) or (N, 3) values in ``mode``, for example each owner's
+    current values): row ``i`` is, to the bit, ``rotation_channels(rotations[i:i + 1], mode,
+    previous=previous[i])[0]``, so many owners' keys are converted in one call. ``previous``
+    angles within ``+-MAX_PREVIOUS_ANGLE``, else ``ValueError``.
+    """
+
 def rotation_channels_near(
     rotations: ArrayLike, mode: RotationModeName, reference: ArrayLike
 ) -> FloatArray:

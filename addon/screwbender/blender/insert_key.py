@@ -28,7 +28,10 @@ one action (a rig's bones) share one pass over its curves (:func:`owners.curves_
 
 Every owner of one run goes through the phases together (:func:`insert_keys`): the motions
 before the insertions are sampled in one `polyscrew.sample_owners` call per rotation mode, and
-so are the motions after (:func:`bake.sample_poses_many`), instead of two samplings per owner.
+so are the motions after (:func:`bake.sample_poses_many`), instead of two samplings per owner;
+every owner's new rotation values are converted in one `polyscrew.rotation_channels_each` call
+per rotation mode (:func:`_rotations`), and every owner's motion before and after compared in
+one `polyscrew.turn_vectors` call (:func:`pose_changes`).
 """
 
 from __future__ import annotations
@@ -74,9 +77,20 @@ def check_frames(before: keys.KeyedMotion, frame: float) -> np.ndarray:
 
 def pose_change(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per pose: origin displacement |t_b - t_a| and rotation angle of `R_a^T R_b` (radians)."""
+    return pose_changes([(a, b)])[0]
+
+
+def pose_changes(pairs: list[tuple[np.ndarray, np.ndarray]]) -> list[tuple[np.ndarray, np.ndarray]]:
+    """:func:`pose_change` of every `(a, b)` of `pairs`, the turns of all of them in one
+    `polyscrew.turn_vectors` call (row by row: the same values as one call per pair)."""
+    if not pairs:
+        return []
+    a = np.concatenate([a for a, _ in pairs])
+    b = np.concatenate([b for _, b in pairs])
     translation = np.linalg.norm(b[:, :3, 3] - a[:, :3, 3], axis=1)
     angle = np.linalg.norm(polyscrew.turn_vectors(a, b), axis=1)  # exact near 0 and pi
-    return translation, angle
+    bounds = np.cumsum([len(a) for a, _ in pairs])[:-1]
+    return list(zip(np.split(translation, bounds), np.split(angle, bounds)))
 
 
 def _current_values(target, curves: dict, path: str, size: int, frame: float) -> np.ndarray:
@@ -213,6 +227,9 @@ class _Keying:
     packed: curves.Packed | None
     before: keys.KeyedMotion
     frames: np.ndarray
+    #: The owner's curves by (property, index) and its new rotation values (:func:`_rotations`).
+    by_prop: dict | None = None
+    rotation: np.ndarray | None = None
     #: Set by the insertion: the owner's nested transaction, values keyed, curves keyed and made.
     one: transaction.Transaction | None = None
     values: dict | None = None
@@ -303,6 +320,7 @@ def _insert_round(
             out[i] = got
         else:
             sampled.append((i, keying, got))
+    _rotations([(keying, poses) for _, keying, (poses, _) in sampled], frame)
     opened = []
     try:
         for _, keying, (poses, scales) in sampled:
@@ -321,6 +339,7 @@ def _insert_round(
                 reread.append((i, keying, after))
         after = bake.sample_poses_many([(k.owner, a, k.frames) for _, k, a in reread], options)
         poses_after = {i: got for (i, _, _), got in zip(reread, after)}
+        compared = []
         for i, keying, (poses, _) in sampled:
             got = poses_after.get(i, out[i])
             if isinstance(got, SmoothError):
@@ -334,8 +353,11 @@ def _insert_round(
             keying.one.commit()
             if keying.given is not None:
                 known[tuple(fc.as_pointer() for fc in keying.given[0])] = keying.given[1]
-            out[i] = _result(keying, poses, got[0], frame)
+            compared.append((i, keying, poses, got[0]))
             done[i] = keying
+        changes = pose_changes([(before, after) for _, _, before, after in compared])
+        for (i, keying, _, _), change in zip(compared, changes):
+            out[i] = _result(keying, change, frame)
     except BaseException:
         for one in opened:  # the parent undoes them with everything else
             one.commit()
@@ -343,28 +365,50 @@ def _insert_round(
     return out, done
 
 
+def _at(keying: _Keying, frame: float) -> int:
+    """The row of `frame` among `keying`'s compared frames."""
+    return int(np.searchsorted(keying.frames, frame))
+
+
+def _rotations(sampled: list[tuple[_Keying, np.ndarray]], frame: float) -> None:
+    """Sets, for every `(keying, poses sampled before)` of `sampled`, its owner's curves by
+    (property, index) (`by_prop`) and its new rotation values at `frame` (`rotation`): the
+    pose sampled at `frame` in the owner's rotation mode, continued from the values its
+    curves (or its static channels) have there. One `polyscrew.rotation_channels_each` call
+    per rotation mode for every owner, row by row the same values as one
+    `rotation_channels(pose, mode, previous=...)` call per owner."""
+    by_mode: dict[str, list[tuple[_Keying, np.ndarray, np.ndarray]]] = {}
+    for keying, poses in sampled:
+        owner = keying.owner
+        keying.by_prop = {}
+        for fc in keying.listed:
+            prop = owner.prop_of(fc.data_path)
+            if prop is not None:
+                keying.by_prop[(prop, fc.array_index)] = fc
+        mode = owner.rotation_mode
+        previous = _current_values(owner.target, keying.by_prop, keys.rotation_path(mode), keys.rotation_width(mode), frame)
+        by_mode.setdefault(mode, []).append((keying, poses[_at(keying, frame)], previous))
+    for mode, rows in by_mode.items():
+        values = polyscrew.rotation_channels_each(
+            np.stack([pose for _, pose, _ in rows]), mode, np.stack([previous for _, _, previous in rows])
+        )
+        for (keying, _, _), row in zip(rows, values):
+            keying.rotation = row
+
+
 def _insert(keying: _Keying, poses: np.ndarray, scales: np.ndarray | None, frame: float) -> None:
     """Inserts the keys of `keying`'s owner at `frame` (inside `keying.one`), the pose sampled
     before at `frame` (among the compared frames: sampling is per frame, the same values as
-    sampling `frame` alone), and splices them into its packed keys (`keying.given`)."""
+    sampling `frame` alone) with the rotation values :func:`_rotations` set, and splices them
+    into its packed keys (`keying.given`)."""
     owner, listed, chosen, packed, before = keying.owner, keying.listed, keying.chosen, keying.packed, keying.before
-    t = keying.one
-    at = int(np.searchsorted(keying.frames, frame))
+    t, by_prop = keying.one, keying.by_prop
+    at = _at(keying, frame)
     pose = poses[at : at + 1]
     scale = scales[at : at + 1] if scales is not None else None
-
-    mode = owner.rotation_mode
-    rotation_path = keys.rotation_path(mode)
-    size = keys.rotation_width(mode)
-    by_prop = {}
-    for fc in listed:
-        prop = owner.prop_of(fc.data_path)
-        if prop is not None:
-            by_prop[(prop, fc.array_index)] = fc
-    previous = _current_values(owner.target, by_prop, rotation_path, size, frame)
     values = {
         "location": pose[0, :3, 3].copy(),
-        rotation_path: polyscrew.rotation_channels(pose, mode, previous=previous)[0],
+        keys.rotation_path(owner.rotation_mode): keying.rotation,
     }
     if not before.located:
         del values["location"]  # a connected bone: Blender ignores its location
@@ -413,9 +457,10 @@ def _insert(keying: _Keying, poses: np.ndarray, scales: np.ndarray | None, frame
         keying.listed = listed_after
 
 
-def _result(keying: _Keying, poses_before: np.ndarray, poses_after: np.ndarray, frame: float) -> InsertResult:
-    """What the insertion of `keying` did: the motion compared before and after."""
-    translation, angle = pose_change(poses_before, poses_after)
+def _result(keying: _Keying, change: tuple[np.ndarray, np.ndarray], frame: float) -> InsertResult:
+    """What the insertion of `keying` did: the motion compared before and after
+    (:func:`pose_change` of the poses before and after)."""
+    translation, angle = change
     worst = int(np.argmax(translation))
     return InsertResult(
         frame=frame,

@@ -430,21 +430,53 @@ class _Evaluated:
         self.row = {fc.as_pointer(): i for i, fc in enumerate(listed)}
         self.plays = plays
         self.memo: dict = {}
+        #: `matrix_basis` per owner ((object pointer, bone)) made by :meth:`bases`.
+        self.made: dict = {}
 
-    def basis(self, obj: bpy.types.Object, bone: str = "") -> np.ndarray:
-        """`matrix_basis` (N, 4, 4): `T R S` of the channels (Blender's BKE_object_to_mat4,
-        BKE_pchan_to_mat4: a connected bone's location ignored)."""
+    def _channels(self, obj: bpy.types.Object, bone: str) -> tuple[str, dict]:
+        """The owner's rotation mode and its channels (path -> (N, width)) at every frame: its
+        curves' values, its static values where no curve plays (a connected bone's location 0)."""
         target = obj.pose.bones[bone] if bone else obj
         mode = target.rotation_mode
-        paths = keys.transform_paths(mode)
         n = len(self.frames)
-        channels_ = {path: np.tile(np.array(getattr(target, path), dtype=np.float64), (n, 1)) for path in paths}
+        channels_ = {path: np.tile(np.array(getattr(target, path), dtype=np.float64), (n, 1)) for path in keys.transform_paths(mode)}
         for fc in self.plays.played(obj, bone):
             prop = fc.data_path.rsplit(".", 1)[-1] if bone else fc.data_path
             channels_[prop][:, fc.array_index] = self.values[self.row[fc.as_pointer()]]
         if bone and obj.data.bones[bone].use_connect:
             channels_["location"][:] = 0.0
-        return keys.compose(channels_["location"], keys.rotation_matrices(channels_[paths[1]], mode), channels_["scale"])
+        return mode, channels_
+
+    def bases(self, owners: list[tuple]) -> None:
+        """Makes :meth:`basis` of every owner ((object, bone)) of `owners`, their rotation
+        matrices in one `polyscrew.rotation_matrices` call per rotation mode (row by row: the
+        same matrices as one call per owner). A mode whose call refuses its values is left to
+        :meth:`basis`, owner by owner, which names the owner's error as before."""
+        by_mode: dict[str, list] = {}
+        for obj, bone in owners:
+            key = (obj.as_pointer(), bone)
+            if key not in self.made:
+                self.made[key] = None  # (once per owner)
+                mode, channels_ = self._channels(obj, bone)
+                by_mode.setdefault(mode, []).append((key, channels_, keys.transform_paths(mode)[1]))
+        for mode, rows in by_mode.items():
+            try:
+                matrices = keys.rotation_matrices(np.concatenate([c[path] for _, c, path in rows]), mode)
+            except ValueError:
+                continue
+            n = len(self.frames)
+            for k, (key, c, _) in enumerate(rows):
+                self.made[key] = keys.compose(c["location"], matrices[k * n : (k + 1) * n], c["scale"])
+
+    def basis(self, obj: bpy.types.Object, bone: str = "") -> np.ndarray:
+        """`matrix_basis` (N, 4, 4): `T R S` of the channels (Blender's BKE_object_to_mat4,
+        BKE_pchan_to_mat4: a connected bone's location ignored); made by :meth:`bases` when
+        it was."""
+        made = self.made.get((obj.as_pointer(), bone))
+        if made is not None:
+            return made
+        mode, channels_ = self._channels(obj, bone)
+        return keys.compose(channels_["location"], keys.rotation_matrices(channels_[keys.transform_paths(mode)[1]], mode), channels_["scale"])
 
     def pose(self, rig: bpy.types.Object, bone: str) -> np.ndarray:
         """`pose_bone.matrix` (armature space): `P_parent R_parent^-1 R B` (R: rest
@@ -554,6 +586,7 @@ def world_poses_all(
     if evaluated:
         frames = np.unique(np.concatenate([items[i][1] for i in evaluated]))
         matrices = _Evaluated(plan.plays, frames, plan.packed, plan.listed)
+        matrices.bases([owner for i in evaluated for owner in plan.chains[i]])
         for i in evaluated:
             obj, wanted, driver = items[i]
             out[i] = _rigid_and_scale(obj.name, matrices.carried(obj, driver)[np.searchsorted(frames, wanted)])

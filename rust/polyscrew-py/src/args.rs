@@ -203,6 +203,7 @@ functions!(
     TimedFrames = "timed_frames",
     RotationChannels = "rotation_channels",
     RotationChannelsNear = "rotation_channels_near",
+    RotationChannelsEach = "rotation_channels_each",
     TurnVectors = "turn_vectors",
     AnglesNear = "angles_near",
     SameRotationMap = "same_rotation_map",

@@ -11,17 +11,18 @@ use polyscrew::motion::subdivision::{subdivision_footprint, SUBDIVISION_HINT};
 use polyscrew::{
     angles_near as core_angles_near, channels_near as core_channels_near,
     direction_steps as core_direction_steps, partial_moves as core_partial_moves,
-    rotation_channels as core_rotation_channels, same_rotation_map as core_same_rotation_map,
-    sample as core_sample, subdivide as core_subdivide, subdivided_len,
-    turn_vectors as core_turn_vectors, Error, MoveBounds, Pose, RotationMode, Scheme, Screw,
-    Timing, MAX_LEVELS,
+    rotation_channels as core_rotation_channels,
+    rotation_channels_each as core_rotation_channels_each,
+    same_rotation_map as core_same_rotation_map, sample as core_sample,
+    subdivide as core_subdivide, subdivided_len, turn_vectors as core_turn_vectors, Error,
+    MoveBounds, Pose, RotationMode, Scheme, Screw, Timing, MAX_LEVELS,
 };
 use pyo3::prelude::*;
 
 use crate::args::{
     self, copy_of, float_array, AnglesNear, Choice, DirectionSteps, FloatArg, FloatArray, Function,
-    PartialMoves, RotationChannels, RotationChannelsNear, SameRotationMap, Sample, SampleChannels,
-    SampleVectors, Subdivide, SubdivideVectors, TurnVectors,
+    PartialMoves, RotationChannels, RotationChannelsEach, RotationChannelsNear, SameRotationMap,
+    Sample, SampleChannels, SampleVectors, Subdivide, SubdivideVectors, TurnVectors,
 };
 use crate::arrays::{
     fill, key_count, pose_count, poses_to_array, read_keys, read_one_pose, read_poses, read_spec,
@@ -682,6 +683,34 @@ fn rotation_channels<'py>(
     Ok(out.into_pyarray(py))
 }
 
+/// rotation_channels_each(
+///     rotations: ArrayLike, mode: RotationModeName, previous: ArrayLike
+/// ) -> FloatArray
+///
+/// Blender rotation channels of ``rotations`` ((N, 3, 3) or (N, 4, 4)), each continued from
+/// its own row of ``previous`` ((N, 4) or (N, 3) values in ``mode``, for example each owner's
+/// current values): row ``i`` is, to the bit, ``rotation_channels(rotations[i:i + 1], mode,
+/// previous=previous[i])[0]``, so many owners' keys are converted in one call. ``previous``
+/// angles within ``+-MAX_PREVIOUS_ANGLE``, else ``ValueError``.
+#[pyfunction]
+fn rotation_channels_each<'py>(
+    py: Python<'py>,
+    rotations: &Bound<'py, PyAny>,
+    mode: Choice<RotationChannelsEach, RotationMode>,
+    previous: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let rows = ("previous", previous);
+    let core: PerRow = core_rotation_channels_each;
+    per_row(
+        py,
+        RotationChannelsEach::NAME,
+        rotations,
+        mode.0,
+        rows,
+        core,
+    )
+}
+
 /// rotation_channels_near(
 ///     rotations: ArrayLike, mode: RotationModeName, reference: ArrayLike
 /// ) -> FloatArray
@@ -700,39 +729,59 @@ fn rotation_channels_near<'py>(
     mode: Choice<RotationChannelsNear, RotationMode>,
     reference: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    const F: &str = RotationChannelsNear::NAME;
-    let mode = mode.0;
-    let rotations = float_array(F, "rotations", rotations)?;
-    let reference = float_array(F, "reference", reference)?;
+    let rows = ("reference", reference);
+    per_row(
+        py,
+        RotationChannelsNear::NAME,
+        rotations,
+        mode.0,
+        rows,
+        core_channels_near,
+    )
+}
+
+/// A core conversion of N rotations in a mode, each with its own row of N x width values.
+type PerRow = fn(&[DQuat], RotationMode, &[f64]) -> Result<Vec<f64>, Error>;
+
+/// The shared body of `rotation_channels_near` and `rotation_channels_each`: reads
+/// `rotations` ((N, 3, 3) or (N, 4, 4)) and the rows `name` ((N, width) values in `mode`),
+/// checks their shapes and the budget, and runs `core` on the N rotations and their rows
+/// with the GIL released.
+fn per_row<'py>(
+    py: Python<'py>,
+    function: &'static str,
+    rotations: &Bound<'py, PyAny>,
+    mode: RotationMode,
+    (name, rows): (&'static str, &Bound<'py, PyAny>),
+    core: PerRow,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    const VALUES: &str = "row values";
+    let f = function;
+    let rotations = float_array(f, "rotations", rotations)?;
+    let rows = float_array(f, name, rows)?;
     let n = rotations.shape().first().copied().unwrap_or(0);
     let width = mode.width();
-    if reference.shape() != [n, width] {
-        return Err(shape_err(
-            F,
-            "reference",
-            &format!("({n}, {width})"),
-            reference.shape(),
-        ));
+    if rows.shape() != [n, width] {
+        return Err(shape_err(f, name, &format!("({n}, {width})"), rows.shape()));
     }
     check_budget(
-        F,
+        f,
         rotations.copy()
-            + reference.copy()
+            + rows.copy()
             + Footprint::of::<DQuat>(n)
             + Footprint::of::<f64>(n.saturating_mul(width).saturating_mul(2)),
         "the rotation channels",
         polyscrew::motion::channels::CHANNELS_HINT,
     )?;
-    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(F, e))?;
-    let (rotations, reference) = (rotations.read()?, reference.read()?);
-    let (view, rv) = (rotations.as_array(), reference.as_array());
+    polyscrew::motion::channels::check_rotation_count(n).map_err(|e| to_py_err(f, e))?;
+    let (rotations, rows) = (rotations.read()?, rows.read()?);
+    let (view, rv) = (rotations.as_array(), rows.as_array());
     let out = py.detach(|| -> PyResult<Array2<f64>> {
-        let quats = read_rotations(F, &view)?;
-        let mut values =
-            try_vec(n.saturating_mul(width), "reference values").map_err(|e| to_py_err(F, e))?;
+        let quats = read_rotations(f, &view)?;
+        let mut values = try_vec(n.saturating_mul(width), VALUES).map_err(|e| to_py_err(f, e))?;
         values.extend(rv.iter().copied());
-        let channels = core_channels_near(&quats, mode, &values).map_err(|e| to_py_err(F, e))?;
-        Array2::from_shape_vec((n, width), channels).map_err(|e| invalid(format!("{F}: {e}")))
+        let channels = core(&quats, mode, &values).map_err(|e| to_py_err(f, e))?;
+        Array2::from_shape_vec((n, width), channels).map_err(|e| invalid(format!("{f}: {e}")))
     })?;
     Ok(out.into_pyarray(py))
 }
@@ -1017,6 +1066,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sample_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_channels_near, m)?)?;
+    m.add_function(wrap_pyfunction!(rotation_channels_each, m)?)?;
     m.add_function(wrap_pyfunction!(turn_vectors, m)?)?;
     m.add_function(wrap_pyfunction!(angles_near, m)?)?;
     m.add_function(wrap_pyfunction!(same_rotation_map, m)?)?;

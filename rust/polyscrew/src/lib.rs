@@ -38,7 +38,7 @@
 //! Keys a variant like them whose parameters [`intent::timed_frames`] computes from
 //! Blender's playback and the body's size. The Python module exposes them
 //! (`ROTATION_MODES`, `CONTINUED_ROTATION_MODES`, `NORMALISED_CHANNELS`, `TIMINGS`,
-//! `PACED_TIMINGS`, `rotation_matrices`, `rotation_channels`, `rotation_channels_near`,
+//! `PACED_TIMINGS`, `rotation_matrices`, `rotation_channels`, `rotation_channels_each`, `rotation_channels_near`,
 //! `angles_near`, `same_rotation_map`, `turn_vectors`, `direction_steps`, `partial_moves`,
 //! `timed_frames`) and the add-on calls them.
 //!
@@ -118,8 +118,8 @@ pub use intent::{
 };
 pub use memory::{memory_budget, set_memory_budget, Footprint, DEFAULT_MEMORY_BUDGET};
 pub use motion::channels::{
-    angles_near, channels_near, rotation_channels, same_rotation_map, EulerOrder, RotationMode,
-    MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
+    angles_near, channels_near, rotation_channels, rotation_channels_each, same_rotation_map,
+    EulerOrder, RotationMode, MAX_PREVIOUS_ANGLE, MAX_ROTATIONS,
 };
 pub use motion::moves::{direction_steps, partial_moves, turn_vectors, MoveBounds};
 pub use motion::pose::{poses_from_rows, Pose, RIGID_TOLERANCE};

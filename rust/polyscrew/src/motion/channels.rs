@@ -545,6 +545,19 @@ pub fn rotation_channels(
     Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
     check_rotation_count(rotations.len())?;
     let mut out = try_vec(values, "rotation channels")?;
+    push_channels(rotations, mode, previous, &mut out);
+    Ok(out)
+}
+
+/// Appends to `out` the channel values of `rotations` in `mode`, continuous frame to frame
+/// from `previous` (checked already): the arithmetic of [`rotation_channels`], shared with
+/// [`rotation_channels_each`] so the two agree to the bit.
+fn push_channels(
+    rotations: &[DQuat],
+    mode: RotationMode,
+    previous: Option<&[f64]>,
+    out: &mut Vec<f64>,
+) {
     match mode {
         RotationMode::Quaternion => {
             let mut prev = previous.map(|p| DQuat::from_xyzw(p[1], p[2], p[3], p[0]));
@@ -589,7 +602,6 @@ pub fn rotation_channels(
         }
         RotationMode::Euler(order) => {
             let prev = previous.map(|p| DVec3::new(p[0], p[1], p[2]));
-            let out = &mut out;
             match order {
                 EulerOrder::Xyz => euler_rows::<0, 1, 2, false>(rotations, prev, out),
                 EulerOrder::Xzy => euler_rows::<0, 2, 1, true>(rotations, prev, out),
@@ -599,6 +611,50 @@ pub fn rotation_channels(
                 EulerOrder::Zyx => euler_rows::<2, 1, 0, true>(rotations, prev, out),
             }
         }
+    }
+}
+
+/// The checks of a conversion of `n` rotations in `mode` each against its own row of
+/// `reference` (named `what`, its values `value`): the rotation count, the reference's
+/// length and values ([`check_reference`]), the memory budget; then the empty output.
+fn per_row_channels(
+    n: usize,
+    mode: RotationMode,
+    reference: &[f64],
+    what: &'static str,
+    value: &'static str,
+) -> Result<Vec<f64>> {
+    let values = n.saturating_mul(mode.width());
+    check_rotation_count(n)?;
+    check_reference(reference, values, mode, what, value)?;
+    Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
+    try_vec(values, "rotation channels")
+}
+
+/// Channel values of each rotation in `mode` continued from its own row of `previous`
+/// (`N x width` values: for example each owner's current channel values): row `i` is, to the
+/// bit, `rotation_channels(&rotations[i..=i], mode, Some(previous row i))`. Many owners'
+/// single keys converted in one call.
+///
+/// # Errors
+/// [`Error::LengthMismatch`] when `previous` does not hold `N x width` values,
+/// [`Error::NotFinite`] for NaN or infinity in it, [`Error::OutOfRange`] for one of its angles
+/// beyond [`MAX_PREVIOUS_ANGLE`], [`Error::Limit`] for more than [`MAX_ROTATIONS`]
+/// rotations, [`Error::Memory`] when the channels exceed the memory budget.
+pub fn rotation_channels_each(
+    rotations: &[DQuat],
+    mode: RotationMode,
+    previous: &[f64],
+) -> Result<Vec<f64>> {
+    let mut out = per_row_channels(
+        rotations.len(),
+        mode,
+        previous,
+        "previous",
+        "previous value",
+    )?;
+    for (q, p) in rotations.iter().zip(previous.chunks_exact(mode.width())) {
+        push_channels(std::slice::from_ref(q), mode, Some(p), &mut out);
     }
     Ok(out)
 }
@@ -648,13 +704,14 @@ pub fn channels_near(
     mode: RotationMode,
     reference: &[f64],
 ) -> Result<Vec<f64>> {
-    let width = mode.width();
-    let values = rotations.len().saturating_mul(width);
-    check_rotation_count(rotations.len())?;
-    check_reference(reference, values, mode, "reference", "reference value")?;
-    Footprint::of::<f64>(values).check("rotation channels", CHANNELS_HINT)?;
-    let mut out = try_vec(values, "rotation channels")?;
-    for (q, r) in rotations.iter().zip(reference.chunks_exact(width)) {
+    let mut out = per_row_channels(
+        rotations.len(),
+        mode,
+        reference,
+        "reference",
+        "reference value",
+    )?;
+    for (q, r) in rotations.iter().zip(reference.chunks_exact(mode.width())) {
         let q = q.normalize();
         match mode {
             RotationMode::Quaternion => {
@@ -1139,6 +1196,46 @@ pub(crate) mod tests {
             err.to_string(),
             "rotation mode: \"xyz\" is not one of QUATERNION, AXIS_ANGLE, XYZ, XZY, YXZ, YZX, ZXY, ZYX"
         );
+    }
+
+    #[test]
+    fn rotation_channels_each_is_one_call_per_row() {
+        let rots: Vec<DQuat> = (0..40)
+            .map(|i| {
+                let axis = DVec3::new((i as f64).sin(), 0.3, (i as f64 * 0.7).cos()).normalize();
+                let q = DQuat::from_axis_angle(axis, i as f64 * 0.37 - 6.0);
+                if i % 3 == 0 {
+                    -q
+                } else {
+                    q
+                }
+            })
+            .collect();
+        for mode in RotationMode::ALL {
+            let w = mode.width();
+            let previous: Vec<f64> = (0..rots.len() * w)
+                .map(|k| 9.0 * ((k as f64) * 1.3).sin())
+                .collect();
+            let got = rotation_channels_each(&rots, mode, &previous).unwrap();
+            let want: Vec<f64> = rots
+                .iter()
+                .zip(previous.chunks_exact(w))
+                .flat_map(|(q, p)| {
+                    rotation_channels(std::slice::from_ref(q), mode, Some(p)).unwrap()
+                })
+                .collect();
+            assert_eq!(got, want, "{mode:?}: previous {previous:?}");
+            assert!(matches!(
+                rotation_channels_each(&rots, mode, &previous[1..]),
+                Err(Error::LengthMismatch { .. })
+            ));
+            let mut bad = previous.clone();
+            bad[w + 1] = f64::NAN;
+            assert!(matches!(
+                rotation_channels_each(&rots, mode, &bad),
+                Err(Error::NotFinite { index, .. }) if index == w + 1
+            ));
+        }
     }
 
     #[test]
