@@ -649,7 +649,7 @@ DEFAULT_CLOSED_TOLERANCE: float
 """The default tolerance of ``sweep_closed``, as a fraction of the body's extent, its bounding box's diagonal (0.005)."""
 
 CLOSED_CELL_PER_TOLERANCE: float
-"""The first cell of ``sweep_closed`` as a multiple of its tolerance (1.25)."""
+"""The first cell of ``sweep_closed`` as a multiple of its tolerance (2)."""
 
 CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
 ParametrizationName = Literal["uniform", "centripetal"]
