@@ -827,6 +827,33 @@ class Playback:
         every function that plays it: how often a caller plays the same curves.
         """
 
+def measure_departures(
+    playbacks: Sequence[Playback],
+    frames: ArrayLike,
+    counts: ArrayLike,
+    location: ArrayLike,
+    rotation: ArrayLike,
+    *,
+    degrees: ArrayLike,
+    distances: ArrayLike,
+    played: ArrayLike | None = None,
+    key_frames: ArrayLike | None = None,
+    key_counts: ArrayLike | None = None,
+    most: int = 64,
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """``Playback.measure_departure`` of many owners in one call, each owner's figures to the
+    bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]`` and the next
+    ``counts[i]`` rows of ``frames`` (N,), ``location`` (N, 3), ``rotation`` (N, 4: an
+    Euler owner's 3 angles and one column not read) and ``played`` (N, 7: location and the
+    rotation's 3 or 4 numbers, the rest not read; NaN rows where not known, as an owner
+    without played rows has), with the limits ``degrees[i]`` and ``distances[i]`` (O,) and,
+    with ``key_frames``, the next ``key_counts[i]`` of them (-1: the owner measures every
+    frame, as without ``key_frames``). Returns the largest angle (degrees) and distance per
+    owner (O,) and ``over`` (N,), the owners' flags one after the other. GIL released.
+    Raises ValueError for what ``measure_departure`` refuses, naming the owner (``part
+    i``), and for counts or shapes that do not match.
+    """
+
 def analyse_spans(
     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
 ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:

@@ -268,6 +268,51 @@ def departure(
     return Departure(degrees=degrees, distance=distance, frames=frames[over])
 
 
+def departures(
+    items: list[tuple[Source, float, np.ndarray, np.ndarray | None, np.ndarray, np.ndarray | None, np.ndarray | None]],
+) -> list[Departure]:
+    """:func:`departure` of each `(source, size, frames, location, rotation, key_frames,
+    played)` of `items`, the same figures to the bit, in one `polyscrew.measure_departures`
+    call for all of them (rotations padded to 4 columns, played rows to 7, NaN rows where an
+    owner has none). When the batch is refused (a bad owner, its memory) each item is
+    measured alone, so that a refusal raises what :func:`departure` raises."""
+    if not items:
+        return []
+    frames = [np.asarray(item[2], dtype=np.float64) for item in items]
+    counts = np.array([len(f) for f in frames], dtype=np.int64)
+    n = int(counts.sum())
+    location = np.zeros((n, 3))
+    rotation = np.zeros((n, 4))
+    played = np.full((n, 7), np.nan) if any(item[6] is not None for item in items) else None
+    keyed = any(item[5] is not None for item in items)
+    ends = np.cumsum(counts)
+    for (_, _, _, loc, rot, _, rows), end, count in zip(items, ends.tolist(), counts.tolist()):
+        at = slice(end - count, end)
+        if loc is not None:
+            location[at] = loc
+        rotation[at, : np.shape(rot)[1]] = rot
+        if rows is not None:
+            played[at, : np.shape(rows)[1]] = rows
+    try:
+        degrees, distance, over = polyscrew.measure_departures(
+            [item[0].playback for item in items], np.concatenate(frames), counts, location, rotation,
+            degrees=np.full(len(items), DEPARTURE_DEGREES),
+            distances=np.array([DEPARTURE_FRACTION * item[1] for item in items], dtype=np.float64),
+            played=played,
+            key_frames=np.concatenate([item[5] for item in items if item[5] is not None] or [np.zeros(0)])
+            if keyed else None,
+            key_counts=np.array([-1 if item[5] is None else len(item[5]) for item in items], dtype=np.int64)
+            if keyed else None,
+            most=DEPARTURE_SPAN_FRAMES,
+        )
+    except (ValueError, MemoryError):  # each alone: the refused one raises its own error
+        return [departure(source, size, f, loc, rot, keys, rows) for (source, size, f, loc, rot, keys, rows) in items]
+    return [
+        Departure(degrees=d, distance=x, frames=f[over[end - count : end]])
+        for d, x, f, end, count in zip(degrees.tolist(), distance.tolist(), frames, ends.tolist(), counts.tolist())
+    ]
+
+
 def departure_note(name: str, found: Departure, size: float, causes: list[str]) -> str | None:
     """The report's line for an owner whose result departs from Blender's playback (None when
     it stays within the thresholds): the owner, the largest angle and distance (and the
