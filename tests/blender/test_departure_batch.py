@@ -10,30 +10,18 @@ import polyscrew
 import pytest
 
 import bake_helpers as h
-import bone_helpers as bh
 from conftest import addon_module
-from test_smooth_batch import result_digests, varied_scene
+from test_smooth_batch import counting_calls, result_digests, smooth_varied_scene
 from test_speed_smooth import keyed
 
 
-def counting_departures(monkeypatch) -> dict[str, int]:
+def counting_departures(monkeypatch):
     """Counts the add-on's departure measures: `polyscrew.measure_departures` (the batch) and
     `intent.departure` (the add-on's only caller of `Playback.measure_departure`, one owner:
-    a pyo3 method cannot be wrapped itself). `raising=False`: a module without the batch is
-    counted too."""
-    intent = addon_module("pure.intent")
-    calls = {"measure_departures": 0, "departure": 0}
-    for owner, name in ((polyscrew, "measure_departures"), (intent, "departure")):
-        original = getattr(owner, name, None)
-        if original is None:
-            continue
-
-        def counted(*args, _name=name, _original=original, **kwargs):
-            calls[_name] += 1
-            return _original(*args, **kwargs)
-
-        monkeypatch.setattr(owner, name, counted, raising=False)
-    return calls
+    a pyo3 method cannot be wrapped itself). Returns what gives the counts so far."""
+    batch = counting_calls(monkeypatch, ("measure_departures",))
+    alone = counting_calls(monkeypatch, ("departure",), addon_module("pure.intent"))
+    return lambda: batch | alone
 
 
 def test_six_and_twenty_four_objects_make_the_same_departure_calls(monkeypatch):
@@ -46,7 +34,7 @@ def test_six_and_twenty_four_objects_make_the_same_departure_calls(monkeypatch):
         calls = counting_departures(monkeypatch)
         assert bpy.ops.screwbender.smooth(scheme="jarek") == {"FINISHED"}
         assert all(o.animation_data.action.name.endswith(".smooth") for o in objects)
-        made[count] = dict(calls)
+        made[count] = calls()
         monkeypatch.undo()
     print(f"departure calls: {made}")
     assert made[6] == made[24] == {"measure_departures": 1, "departure": 0}
@@ -66,11 +54,6 @@ def test_batched_departures_report_and_write_what_each_owner_alone_did(monkeypat
     got = {}
     for way in ("batched", "alone"):
         capfd.readouterr()
-        objects = varied_scene(way)
-        rig = bh.armature()
-        rig.name = f"Rig{way}"
-        for n, bone in enumerate(("Upper", "Fore", "Hand")):
-            bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=30 + n, gentle=False))
         alone = []
         if way == "alone":
             def refuse(*args, **kwargs):
@@ -84,17 +67,10 @@ def test_batched_departures_report_and_write_what_each_owner_alone_did(monkeypat
 
             monkeypatch.setattr(polyscrew, "measure_departures", refuse)
             monkeypatch.setattr(intent, "departure", counted)
-        h.select_only(*objects)
-        assert bpy.ops.screwbender.smooth(scheme=scheme) == {"FINISHED"}
-        h.select_only(rig)
-        bpy.ops.object.mode_set(mode="POSE")
-        bh.select_bones(rig, ["Upper", "Fore", "Hand"])
-        assert bpy.ops.screwbender.smooth(scheme=scheme) == {"FINISHED"}
-        bpy.ops.object.mode_set(mode="OBJECT")
-        lines = [line.replace(way, "") for line in reports(capfd)]
-        got[way] = (lines, result_digests(objects + [rig]))
+        owners = smooth_varied_scene(way, gentle=False, scheme=scheme)
+        got[way] = ([line.replace(way, "") for line in reports(capfd)], result_digests(owners))
         if way == "alone":
-            assert len(alone) == len(objects) - 1 + 3  # (every owner alone: the twins share one action)
+            assert len(alone) == len(owners) - 2 + 3  # (every owner alone: the twins share one action, 3 bones)
             monkeypatch.undo()
     assert got["batched"] == got["alone"]
     departs = [line for line in got["batched"][0] if "departs from what Blender played" in line]

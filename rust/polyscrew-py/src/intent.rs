@@ -378,16 +378,13 @@ impl PyPlayback {
         // the result, a row and the figures; the playback's rows of one chunk), the output
         check_budget(
             F,
-            frames.copy()
-                + location.copy()
-                + rotation.copy()
-                + played
-                    .as_ref()
-                    .map_or(Footprint::of::<f64>(0), |p| p.copy())
-                + key_frames
-                    .as_ref()
-                    .map_or(Footprint::of::<f64>(0), |a| a.copy())
-                + Footprint::of::<f64>(t.saturating_mul(3 + w + 3 + w + 1).saturating_add(k))
+            departure_copies([
+                Some(&frames),
+                Some(&location),
+                Some(&rotation),
+                played.as_ref(),
+                key_frames.as_ref(),
+            ]) + Footprint::of::<f64>(t.saturating_mul(3 + w + 3 + w + 1).saturating_add(k))
                 + Footprint::of::<f64>(t.saturating_mul(4 + 3 + w + 3))
                     .and::<f64>(4096 * inner.width())
                     .and::<bool>(t),
@@ -434,6 +431,30 @@ impl PyPlayback {
     fn rows_evaluated(&self) -> u64 {
         self.inner.rows_evaluated()
     }
+}
+
+/// What converting the arguments of a departure measure costs (frames, location, rotation,
+/// and the played rows and key frames when given).
+fn departure_copies(arrays: [Option<&args::FloatArg<'_>>; 5]) -> Footprint {
+    arrays.into_iter().flatten().map(|a| a.copy()).sum()
+}
+
+/// The `Playback`s of the sequence `obj` (at most [`crate::many::MAX_PARTS`]), or a
+/// `TypeError` naming `function`.
+pub(crate) fn playbacks_arg<'py>(
+    function: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<Vec<Bound<'py, PyPlayback>>> {
+    args::sequence(
+        function,
+        "playbacks",
+        obj,
+        Most::AtMost(crate::many::MAX_PARTS),
+        "a sequence of polyscrew.Playback",
+    )?
+    .iter()
+    .map(|p| playback_arg(function, "playbacks", p).cloned())
+    .collect()
 }
 
 /// `counts` of `measure_departures` (one per owner, each at least `least`: -1 for "none").
@@ -528,17 +549,7 @@ fn measure_departures<'py>(
     Bound<'py, PyArray1<bool>>,
 )> {
     const F: &str = MeasureDepartures::NAME;
-    let items = args::sequence(
-        F,
-        "playbacks",
-        playbacks,
-        Most::AtMost(1 << 32),
-        "a sequence of polyscrew.Playback",
-    )?;
-    let bound: Vec<Bound<'py, PyPlayback>> = items
-        .iter()
-        .map(|p| playback_arg(F, "playbacks", p).cloned())
-        .collect::<PyResult<_>>()?;
+    let bound = playbacks_arg(F, playbacks)?;
     let o = bound.len();
     let as_len = |c: i64| usize::try_from(c).unwrap_or(0);
     let counts: Vec<usize> = owner_counts("counts", counts, o, 0)?
@@ -609,16 +620,13 @@ fn measure_departures<'py>(
     // owner at most (as `measure_departure`), the outputs
     check_budget(
         F,
-        frames.copy()
-            + location.copy()
-            + rotation.copy()
-            + played
-                .as_ref()
-                .map_or(Footprint::of::<f64>(0), |p| p.copy())
-            + key_frames
-                .as_ref()
-                .map_or(Footprint::of::<f64>(0), |a| a.copy())
-            + Footprint::of::<f64>(n.saturating_mul(1 + 3 + 4 + 7 + 4 + 7).saturating_add(k))
+        departure_copies([
+            Some(&frames),
+            Some(&location),
+            Some(&rotation),
+            played.as_ref(),
+            key_frames.as_ref(),
+        ]) + Footprint::of::<f64>(n.saturating_mul(1 + 3 + 4 + 7 + 4 + 7).saturating_add(k))
             + Footprint::of::<f64>(n.saturating_mul(4 + 7 + 3 + 4 + 7 + 1))
                 .and::<f64>(4096 * widest)
                 .and::<bool>(n.saturating_mul(2))
