@@ -842,14 +842,15 @@ def measure_departures(
     most: int = 64,
 ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
     """``Playback.measure_departure`` of many owners in one call, each owner's figures to the
-    bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]`` and the next
-    ``counts[i]`` rows of ``frames`` (N,), ``location`` (N, 3), ``rotation`` (N, 4: an
-    Euler owner's 3 angles and one column not read) and ``played`` (N, 7: location and the
-    rotation's 3 or 4 numbers, the rest not read; NaN rows where not known, as an owner
-    without played rows has), with the limits ``degrees[i]`` and ``distances[i]`` (O,) and,
-    with ``key_frames``, the next ``key_counts[i]`` of them (-1: the owner measures every
-    frame, as without ``key_frames``). Returns the largest angle (degrees) and distance per
-    owner (O,) and ``over`` (N,), the owners' flags one after the other. GIL released.
+    bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]``, the next
+    ``counts[i]`` frames of ``frames`` (N,) and rows of ``location`` (N, 3), the next
+    ``counts[i] * w`` numbers of ``rotation`` (its rotation rows, ``w`` = 3 or 4 numbers each
+    in its playback's mode, row-major) and of ``played`` the next ``counts[i] * (3 + w)`` (its
+    played rows, row-major; NaN rows where not known, as an owner without played rows has),
+    with the limits ``degrees[i]`` and ``distances[i]`` (O,) and, with ``key_frames``, the
+    next ``key_counts[i]`` of them (-1: the owner measures every frame, as without
+    ``key_frames``). Returns the largest angle (degrees) and distance per owner (O,) and
+    ``over`` (N,), the owners' flags one after the other. GIL released.
     Raises ValueError for what ``measure_departure`` refuses, naming the owner (``part
     i``), and for counts or shapes that do not match.
     """

@@ -51,25 +51,22 @@ def alone(owner: dict, most: int):
 
 
 def batch(owners: list[dict], most: int, keyed: bool = True):
+    """`measure_departures` of `owners`: their rows one after the other (rotation and played
+    rows flat, row-major, each in its owner's width; NaN played rows for an owner without)."""
     counts = np.array([len(o["frames"]) for o in owners], dtype=np.int64)
-    n = int(counts.sum())
-    rotation = np.full((n, 4), 7.0)  # (the padding of Euler rows is not read)
-    played = np.full((n, 7), 3.0)
-    ends = np.cumsum(counts)
-    for o, end, c in zip(owners, ends, counts):
-        rotation[end - c : end, : width(o["mode"])] = o["rotation"]
-        played[end - c : end, : 3 + width(o["mode"])] = np.nan if o["played"] is None else o["played"]
+    played = [np.full(len(o["frames"]) * (3 + width(o["mode"])), np.nan) if o["played"] is None else o["played"].ravel()
+              for o in owners]
     given = [o["key_frames"] for o in owners if o["key_frames"] is not None]
     return polyscrew.measure_departures(
         [o["playback"] for o in owners], np.concatenate([o["frames"] for o in owners]), counts,
-        np.concatenate([o["location"] for o in owners]), rotation,
+        np.concatenate([o["location"] for o in owners]), np.concatenate([o["rotation"].ravel() for o in owners]),
         degrees=np.array([o["degrees"] for o in owners]), distances=np.array([o["distance"] for o in owners]),
-        played=played if any(o["played"] is not None for o in owners) else None,
+        played=np.concatenate(played) if any(o["played"] is not None for o in owners) else None,
         key_frames=np.concatenate(given or [np.zeros(0)]) if keyed else None,
         key_counts=np.array([-1 if o["key_frames"] is None else len(o["key_frames"]) for o in owners])
         if keyed else None,
         most=most,
-    ), ends, counts
+    ), np.cumsum(counts), counts
 
 
 def test_measure_departures_is_measure_departure_per_owner(rng):
@@ -118,7 +115,7 @@ def test_refusals_name_the_owner_and_the_add_on_measures_it_alone(rng):
         o["key_frames"] = o["key_frames"] if o["key_frames"] is not None else o["frames"][:1]
     owners[2]["frames"] = np.concatenate([owners[2]["frames"], [99.0]])
     owners[2]["location"] = np.vstack([owners[2]["location"], [np.nan, 0.0, 0.0]])
-    owners[2]["rotation"] = np.vstack([owners[2]["rotation"], [1.0, 0.0, 0.0, 0.0]])
+    owners[2]["rotation"] = np.vstack([owners[2]["rotation"], [1.0, 0.0, 0.0, 0.0]])  # (axis-angle)
     if owners[2]["played"] is not None:
         owners[2]["played"] = np.vstack([owners[2]["played"], np.full(7, np.nan)])
     with pytest.raises(ValueError, match=r"measure_departures: .*part 2"):
@@ -133,17 +130,17 @@ def test_refusals_name_the_owner_and_the_add_on_measures_it_alone(rng):
     ok, _, _ = owners
     frames, loc, rot = ok["frames"], ok["location"], ok["rotation"]
     pb = [ok["playback"]]
-    rot4 = np.hstack([rot, np.zeros((len(rot), 1))])
+    flat = rot.ravel()  # (an Euler owner: 3 numbers a row)
     d = dict(degrees=[5.0], distances=[0.1])
     with pytest.raises(ValueError, match="counts"):
-        polyscrew.measure_departures(pb, frames, [len(frames) + 1], loc, rot4, **d)
+        polyscrew.measure_departures(pb, frames, [len(frames) + 1], loc, flat, **d)
     with pytest.raises(ValueError, match="key_frames and key_counts"):
-        polyscrew.measure_departures(pb, frames, [len(frames)], loc, rot4, key_frames=[1.0], **d)
+        polyscrew.measure_departures(pb, frames, [len(frames)], loc, flat, key_frames=[1.0], **d)
     with pytest.raises(ValueError, match="key_counts"):
-        polyscrew.measure_departures(pb, frames, [len(frames)], loc, rot4, key_frames=[1.0], key_counts=[2], **d)
+        polyscrew.measure_departures(pb, frames, [len(frames)], loc, flat, key_frames=[1.0], key_counts=[2], **d)
     with pytest.raises(ValueError, match="rotation"):
         polyscrew.measure_departures(pb, frames, [len(frames)], loc, rot, **d)
     with pytest.raises(ValueError, match="distances"):
-        polyscrew.measure_departures(pb, frames, [len(frames)], loc, rot4, degrees=[5.0], distances=[0.1, 0.2])
+        polyscrew.measure_departures(pb, frames, [len(frames)], loc, flat, degrees=[5.0], distances=[0.1, 0.2])
     with pytest.raises(TypeError, match="playbacks"):
-        polyscrew.measure_departures([None], frames, [len(frames)], loc, rot4, **d)
+        polyscrew.measure_departures([None], frames, [len(frames)], loc, flat, **d)

@@ -27,7 +27,8 @@ for the following, each one `polyscrew` call per owner (`polyscrew.analyse_spans
   Shortest takes the short screw between every two key poses. The removed flips are
   reported with their frames.
 - **Departure.** After a bake the result is measured against Blender's playback of the
-  source at every baked frame (`polyscrew.Playback.measure_departure`, one call per owner,
+  source at every baked frame (`polyscrew.measure_departures`, one call for all the owners
+  of a Smooth Motion, :func:`departures`; `polyscrew.Playback.measure_departure` for one,
   comparing with the playback timing "Keys" has played already at those frames): where it
   departs by more than :data:`DEPARTURE_DEGREES` or :data:`DEPARTURE_FRACTION` of the
   owner's size, the report names the owner, the frames and the size (:func:`departure_note`).
@@ -273,29 +274,26 @@ def departures(
 ) -> list[Departure]:
     """:func:`departure` of each `(source, size, frames, location, rotation, key_frames,
     played)` of `items`, the same figures to the bit, in one `polyscrew.measure_departures`
-    call for all of them (rotations padded to 4 columns, played rows to 7, NaN rows where an
+    call for all of them (the owners' rows one after the other, NaN played rows where an
     owner has none). When the batch is refused (a bad owner, its memory) each item is
     measured alone, so that a refusal raises what :func:`departure` raises."""
     if not items:
         return []
     frames = [np.asarray(item[2], dtype=np.float64) for item in items]
+    rotations = [np.asarray(item[4], dtype=np.float64) for item in items]
     counts = np.array([len(f) for f in frames], dtype=np.int64)
-    n = int(counts.sum())
-    location = np.zeros((n, 3))
-    rotation = np.zeros((n, 4))
-    played = np.full((n, 7), np.nan) if any(item[6] is not None for item in items) else None
+    location = np.concatenate([np.zeros((len(f), 3)) if item[3] is None else item[3] for item, f in zip(items, frames)])
+    played = None
+    if any(item[6] is not None for item in items):
+        played = np.concatenate([
+            np.full(len(f) * (3 + r.shape[1]), np.nan) if item[6] is None else np.ravel(item[6])
+            for item, f, r in zip(items, frames, rotations)
+        ])
     keyed = any(item[5] is not None for item in items)
-    ends = np.cumsum(counts)
-    for (_, _, _, loc, rot, _, rows), end, count in zip(items, ends.tolist(), counts.tolist()):
-        at = slice(end - count, end)
-        if loc is not None:
-            location[at] = loc
-        rotation[at, : np.shape(rot)[1]] = rot
-        if rows is not None:
-            played[at, : np.shape(rows)[1]] = rows
     try:
         degrees, distance, over = polyscrew.measure_departures(
-            [item[0].playback for item in items], np.concatenate(frames), counts, location, rotation,
+            [item[0].playback for item in items], np.concatenate(frames), counts, location,
+            np.concatenate([r.ravel() for r in rotations]),
             degrees=np.full(len(items), DEPARTURE_DEGREES),
             distances=np.array([DEPARTURE_FRACTION * item[1] for item in items], dtype=np.float64),
             played=played,
@@ -307,9 +305,10 @@ def departures(
         )
     except (ValueError, MemoryError):  # each alone: the refused one raises its own error
         return [departure(source, size, f, loc, rot, keys, rows) for (source, size, f, loc, rot, keys, rows) in items]
+    ends = np.cumsum(counts).tolist()
     return [
-        Departure(degrees=d, distance=x, frames=f[over[end - count : end]])
-        for d, x, f, end, count in zip(degrees.tolist(), distance.tolist(), frames, ends.tolist(), counts.tolist())
+        Departure(degrees=d, distance=x, frames=f[over[end - len(f) : end]])
+        for d, x, f, end in zip(degrees.tolist(), distance.tolist(), frames, ends)
     ]
 
 

@@ -4,6 +4,8 @@
 //! (the add-on's `curves.Packed.arguments()`), the channel each curve drives and the owner's
 //! own values; `analyse_spans` and `keys_parameters` take it.
 
+use std::borrow::Cow;
+
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
@@ -457,6 +459,17 @@ pub(crate) fn playbacks_arg<'py>(
     .collect()
 }
 
+/// The values of `view` row-major: its own when contiguous, else a copy.
+fn contiguous<'a>(
+    function: &str,
+    view: &'a numpy::ndarray::ArrayViewD<'_, f64>,
+) -> PyResult<Cow<'a, [f64]>> {
+    Ok(match view.as_slice() {
+        Some(values) => Cow::Borrowed(values),
+        None => Cow::Owned(flat_values(function, view)?),
+    })
+}
+
 /// `counts` of `measure_departures` (one per owner, each at least `least`: -1 for "none").
 fn owner_counts(
     what: &'static str,
@@ -481,26 +494,6 @@ fn owner_counts(
     Ok(counts)
 }
 
-/// The rows `rows` (row-major, `stride` numbers each) of every owner (`counts` rows, the
-/// first `widths` numbers of each row), one owner after the other without the padding.
-fn unpadded(rows: &[f64], stride: usize, counts: &[usize], widths: &[usize]) -> PyResult<Vec<f64>> {
-    let total = counts
-        .iter()
-        .zip(widths)
-        .map(|(&c, &w)| c.saturating_mul(w))
-        .sum();
-    let mut out =
-        try_vec(total, "input values").map_err(|e| to_py_err(MeasureDepartures::NAME, e))?;
-    let mut row = 0;
-    for (&c, &w) in counts.iter().zip(widths) {
-        for r in row..row + c {
-            out.extend_from_slice(&rows[r * stride..r * stride + w]);
-        }
-        row += c;
-    }
-    Ok(out)
-}
-
 /// measure_departures(
 ///     playbacks: Sequence[Playback],
 ///     frames: ArrayLike,
@@ -517,14 +510,15 @@ fn unpadded(rows: &[f64], stride: usize, counts: &[usize], widths: &[usize]) -> 
 /// ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]
 ///
 /// ``Playback.measure_departure`` of many owners in one call, each owner's figures to the
-/// bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]`` and the next
-/// ``counts[i]`` rows of ``frames`` (N,), ``location`` (N, 3), ``rotation`` (N, 4: an
-/// Euler owner's 3 angles and one column not read) and ``played`` (N, 7: location and the
-/// rotation's 3 or 4 numbers, the rest not read; NaN rows where not known, as an owner
-/// without played rows has), with the limits ``degrees[i]`` and ``distances[i]`` (O,) and,
-/// with ``key_frames``, the next ``key_counts[i]`` of them (-1: the owner measures every
-/// frame, as without ``key_frames``). Returns the largest angle (degrees) and distance per
-/// owner (O,) and ``over`` (N,), the owners' flags one after the other. GIL released.
+/// bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]``, the next
+/// ``counts[i]`` frames of ``frames`` (N,) and rows of ``location`` (N, 3), the next
+/// ``counts[i] * w`` numbers of ``rotation`` (its rotation rows, ``w`` = 3 or 4 numbers each
+/// in its playback's mode, row-major) and of ``played`` the next ``counts[i] * (3 + w)`` (its
+/// played rows, row-major; NaN rows where not known, as an owner without played rows has),
+/// with the limits ``degrees[i]`` and ``distances[i]`` (O,) and, with ``key_frames``, the
+/// next ``key_counts[i]`` of them (-1: the owner measures every frame, as without
+/// ``key_frames``). Returns the largest angle (degrees) and distance per owner (O,) and
+/// ``over`` (N,), the owners' flags one after the other. GIL released.
 /// Raises ValueError for what ``measure_departure`` refuses, naming the owner (``part
 /// i``), and for counts or shapes that do not match.
 #[pyfunction]
@@ -578,13 +572,23 @@ fn measure_departures<'py>(
     let location = float_array(F, "location", location)?;
     let rotation = float_array(F, "rotation", rotation)?;
     let played = args::optional_float_array(F, "played", played)?;
-    for (array, what, width) in [
-        (Some(&location), "location", 3),
-        (Some(&rotation), "rotation", 4),
-        (played.as_ref(), "played", 7),
+    check_rows(F, "location", location.shape(), n, 3)?;
+    // each owner's rotation rows (`w` numbers each) and played rows (`3 + w`) one after the other
+    let w: Vec<usize> = bound.iter().map(|p| p.get().inner.mode().width()).collect();
+    let rotations: usize = counts
+        .iter()
+        .zip(&w)
+        .map(|(&c, &w)| c.saturating_mul(w))
+        .sum();
+    let rows = rotations.saturating_add(n.saturating_mul(3));
+    for (array, what, len) in [
+        (Some(&rotation), "rotation", rotations),
+        (played.as_ref(), "played", rows),
     ] {
         if let Some(array) = array {
-            check_rows(F, what, array.shape(), n, width)?;
+            if array.shape() != [len] {
+                return Err(shape_err(F, what, &format!("({len},)"), array.shape()));
+            }
         }
     }
     let degrees = float_array(F, "degrees", degrees)?;
@@ -616,7 +620,7 @@ fn measure_departures<'py>(
         .map(|p| p.get().inner.width())
         .max()
         .unwrap_or(0);
-    // the arguments' conversions, the values read and unpadded, the core's work for one
+    // the arguments' conversions, the values read, the core's work for one
     // owner at most (as `measure_departure`), the outputs
     check_budget(
         F,
@@ -645,23 +649,15 @@ fn measure_departures<'py>(
     let key_frames = key_frames.as_ref().map(|a| a.as_array());
     let inner: Vec<&Playback> = bound.iter().map(|p| &p.get().inner).collect();
     let out = py.detach(|| -> PyResult<_> {
-        let frames = read_vector(F, "frames", &frames)?;
         let degrees = read_vector(F, "degrees", &degrees)?;
         let distances = read_vector(F, "distances", &distances)?;
-        let key_frames = key_frames
-            .as_ref()
-            .map(|k| read_vector(F, "key_frames", k))
-            .transpose()?;
-        // (shapes checked above) row-major values, each owner's rows without the padding
-        let flat = |view: &numpy::ndarray::ArrayViewD<'_, f64>| flat_values(F, view);
+        // (shapes checked above) row-major values: the arrays' own when contiguous
+        let flat = |view| contiguous(F, view);
+        let frames = flat(&frames)?;
+        let key_frames = key_frames.as_ref().map(flat).transpose()?;
         let location = flat(&location)?;
-        let w: Vec<usize> = inner.iter().map(|p| p.mode().width()).collect();
-        let rotation = unpadded(&flat(&rotation)?, 4, &counts, &w)?;
-        let pw: Vec<usize> = w.iter().map(|w| 3 + w).collect();
-        let played = played
-            .as_ref()
-            .map(|p| unpadded(&flat(p)?, 7, &counts, &pw))
-            .transpose()?;
+        let rotation = flat(&rotation)?;
+        let played = played.as_ref().map(flat).transpose()?;
         let mut owners = Vec::with_capacity(o);
         let (mut row, mut rot, mut pl, mut key) = (0, 0, 0, 0);
         for i in 0..o {
@@ -678,14 +674,14 @@ fn measure_departures<'py>(
                 frames: &frames[row..row + c],
                 location: &location[3 * row..3 * (row + c)],
                 rotation: &rotation[rot..rot + c * w[i]],
-                played: played.as_ref().map(|p| &p[pl..pl + c * pw[i]]),
+                played: played.as_ref().map(|p| &p[pl..pl + c * (3 + w[i])]),
                 spans,
                 limits: DepartureLimits {
                     degrees: degrees[i],
                     distance: distances[i],
                 },
             });
-            (row, rot, pl) = (row + c, rot + c * w[i], pl + c * pw[i]);
+            (row, rot, pl) = (row + c, rot + c * w[i], pl + c * (3 + w[i]));
         }
         core_measure_departures(&owners).map_err(|e| to_py_err(F, e))
     })?;
