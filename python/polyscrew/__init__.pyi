@@ -882,6 +882,34 @@ class Playback:
         every function that plays it: how often a caller plays the same curves.
         """
 
+def measure_departures(
+    playbacks: Sequence[Playback],
+    frames: ArrayLike,
+    counts: ArrayLike,
+    location: ArrayLike,
+    rotation: ArrayLike,
+    *,
+    degrees: ArrayLike,
+    distances: ArrayLike,
+    played: ArrayLike | None = None,
+    key_frames: ArrayLike | None = None,
+    key_counts: ArrayLike | None = None,
+    most: int = 64,
+) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]:
+    """``Playback.measure_departure`` of many owners in one call, each owner's figures to the
+    bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]``, the next
+    ``counts[i]`` frames of ``frames`` (N,) and rows of ``location`` (N, 3), the next
+    ``counts[i] * w`` numbers of ``rotation`` (its rotation rows, ``w`` = 3 or 4 numbers each
+    in its playback's mode, row-major) and of ``played`` the next ``counts[i] * (3 + w)`` (its
+    played rows, row-major; NaN rows where not known, as an owner without played rows has),
+    with the limits ``degrees[i]`` and ``distances[i]`` (O,) and, with ``key_frames``, the
+    next ``key_counts[i]`` of them (-1: the owner measures every frame, as without
+    ``key_frames``). Returns the largest angle (degrees) and distance per owner (O,) and
+    ``over`` (N,), the owners' flags one after the other. GIL released.
+    Raises ValueError for what ``measure_departure`` refuses, naming the owner (``part
+    i``), and for counts or shapes that do not match.
+    """
+
 def analyse_spans(
     playback: Playback, frames: ArrayLike, turns: Literal["AUTO", "BLENDER", "SHORTEST"] = "AUTO"
 ) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], FloatArray, FloatArray]:

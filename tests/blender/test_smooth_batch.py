@@ -19,12 +19,13 @@ from test_speed_smooth import keyed
 SAMPLERS = ("sample_owners", "sample_channels", "sample_vectors", "sample", "timed_frames", "rotation_channels")
 
 
-def counting_calls(monkeypatch) -> dict[str, int]:
-    """Wraps polyscrew's sampling functions (the module object the add-on imports) to count
-    their calls; `raising=False`: a module without `sample_owners` is counted too."""
-    calls = dict.fromkeys(SAMPLERS, 0)
-    for name in SAMPLERS:
-        original = getattr(polyscrew, name, None)
+def counting_calls(monkeypatch, names: tuple[str, ...] = SAMPLERS, module=polyscrew) -> dict[str, int]:
+    """Wraps the functions `names` of `module` (by default polyscrew's sampling functions, the
+    module object the add-on imports) to count their calls; `raising=False`: a module without
+    one of them (`sample_owners`) is counted too."""
+    calls = dict.fromkeys(names, 0)
+    for name in names:
+        original = getattr(module, name, None)
         if original is None:
             continue
 
@@ -32,7 +33,7 @@ def counting_calls(monkeypatch) -> dict[str, int]:
             calls[_name] += 1
             return _original(*args, **kwargs)
 
-        monkeypatch.setattr(polyscrew, name, counted, raising=False)
+        monkeypatch.setattr(module, name, counted, raising=False)
     return calls
 
 
@@ -72,6 +73,24 @@ def varied_scene(suffix: str) -> list:
     return made
 
 
+def smooth_varied_scene(suffix: str, gentle: bool = True, **options) -> list:
+    """The :func:`varied_scene` and a rig of three keyed bones (`gentle` poses or not), each
+    smoothed with `options` (the objects, then the bones in Pose Mode): the owners smoothed."""
+    objects = varied_scene(suffix)
+    rig = bh.armature()
+    rig.name = f"Rig{suffix}"
+    for n, bone in enumerate(("Upper", "Fore", "Hand")):
+        bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=30 + n, gentle=gentle))
+    h.select_only(*objects)
+    assert bpy.ops.screwbender.smooth(**options) == {"FINISHED"}
+    h.select_only(rig)
+    bpy.ops.object.mode_set(mode="POSE")
+    bh.select_bones(rig, ["Upper", "Fore", "Hand"])
+    assert bpy.ops.screwbender.smooth(**options) == {"FINISHED"}
+    bpy.ops.object.mode_set(mode="OBJECT")
+    return objects + [rig]
+
+
 def result_digests(objects) -> list[str]:
     bake = addon_module("blender.bake")
     channels = addon_module("blender.channels")
@@ -91,20 +110,8 @@ def test_batched_keys_are_the_owner_by_owner_keys(monkeypatch, timing):
     sampling = addon_module("pure.sampling")
     digests = {}
     for way in ("batched", "alone"):
-        objects = varied_scene(way)
-        rig = bh.armature()
-        rig.name = f"Rig{way}"
-        for n, bone in enumerate(("Upper", "Fore", "Hand")):
-            bh.key_bone(rig, bone, [1, 6, 13, 20], bh.random_poses(4, seed=30 + n, gentle=True))
         if way == "alone":
             monkeypatch.setattr(sampling, "sample_many", lambda items, options, poses=False: [None] * len(items))
-        h.select_only(*objects)
-        assert bpy.ops.screwbender.smooth(timing=timing) == {"FINISHED"}
-        h.select_only(rig)
-        bpy.ops.object.mode_set(mode="POSE")
-        bh.select_bones(rig, ["Upper", "Fore", "Hand"])
-        assert bpy.ops.screwbender.smooth(timing=timing) == {"FINISHED"}
-        bpy.ops.object.mode_set(mode="OBJECT")
-        digests[way] = result_digests(objects + [rig])
+        digests[way] = result_digests(smooth_varied_scene(way, timing=timing))
     assert digests["batched"] == digests["alone"]
     print(f"timing {timing}: {len(digests['alone'])} results, digests identical")

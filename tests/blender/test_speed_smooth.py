@@ -211,19 +211,19 @@ def test_departure_of_a_long_bake_measured_per_span_agrees_with_every_frame():
 
 
 def departure_plays(intent) -> tuple[list, object]:
-    """Wraps `intent.departure` (what Smooth Motion measures each owner's result with): per
-    call, (rows the owner's playback had played before it, rows the departure played, frames
-    measured). Returns the list and the original, to put back."""
+    """Wraps `intent.departures` (what Smooth Motion measures its owners' results with, all in
+    one call): per owner measured, (rows the owner's playback had played before it, rows the
+    departure played, frames measured). Returns the list and the original, to put back."""
     seen = []
-    original = intent.departure
+    original = intent.departures
 
-    def counted(source, size, frames, *args, **kwargs):
-        before = source.playback.rows_evaluated
-        found = original(source, size, frames, *args, **kwargs)
-        seen.append((before, source.playback.rows_evaluated - before, len(frames)))
+    def counted(items, *args, **kwargs):
+        before = [item[0].playback.rows_evaluated for item in items]
+        found = original(items, *args, **kwargs)
+        seen.extend((b, item[0].playback.rows_evaluated - b, len(item[2])) for b, item in zip(before, items))
         return found
 
-    intent.departure = counted
+    intent.departures = counted
     return seen, original
 
 
@@ -252,7 +252,7 @@ def test_the_departure_measure_plays_no_frame_timing_keys_has_played():
         h.select_only(long_object("LongOnce"))
         assert bpy.ops.screwbender.smooth() == {"FINISHED"}
     finally:
-        intent.departure = original
+        intent.departures = original
     for before, played, frames in short:
         print(f"{frames} baked frames: the owner's playback played {before} rows before the departure "
               f"(span analysis and timing Keys), the departure {played} (before this change: {frames})")

@@ -946,7 +946,7 @@ def _bake_groups(
     plans = [p for *_, p in planned if isinstance(p, _Plan)]
     sampled = iter(_sample_plans(plans, options))
     bakes, skipped, notes = [], [], []
-    by_unit: dict[tuple[int, int], list[Baked]] = {}
+    finished = []  # (read, objects, owner, motion, bake) per owner baked, in order
     for read, objects, owner, motion, plan in planned:
         try:
             if isinstance(plan, SmoothError):
@@ -954,16 +954,17 @@ def _bake_groups(
             channels_of = next(sampled)
             if isinstance(channels_of, SmoothError):
                 raise channels_of
-            part = _finish(plan, channels_of)
+            finished.append((read, objects, owner, motion, _finish(plan, channels_of)))
         except SmoothError as err:
             read.skipped.append((owner, str(err)))
-            continue
+    departures = _departure_notes([(owner, motion, part) for _, _, owner, motion, part in finished], options)
+    by_unit: dict[tuple[int, int], list[Baked]] = {}
+    for (read, objects, owner, motion, part), departed in zip(finished, departures):
         by_unit.setdefault((id(read), id(objects)), []).append(part)
         if motion.kept:
             read.notes.append(f"{owner.name}: kept {'; '.join(motion.kept)}")
         if motion.removed:
             read.notes.append(f"{owner.name}: removed {'; '.join(motion.removed)}")
-        departed = _departure_note(owner, motion, part, options)
         if departed is not None:
             read.notes.append(departed)
         for prop, index in part.written if read.unread else ():
@@ -982,26 +983,36 @@ def _bake_groups(
     return bakes, skipped, notes
 
 
-def _departure_note(owner: owners.Owner, motion: keys.KeyedMotion, part: Baked, options: Options) -> str | None:
-    """The report's line when the bake of `owner` departs from Blender's playback of its
-    source by more than :data:`intent.DEPARTURE_DEGREES` or :data:`intent.DEPARTURE_FRACTION`
-    of its size at its baked frames (one `polyscrew` call); None when it does not, or when
-    the source's curves cannot be played (:attr:`keys.KeyedMotion.source` is None)."""
-    if motion.source is None:
-        return None
-    mode = motion.rotation_mode
-    played = part.played if part.motion.source is motion.source else None  # (rows of this playback only)
-    found = intent.departure(
-        motion.source, motion.size, part.frames, part.values.get("location"), part.values[keys.rotation_path(mode)],
-        motion.frames, played,
+def _departure_notes(
+    items: list[tuple[owners.Owner, keys.KeyedMotion, Baked]], options: Options
+) -> list[str | None]:
+    """Per `(owner, motion, bake)` of `items`, the report's line when the bake departs from
+    Blender's playback of its source by more than :data:`intent.DEPARTURE_DEGREES` or
+    :data:`intent.DEPARTURE_FRACTION` of its size at its baked frames; None when it does not,
+    or when the source's curves cannot be played (:attr:`keys.KeyedMotion.source` is None).
+    Every owner measured in one `polyscrew` call (:func:`intent.departures`)."""
+    measured = [(owner, motion, part) for owner, motion, part in items if motion.source is not None]
+    found = iter(
+        intent.departures([
+            (
+                motion.source, motion.size, part.frames, part.values.get("location"),
+                part.values[keys.rotation_path(motion.rotation_mode)], motion.frames,
+                part.played if part.motion.source is motion.source else None,  # (rows of this playback only)
+            )
+            for _, motion, part in measured
+        ])
     )
-    causes = list(motion.causes)
+    extra = []
     if options.method == "FEATURE" and options.approximate:
-        causes.append("Approximate Keys passes near the selected keys")
+        extra.append("Approximate Keys passes near the selected keys")
     elif options.method != "FEATURE" and options.scheme != "four_point":
         label = {identifier: name for identifier, name, _ in SCHEMES}.get(options.scheme, options.scheme)
-        causes.append(f"the {label} scheme cuts inside the keys")
-    return intent.departure_note(owner.name, found, motion.size, causes)
+        extra.append(f"the {label} scheme cuts inside the keys")
+    return [
+        None if motion.source is None
+        else intent.departure_note(owner.name, next(found), motion.size, [*motion.causes, *extra])
+        for owner, motion, _ in items
+    ]
 
 
 @dataclass

@@ -27,7 +27,8 @@ for the following, each one `polyscrew` call per owner (`polyscrew.analyse_spans
   Shortest takes the short screw between every two key poses. The removed flips are
   reported with their frames.
 - **Departure.** After a bake the result is measured against Blender's playback of the
-  source at every baked frame (`polyscrew.Playback.measure_departure`, one call per owner,
+  source at every baked frame (`polyscrew.measure_departures`, one call for all the owners
+  of a Smooth Motion, :func:`departures`; `polyscrew.Playback.measure_departure` for one,
   comparing with the playback timing "Keys" has played already at those frames): where it
   departs by more than :data:`DEPARTURE_DEGREES` or :data:`DEPARTURE_FRACTION` of the
   owner's size, the report names the owner, the frames and the size (:func:`departure_note`).
@@ -266,6 +267,49 @@ def departure(
         played=played, key_frames=key_frames, most=DEPARTURE_SPAN_FRAMES,
     )
     return Departure(degrees=degrees, distance=distance, frames=frames[over])
+
+
+def departures(
+    items: list[tuple[Source, float, np.ndarray, np.ndarray | None, np.ndarray, np.ndarray | None, np.ndarray | None]],
+) -> list[Departure]:
+    """:func:`departure` of each `(source, size, frames, location, rotation, key_frames,
+    played)` of `items`, the same figures to the bit, in one `polyscrew.measure_departures`
+    call for all of them (the owners' rows one after the other, NaN played rows where an
+    owner has none). When the batch is refused (a bad owner, its memory) each item is
+    measured alone, so that a refusal raises what :func:`departure` raises."""
+    if not items:
+        return []
+    frames = [np.asarray(item[2], dtype=np.float64) for item in items]
+    rotations = [np.asarray(item[4], dtype=np.float64) for item in items]
+    counts = np.array([len(f) for f in frames], dtype=np.int64)
+    location = np.concatenate([np.zeros((len(f), 3)) if item[3] is None else item[3] for item, f in zip(items, frames)])
+    played = None
+    if any(item[6] is not None for item in items):
+        played = np.concatenate([
+            np.full(len(f) * (3 + r.shape[1]), np.nan) if item[6] is None else np.ravel(item[6])
+            for item, f, r in zip(items, frames, rotations)
+        ])
+    keyed = any(item[5] is not None for item in items)
+    try:
+        degrees, distance, over = polyscrew.measure_departures(
+            [item[0].playback for item in items], np.concatenate(frames), counts, location,
+            np.concatenate([r.ravel() for r in rotations]),
+            degrees=np.full(len(items), DEPARTURE_DEGREES),
+            distances=np.array([DEPARTURE_FRACTION * item[1] for item in items], dtype=np.float64),
+            played=played,
+            key_frames=np.concatenate([item[5] for item in items if item[5] is not None] or [np.zeros(0)])
+            if keyed else None,
+            key_counts=np.array([-1 if item[5] is None else len(item[5]) for item in items], dtype=np.int64)
+            if keyed else None,
+            most=DEPARTURE_SPAN_FRAMES,
+        )
+    except (ValueError, MemoryError):  # each alone: the refused one raises its own error
+        return [departure(source, size, f, loc, rot, keys, rows) for (source, size, f, loc, rot, keys, rows) in items]
+    ends = np.cumsum(counts).tolist()
+    return [
+        Departure(degrees=d, distance=x, frames=f[over[end - len(f) : end]])
+        for d, x, f, end in zip(degrees.tolist(), distance.tolist(), frames, ends)
+    ]
 
 
 def departure_note(name: str, found: Departure, size: float, causes: list[str]) -> str | None:

@@ -220,6 +220,7 @@ functions!(
     SampleMany = "sample_many",
     ChannelsMany = "channels_many",
     ReadOwners = "read_owners",
+    MeasureDepartures = "measure_departures",
 );
 
 /// The name of `obj`'s type, for messages.

@@ -4,24 +4,26 @@
 //! (the add-on's `curves.Packed.arguments()`), the channel each curve drives and the owner's
 //! own values; `analyse_spans` and `keys_parameters` take it.
 
+use std::borrow::Cow;
+
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use polyscrew::intent::{
     analyse_turns as core_analyse_turns, departure as core_departure,
-    measure_departure as core_measure_departure, pace_parameters as core_pace_parameters,
-    rotation_matrices as core_rotation_matrices, timed_frames as core_timed_frames, Channel,
-    DepartureLimits, PaceSource, Playback, Spans, Timed, Turns, HOLD_TOLERANCE,
-    MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES, PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES,
-    WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
+    measure_departure as core_measure_departure, measure_departures as core_measure_departures,
+    pace_parameters as core_pace_parameters, rotation_matrices as core_rotation_matrices,
+    timed_frames as core_timed_frames, Channel, DepartureLimits, DepartureOwner, PaceSource,
+    Playback, Spans, Timed, Turns, HOLD_TOLERANCE, MAX_ANALYSIS_SAMPLES, MAX_SPAN_SAMPLES,
+    PACE_SAMPLES, RANGE_TOLERANCE, SPAN_SAMPLES, WIND_LIMIT, WIND_STEP, WRAP_MARGIN,
 };
 use polyscrew::memory::{try_vec, Footprint};
 use polyscrew::{Error, MotionSpec, Pose, RotationMode, Scheme, Timing};
 
 use crate::args::{
-    self, float_array, AnalyseSpans, AnalyseTurns, Choice, Function, KeysParameters, Most,
-    PlaybackNew, RotationMatrices, TimedFrames,
+    self, float_array, AnalyseSpans, AnalyseTurns, Choice, Function, KeysParameters,
+    MeasureDepartures, Most, PlaybackNew, RotationMatrices, TimedFrames,
 };
 use crate::arrays::{key_count, pose_count, read_keys, read_poses, read_vector, vector_len};
 use crate::errors::{check_budget, shape_err, to_py_err};
@@ -378,16 +380,13 @@ impl PyPlayback {
         // the result, a row and the figures; the playback's rows of one chunk), the output
         check_budget(
             F,
-            frames.copy()
-                + location.copy()
-                + rotation.copy()
-                + played
-                    .as_ref()
-                    .map_or(Footprint::of::<f64>(0), |p| p.copy())
-                + key_frames
-                    .as_ref()
-                    .map_or(Footprint::of::<f64>(0), |a| a.copy())
-                + Footprint::of::<f64>(t.saturating_mul(3 + w + 3 + w + 1).saturating_add(k))
+            departure_copies([
+                Some(&frames),
+                Some(&location),
+                Some(&rotation),
+                played.as_ref(),
+                key_frames.as_ref(),
+            ]) + Footprint::of::<f64>(t.saturating_mul(3 + w + 3 + w + 1).saturating_add(k))
                 + Footprint::of::<f64>(t.saturating_mul(4 + 3 + w + 3))
                     .and::<f64>(4096 * inner.width())
                     .and::<bool>(t),
@@ -434,6 +433,266 @@ impl PyPlayback {
     fn rows_evaluated(&self) -> u64 {
         self.inner.rows_evaluated()
     }
+}
+
+/// What converting the arguments of a departure measure costs (frames, location, rotation,
+/// and the played rows and key frames when given).
+fn departure_copies(arrays: [Option<&args::FloatArg<'_>>; 5]) -> Footprint {
+    arrays.into_iter().flatten().map(|a| a.copy()).sum()
+}
+
+/// The `Playback`s of the sequence `obj` (at most [`crate::many::MAX_PARTS`]), or a
+/// `TypeError` naming `function`.
+pub(crate) fn playbacks_arg<'py>(
+    function: &str,
+    obj: &Bound<'py, PyAny>,
+) -> PyResult<Vec<Bound<'py, PyPlayback>>> {
+    args::sequence(
+        function,
+        "playbacks",
+        obj,
+        Most::AtMost(crate::many::MAX_PARTS),
+        "a sequence of polyscrew.Playback",
+    )?
+    .iter()
+    .map(|p| playback_arg(function, "playbacks", p).cloned())
+    .collect()
+}
+
+/// The values of `view` row-major: its own when contiguous, else a copy.
+fn contiguous<'a>(
+    function: &str,
+    view: &'a numpy::ndarray::ArrayViewD<'_, f64>,
+) -> PyResult<Cow<'a, [f64]>> {
+    Ok(match view.as_slice() {
+        Some(values) => Cow::Borrowed(values),
+        None => Cow::Owned(flat_values(function, view)?),
+    })
+}
+
+/// `counts` of `measure_departures` (one per owner, each at least `least`: -1 for "none").
+fn owner_counts(
+    what: &'static str,
+    obj: &Bound<'_, PyAny>,
+    o: usize,
+    least: i64,
+) -> PyResult<Vec<i64>> {
+    let counts = args::int_list(MeasureDepartures::NAME, what, obj, Most::Exactly(o))?;
+    if counts.len() != o {
+        return Err(crate::errors::invalid(format!(
+            "{}: {what}: {} counts for {o} playbacks",
+            MeasureDepartures::NAME,
+            counts.len()
+        )));
+    }
+    if let Some(&bad) = counts.iter().find(|&&c| c < least) {
+        return Err(crate::errors::invalid(format!(
+            "{}: {what}: {bad} is below {least}",
+            MeasureDepartures::NAME
+        )));
+    }
+    Ok(counts)
+}
+
+/// measure_departures(
+///     playbacks: Sequence[Playback],
+///     frames: ArrayLike,
+///     counts: ArrayLike,
+///     location: ArrayLike,
+///     rotation: ArrayLike,
+///     *,
+///     degrees: ArrayLike,
+///     distances: ArrayLike,
+///     played: ArrayLike | None = None,
+///     key_frames: ArrayLike | None = None,
+///     key_counts: ArrayLike | None = None,
+///     most: int = 64,
+/// ) -> tuple[FloatArray, FloatArray, npt.NDArray[np.bool_]]
+///
+/// ``Playback.measure_departure`` of many owners in one call, each owner's figures to the
+/// bit what its own call gives. Owner ``i`` (of O) is ``playbacks[i]``, the next
+/// ``counts[i]`` frames of ``frames`` (N,) and rows of ``location`` (N, 3), the next
+/// ``counts[i] * w`` numbers of ``rotation`` (its rotation rows, ``w`` = 3 or 4 numbers each
+/// in its playback's mode, row-major) and of ``played`` the next ``counts[i] * (3 + w)`` (its
+/// played rows, row-major; NaN rows where not known, as an owner without played rows has),
+/// with the limits ``degrees[i]`` and ``distances[i]`` (O,) and, with ``key_frames``, the
+/// next ``key_counts[i]`` of them (-1: the owner measures every frame, as without
+/// ``key_frames``). Returns the largest angle (degrees) and distance per owner (O,) and
+/// ``over`` (N,), the owners' flags one after the other. GIL released.
+/// Raises ValueError for what ``measure_departure`` refuses, naming the owner (``part
+/// i``), and for counts or shapes that do not match.
+#[pyfunction]
+#[pyo3(signature = (playbacks, frames, counts, location, rotation, *, degrees, distances, played=None, key_frames=None, key_counts=None, most=64))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn measure_departures<'py>(
+    py: Python<'py>,
+    playbacks: &Bound<'py, PyAny>,
+    frames: &Bound<'py, PyAny>,
+    counts: &Bound<'py, PyAny>,
+    location: &Bound<'py, PyAny>,
+    rotation: &Bound<'py, PyAny>,
+    degrees: &Bound<'py, PyAny>,
+    distances: &Bound<'py, PyAny>,
+    played: Option<&Bound<'py, PyAny>>,
+    key_frames: Option<&Bound<'py, PyAny>>,
+    key_counts: Option<&Bound<'py, PyAny>>,
+    #[pyo3(from_py_with = most_arg)] most: usize,
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<bool>>,
+)> {
+    const F: &str = MeasureDepartures::NAME;
+    let bound = playbacks_arg(F, playbacks)?;
+    let o = bound.len();
+    let as_len = |c: i64| usize::try_from(c).unwrap_or(0);
+    let counts: Vec<usize> = owner_counts("counts", counts, o, 0)?
+        .into_iter()
+        .map(as_len)
+        .collect();
+    let key_counts = match (
+        key_frames.filter(|k| !k.is_none()),
+        key_counts.filter(|k| !k.is_none()),
+    ) {
+        (Some(_), Some(k)) => Some(owner_counts("key_counts", k, o, -1)?),
+        (None, None) => None,
+        _ => {
+            return Err(crate::errors::invalid(format!(
+                "{F}: key_frames and key_counts go together"
+            )))
+        }
+    };
+    let frames = float_array(F, "frames", frames)?;
+    let n = vector_len(F, "frames", &frames)?;
+    if counts.iter().try_fold(0usize, |a, &c| a.checked_add(c)) != Some(n) {
+        return Err(crate::errors::invalid(format!(
+            "{F}: counts: they do not add up to the {n} frames"
+        )));
+    }
+    let location = float_array(F, "location", location)?;
+    let rotation = float_array(F, "rotation", rotation)?;
+    let played = args::optional_float_array(F, "played", played)?;
+    check_rows(F, "location", location.shape(), n, 3)?;
+    // each owner's rotation rows (`w` numbers each) and played rows (`3 + w`) one after the other
+    let w: Vec<usize> = bound.iter().map(|p| p.get().inner.mode().width()).collect();
+    let rotations: usize = counts
+        .iter()
+        .zip(&w)
+        .map(|(&c, &w)| c.saturating_mul(w))
+        .sum();
+    let rows = rotations.saturating_add(n.saturating_mul(3));
+    for (array, what, len) in [
+        (Some(&rotation), "rotation", rotations),
+        (played.as_ref(), "played", rows),
+    ] {
+        if let Some(array) = array {
+            if array.shape() != [len] {
+                return Err(shape_err(F, what, &format!("({len},)"), array.shape()));
+            }
+        }
+    }
+    let degrees = float_array(F, "degrees", degrees)?;
+    let distances = float_array(F, "distances", distances)?;
+    for (what, limits) in [("degrees", &degrees), ("distances", &distances)] {
+        if limits.shape() != [o] {
+            return Err(shape_err(F, what, &format!("({o},)"), limits.shape()));
+        }
+    }
+    let key_frames = args::optional_float_array(F, "key_frames", key_frames)?;
+    let k = key_frames
+        .as_ref()
+        .map(|a| vector_len(F, "key_frames", a))
+        .transpose()?
+        .unwrap_or(0);
+    if let Some(key_counts) = &key_counts {
+        let given = key_counts
+            .iter()
+            .map(|&c| as_len(c))
+            .try_fold(0usize, |a, c| a.checked_add(c));
+        if given != Some(k) {
+            return Err(crate::errors::invalid(format!(
+                "{F}: key_counts: they do not add up to the {k} key frames"
+            )));
+        }
+    }
+    let widest = bound
+        .iter()
+        .map(|p| p.get().inner.width())
+        .max()
+        .unwrap_or(0);
+    // the arguments' conversions, the values read, the core's work for one
+    // owner at most (as `measure_departure`), the outputs
+    check_budget(
+        F,
+        departure_copies([
+            Some(&frames),
+            Some(&location),
+            Some(&rotation),
+            played.as_ref(),
+            key_frames.as_ref(),
+        ]) + Footprint::of::<f64>(n.saturating_mul(1 + 3 + 4 + 7 + 4 + 7).saturating_add(k))
+            + Footprint::of::<f64>(n.saturating_mul(4 + 7 + 3 + 4 + 7 + 1))
+                .and::<f64>(4096 * widest)
+                .and::<bool>(n.saturating_mul(2))
+                .and::<f64>(o.saturating_mul(4)),
+        "the departures",
+        HINT,
+    )?;
+    let (frames, location, rotation) = (frames.read()?, location.read()?, rotation.read()?);
+    let (degrees, distances) = (degrees.read()?, distances.read()?);
+    let played = played.as_ref().map(|p| p.read()).transpose()?;
+    let key_frames = key_frames.as_ref().map(|a| a.read()).transpose()?;
+    let (frames, location, rotation) =
+        (frames.as_array(), location.as_array(), rotation.as_array());
+    let (degrees, distances) = (degrees.as_array(), distances.as_array());
+    let played = played.as_ref().map(|p| p.as_array());
+    let key_frames = key_frames.as_ref().map(|a| a.as_array());
+    let inner: Vec<&Playback> = bound.iter().map(|p| &p.get().inner).collect();
+    let out = py.detach(|| -> PyResult<_> {
+        let degrees = read_vector(F, "degrees", &degrees)?;
+        let distances = read_vector(F, "distances", &distances)?;
+        // (shapes checked above) row-major values: the arrays' own when contiguous
+        let flat = |view| contiguous(F, view);
+        let frames = flat(&frames)?;
+        let key_frames = key_frames.as_ref().map(flat).transpose()?;
+        let location = flat(&location)?;
+        let rotation = flat(&rotation)?;
+        let played = played.as_ref().map(flat).transpose()?;
+        let mut owners = Vec::with_capacity(o);
+        let (mut row, mut rot, mut pl, mut key) = (0, 0, 0, 0);
+        for i in 0..o {
+            let c = counts[i];
+            let spans = match (&key_frames, &key_counts) {
+                (Some(all), Some(kc)) if kc[i] >= 0 => {
+                    key += as_len(kc[i]);
+                    Some((&all[key - as_len(kc[i])..key], most))
+                }
+                _ => None,
+            };
+            owners.push(DepartureOwner {
+                playback: inner[i],
+                frames: &frames[row..row + c],
+                location: &location[3 * row..3 * (row + c)],
+                rotation: &rotation[rot..rot + c * w[i]],
+                played: played.as_ref().map(|p| &p[pl..pl + c * (3 + w[i])]),
+                spans,
+                limits: DepartureLimits {
+                    degrees: degrees[i],
+                    distance: distances[i],
+                },
+            });
+            (row, rot, pl) = (row + c, rot + c * w[i], pl + c * (3 + w[i]));
+        }
+        core_measure_departures(&owners).map_err(|e| to_py_err(F, e))
+    })?;
+    let over: Vec<bool> = out.iter().flat_map(|d| d.over.iter().copied()).collect();
+    let degrees: Vec<f64> = out.iter().map(|d| d.degrees).collect();
+    let distances: Vec<f64> = out.iter().map(|d| d.distance).collect();
+    Ok((
+        degrees.into_pyarray(py),
+        distances.into_pyarray(py),
+        over.into_pyarray(py),
+    ))
 }
 
 /// Reads the arguments of `analyse_spans` / `analyse_turns` and runs the core, GIL released.
@@ -951,6 +1210,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(timed_frames, m)?)?;
     m.add_function(wrap_pyfunction!(pace_parameters, m)?)?;
     m.add_function(wrap_pyfunction!(rotation_matrices, m)?)?;
+    m.add_function(wrap_pyfunction!(measure_departures, m)?)?;
     // stub:
     // stub: WIND_LIMIT: float
     // stub: """A span whose rotation channels turn further than this (radians, 150 degrees) is a spin."""

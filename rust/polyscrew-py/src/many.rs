@@ -20,11 +20,11 @@ use crate::args::{
 };
 use crate::arrays::{poses_to_array, read_keys, read_spec, read_vec3s, read_vector, vector_len};
 use crate::errors::{check_budget, invalid, shape_err, to_py_err};
-use crate::intent::{playback_arg, PyPlayback};
+use crate::intent::playbacks_arg;
 use crate::motion::{moved_poses, wrapped_angles, MovedPoses};
 
 /// The most parts one call takes (a list of that many entries is refused before it is read).
-const MAX_PARTS: usize = 1 << 32;
+pub(crate) const MAX_PARTS: usize = 1 << 32;
 
 /// `counts` (S,) as lengths, each at least 0.
 fn lengths(
@@ -230,17 +230,7 @@ fn channels_many<'py>(
     frames: &Bound<'py, PyAny>,
 ) -> PyResult<Vec<Channels<'py>>> {
     const F: &str = ChannelsMany::NAME;
-    let items = sequence(
-        F,
-        "playbacks",
-        playbacks,
-        Most::AtMost(MAX_PARTS),
-        "a sequence of polyscrew.Playback",
-    )?;
-    let bound: Vec<Bound<'py, PyPlayback>> = items
-        .iter()
-        .map(|p| playback_arg(F, "playbacks", p).cloned())
-        .collect::<PyResult<_>>()?;
+    let bound = playbacks_arg(F, playbacks)?;
     let frames = float_array(F, "frames", frames)?;
     let t = vector_len(F, "frames", &frames)?;
     let values: usize = bound.iter().map(|p| p.get().inner.width()).sum();

@@ -330,6 +330,43 @@ pub fn measure_departure(
     })
 }
 
+/// One owner of [`measure_departures`]: the arguments of one [`measure_departure`] call.
+#[derive(Debug, Clone, Copy)]
+pub struct DepartureOwner<'a> {
+    /// The owner's playback.
+    pub playback: &'a Playback,
+    /// The result's frames (sorted).
+    pub frames: &'a [f64],
+    /// The result's location (`frames.len() x 3`) and rotation (`frames.len() x w`).
+    pub location: &'a [f64],
+    /// See `location`.
+    pub rotation: &'a [f64],
+    /// The rows played already (see [`measure_departure`]).
+    pub played: Option<&'a [f64]>,
+    /// `(key_frames, most)` (see [`measure_departure`]).
+    pub spans: Option<(&'a [f64], usize)>,
+    /// The owner's limits.
+    pub limits: DepartureLimits,
+}
+
+/// [`measure_departure`] of every owner in turn, each to the bit what its own call gives:
+/// one call for all the owners of an operator.
+///
+/// # Errors
+/// What [`measure_departure`] refuses, in [`Error::In`] (`"part"`, the owner's index).
+pub fn measure_departures(owners: &[DepartureOwner<'_>]) -> Result<Vec<DepartureSummary>> {
+    let mut out = try_vec(owners.len(), "departures")?;
+    for (i, o) in owners.iter().enumerate() {
+        out.push(
+            measure_departure(
+                o.playback, o.frames, o.location, o.rotation, o.played, o.spans, o.limits,
+            )
+            .map_err(|e| e.within("part", i))?,
+        );
+    }
+    Ok(out)
+}
+
 /// Indices of the frames (sorted) a departure measures: every frame of a key span (of
 /// `key_frames`) baked at no more than `most` frames; of a span of `c > most` frames, the
 /// `most` frames `round(k (c - 1) / (most - 1))` (evenly spaced, its first and last

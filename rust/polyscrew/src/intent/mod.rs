@@ -61,7 +61,8 @@ pub use batch::{
     sample_owner_channels, sample_owner_poses, OwnerChannels, OwnerMotion, OwnerPoses, Segment,
 };
 pub use departure::{
-    departure, measure_departure, measured_frames, Departure, DepartureLimits, DepartureSummary,
+    departure, measure_departure, measure_departures, measured_frames, Departure, DepartureLimits,
+    DepartureOwner, DepartureSummary,
 };
 pub use many::{
     angles_near_many, channels_many, partial_moves_many, sample_many, AngleRun, MoveRun,
