@@ -75,7 +75,7 @@ pub fn guaranteed_cell(tolerance: f64) -> f64 {
 
 /// How far below the minimum over the poses the refinement reads the minimum over the whole
 /// continuous motion can be, at a cell of `cell`: `cell / (2 REFINE_POSES)` (see `contour`).
-fn motion_gap(cell: f64) -> f64 {
+pub fn motion_gap(cell: f64) -> f64 {
     cell / (2.0 * REFINE_POSES as f64)
 }
 
