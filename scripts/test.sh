@@ -42,6 +42,9 @@ gate "ruff" "fix the findings above (\`.venv/bin/ruff check --fix\` sorts import
 stage "cargo test (workspace)"
 cargo test --workspace --quiet
 
+stage "cargo test (release): the closed sweep's face points"
+cargo test --release -p polyscrew --lib --quiet -- --ignored face_point
+
 stage "cargo doc (warnings are errors)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet -p polyscrew
 

@@ -15,9 +15,11 @@
 //!    samples, each span on its own screw) and the region's field `g(x) = min_j d(P_j^-1 x)`
 //!    is taken on a world grid of spacing `cell` around the region, only in the blocks of
 //!    the grid that may hold the boundary (see `narrow_band`; elsewhere only its sign);
-//! 3. each grid cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the
-//!    main diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where
-//!    `g` changes sign gives one triangle or a quad (two triangles) with its vertices on the
+//! 3. the sign of every grid point whose value is within the grid's error of zero is settled
+//!    by the exact minimum over every refined pose of the motion (`settle_signs`); each grid
+//!    cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the main
+//!    diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where `g`
+//!    changes sign gives one triangle or a quad (two triangles) with its vertices on the
 //!    tetrahedron's edges;
 //! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
 //!    the motion (the body at 8 poses per sample interval on each side of the sample that
@@ -26,9 +28,16 @@
 //!    read only at the poses whose trilinear read can give the minimum; the value left is
 //!    checked against every refined pose of the motion (an interval is skipped when a bound
 //!    shows it above that value), and the steps are redone over all of them when a pose
-//!    elsewhere is lower. The reported bound is the largest exact `|g|` left at a vertex.
+//!    elsewhere is lower; a vertex still off by more than [`BRACKET_START`] cells is found by
+//!    regula falsi between its edge's ends, whose exact signs differ (step 3);
+//! 5. edges across creases are split at their midpoints moved onto the boundary
+//!    (`crease.rs`), so that faces, not only vertices, lie on it.
 //!
-//! Why it is closed and intersection-free: the surface pieces of a tetrahedron lie inside it
+//! The reported bound is the largest exact `|g|` left at a vertex, plus the motion's gap
+//! ([`motion_gap`]).
+//!
+//! Why it is closed and intersection-free (before step 5, which keeps both: `crease.rs`): the
+//! surface pieces of a tetrahedron lie inside it
 //! and meet the pieces of its neighbours exactly on their shared faces (a vertex is owned by
 //! its grid edge, shared by every tetrahedron around the edge); every tetrahedron edge
 //! crossed by the zero set holds one vertex, so every surface edge is in exactly two
@@ -117,6 +126,20 @@ pub const REFINE_ITERATIONS: usize = 5;
 /// falsi steps.
 pub const EXACT_ITERATIONS: usize = 3;
 
+/// A vertex whose secant steps leave it more than this many cells off the exact field's zero
+/// is refined by regula falsi between its edge's ends (`bracketed`) ...
+pub const BRACKET_START: f64 = 0.01;
+
+/// ... until within this many cells of it ...
+pub const BRACKET_STOP: f64 = 0.001;
+
+/// ... or this many steps.
+pub const BRACKET_ITERATIONS: usize = 30;
+
+/// Creased edges are split until their midpoints are within this many cells of the boundary
+/// (`crease.rs`).
+pub const CREASE_TARGET: f64 = 0.025;
+
 /// The exact distance's triangle lists are kept per cube of side `cell /` this.
 pub const EXACT_LISTS_PER_CELL: f64 = 2.0;
 
@@ -176,9 +199,10 @@ pub struct ClosedMesh {
     pub triangles: Vec<[u32; 3]>,
     /// The world grid's cell.
     pub cell: f64,
-    /// A bound on the distance of every vertex from the exact swept boundary (of the
-    /// sampled motion refined [`REFINE_POSES`] times): the largest `|g|` left at a vertex,
-    /// `g` read with the body's exact distance.
+    /// A bound on the distance of every vertex from the exact swept boundary: the largest
+    /// `|g|` left at a vertex, `g` read with the body's exact distance at the motion refined
+    /// [`REFINE_POSES`] times, plus the motion's gap ([`motion_gap`]). Faces are not bounded
+    /// by it: they are measured (`closed_tests.rs`: within the tolerance at the defaults).
     pub error_bound: f64,
     /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
     pub tolerance: f64,
@@ -824,7 +848,7 @@ fn contoured(
         boxes,
         grid,
     } = Plan::new(body, poses, cell)?;
-    let Grid { origin, n, .. } = grid;
+    let n = grid.n;
     let count = n[0] * n[1] * n[2];
     // Both grids checked before either is sampled: an oversized request costs no work.
     let [bx, by, bz] = BodyField::dims(body, cell / BODY_SUBCELLS, band).1;
@@ -859,12 +883,13 @@ fn contoured(
     }
     let exact = exact_field(body, &field, cell)?;
     let refine = Refiner::new(&field, exact, &motion, body, cell)?;
+    settle_signs(&mut g, grid, &refine, threads)?;
     let mut out = ClosedMesh {
         cell,
         poses: motion.poses.len(),
         ..ClosedMesh::default()
     };
-    contour(&g, &arg, n, origin, cell, &refine, &mut out)?;
+    contour(&g, &arg, grid, &refine, threads, &mut out)?;
     Ok(out)
 }
 
@@ -1303,6 +1328,78 @@ impl Refiner<'_> {
     }
 }
 
+/// Regula falsi (Illinois) for a zero of `f` on `[0, 1]` from its values `ends` at 0 and 1 (of
+/// opposite signs), each step kept within [`EDGE_MARGIN`] of the ends, until a value within
+/// `stop` of zero, [`BRACKET_ITERATIONS`] steps or a bracket of no width: the step with the
+/// least `|f|` (or `start`, a step already taken, if less).
+fn bracketed(ends: [f64; 2], start: (f64, f64), stop: f64, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
+    let ([mut ga, mut gb], [mut ta, mut tb]) = (ends, [0.0, 1.0]);
+    let mut best = start;
+    if (ga < 0.0) == (gb < 0.0) {
+        return best;
+    }
+    // The end kept last (-1: a, 1: b), whose value Illinois halves when it is kept again.
+    let mut kept = 0;
+    for _ in 0..BRACKET_ITERATIONS {
+        let t = (ta + (tb - ta) * ga / (ga - gb)).clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN);
+        let gt = f(t);
+        if gt.abs() < best.0.abs() {
+            best = (gt, t);
+        }
+        if gt.abs() <= stop || !(ta < t && t < tb) {
+            break;
+        }
+        if (gt < 0.0) == (ga < 0.0) {
+            (ta, ga) = (t, gt);
+            if kept == -1 {
+                gb *= 0.5;
+            }
+            kept = -1;
+        } else {
+            (tb, gb) = (t, gt);
+            if kept == 1 {
+                ga *= 0.5;
+            }
+            kept = 1;
+        }
+    }
+    best
+}
+
+/// Settles the sign of every grid point whose value is within the grid's error of zero: the
+/// exact minimum over every refined pose of the motion ([`Refiner::exact_all`]) is written in
+/// its place. The grid's value is the least trilinear read over the samples of the motion: the
+/// exact minimum is at most half the read's [`Refiner::spread`] above it (the exact value at the
+/// sample that gave it) and at most that plus half a sample interval's travel below it (a
+/// refined pose is within half of it from a sample). A point whose value is further from zero
+/// keeps its sign, which is then the exact one.
+///
+/// So every grid edge the contouring crosses has ends of opposite exact signs and holds a zero
+/// of the exact field, which its vertex is refined to: without this, an edge whose ends the
+/// trilinear reads got on the wrong side of zero kept its vertex off the boundary by up to
+/// their error (most of the reported bound).
+fn settle_signs(g: &mut [f32], grid: Grid, refine: &Refiner<'_>, threads: usize) -> Result<()> {
+    let half = 0.5 * refine.spread;
+    let below = half + 0.5 * refine.travel;
+    let band = refine.field.band;
+    let [nx, ny, _] = grid.n;
+    let parts: Vec<_> = g.chunks_mut(nx * ny).enumerate().collect();
+    in_parts(parts, threads, "the region's signs", |(k, layer)| {
+        for (s, v) in layer.iter_mut().enumerate() {
+            let value = f64::from(*v);
+            if value + half < 0.0 || value - below > 0.0 {
+                continue;
+            }
+            let exact = refine.exact_all(grid.point(s % nx, s / nx, k), value + half);
+            *v = if exact < 0.0 {
+                (exact.max(-band) as f32).min(-f32::MIN_POSITIVE)
+            } else {
+                (exact.min(band) as f32).max(0.0)
+            };
+        }
+    })
+}
+
 /// The six tetrahedra of Kuhn's triangulation of the unit cube, as corner codes
 /// (`x | y << 1 | z << 2`), each positively oriented.
 const KUHN: [[u8; 4]; 6] = [
@@ -1318,12 +1415,12 @@ const KUHN: [[u8; 4]; 6] = [
 fn contour(
     g: &[f32],
     arg: &[u32],
-    n: [usize; 3],
-    origin: DVec3,
-    cell: f64,
+    grid: Grid,
     refine: &Refiner<'_>,
+    threads: usize,
     out: &mut ClosedMesh,
 ) -> Result<()> {
+    let Grid { origin, cell, n } = grid;
     use std::collections::HashMap;
     let [nx, ny, nz] = n;
     let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
@@ -1335,6 +1432,8 @@ fn contour(
         (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
     };
     let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
+    // Each vertex's motion samples (those of its edge's ends).
+    let mut near: Vec<[u32; 2]> = Vec::new();
     let mut residual: f64 = 0.0;
     // The vertex on the grid edge from point `p` to point `q` (`q` above `p` on every axis
     // it differs in), made once.
@@ -1392,13 +1491,24 @@ fn contour(
             (best, slope)
         };
         let ((local, t), slope) = secant(t, (gb - ga) / (tb - ta), &|x| refine.exact_near(x, js));
+        let all = |x: DVec3| refine.exact_all(x, refine.near(x, js) + refine.spread);
         let (g, t) = if refine.exact_all(lerp(t), local) < local {
-            secant(t, slope, &|x| {
-                refine.exact_all(x, refine.near(x, js) + refine.spread)
-            })
-            .0
+            secant(t, slope, &all).0
         } else {
             (local, t)
+        };
+        // Where the secant steps stall on a kink of the minimum, regula falsi (Illinois) on
+        // the exact field over every pose, between the edge's ends: their signs are exact
+        // (`settle_signs`), so the edge holds a zero.
+        let (g, t) = if g.abs() > BRACKET_START * cell {
+            let half = 0.5 * refine.spread;
+            let ends = [
+                refine.exact_all(a, fa + half),
+                refine.exact_all(b, fb + half),
+            ];
+            bracketed(ends, (g, t), BRACKET_STOP * cell, &|t| all(lerp(t)))
+        } else {
+            (g, t)
         };
         let x = lerp(t);
         residual = residual.max(g.abs().min(cell));
@@ -1413,6 +1523,7 @@ fn contour(
             });
         }
         out.vertices.push(x);
+        near.push(js);
         edges.insert(key, v as u32);
         Ok(v as u32)
     };
@@ -1489,6 +1600,37 @@ fn contour(
             }
         }
     }
+    // Creases: their edges split until each midpoint is within CREASE_TARGET cells.
+    let exact = |x: DVec3, js: [u32; 2]| refine.exact_all(x, refine.exact_near(x, js));
+    let onto = |from: DVec3, dir: DVec3, value: f64, js: [u32; 2]| {
+        // The zero along `dir` (out from inside, in from outside), else the other way,
+        // bracketed by steps of growing length (at most a cell).
+        for way in [-value, value] {
+            let mut reach = way;
+            for _ in 0..4 {
+                let there = exact(from + reach * dir, js);
+                if (there < 0.0) != (value < 0.0) {
+                    let (g, t) =
+                        bracketed([value, there], (value, 0.0), BRACKET_STOP * cell, &|t| {
+                            exact(from + t * reach * dir, js)
+                        });
+                    return Some((from + t * reach * dir, g));
+                }
+                reach = (1.5 * reach).clamp(-cell, cell);
+            }
+        }
+        None
+    };
+    let moved = super::crease::split_creases(
+        &mut out.vertices,
+        &mut near,
+        &mut out.triangles,
+        CREASE_TARGET * cell,
+        thread_count(threads),
+        &exact,
+        &onto,
+    );
+    residual = residual.max(moved);
     // The refinement reads the body at REFINE_POSES poses per sample interval, over which no
     // body point travels more than a cell (`DenseMotion::new`: the helix arc, linear in the
     // screw's parameter), so every instant of the motion is within `cell / (2 REFINE_POSES)` of

@@ -53,6 +53,7 @@
 
 pub mod body;
 pub mod closed;
+mod crease;
 mod exact;
 pub mod generator;
 
