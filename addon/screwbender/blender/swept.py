@@ -16,7 +16,9 @@ The pipeline, per object (Rossignac-Kim, "Swept volumes"):
    region's boundary as a closed, consistently oriented, self-intersection-free mesh, every
    vertex within a tolerance (by default 0.5 % of the body's bounding-box diagonal; slower:
    seconds, many more triangles), its work told first (`polyscrew.sweep_closed_work`) and
-   refused when it would run for minutes (:func:`sweep_report.closed_refusal`);
+   refused when it would run for minutes (:func:`sweep_report.closed_refusal`); a mesh that
+   is not closed (decided from its triangles before any work, :func:`sweep_report.closed_choice`)
+   refuses the run, or at Closed Volume's default gets the open sweep;
 4. :func:`create_object` writes it into a new object of the "Swept Regions" collection.
 
 Steps 1 to 3 run for every object before anything is created, so a refusal leaves the scene
@@ -69,6 +71,9 @@ class Swept:
     #: grids it contoured (2 when the first cell's bound exceeded the tolerance).
     cell: float = 0.0
     attempts: int = 0
+    #: Closed Volume at its default on a mesh that is not closed: the open sweep instead
+    #: (:func:`sweep_report.closed_choice`).
+    fallback: bool = False
 
 
 def body_mesh(obj: bpy.types.Object, depsgraph: bpy.types.Depsgraph) -> tuple[np.ndarray, np.ndarray]:
@@ -646,6 +651,7 @@ def compute(
     read: dict | None = None,
     closed: bool = False,
     cell: float | None = None,
+    fallback: bool = False,
 ) -> Swept:
     """The swept mesh of `obj` along its world motion (nothing is created): each screw in the
     fewest steps (at least `steps`) within `tolerance` (world units; None: 0.2 % of the body's
@@ -654,8 +660,9 @@ def compute(
     region's closed boundary instead (`polyscrew.sweep_closed`: every vertex within `tolerance`,
     None: 0.5 % of the body's extent, or a fixed grid `cell` in world units; `steps` and `caps`
     do not apply), refused before any is computed when one would sample more than
-    :func:`sweep_report.closed_refusal` allows."""
-    return compute_all([obj], context, steps, caps, tolerance, read, closed, cell)[0]
+    :func:`sweep_report.closed_refusal` allows, or when the mesh is not closed (it has no
+    inside) unless `fallback` (Closed Volume at its default): then the open sweep."""
+    return compute_all([obj], context, steps, caps, tolerance, read, closed, cell, fallback)[0]
 
 
 def compute_all(
@@ -667,10 +674,14 @@ def compute_all(
     read: dict | None = None,
     closed: bool = False,
     cell: float | None = None,
+    fallback: bool = False,
 ) -> list[Swept]:
     """:func:`compute` of every object of `objects`, their world poses read together
     (:func:`world_poses_all`: the curves evaluated in one call where they alone move the
-    objects, else one `frame_set` per frame for all)."""
+    objects, else one `frame_set` per frame for all). With `closed`, which objects get the
+    closed boundary is decided from their meshes before any pose is read
+    (:func:`sweep_report.closed_choice`): an open mesh refuses the run, or with `fallback` gets
+    the open sweep (its :attr:`Swept.fallback` set)."""
     scene = context.scene
     read = {} if read is None else read
     prepared = []
@@ -685,6 +696,11 @@ def compute_all(
             to_body = np.linalg.inv(carried_matrix(obj, driver)) @ np.array(obj.matrix_world, dtype=np.float64)
             verts = verts @ to_body[:3, :3].T + to_body[:3, 3]
         prepared.append((obj, driver, verts, tris))
+    names = [obj.name for obj, _, _, _ in prepared]
+    closed_meshes = [sweep_report.is_closed(tris) for _, _, _, tris in prepared] if closed else []
+    kinds, refusal = sweep_report.closed_choice(names, closed_meshes, closed, fallback)
+    if refusal is not None:
+        raise SweepError(refusal)
     # The curves evaluated for the poses are read first: their key frames serve motion_frames.
     plan = _plan([(obj, driver) for obj, driver, _, _ in prepared], scene, read, True)
     items = []
@@ -696,22 +712,22 @@ def compute_all(
     posed = world_poses_all(items, scene, read, plan=plan)
     # A closed boundary's grid: a cell given, else the tolerance's (None: the default).
     grid = {"cell": cell} if cell is not None else {"tolerance": tolerance}
-    if closed:  # every object's work told before any is computed
-        for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
-            try:
-                work = polyscrew.sweep_closed_work(verts * scale, tris, poses, **grid)
-            except ValueError as err:
-                # An open mesh has no inside: say where the open sweep is.
-                hint = "; Closed Volume needs a closed mesh: turn it off for the open sweep" if "not closed" in str(err) else ""
-                raise SweepError(f"{obj.name}: {err}{hint}") from err
-            refusal = sweep_report.closed_refusal(work)
-            if refusal is not None:
-                raise SweepError(f"{obj.name}: {refusal}")
+    # Every closed boundary's work told before any object is computed.
+    for (obj, _, verts, tris), (poses, scale), kind in zip(prepared, posed, kinds):
+        if not kind:
+            continue
+        try:
+            work = polyscrew.sweep_closed_work(verts * scale, tris, poses, **grid)
+        except ValueError as err:
+            raise SweepError(f"{obj.name}: {err}") from err
+        refusal = sweep_report.closed_refusal(work)
+        if refusal is not None:
+            raise SweepError(f"{obj.name}: {refusal}")
     out = []
-    for (obj, _, verts, tris), (poses, scale) in zip(prepared, posed):
+    for (obj, _, verts, tris), (poses, scale), kind in zip(prepared, posed, kinds):
         start = time.perf_counter()
         try:
-            if closed:
+            if kind:
                 v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, **grid)
                 out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
                                  info["error_bound"], info["cell"], info["attempts"]))
@@ -719,7 +735,8 @@ def compute_all(
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:
             raise SweepError(f"{obj.name}: {err}") from err
-        out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"]))
+        out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"],
+                         fallback=closed))
     return out
 
 

@@ -48,7 +48,8 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         default=True,
         description="Build the region's boundary as a closed, consistently oriented, self-intersection-free "
         "mesh (for booleans, printing, volume, clearance): seconds, many triangles. Off: the open sweep, the "
-        "live preview's fast superset (milliseconds; not closed)",
+        "live preview's fast superset (milliseconds; not closed). Left at its default, a mesh that is not "
+        "closed gets the open sweep; turned on, it is refused",
     )
     cell: FloatProperty(
         name="Cell Size",
@@ -98,7 +99,10 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
             tolerance = self.tolerance if self.tolerance > 0.0 else None
             cell = self.cell if self.cell > 0.0 else (self.voxel_size if self.properties.is_property_set("voxel_size") else None)
             read: dict = {}  # each key curve read once, also when meshes share an action or a rig
-            computed = swept.compute_all(objects, context, self.steps, self.caps, tolerance, read, self.closed, cell)
+            # Closed Volume left at its default: a mesh that is not closed gets the open sweep.
+            fallback = not self.properties.is_property_set("closed")
+            computed = swept.compute_all(objects, context, self.steps, self.caps, tolerance, read, self.closed, cell,
+                                         fallback)
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, t) for s in computed]
                 # Area, volume (a closed result) and the tolerance met, on each new object.
@@ -125,15 +129,23 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
             tris = sum(swept.triangle_count(o.data) for o in created)
             sweep_ms = 1e3 * sum(s.seconds for s in computed)
             volumes = [m.volume for m in found]
+            fell = [s for s in computed if s.fallback]
+            # The figures of the kind asked for, and beside them those of the objects that fell back.
+            kept = [s for s in computed if not s.fallback]
+            main = kept or fell
+            beside = (len(fell), max(s.tolerance for s in fell), max(s.error_bound for s in fell)) if kept and fell else None
             self.report(
                 {"INFO"},
                 sweep_report.summary(
-                    len(created), tris, seconds, sweep_ms, max(s.tolerance for s in computed),
-                    max(s.error_bound for s in computed), sum(m.area for m in found),
+                    len(created), tris, seconds, sweep_ms, max(s.tolerance for s in main),
+                    max(s.error_bound for s in main), sum(m.area for m in found),
                     None if any(v is None for v in volumes) else sum(volumes),
-                    cell=max(s.cell for s in computed), attempts=max(s.attempts for s in computed),
+                    cell=max(s.cell for s in main), attempts=max(s.attempts for s in main), open_sweep=beside,
                 ),
             )
+            note = sweep_report.fallback_note([s.obj.name for s in fell])
+            if note is not None:  # last: the status bar shows the last report
+                self.report({"WARNING"}, note)
             return {"FINISHED"}
 
         return pipeline.run(self, "Build Swept Region", work, report, refusals=(swept.SweepError,))

@@ -5,7 +5,10 @@
   divergence theorem: the sum over triangles of ``a . (b x c) / 6``);
 - :func:`summary`: the operator's one-line report;
 - :func:`closed_refusal`: whether a closed boundary's work (`polyscrew.sweep_closed_work`,
-  told before the call) is too much to run inside Blender, and what to change.
+  told before the call) is too much to run inside Blender, and what to change;
+- :func:`closed_choice`: which objects get the closed boundary (Closed Volume) and which the
+  open sweep, decided from their meshes (:func:`is_closed`) before any work, or why the run is
+  refused; :func:`fallback_note`: the warning naming the objects that got the open sweep.
 """
 
 from __future__ import annotations
@@ -37,6 +40,43 @@ def closed_refusal(work: dict) -> str | None:
     return (f"Closed Volume at {asked} would sample {grid:,} grid points over {poses:,} poses (at most "
             f"{MAX_CLOSED_GRID_POINTS:,} and {MAX_CLOSED_POSES:,}: minutes of work); raise the Tolerance (the "
             f"work grows as its cube), shorten the frame range, or turn Closed Volume off for the open sweep")
+
+
+#: Why a mesh cannot have a closed boundary (the core's own rule: `Body::is_closed`).
+NOT_CLOSED_WHY = "every edge in two faces, consistently oriented"
+
+
+def _not_closed(names: list[str]) -> str:
+    """``Plane: the mesh is not closed``, ``Plane, Cone.001: the meshes are not closed``."""
+    return f"{', '.join(names)}: {'the mesh is' if len(names) == 1 else 'the meshes are'} not closed"
+
+
+def closed_choice(names: list[str], closed_meshes: list[bool], closed: bool, fallback: bool) -> tuple[list[bool], str | None]:
+    """For each object (`names`, with whether its mesh is closed: :func:`is_closed` of its
+    triangles), whether it gets the closed boundary, and the refusal of the whole run (None
+    when it runs).
+
+    - `closed` False (Closed Volume off): every object gets the open sweep;
+    - `closed` True and `fallback` False (the animator turned Closed Volume on): every object
+      gets the closed boundary, and the run is refused, naming the open meshes and how to get
+      the open sweep, when any mesh is not closed (it has no inside);
+    - `closed` True and `fallback` True (Closed Volume at its default): the closed meshes get
+      the closed boundary, the others the open sweep (:func:`fallback_note` names them)."""
+    if not closed:
+        return [False] * len(names), None
+    open_names = [n for n, c in zip(names, closed_meshes) if not c]
+    if open_names and not fallback:
+        return [True] * len(names), (f"{_not_closed(open_names)} ({NOT_CLOSED_WHY}); Closed Volume needs a closed "
+                                     "mesh: turn it off for the open sweep")
+    return list(closed_meshes), None
+
+
+def fallback_note(names: list[str]) -> str | None:
+    """The warning naming the objects that got the open sweep at Closed Volume's default
+    (:func:`closed_choice`), in one line; None when there are none."""
+    if not names:
+        return None
+    return f"{_not_closed(names)}, built the open sweep (Closed Volume needs a closed mesh: {NOT_CLOSED_WHY})"
 
 
 @dataclass
@@ -80,12 +120,16 @@ def measures(vertices: np.ndarray, triangles: np.ndarray) -> Measures:
 
 
 def summary(objects: int, triangles: int, seconds: float, sweep_ms: float, tolerance: float, bound: float,
-            area: float, volume: float | None, cell: float = 0.0, attempts: int = 1) -> str:
+            area: float, volume: float | None, cell: float = 0.0, attempts: int = 1,
+            open_sweep: tuple[int, float, float] | None = None) -> str:
     """``Swept 1 object(s): 6536 triangles in 0.05 s (sweep 2.1 ms); tolerance 0.00173 (met
     within 0.00164); area 12.3; volume 5.08`` (volume only for a closed result). A closed
     boundary (`cell` > 0) names the tolerance its vertices meet (when it was given one) and its
     cell: ``closed boundary, tolerance 0.00866 (vertices within 0.0061 of the swept boundary;
-    cell 0.0108)``, and a second grid when the first did not meet the tolerance."""
+    cell 0.0108)``, and a second grid when the first did not meet the tolerance. `open_sweep`:
+    (objects, tolerance, bound) of the objects that got the open sweep beside closed
+    boundaries (:func:`closed_choice`), named after them: ``; open sweep of 1 object(s):
+    tolerance 0.00283 (met within 0.00278)``."""
     text = f"Swept {objects} object(s): {triangles} triangles in {seconds:.2f} s (sweep {sweep_ms:.1f} ms)"
     if cell > 0.0:
         grids = f", {attempts} grids" if attempts > 1 else ""
@@ -96,6 +140,9 @@ def summary(objects: int, triangles: int, seconds: float, sweep_ms: float, toler
             text += f"; closed boundary, cell {cell:.3g} (vertices within {bound:.3g} of the swept boundary)"
     elif tolerance > 0.0:
         text += f"; tolerance {tolerance:.3g} (met within {bound:.3g})"
+    if open_sweep is not None:
+        count, open_tolerance, open_bound = open_sweep
+        text += f"; open sweep of {count} object(s): tolerance {open_tolerance:.3g} (met within {open_bound:.3g})"
     text += f"; area {area:.6g}"
     if volume is not None:
         text += f"; volume {volume:.6g}"
