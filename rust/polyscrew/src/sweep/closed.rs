@@ -37,8 +37,8 @@
 //! ([`motion_gap`]).
 //!
 //! Why it is closed and intersection-free (before step 5, which keeps both: `crease.rs`): the
-//! surface pieces of a tetrahedron lie inside it
-//! and meet the pieces of its neighbours exactly on their shared faces (a vertex is owned by
+//! surface pieces of a tetrahedron lie inside it and meet the pieces of its neighbours exactly
+//! on their shared faces (a vertex is owned by
 //! its grid edge, shared by every tetrahedron around the edge); every tetrahedron edge
 //! crossed by the zero set holds one vertex, so every surface edge is in exactly two
 //! triangles (two tetrahedra share a face, or two triangles of one quad share its diagonal),

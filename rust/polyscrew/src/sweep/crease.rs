@@ -12,6 +12,7 @@
 //! against that direction or cross any triangle of the mesh (a segment-triangle test with the
 //! vertices rounded to float32, as Blender keeps them, against the triangles in the buckets
 //! the new ones meet). So the mesh stays self-intersection-free.
+
 use std::collections::HashMap;
 
 use glam::DVec3;
