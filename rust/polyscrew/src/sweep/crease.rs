@@ -17,6 +17,8 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
+use super::closed::point_triangle_distance;
+
 /// Edges whose two triangles' normals differ by more than this angle (its cosine) are checked.
 /// A smooth sheet's chord between two vertices whose normals differ by `theta` is off it by
 /// about `length * theta / 8`: at most 0.03 cells on the contoured edges (under 1.8 cells).
@@ -24,6 +26,10 @@ pub const CREASE_COSINE: f64 = 0.990_268_068_741_570_3; // cos 8 degrees
 
 /// Rounds of splits at most (each halves the edges across a crease).
 pub const CREASE_ROUNDS: usize = 8;
+
+/// A split is refused when its new vertex comes nearer than this many targets to a triangle
+/// (or a triangle's corner to a new triangle) that shares no corner with the new one.
+pub const TOUCH: f64 = 0.04;
 
 /// An edge's two triangles (by index), the edge by its vertices, lower first.
 type Edges = HashMap<(u32, u32), [u32; 2]>;
@@ -153,7 +159,7 @@ pub fn split_creases(
             let fits = |vertices: &mut Vec<DVec3>, at: DVec3, dir: DVec3| {
                 vertices.push(at);
                 let fits = new.iter().all(|&n| cross(vertices, n).dot(dir) > 0.0)
-                    && !buckets.crosses(vertices, triangles, &new, [p, q]);
+                    && !buckets.crosses(vertices, triangles, &new, [p, q], TOUCH * target);
                 vertices.pop();
                 fits
             };
@@ -284,7 +290,14 @@ impl Buckets {
 
     /// Whether a triangle of `new` crosses a triangle of the mesh other than those of
     /// `replaced` (other than along what they share: [`crosses`]).
-    fn crosses(&self, v: &[DVec3], t: &[[u32; 3]], new: &[[u32; 3]], replaced: [u32; 2]) -> bool {
+    fn crosses(
+        &self,
+        v: &[DVec3],
+        t: &[[u32; 3]],
+        new: &[[u32; 3]],
+        replaced: [u32; 2],
+        margin: f64,
+    ) -> bool {
         let mut near: Vec<u32> = new
             .iter()
             .flat_map(|&n| self.cubes(v, n))
@@ -295,8 +308,24 @@ impl Buckets {
             .collect();
         near.sort_unstable();
         near.dedup();
-        new.iter()
-            .any(|&n| near.iter().any(|&i| crosses(v, n, t[i as usize])))
+        // The new vertex (last) nearer than `margin` to a triangle it is not a corner of, or a
+        // corner of such a triangle nearer than that to a new triangle, is refused too: a touch
+        // is a crossing to a test with a tolerance (Blender's `BVHTree.overlap`).
+        let w = (v.len() - 1) as u32;
+        let touches = |n: [u32; 3], s: [u32; 3]| {
+            let at = |k: u32| v[k as usize];
+            let [a, b, c] = s.map(at);
+            let [d, e, f] = n.map(at);
+            (!s.contains(&w) && point_triangle_distance(at(w), a, b, c) < margin)
+                || s.iter()
+                    .any(|&k| !n.contains(&k) && point_triangle_distance(at(k), d, e, f) < margin)
+        };
+        new.iter().any(|&n| {
+            near.iter().any(|&i| {
+                let s = t[i as usize];
+                crosses(v, n, s) || (s.iter().all(|k| !n.contains(k)) && touches(n, s))
+            })
+        })
     }
 }
 
