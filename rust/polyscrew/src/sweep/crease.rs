@@ -62,8 +62,9 @@ fn retarget(edges: &mut Edges, a: u32, b: u32, old: u32, new: u32) {
 /// farthest first). `field(x, near)` is the region's exact field at `x`, `near` the motion
 /// samples near which to look first (a vertex's, in `near`); `onto(from, dir, value, near)`
 /// moves the point `from`, where the field is `value`, along the unit `dir` to the field's
-/// zero, if it finds it: (the point, the field there). Returns the largest `|field|` at a new
-/// vertex (0 with none); a new vertex's `near` is its edge's first end's.
+/// zero, if it finds it: (the point, the field there). The midpoints are read on `threads`
+/// threads (the splits, one after another, do not depend on the count). Returns the largest
+/// `|field|` at a new vertex (0 with none); a new vertex's `near` is its edge's first end's.
 pub fn split_creases(
     vertices: &mut Vec<DVec3>,
     near: &mut Vec<[u32; 2]>,
