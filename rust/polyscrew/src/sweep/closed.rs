@@ -149,6 +149,9 @@ pub const EXACT_LISTS_PER_CELL: f64 = 2.0;
 /// fold through each other.
 pub const EDGE_MARGIN: f64 = 0.02;
 
+/// Vertices refined per part dealt to a thread (parts in turn, so uneven ones even out).
+const REFINE_CHUNK: usize = 2048;
+
 /// A cell below `extent / MAX_CELLS_PER_EXTENT` (the body's extent) is refused.
 pub const MAX_CELLS_PER_EXTENT: f64 = 1000.0;
 
@@ -1287,37 +1290,75 @@ impl<'a> Refiner<'a> {
 
 impl Refiner<'_> {
     /// The exact minimum at `x` over every refined pose of the motion; `upper` is at least
-    /// that minimum (a value already
-    /// found). An interval between two samples is skipped when every pose in it is above
-    /// `upper`: a body point moves at most `travel` across the interval, so at most half of it
-    /// from the nearer sample, and a pose there is at least the nearer sample's distance to
-    /// the body's bounding sphere, and at least its trilinear read (less the read's error),
-    /// less `travel / 2`; a pose is read exactly only when its trilinear read, less its error,
-    /// is not above `upper`.
+    /// that minimum (a value already found). An interval between two samples is skipped when
+    /// every pose in it is above `upper`: a body point moves at most `travel` across the
+    /// interval, so at most half of it from the nearer sample, and the distance at a sample is
+    /// at least its distance to the body's bounding sphere, at least its trilinear read less
+    /// the read's error, and at least the last sample read's bound less `travel` per interval
+    /// since (so a sample far off lets the next ones go unread). The intervals left are read
+    /// least bounded first, and a pose is read exactly only when its trilinear read, less its
+    /// error, is not above `upper` (the least reads first): the minimum found early bounds
+    /// out the rest. Which poses are read exactly changes nothing but the time: each one
+    /// skipped is above the minimum.
     fn exact_all(&self, x: DVec3, mut upper: f64) -> f64 {
         let half = 0.5 * self.spread;
-        let reach = self.radius + 0.5 * self.travel;
+        let floor = -self.field.band;
         let mut best = f64::INFINITY;
-        // The sample before: its read, less the read's error (infinite: out of reach).
+        // The sample before: at most its distance (its read less the read's error, or a bound).
         let mut before = f64::INFINITY;
+        // The last sample read and at most its distance (none: minus infinity).
+        let mut last = (0usize, f64::NEG_INFINITY);
+        // The sample intervals (by their first sample) that may hold a pose below `upper`,
+        // each with at most its poses' distances.
+        let mut intervals: Vec<(f64, usize)> = Vec::new();
         for (i, c) in self.centres.iter().enumerate() {
-            let here = if c.distance(x) - reach > upper {
-                f64::INFINITY
+            // At most the distance at sample `i`: from the body's bounding sphere, and from the
+            // last read (a body point moves at most `travel` per sample interval).
+            let bound =
+                (c.distance(x) - self.radius).max(last.1 - (i - last.0) as f64 * self.travel);
+            let here = if bound - 0.5 * self.travel > upper {
+                bound
             } else {
-                self.field
-                    .at(self.fine[i * REFINE_POSES].transform_point3(x))
-                    - half
+                let read = self
+                    .field
+                    .at(self.fine[i * REFINE_POSES].transform_point3(x));
+                // A read clamped below (deep inside) bounds nothing from below.
+                last = (
+                    i,
+                    if read > floor {
+                        read - half
+                    } else {
+                        f64::NEG_INFINITY
+                    },
+                );
+                read - half
             };
             let low = before.min(here) - 0.5 * self.travel;
             before = here;
-            if i == 0 || low > upper {
-                continue;
+            if i > 0 && low <= upper {
+                intervals.push((low, i - 1));
             }
-            let first = (i - 1) * REFINE_POSES;
-            for a in &self.fine[first..=first + REFINE_POSES] {
+        }
+        // The intervals least bounded first, and in each the poses read least first: the
+        // minimum is found early and bounds out the rest.
+        intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        let mut reads = [(0.0f64, DVec3::ZERO); REFINE_POSES + 1];
+        for &(low, i) in &intervals {
+            if low > upper {
+                break;
+            }
+            let first = i * REFINE_POSES;
+            for (slot, a) in reads
+                .iter_mut()
+                .zip(&self.fine[first..=first + REFINE_POSES])
+            {
                 let y = a.transform_point3(x);
-                if self.field.at(y) - half > upper {
-                    continue;
+                *slot = (self.field.at(y), y);
+            }
+            reads.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+            for &(read, y) in &reads {
+                if read - half > upper {
+                    break;
                 }
                 let d = self.exact.at(y).0;
                 best = best.min(d);
@@ -1411,42 +1452,27 @@ const KUHN: [[u8; 4]; 6] = [
     [0, 4, 6, 7],
 ];
 
-/// Marching tetrahedra over the world grid (see the module documentation).
-fn contour(
-    g: &[f32],
-    arg: &[u32],
-    grid: Grid,
-    refine: &Refiner<'_>,
-    threads: usize,
-    out: &mut ClosedMesh,
-) -> Result<()> {
-    let Grid { origin, cell, n } = grid;
-    use std::collections::HashMap;
-    let [nx, ny, nz] = n;
-    let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
-    let point = |p: usize| {
-        let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
-        origin + DVec3::new(i as f64, j as f64, k as f64) * cell
-    };
-    let offset = |code: u8| {
-        (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
-    };
-    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
-    // Each vertex's motion samples (those of its edge's ends).
-    let mut near: Vec<[u32; 2]> = Vec::new();
-    let mut residual: f64 = 0.0;
-    // The vertex on the grid edge from point `p` to point `q` (`q` above `p` on every axis
-    // it differs in), made once.
-    let mut vertex = |p: usize, q: usize, out: &mut ClosedMesh| -> Result<u32> {
-        let key = (p, q);
-        if let Some(&v) = edges.get(&key) {
-            return Ok(v);
-        }
-        let (a, b) = (point(p), point(q));
-        let (fa, fb) = (g[p] as f64, g[q] as f64);
+/// A grid edge the contouring crosses: its ends, the region's field there and the motion
+/// samples that gave it.
+struct GridEdge {
+    ends: [DVec3; 2],
+    values: [f64; 2],
+    samples: [u32; 2],
+}
+
+impl GridEdge {
+    /// The point of the edge where the region's field is zero, with the exact field there
+    /// (module documentation, step 4): regula falsi on the refined field, secant steps on the
+    /// exact field near the edge's samples (over every pose where one elsewhere is lower),
+    /// and, where those stall on a kink of the minimum, regula falsi (Illinois) on the exact
+    /// field over every pose between the edge's ends, whose signs are exact
+    /// ([`settle_signs`]), so that the edge holds a zero.
+    fn refined(&self, refine: &Refiner<'_>, cell: f64) -> (DVec3, f64) {
+        let [a, b] = self.ends;
+        let [fa, fb] = self.values;
+        let js = self.samples;
         let lerp = |t: f64| a.lerp(b, t.clamp(EDGE_MARGIN, 1.0 - EDGE_MARGIN));
         let mut t = fa / (fa - fb);
-        let js = [arg[p], arg[q]];
         // Regula falsi on the refined field, when it still brackets the edge.
         let (mut ta, mut tb) = (0.0, 1.0);
         let (mut ga, mut gb) = (refine.near(a, js), refine.near(b, js));
@@ -1497,9 +1523,6 @@ fn contour(
         } else {
             (local, t)
         };
-        // Where the secant steps stall on a kink of the minimum, regula falsi (Illinois) on
-        // the exact field over every pose, between the edge's ends: their signs are exact
-        // (`settle_signs`), so the edge holds a zero.
         let (g, t) = if g.abs() > BRACKET_START * cell {
             let half = 0.5 * refine.spread;
             let ends = [
@@ -1510,8 +1533,41 @@ fn contour(
         } else {
             (g, t)
         };
-        let x = lerp(t);
-        residual = residual.max(g.abs().min(cell));
+        (lerp(t), g)
+    }
+}
+
+/// Marching tetrahedra over the world grid (see the module documentation).
+fn contour(
+    g: &[f32],
+    arg: &[u32],
+    grid: Grid,
+    refine: &Refiner<'_>,
+    threads: usize,
+    out: &mut ClosedMesh,
+) -> Result<()> {
+    let Grid { origin, cell, n } = grid;
+    use std::collections::HashMap;
+    let [nx, ny, nz] = n;
+    let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
+    let point = |p: usize| {
+        let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
+        origin + DVec3::new(i as f64, j as f64, k as f64) * cell
+    };
+    let offset = |code: u8| {
+        (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
+    };
+    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
+    // Each vertex's grid edge (its ends' points), refined once the mesh is walked.
+    let mut ends: Vec<(usize, usize)> = Vec::new();
+    // The vertex on the grid edge from point `p` to point `q` (`q` above `p` on every axis
+    // it differs in), made once, at the edge's midpoint for now: a triangle's orientation
+    // along a crossed edge is the same wherever its vertices lie inside their edges.
+    let mut vertex = |p: usize, q: usize, out: &mut ClosedMesh| -> Result<u32> {
+        let key = (p, q);
+        if let Some(&v) = edges.get(&key) {
+            return Ok(v);
+        }
         let v = out.vertices.len();
         if v >= u32::MAX as usize {
             return Err(Error::Limit {
@@ -1522,8 +1578,8 @@ fn contour(
                 hint: CELL_HINT,
             });
         }
-        out.vertices.push(x);
-        near.push(js);
+        out.vertices.push(point(p).lerp(point(q), 0.5));
+        ends.push(key);
         edges.insert(key, v as u32);
         Ok(v as u32)
     };
@@ -1600,6 +1656,27 @@ fn contour(
             }
         }
     }
+    drop(edges);
+    // Every vertex moved onto the boundary along its edge, on every core: each is its own.
+    let mut near: Vec<[u32; 2]> = ends.iter().map(|&(p, q)| [arg[p], arg[q]]).collect();
+    let mut found = vec![0.0; ends.len()];
+    let parts: Vec<_> = out
+        .vertices
+        .chunks_mut(REFINE_CHUNK)
+        .zip(found.chunks_mut(REFINE_CHUNK))
+        .zip(ends.chunks(REFINE_CHUNK))
+        .collect();
+    in_parts(parts, threads, "the vertices", |((xs, gs), es)| {
+        for ((x, g_at), &(p, q)) in xs.iter_mut().zip(gs.iter_mut()).zip(es) {
+            let edge = GridEdge {
+                ends: [point(p), point(q)],
+                values: [g[p] as f64, g[q] as f64],
+                samples: [arg[p], arg[q]],
+            };
+            (*x, *g_at) = edge.refined(refine, cell);
+        }
+    })?;
+    let mut residual = found.iter().fold(0.0f64, |r, g| r.max(g.abs().min(cell)));
     // Creases: their edges split until each midpoint is within CREASE_TARGET cells.
     let exact = |x: DVec3, js: [u32; 2]| refine.exact_all(x, refine.exact_near(x, js));
     let onto = |from: DVec3, dir: DVec3, value: f64, js: [u32; 2]| {

@@ -31,6 +31,9 @@ pub const CREASE_ROUNDS: usize = 8;
 /// (or a triangle's corner to a new triangle) that shares no corner with the new one.
 pub const TOUCH: f64 = 0.04;
 
+/// The float32 rounding Blender keeps vertices at, relative to their coordinates, and more.
+const ROUNDING_SLACK: f64 = 1e-6;
+
 /// An edge's two triangles (by index), the edge by its vertices, lower first.
 type Edges = HashMap<(u32, u32), [u32; 2]>;
 
@@ -62,8 +65,10 @@ fn retarget(edges: &mut Edges, a: u32, b: u32, old: u32, new: u32) {
 /// farthest first). `field(x, near)` is the region's exact field at `x`, `near` the motion
 /// samples near which to look first (a vertex's, in `near`); `onto(from, dir, value, near)`
 /// moves the point `from`, where the field is `value`, along the unit `dir` to the field's
-/// zero, if it finds it: (the point, the field there). The midpoints are read on `threads`
-/// threads (the splits, one after another, do not depend on the count). Returns the largest
+/// zero, if it finds it: (the point, the field there). The midpoints (once per edge) and the
+/// moves of the splits a round plans are found on `threads` threads; the splits, one after
+/// another, do not depend on the count. The new vertex moves along its ends' normals as they
+/// were at the round's start, else its two triangles'. Returns the largest
 /// `|field|` at a new vertex (0 with none); a new vertex's `near` is its edge's first end's.
 pub fn split_creases(
     vertices: &mut Vec<DVec3>,
@@ -106,24 +111,64 @@ pub fn split_creases(
     candidates.sort_unstable();
     let mut buckets = Buckets::new(vertices, triangles);
     let mut residual: f64 = 0.0;
+    // Midpoint values read so far, by edge.
+    let mut known: HashMap<(u32, u32), f64> = HashMap::new();
     for _ in 0..CREASE_ROUNDS {
-        // Each candidate's midpoint value, most off first.
+        // Each candidate's midpoint value, most off first: read once per edge (an edge's
+        // ends never move), the new ones on every core.
         let value = |&(a, b): &(u32, u32)| {
             field(
                 0.5 * (vertices[a as usize] + vertices[b as usize]),
                 near[a as usize],
             )
         };
-        let mut off: Vec<(f64, (u32, u32))> = in_chunks(&candidates, threads, &value)
-            .into_iter()
-            .zip(&candidates)
+        let unread: Vec<(u32, u32)> = candidates
+            .iter()
+            .copied()
+            .filter(|e| !known.contains_key(e))
+            .collect();
+        known.extend(
+            unread
+                .iter()
+                .copied()
+                .zip(in_chunks(&unread, threads, &value)),
+        );
+        let mut off: Vec<(f64, (u32, u32))> = candidates
+            .iter()
+            .map(|e| (known[e], *e))
             .filter(|(g, _)| g.abs() > target)
-            .map(|(g, &e)| (g, e))
             .collect();
         if off.is_empty() {
             break;
         }
         off.sort_by(|x, y| y.0.abs().total_cmp(&x.0.abs()).then(x.1.cmp(&y.1)));
+        // The splits this round takes if none is refused (at most one per triangle), each
+        // moved along its ends' normals as they are at the round's start, on every core. A
+        // split the round takes only because one before it was refused moves when its turn
+        // comes, along the same normals, so the result does not depend on the thread count.
+        let start = normals.clone();
+        let mut claimed = vec![false; triangles.len()];
+        let planned: Vec<(f64, (u32, u32))> = off
+            .iter()
+            .copied()
+            .filter(|(_, e)| {
+                edges.get(e).is_some_and(|&[p, q]| {
+                    let free = !claimed[p as usize] && !claimed[q as usize];
+                    claimed[p as usize] = true;
+                    claimed[q as usize] = true;
+                    free
+                })
+            })
+            .collect();
+        let along = |a: u32, b: u32| (start[a as usize] + start[b as usize]).normalize_or_zero();
+        let ahead = |&(g, (a, b)): &(f64, (u32, u32))| {
+            let dir = along(a, b);
+            let mid = 0.5 * (vertices[a as usize] + vertices[b as usize]);
+            let moved = (dir != DVec3::ZERO).then(|| onto(mid, dir, g, near[a as usize]));
+            ((a, b), moved.flatten())
+        };
+        let ahead: HashMap<(u32, u32), Option<(DVec3, f64)>> =
+            in_chunks(&planned, threads, &ahead).into_iter().collect();
         // At most one split per triangle per round.
         let mut taken = vec![false; triangles.len()];
         let mut next = Vec::new();
@@ -152,8 +197,9 @@ pub fn split_creases(
             // two triangles': the first that turns no new triangle against it and crosses
             // nothing.
             let ways = [
-                normals[a as usize] + normals[b as usize],
-                normal(vertices, triangles[p as usize]) + normal(vertices, triangles[q as usize]),
+                along(a, b),
+                (normal(vertices, triangles[p as usize]) + normal(vertices, triangles[q as usize]))
+                    .normalize_or_zero(),
             ];
             let mid = 0.5 * (pa + pb);
             // Whether `w` at `at` turns no new triangle against `dir` and crosses nothing.
@@ -165,11 +211,15 @@ pub fn split_creases(
                 fits
             };
             let mut found: Option<(DVec3, f64)> = None;
-            for dir in ways.map(DVec3::normalize_or_zero) {
+            for (way, dir) in ways.into_iter().enumerate() {
                 if dir == DVec3::ZERO {
                     continue;
                 }
-                let Some((at, gw)) = onto(mid, dir, g, near[a as usize]) else {
+                let o = match ahead.get(&(a, b)) {
+                    Some(&moved) if way == 0 => moved,
+                    _ => onto(mid, dir, g, near[a as usize]),
+                };
+                let Some((at, gw)) = o else {
                     continue;
                 };
                 if gw.abs() >= g.abs() {
@@ -229,7 +279,11 @@ pub fn split_creases(
 }
 
 /// `f` of every item, in order, computed on `threads` threads (contiguous chunks).
-fn in_chunks<T: Sync>(items: &[T], threads: usize, f: &(dyn Fn(&T) -> f64 + Sync)) -> Vec<f64> {
+fn in_chunks<T: Sync, R: Send>(
+    items: &[T],
+    threads: usize,
+    f: &(dyn Fn(&T) -> R + Sync),
+) -> Vec<R> {
     let size = items.len().div_ceil(threads.max(1)).max(1);
     if threads <= 1 || items.len() <= size {
         return items.iter().map(f).collect();
@@ -237,7 +291,7 @@ fn in_chunks<T: Sync>(items: &[T], threads: usize, f: &(dyn Fn(&T) -> f64 + Sync
     std::thread::scope(|scope| {
         let handles: Vec<_> = items
             .chunks(size)
-            .map(|chunk| scope.spawn(move || chunk.iter().map(f).collect::<Vec<f64>>()))
+            .map(|chunk| scope.spawn(move || chunk.iter().map(f).collect::<Vec<R>>()))
             .collect();
         handles
             .into_iter()
@@ -321,9 +375,22 @@ impl Buckets {
                 || s.iter()
                     .any(|&k| !n.contains(&k) && point_triangle_distance(at(k), d, e, f) < margin)
         };
+        // Triangles whose boxes (grown by the margin and the float32 rounding) are apart
+        // neither cross nor touch.
+        let boxes = |s: [u32; 3]| {
+            let [a, b, c] = s.map(|k| v[k as usize]);
+            let (lo, hi) = (a.min(b).min(c), a.max(b).max(c));
+            let slack = margin + ROUNDING_SLACK * lo.abs().max(hi.abs()).max_element();
+            (lo - slack, hi + slack)
+        };
         new.iter().any(|&n| {
+            let (lo, hi) = boxes(n);
             near.iter().any(|&i| {
                 let s = t[i as usize];
+                let (slo, shi) = boxes(s);
+                if slo.cmpgt(hi).any() || lo.cmpgt(shi).any() {
+                    return false;
+                }
                 crosses(v, n, s) || (s.iter().all(|k| !n.contains(k)) && touches(n, s))
             })
         })
