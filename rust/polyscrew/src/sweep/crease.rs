@@ -11,7 +11,10 @@
 //! normal; a split is refused, and tried again next round, when a new triangle would face
 //! against that direction or cross any triangle of the mesh (a segment-triangle test with the
 //! vertices rounded to float32, as Blender keeps them, against the triangles in the buckets
-//! the new ones meet). So the mesh stays self-intersection-free.
+//! the new ones meet). So the mesh stays self-intersection-free. An edge no split fits is
+//! flipped instead (to the other diagonal of its two triangles) when the flipped diagonal's
+//! midpoint is nearer the boundary, under the same checks: where neighbours split in earlier
+//! rounds block the move, the flip mostly lines the edge up with the crease.
 
 use std::collections::HashMap;
 
@@ -206,7 +209,7 @@ pub fn split_creases(
             let fits = |vertices: &mut Vec<DVec3>, at: DVec3, dir: DVec3| {
                 vertices.push(at);
                 let fits = new.iter().all(|&n| cross(vertices, n).dot(dir) > 0.0)
-                    && !buckets.crosses(vertices, triangles, &new, [p, q], TOUCH * target);
+                    && !buckets.crosses(vertices, triangles, &new, [p, q], TOUCH * target, Some(w));
                 vertices.pop();
                 fits
             };
@@ -231,6 +234,49 @@ pub fn split_creases(
                 }
             }
             let Some((w_at, gw)) = found else {
+                // No split fits: the edge flipped instead (to the other diagonal of its two
+                // triangles), when that one's midpoint is nearer the boundary and the flip
+                // turns nothing over and crosses nothing.
+                let [u, v, x] = sides[0].2;
+                let y = sides[1].2[2];
+                let flipped = [[u, y, x], [y, v, x]];
+                let facing = cross(vertices, sides[0].1) + cross(vertices, sides[1].1);
+                let xy = key(x, y);
+                let turns = flipped
+                    .iter()
+                    .any(|&n| cross(vertices, n).dot(facing) <= 0.0);
+                let gxy = if x == y || edges.contains_key(&xy) || turns {
+                    f64::INFINITY
+                } else {
+                    *known.entry(xy).or_insert_with(|| {
+                        field(
+                            0.5 * (vertices[x as usize] + vertices[y as usize]),
+                            near[xy.0 as usize],
+                        )
+                    })
+                };
+                if gxy.abs() < g.abs()
+                    && !buckets.crosses(vertices, triangles, &flipped, [p, q], TOUCH * target, None)
+                {
+                    let before = [p, q].map(|t| cross(vertices, triangles[t as usize]));
+                    triangles[p as usize] = flipped[0];
+                    triangles[q as usize] = flipped[1];
+                    taken[p as usize] = true;
+                    taken[q as usize] = true;
+                    buckets.insert(vertices, flipped[0], p);
+                    buckets.insert(vertices, flipped[1], q);
+                    let after = flipped.map(|n| cross(vertices, n));
+                    normals[u as usize] += after[0] - before[0] - before[1];
+                    normals[v as usize] += after[1] - before[0] - before[1];
+                    normals[x as usize] += after[0] + after[1] - before[0];
+                    normals[y as usize] += after[0] + after[1] - before[1];
+                    edges.remove(&(a, b));
+                    edges.insert(xy, [p, q]);
+                    retarget(&mut edges, u, y, q, p);
+                    retarget(&mut edges, v, x, p, q);
+                    next.extend([xy, key(u, y), key(v, x), key(u, x), key(v, y)]);
+                    continue;
+                }
                 // Tried again next round, its neighbours perhaps changed.
                 next.push((a, b));
                 continue;
@@ -352,6 +398,7 @@ impl Buckets {
         new: &[[u32; 3]],
         replaced: [u32; 2],
         margin: f64,
+        apex: Option<u32>,
     ) -> bool {
         let mut near: Vec<u32> = new
             .iter()
@@ -366,14 +413,15 @@ impl Buckets {
         // The new vertex (last) nearer than `margin` to a triangle it is not a corner of, or a
         // corner of such a triangle nearer than that to a new triangle, is refused too: a touch
         // is a crossing to a test with a tolerance (Blender's `BVHTree.overlap`).
-        let w = (v.len() - 1) as u32;
         let touches = |n: [u32; 3], s: [u32; 3]| {
             let at = |k: u32| v[k as usize];
             let [a, b, c] = s.map(at);
             let [d, e, f] = n.map(at);
-            (!s.contains(&w) && point_triangle_distance(at(w), a, b, c) < margin)
-                || s.iter()
-                    .any(|&k| !n.contains(&k) && point_triangle_distance(at(k), d, e, f) < margin)
+            apex.is_some_and(|w| {
+                !s.contains(&w) && point_triangle_distance(at(w), a, b, c) < margin
+            }) || s
+                .iter()
+                .any(|&k| !n.contains(&k) && point_triangle_distance(at(k), d, e, f) < margin)
         };
         // Triangles whose boxes (grown by the margin and the float32 rounding) are apart
         // neither cross nor touch.
