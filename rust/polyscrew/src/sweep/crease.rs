@@ -157,8 +157,10 @@ pub fn split_creases(
             .filter(|(_, e)| {
                 edges.get(e).is_some_and(|&[p, q]| {
                     let free = !claimed[p as usize] && !claimed[q as usize];
-                    claimed[p as usize] = true;
-                    claimed[q as usize] = true;
+                    if free {
+                        claimed[p as usize] = true;
+                        claimed[q as usize] = true;
+                    }
                     free
                 })
             })
@@ -410,9 +412,9 @@ impl Buckets {
             .collect();
         near.sort_unstable();
         near.dedup();
-        // The new vertex (last) nearer than `margin` to a triangle it is not a corner of, or a
-        // corner of such a triangle nearer than that to a new triangle, is refused too: a touch
-        // is a crossing to a test with a tolerance (Blender's `BVHTree.overlap`).
+        // A split's new vertex (`apex`) nearer than `margin` to a triangle it is not a corner
+        // of, or a corner of such a triangle nearer than that to a new triangle, is refused
+        // too: a touch is a crossing to a test with a tolerance (Blender's `BVHTree.overlap`).
         let touches = |n: [u32; 3], s: [u32; 3]| {
             let at = |k: u32| v[k as usize];
             let [a, b, c] = s.map(at);
