@@ -1664,14 +1664,14 @@ fn contour(
         .vertices
         .chunks_mut(REFINE_CHUNK)
         .zip(found.chunks_mut(REFINE_CHUNK))
-        .zip(ends.chunks(REFINE_CHUNK))
+        .zip(ends.chunks(REFINE_CHUNK).zip(near.chunks(REFINE_CHUNK)))
         .collect();
-    in_parts(parts, threads, "the vertices", |((xs, gs), es)| {
-        for ((x, g_at), &(p, q)) in xs.iter_mut().zip(gs.iter_mut()).zip(es) {
+    in_parts(parts, threads, "the vertices", |((xs, gs), (es, js))| {
+        for (((x, g_at), &(p, q)), &samples) in xs.iter_mut().zip(gs.iter_mut()).zip(es).zip(js) {
             let edge = GridEdge {
                 ends: [point(p), point(q)],
                 values: [g[p] as f64, g[q] as f64],
-                samples: [arg[p], arg[q]],
+                samples,
             };
             (*x, *g_at) = edge.refined(refine, cell);
         }
