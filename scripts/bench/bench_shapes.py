@@ -1,4 +1,5 @@
-"""Test bodies shared by the sweep benchmarks (numpy only, so they load inside Blender too)."""
+"""Test bodies shared by the sweep benchmarks (numpy only, so they load inside Blender too),
+and the playback that takes the most samples per span (`spinning_playback`)."""
 
 from __future__ import annotations
 
@@ -26,3 +27,20 @@ def bumpy_torus(n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
     """The bumpy torus of benches/sweep.rs with `n x m` quads: vertices (n m, 3) and outward
     triangles (2 n m, 3) int64."""
     return torus(n, m, bumps=0.25)
+
+
+def spinning_playback(k: int):
+    """A `polyscrew.Playback` of nine LINEAR curves over `k` keys one frame apart, the three
+    Euler angles turning 10,000 radians per frame, and its key frames: every span takes
+    `polyscrew.MAX_SPAN_SAMPLES` samples in `analyse_spans`."""
+    import polyscrew as ps
+
+    f = np.arange(k, dtype=float)
+    cols = [(p, i) for p in ("location", "rotation_euler", "scale") for i in range(3)]
+    values = {"location": 0.1 * f, "rotation_euler": 1e4 * f, "scale": 1 + 0 * f}
+    co = np.concatenate([np.stack([f, values[p]], 1) for p, _ in cols])
+    n = len(co)
+    pb = ps.Playback(channels=cols, unkeyed=np.array([0, 0, 0, 0, 0, 0, 1, 1, 1.0]), mode="XYZ",
+                     offsets=np.arange(0, n + 1, k), co=co, handle_left=co - [1, 0], handle_right=co + [1, 0],
+                     interpolation=np.full(n, ps.INTERPOLATIONS.index("LINEAR")), easing=np.zeros(n, int))
+    return pb, f

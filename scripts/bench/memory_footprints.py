@@ -25,7 +25,7 @@ SETUP = r"""
 import json, re, sys
 import numpy as np, polyscrew as ps
 sys.path.insert(0, "scripts/bench")
-from bench_shapes import bumpy_torus
+from bench_shapes import bumpy_torus, spinning_playback
 
 def keys(n, seed=1):
     rng = np.random.default_rng(seed)
@@ -66,12 +66,15 @@ def estimate(call):
     return None
 
 def measure(call):
+    import time
     call()  # warm: the allocator's arenas, the module's first-call setup
     with open("/proc/self/clear_refs", "w") as f:
         f.write("5")
     before = status("VmRSS")
+    start = time.process_time()
     call()
-    return status("VmHWM") - before
+    cpu = time.process_time() - start
+    return status("VmHWM") - before, cpu
 """
 
 CASES = {
@@ -99,6 +102,15 @@ CASES = {
         "r = np.tile(np.eye(3), (1_000_000, 1, 1))",
         "lambda: ps.rotation_channels(r, 'XYZ')",
     ),
+    # the largest calls the caps accept, where the caps bound time rather than memory
+    "rotation_channels at its cap: 2**24 rotations, QUATERNION": (
+        "r = np.broadcast_to(np.eye(3), (ps.MAX_ROTATIONS, 3, 3))",
+        "lambda: ps.rotation_channels(r, 'QUATERNION')",
+    ),
+    "analyse_spans at its cap: 512 spans, each a spin": (
+        "pb, f = spinning_playback(513)",
+        "lambda: ps.analyse_spans(pb, f)",
+    ),
 }
 
 
@@ -107,7 +119,8 @@ def run(setup: str, call: str) -> dict:
         "e = estimate(call)\n"
         "if 'sweep' in " + repr(call) + ":\n"
         "    vo, to = call(); e += 48 * len(vo) + 36 * len(to)\n"
-        "print(json.dumps({'estimate': e, 'peak': measure(call)}))"
+        "peak, cpu = measure(call)\n"
+        "print(json.dumps({'estimate': e, 'peak': peak, 'cpu': cpu}))"
     )
     env = dict(os.environ, MALLOC_MMAP_THRESHOLD_="131072")
     out = subprocess.run(
@@ -120,10 +133,11 @@ def main() -> None:
     import polyscrew
 
     print(f"memory budget: {polyscrew.memory_budget() / 1e6:.0f} MB (default {polyscrew.DEFAULT_MEMORY_BUDGET})")
-    print(f"{'case':72s} {'estimate':>10s} {'measured':>10s}")
+    print(f"{'case':72s} {'estimate':>10s} {'measured':>10s} {'CPU':>8s}")
     for name, (setup, call) in CASES.items():
         r = run(setup, call)
-        print(f"{name:72s} {r['estimate'] / 1e6:8.1f} MB {r['peak'] / 1e6:8.1f} MB")
+        estimate = "-" if r["estimate"] is None else f"{r['estimate'] / 1e6:.1f} MB"
+        print(f"{name:72s} {estimate:>10s} {r['peak'] / 1e6:7.1f} MB {r['cpu']:6.2f} s")
 
 
 if __name__ == "__main__":
