@@ -204,13 +204,22 @@ def test_single_frame_refused():
     refuse(r"Still: .*single frame")
 
 
-def test_one_of_two_bad_creates_nothing():
+def test_one_of_two_bad_creates_nothing(monkeypatch):
+    """The faceless mesh is refused before the closed cube (seconds at the defaults) is
+    computed: the open sweeps run first."""
+    from conftest import addon_module
+
+    swept = addon_module("blender.swept")
+    closed_calls = []
+    sweep_closed = swept.polyscrew.sweep_closed
+    monkeypatch.setattr(swept.polyscrew, "sweep_closed", lambda *a, **k: closed_calls.append(1) or sweep_closed(*a, **k))
     moving(mesh_object("Good", CUBE_V, CUBE_F))
     bad = mesh_object("Nothing", [], [])
     key(bad, 1, (0, 0, 0))
     key(bad, 10, (1, 0, 0))
     h.select_only(*[bpy.data.objects["Good"], bad])
     refuse(r"Nothing: ")
+    assert closed_calls == []
 
 
 def test_sweeps_the_smoothed_motion_at_its_baked_keys():

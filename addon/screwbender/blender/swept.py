@@ -681,7 +681,9 @@ def compute_all(
     objects, else one `frame_set` per frame for all). With `closed`, which objects get the
     closed boundary is decided from their meshes before any pose is read
     (:func:`sweep_report.closed_choice`): an open mesh refuses the run, or with `fallback` gets
-    the open sweep (its :attr:`Swept.fallback` set)."""
+    the open sweep (its :attr:`Swept.fallback` set). The open sweeps are computed before the
+    closed boundaries, so a refusal comes before the long work; the results are in the
+    objects' order."""
     scene = context.scene
     read = {} if read is None else read
     prepared = []
@@ -723,20 +725,24 @@ def compute_all(
         refusal = sweep_report.closed_refusal(work)
         if refusal is not None:
             raise SweepError(f"{obj.name}: {refusal}")
-    out = []
-    for (obj, _, verts, tris), (poses, scale), kind in zip(prepared, posed, kinds):
+    # The open sweeps (milliseconds) before the closed boundaries (seconds): an object the open
+    # sweep refuses (a mesh without faces) stops the run before the long work, not after it.
+    out: list = [None] * len(prepared)
+    order = sorted(range(len(prepared)), key=lambda i: bool(kinds[i]))
+    for i in order:
+        (obj, _, verts, tris), (poses, scale) = prepared[i], posed[i]
         start = time.perf_counter()
         try:
-            if kind:
+            if kinds[i]:
                 v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, **grid)
-                out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
-                                 info["error_bound"], info["cell"], info["attempts"]))
+                out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
+                               info["error_bound"], info["cell"], info["attempts"])
                 continue
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:
             raise SweepError(f"{obj.name}: {err}") from err
-        out.append(Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"],
-                         fallback=closed))
+        out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"], info["error_bound"],
+                       fallback=closed)
     return out
 
 
