@@ -74,11 +74,36 @@ stage "fuzz the module (Hypothesis, seeded; children under a 4 GB address-space 
 stage "pytest tests/packaging"
 "$py" -m pytest -q -p no:cacheprovider tests/packaging
 
-for row in "${BLENDER_MATRIX[@]}"; do
-  read -r version cpython _ <<<"$row"
-  stage "pytest tests/blender under bpy $version (CPython $cpython)"
-  scripts/test_blender.sh "$version"
+# The Blender versions run two at a time (each run is mostly one thread; these machines have
+# two cores), each into its own log, printed whole when its run ends; the run fails if any
+# version fails.
+versions=()
+for row in "${BLENDER_MATRIX[@]}"; do read -r version _ <<<"$row"; versions+=("$version"); done
+stage "pytest tests/blender under bpy ${versions[*]} (two at a time)"
+logs=$(mktemp -d)
+lane() { # runs every other version from index $1; each version's log and its time per version
+  local i version began
+  for ((i = $1; i < ${#versions[@]}; i += 2)); do
+    version=${versions[$i]} began=$(date +%s)
+    if scripts/test_blender.sh "$version" > "$logs/$version.log" 2>&1; then
+      echo "$version passed in $(($(date +%s) - began)) s" > "$logs/$version.status"
+    else
+      echo "$version FAILED in $(($(date +%s) - began)) s" > "$logs/$version.status"
+    fi
+    cat "$logs/$version.log"
+  done
+}
+lane 0 & first=$!
+lane 1 & second=$!
+wait "$first" "$second"
+blender_failed=0 per_version=()
+for version in "${versions[@]}"; do
+  per_version+=("bpy $(cat "$logs/$version.status" 2>/dev/null || echo "$version did not run")")
+  grep -q passed "$logs/$version.status" 2>/dev/null || blender_failed=1
 done
-stage "all tests passed"
+rm -rf "$logs"
+[ "$blender_failed" = 1 ] && stage "the Blender tests failed" || stage "all tests passed"
 echo "time per stage:"
 printf '  %s\n' "${timings[@]}"
+printf '    %s\n' "${per_version[@]}"
+exit "$blender_failed"
