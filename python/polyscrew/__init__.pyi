@@ -60,7 +60,7 @@ estimates beside the peaks measured for the largest uses (all below 160 MB).
 The module releases the GIL while it reads its input, computes and builds its output.
 """
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any, Literal, TypedDict, overload
 
 import numpy as np
@@ -568,6 +568,7 @@ def sweep_closed(
     *,
     tolerance: float | None = None,
     threads: int | None = None,
+    progress: Callable[[float], object] | None = None,
 ) -> tuple[FloatArray, IntArray]: ...
 @overload
 def sweep_closed(
@@ -579,6 +580,7 @@ def sweep_closed(
     info: Literal[True],
     tolerance: float | None = None,
     threads: int | None = None,
+    progress: Callable[[float], object] | None = None,
 ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]:
     """The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
     one closed, consistently oriented, self-intersection-free triangle mesh, every vertex within
@@ -599,6 +601,12 @@ def sweep_closed(
     the mesh is the same, bit for bit. Slower than ``sweep`` (seconds, not milliseconds) and
     many more triangles: for meshes that must be closed (``sweep_closed_work`` tells the work
     before).
+
+    ``progress``: a callable, called with the fraction done (0 to 1; from 0 again for a second
+    grid) about ten times a second, on the calling thread, while the sweep runs on a thread of
+    its own; whatever it raises stops the sweep within a part of its work (a few thousand
+    vertices, a round of crease splits) and is raised by ``sweep_closed``, as is a signal
+    (Ctrl-C: ``KeyboardInterrupt``). None: no calls, and the sweep runs on the calling thread.
 
     Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
     triangles counter-clockwise seen from outside, every edge in exactly two; with

@@ -161,14 +161,33 @@ def short_motion(obj):
     return [1.0, 2.0]
 
 
-def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance():
+def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance(monkeypatch):
     """The operator with no options: Closed Volume, the tolerance 0.5 % of the object's
     bounding-box diagonal, the bound reported within it, closed, no two triangles crossing,
-    every sampled vertex within the bound of the region's boundary."""
+    every sampled vertex within the bound of the region's boundary. The seconds it takes
+    move Blender's progress indicator: the add-on gives `sweep_closed` a progress callable,
+    which runs (calling `WindowManager.progress_update`) without failing the run."""
+    from conftest import addon_module
+
+    swept = addon_module("blender.swept")
+    heard: list[float] = []
+    sweep_closed = swept.polyscrew.sweep_closed
+
+    def listened(*args, progress=None, **kwargs):
+        assert progress is not None, "the operator gave no progress callable"
+
+        def relay(fraction):
+            heard.append(fraction)
+            progress(fraction)
+
+        return sweep_closed(*args, progress=relay, **kwargs)
+
+    monkeypatch.setattr(swept.polyscrew, "sweep_closed", listened)
     body = cube()
     poses = played_poses(body, short_motion(body))
     h.select_only(body)
     assert bpy.ops.screwbender.sweep() == {"FINISHED"}
+    assert heard and all(0.0 <= f <= 1.0 for f in heard)
     region = swept_region()
     tol, bound, cell = (region[k] for k in ("screwbender_tolerance", "screwbender_error_bound", "screwbender_cell"))
     assert tol == pytest.approx(0.005 * np.sqrt(3.0), rel=1e-6)

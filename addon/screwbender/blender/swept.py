@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import bpy
@@ -45,6 +46,8 @@ from . import bake, bulk, channels, curves, keys, owners, transaction
 COLLECTION = "Swept Regions"
 #: A world scale that varies by more than this (relative) over the frame range is refused.
 SCALE_TOLERANCE = 1e-5
+#: A closed boundary's progress, in steps of its own (polyscrew reports fractions).
+PROGRESS_STEPS = 1000
 #: Custom property on a swept-region object: the name of the object it was swept from.
 SOURCE_KEY = "screwbender_swept_from"
 
@@ -665,6 +668,16 @@ def compute(
     return compute_all([obj], context, steps, caps, tolerance, read, closed, cell, fallback)[0]
 
 
+def _closed_progress(
+    progress: Callable[[int, int], None] | None, done: int, total: int
+) -> Callable[[float], None] | None:
+    """`progress(done, total)` of a run as `polyscrew.sweep_closed`'s `progress(fraction)` of
+    its closed boundary from `done` (None without `progress`)."""
+    if progress is None:
+        return None
+    return lambda fraction: progress(done + int(PROGRESS_STEPS * fraction), total)
+
+
 def compute_all(
     objects: list[bpy.types.Object],
     context: bpy.types.Context,
@@ -675,6 +688,7 @@ def compute_all(
     closed: bool = False,
     cell: float | None = None,
     fallback: bool = False,
+    progress: Callable[[int, int], None] | None = None,
 ) -> list[Swept]:
     """:func:`compute` of every object of `objects`, their world poses read together
     (:func:`world_poses_all`: the curves evaluated in one call where they alone move the
@@ -683,7 +697,8 @@ def compute_all(
     (:func:`sweep_report.closed_choice`): an open mesh refuses the run, or with `fallback` gets
     the open sweep (its :attr:`Swept.fallback` set). The open sweeps are computed before the
     closed boundaries, so a refusal comes before the long work; the results are in the
-    objects' order."""
+    objects' order. `progress(done, total)` follows the closed boundaries (seconds each), in
+    thousandths of each."""
     scene = context.scene
     read = {} if read is None else read
     prepared = []
@@ -729,12 +744,16 @@ def compute_all(
     # sweep refuses (a mesh without faces) stops the run before the long work, not after it.
     out: list = [None] * len(prepared)
     order = sorted(range(len(prepared)), key=lambda i: bool(kinds[i]))
+    closed_total = PROGRESS_STEPS * sum(map(bool, kinds))
+    closed_done = 0
     for i in order:
         (obj, _, verts, tris), (poses, scale) = prepared[i], posed[i]
         start = time.perf_counter()
         try:
             if kinds[i]:
-                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, **grid)
+                watch = _closed_progress(progress, closed_done, closed_total)
+                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, progress=watch, **grid)
+                closed_done += PROGRESS_STEPS
                 out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
                                info["error_bound"], info["cell"], info["attempts"])
                 continue

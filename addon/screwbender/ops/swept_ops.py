@@ -102,7 +102,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
             # Closed Volume left at its default: a mesh that is not closed gets the open sweep.
             fallback = not self.properties.is_property_set("closed")
             computed = swept.compute_all(objects, context, self.steps, self.caps, tolerance, read, self.closed, cell,
-                                         fallback)
+                                         fallback, progress)
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, t) for s in computed]
                 # Area, volume (a closed result) and the tolerance met, on each new object.
@@ -148,7 +148,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                 self.report({"WARNING"}, note)
             return {"FINISHED"}
 
-        return pipeline.run(self, "Build Swept Region", work, report, refusals=(swept.SweepError,))
+        return pipeline.run(self, "Build Swept Region", work, report, context, refusals=(swept.SweepError,))
 
 
 class SCREWBENDER_OT_check_clearance(bpy.types.Operator):

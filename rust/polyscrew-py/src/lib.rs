@@ -18,6 +18,7 @@ mod feature;
 mod intent;
 mod many;
 mod motion;
+mod progress;
 mod read;
 mod reduce;
 mod sweep;
@@ -41,7 +42,7 @@ where
     }
 }
 
-// stub: from collections.abc import Mapping, Sequence
+// stub: from collections.abc import Callable, Mapping, Sequence
 // stub: from typing import Any, Literal, TypedDict, overload
 // stub:
 // stub: import numpy as np

@@ -21,6 +21,7 @@ use crate::args::{self, Function, Sweep};
 use crate::args::{float_array, FloatArg, IntArg};
 use crate::arrays::{pose_count, read_poses, read_rows3};
 use crate::errors::{check_budget, shape_err, to_py_err};
+use crate::progress::watched;
 
 /// Reads `(T, 3)` integer triangles (no GIL needed).
 fn read_triangles(
@@ -174,6 +175,7 @@ fn sweep<'py>(
 ///     *,
 ///     tolerance: float | None = None,
 ///     threads: int | None = None,
+///     progress: Callable[[float], object] | None = None,
 /// ) -> tuple[FloatArray, IntArray]
 /// sweep_closed(
 ///     vertices: ArrayLike,
@@ -184,6 +186,7 @@ fn sweep<'py>(
 ///     info: Literal[True],
 ///     tolerance: float | None = None,
 ///     threads: int | None = None,
+///     progress: Callable[[float], object] | None = None,
 /// ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]
 ///
 /// The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
@@ -206,6 +209,12 @@ fn sweep<'py>(
 /// many more triangles: for meshes that must be closed (``sweep_closed_work`` tells the work
 /// before).
 ///
+/// ``progress``: a callable, called with the fraction done (0 to 1; from 0 again for a second
+/// grid) about ten times a second, on the calling thread, while the sweep runs on a thread of
+/// its own; whatever it raises stops the sweep within a part of its work (a few thousand
+/// vertices, a round of crease splits) and is raised by ``sweep_closed``, as is a signal
+/// (Ctrl-C: ``KeyboardInterrupt``). None: no calls, and the sweep runs on the calling thread.
+///
 /// Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
 /// triangles counter-clockwise seen from outside, every edge in exactly two; with
 /// ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
@@ -217,7 +226,7 @@ fn sweep<'py>(
 /// or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
 /// extent), both of them, or grids over the memory budget.
 #[pyfunction]
-#[pyo3(signature = (vertices, triangles, poses, cell = None, info = false, *, tolerance = None, threads = None))]
+#[pyo3(signature = (vertices, triangles, poses, cell = None, info = false, *, tolerance = None, threads = None, progress = None))]
 #[allow(clippy::too_many_arguments)]
 fn sweep_closed<'py>(
     py: Python<'py>,
@@ -228,6 +237,7 @@ fn sweep_closed<'py>(
     #[pyo3(from_py_with = info_arg)] info: bool,
     tolerance: Option<&Bound<'py, PyAny>>,
     threads: Option<&Bound<'py, PyAny>>,
+    progress: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyTuple>> {
     const F: &str = "sweep_closed";
     let options = closed_options(F, cell, tolerance, threads)?;
@@ -235,12 +245,12 @@ fn sweep_closed<'py>(
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
     type Closed = (Array2<f64>, Array2<i64>, [f64; 3], [usize; 2]);
-    let (vo, to, figures, counts) = py.detach(|| -> PyResult<Closed> {
+    let (vo, to, figures, counts) = watched(py, F, progress, |watch| -> PyResult<Closed> {
         let (va, ta, pa) = &views;
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
         let t = read_triangles(F, "triangles", ta)?;
         let p = read_poses(F, "poses", pa)?;
-        let out = sweep_closed_mesh(&v, &t, &p, &options).map_err(|e| to_py_err(F, e))?;
+        let out = sweep_closed_mesh(&v, &t, &p, &options, watch).map_err(|e| to_py_err(F, e))?;
         drop((v, t, p));
         let (vo, to) = mesh_arrays(F, &out.vertices, &out.triangles)?;
         let figures = [out.cell, out.error_bound, out.tolerance];

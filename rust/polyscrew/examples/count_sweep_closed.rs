@@ -70,7 +70,14 @@ fn main() {
         threads,
         ..ClosedOptions::default()
     };
-    let out = sweep_closed_mesh(&vertices, &triangles, &poses, &options).expect("the closed sweep");
+    let out = sweep_closed_mesh(
+        &vertices,
+        &triangles,
+        &poses,
+        &options,
+        &polyscrew::Progress::new(),
+    )
+    .expect("the closed sweep");
     let cpu = cpu_seconds().zip(before).map(|(a, b)| a - b);
     let wall = wall.elapsed().as_secs_f64();
     // FNV-1a over the vertices' bits and the triangles: equal meshes, equal digests.

@@ -284,6 +284,8 @@ pub enum Error {
         /// The computation.
         what: &'static str,
     },
+    /// The computation was asked to stop ([`Progress::cancel`](crate::Progress::cancel)).
+    Cancelled,
     /// An error about one entry of a batch (a curve, a channel, an owner, a sample), with
     /// the entry.
     In {
@@ -736,6 +738,7 @@ impl fmt::Display for Error {
                 }
             }
             Self::Worker { what } => write!(f, "{what}: a worker thread failed"),
+            Self::Cancelled => write!(f, "stopped: the caller asked the computation to stop"),
             Self::In {
                 what: "",
                 at,

@@ -90,6 +90,7 @@ pub mod intent;
 pub mod memory;
 pub mod motion;
 pub(crate) mod numeric;
+pub mod progress;
 pub mod reduce;
 pub mod sweep;
 
@@ -129,6 +130,7 @@ pub use motion::subdivision::{
     subdivide, subdivided_len, Interpolant, Scheme, MAX_LEVELS, MIN_POSES,
 };
 pub use motion::timing::{check_key_times, TimeMap, Timing};
+pub use progress::Progress;
 pub use reduce::{
     reduce_keys, Between, Group, HandleType, ReduceInput, ReduceOptions, Reduced, ReducedCurve,
     ReducedKey, Tolerance,

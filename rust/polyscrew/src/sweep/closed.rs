@@ -45,6 +45,8 @@
 //! and the orientation is taken from which end of a crossed edge is inside. The outer layer
 //! of the grid is outside every instance, so the surface has no border.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
+
 use glam::{DAffine3, DVec3};
 
 use super::exact::{closest_on_triangle, ExactField};
@@ -53,6 +55,7 @@ use crate::error::{Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
 use crate::motion::pose::Pose;
 use crate::motion::screw::Screw;
+use crate::progress::{Progress, Span};
 
 /// The default cell of [`sweep_closed`] with neither a cell nor a tolerance given, before
 /// issue 29 item 1 (kept for scripts that name it), as a fraction of the body's extent (the
@@ -164,6 +167,15 @@ const SLABS_PER_THREAD: usize = 4;
 
 /// Most dense poses [`sweep_closed`] takes.
 pub const MAX_POSES: usize = 1 << 20;
+
+/// Where the stages of one contouring end, as fractions of its progress: the body's distance
+/// grids, the region's narrow band, the signs settled; then the contouring (its shares of the
+/// time on the L-prism at the defaults, one thread: 1.4, 2.0, 0.5 and 15 of 19 s).
+const STAGE_ENDS: [f64; 3] = [0.07, 0.18, 0.21];
+
+/// Within the contouring: where the walk over the grid and the vertices' refinement end (then
+/// the creases; 0.2, 8.3 and 6.5 s of its 15).
+const CONTOUR_STAGE_ENDS: [f64; 2] = [0.013, 0.57];
 
 /// How to ask [`sweep_closed`] for less.
 const CELL_HINT: &str = "use a larger tolerance (or cell)";
@@ -319,7 +331,7 @@ impl BodyField {
     /// [`BodyField::dims`], the unsigned distances spread over `threads` threads by slabs of
     /// the grid along z (each point's value is the same whatever thread computes it: the
     /// least over the triangles).
-    fn new(body: &Body, h: f64, band: f64, threads: usize) -> Result<Self> {
+    fn new(body: &Body, h: f64, band: f64, threads: usize, span: Span<'_>) -> Result<Self> {
         let verts = body.vertices();
         let (lo, hi) = verts
             .iter()
@@ -341,9 +353,15 @@ impl BodyField {
             .enumerate()
             .map(|(s, slab)| (s * per, slab))
             .collect();
-        in_parts(slabs, threads, "the body's distance grid", |(k0, slab)| {
-            unsigned_distances(body, grid, band, roundoff, k0, slab);
-        })?;
+        in_parts(
+            slabs,
+            threads,
+            "the body's distance grid",
+            span,
+            |(k0, slab)| {
+                unsigned_distances(body, grid, band, roundoff, k0, slab);
+            },
+        )?;
         // Signs: crossings of each column (x_i, y_j) along z.
         let mut crossings: Vec<(usize, f64)> = Vec::new();
         for t in body.triangles() {
@@ -500,20 +518,31 @@ fn thread_count(threads: usize) -> usize {
 
 /// Runs `work(part)` on every part of `parts`, spread over [`thread_count`]`(threads)`
 /// threads, the parts dealt in turn (so that uneven parts even out). Each part is its own
-/// slice of the output, so the result does not depend on the count.
+/// slice of the output, so the result does not depend on the count. `span` follows the parts
+/// done; once the computation is asked to stop, the parts not started are left.
 ///
 /// # Errors
-/// [`Error::Worker`] (`what`) if a thread failed (a bug: the work does not panic on data).
+/// [`Error::Worker`] (`what`) if a thread failed (a bug: the work does not panic on data);
+/// [`Error::Cancelled`] if the computation was asked to stop.
 fn in_parts<P: Send>(
     parts: Vec<P>,
     threads: usize,
     what: &'static str,
+    span: Span<'_>,
     work: impl Fn(P) + Sync,
 ) -> Result<()> {
+    let total = parts.len().max(1) as f64;
+    let done = AtomicUsize::new(0);
+    let work = |part: P| {
+        if !span.is_cancelled() {
+            work(part);
+            span.advance((done.fetch_add(1, Ordering::Relaxed) + 1) as f64 / total);
+        }
+    };
     let threads = thread_count(threads).min(parts.len());
     if threads <= 1 {
         parts.into_iter().for_each(work);
-        return Ok(());
+        return span.check();
     }
     let mut dealt: Vec<Vec<P>> = (0..threads).map(|_| Vec::new()).collect();
     for (s, part) in parts.into_iter().enumerate() {
@@ -529,7 +558,8 @@ fn in_parts<P: Send>(
     });
     joined
         .into_iter()
-        .try_for_each(|r| r.map_err(|_| Error::Worker { what }))
+        .try_for_each(|r| r.map_err(|_| Error::Worker { what }))?;
+    span.check()
 }
 
 /// The body's distance grid of spacing `h` and band `band`: its origin, points per axis and
@@ -540,7 +570,7 @@ pub(super) fn body_distance_grid(
     h: f64,
     band: f64,
 ) -> Result<(DVec3, [usize; 3], Vec<f32>)> {
-    let field = BodyField::new(body, h, band, 0)?;
+    let field = BodyField::new(body, h, band, 0, Progress::new().span(0.0, 1.0))?;
     Ok((field.origin, field.n, field.values))
 }
 
@@ -552,7 +582,13 @@ pub(super) fn exact_distance(
     body: &Body,
     cell: f64,
 ) -> Result<impl Fn(DVec3) -> (f64, Option<DVec3>) + '_> {
-    let field = BodyField::new(body, cell / BODY_SUBCELLS, BAND_CELLS * cell, 0)?;
+    let field = BodyField::new(
+        body,
+        cell / BODY_SUBCELLS,
+        BAND_CELLS * cell,
+        0,
+        Progress::new().span(0.0, 1.0),
+    )?;
     let exact = exact_field(body, &field, cell)?;
     Ok(move |p| exact.at(p))
 }
@@ -665,7 +701,23 @@ impl DenseMotion {
 /// - [`Error::Conflict`] (`"cell"`) for both a cell and a tolerance;
 /// - [`Error::Memory`] for grids or a mesh over the memory budget.
 pub fn sweep_closed(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedMesh> {
-    sweep_closed_with(body, poses, options, Evaluation::NarrowBand)
+    sweep_closed_watched(body, poses, options, &Progress::new())
+}
+
+/// [`sweep_closed`], reporting its fraction done to `progress` (from 0 again for a second
+/// grid, `attempts` 2) and stopping with [`Error::Cancelled`] once it is asked to, within a
+/// part of its work (a few thousand vertices, a layer of grid blocks, a round of crease
+/// splits): for a caller on another thread to show the one and offer the other.
+///
+/// # Errors
+/// Those of [`sweep_closed`], and [`Error::Cancelled`].
+pub fn sweep_closed_watched(
+    body: &Body,
+    poses: &[Pose],
+    options: &ClosedOptions,
+    progress: &Progress,
+) -> Result<ClosedMesh> {
+    sweep_closed_with(body, poses, options, Evaluation::NarrowBand, progress)
 }
 
 /// What [`sweep_closed`] will sample (its first attempt), without sampling it: the checks of
@@ -755,17 +807,21 @@ pub(super) fn sweep_closed_with(
     poses: &[Pose],
     options: &ClosedOptions,
     evaluation: Evaluation,
+    progress: &Progress,
 ) -> Result<ClosedMesh> {
     let (cell, tolerance) = first_cell(body, poses, options)?;
-    let mut out = contoured(body, poses, cell, options.threads, evaluation)?;
+    let whole = progress.span(0.0, 1.0);
+    let mut out = contoured(body, poses, cell, options.threads, evaluation, whole)?;
     out.attempts = 1;
     if tolerance > 0.0 && out.error_bound > tolerance {
+        progress.restart();
         out = contoured(
             body,
             poses,
             guaranteed_cell(tolerance),
             options.threads,
             evaluation,
+            whole,
         )?;
         out.attempts = 2;
     }
@@ -844,7 +900,9 @@ fn contoured(
     cell: f64,
     threads: usize,
     evaluation: Evaluation,
+    span: Span<'_>,
 ) -> Result<ClosedMesh> {
+    let [grids, band_end, signs_end] = STAGE_ENDS;
     let band = BAND_CELLS * cell;
     let Plan {
         motion,
@@ -858,7 +916,13 @@ fn contoured(
     (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
         + Footprint::of::<f32>(bx.saturating_mul(by).saturating_mul(bz)))
     .check("the region's distance grid", CLOSED_HINT)?;
-    let field = BodyField::new(body, cell / BODY_SUBCELLS, band, threads)?;
+    let field = BodyField::new(
+        body,
+        cell / BODY_SUBCELLS,
+        band,
+        threads,
+        span.part(0.0, grids),
+    )?;
     let to_body: Vec<DAffine3> = motion
         .poses
         .iter()
@@ -870,7 +934,14 @@ fn contoured(
     arg.resize(count, u32::MAX);
     match evaluation {
         Evaluation::NarrowBand => {
-            let coarse = BodyField::new(body, cell, COARSE_BAND_CELLS * cell, threads)?;
+            // (The coarse grid is a small part of the grids' time.)
+            let coarse = BodyField::new(
+                body,
+                cell,
+                COARSE_BAND_CELLS * cell,
+                threads,
+                span.part(grids, grids),
+            )?;
             narrow_band(
                 &field,
                 &coarse,
@@ -880,19 +951,34 @@ fn contoured(
                 grid,
                 (&mut g, &mut arg),
                 threads,
+                span.part(grids, band_end),
             )?;
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
     let exact = exact_field(body, &field, cell)?;
     let refine = Refiner::new(&field, exact, &motion, body, cell)?;
-    settle_signs(&mut g, grid, &refine, threads)?;
+    settle_signs(
+        &mut g,
+        grid,
+        &refine,
+        threads,
+        span.part(band_end, signs_end),
+    )?;
     let mut out = ClosedMesh {
         cell,
         poses: motion.poses.len(),
         ..ClosedMesh::default()
     };
-    contour(&g, &arg, grid, &refine, threads, &mut out)?;
+    contour(
+        &g,
+        &arg,
+        grid,
+        &refine,
+        threads,
+        span.part(signs_end, 1.0),
+        &mut out,
+    )?;
     Ok(out)
 }
 
@@ -1022,6 +1108,7 @@ fn narrow_band(
     grid: Grid,
     (g, arg): (&mut [f32], &mut [u32]),
     threads: usize,
+    span: Span<'_>,
 ) -> Result<()> {
     let n = grid.n;
     let root3 = 3f64.sqrt();
@@ -1046,6 +1133,7 @@ fn narrow_band(
         parts,
         threads,
         "the region's distance grid",
+        span,
         |(bk, (g, arg))| {
             band.layer(bk, g, arg);
         },
@@ -1419,13 +1507,19 @@ fn bracketed(ends: [f64; 2], start: (f64, f64), stop: f64, f: &dyn Fn(f64) -> f6
 /// of the exact field, which its vertex is refined to: without this, an edge whose ends the
 /// trilinear reads got on the wrong side of zero kept its vertex off the boundary by up to
 /// their error (most of the reported bound).
-fn settle_signs(g: &mut [f32], grid: Grid, refine: &Refiner<'_>, threads: usize) -> Result<()> {
+fn settle_signs(
+    g: &mut [f32],
+    grid: Grid,
+    refine: &Refiner<'_>,
+    threads: usize,
+    span: Span<'_>,
+) -> Result<()> {
     let half = 0.5 * refine.spread;
     let below = half + 0.5 * refine.travel;
     let band = refine.field.band;
     let [nx, ny, _] = grid.n;
     let parts: Vec<_> = g.chunks_mut(nx * ny).enumerate().collect();
-    in_parts(parts, threads, "the region's signs", |(k, layer)| {
+    in_parts(parts, threads, "the region's signs", span, |(k, layer)| {
         for (s, v) in layer.iter_mut().enumerate() {
             let value = f64::from(*v);
             if value + half < 0.0 || value - below > 0.0 {
@@ -1544,8 +1638,10 @@ fn contour(
     grid: Grid,
     refine: &Refiner<'_>,
     threads: usize,
+    span: Span<'_>,
     out: &mut ClosedMesh,
 ) -> Result<()> {
+    let [walked, refined] = CONTOUR_STAGE_ENDS;
     let Grid { origin, cell, n } = grid;
     use std::collections::HashMap;
     let [nx, ny, nz] = n;
@@ -1666,16 +1762,25 @@ fn contour(
         .zip(found.chunks_mut(REFINE_CHUNK))
         .zip(ends.chunks(REFINE_CHUNK).zip(near.chunks(REFINE_CHUNK)))
         .collect();
-    in_parts(parts, threads, "the vertices", |((xs, gs), (es, js))| {
-        for (((x, g_at), &(p, q)), &samples) in xs.iter_mut().zip(gs.iter_mut()).zip(es).zip(js) {
-            let edge = GridEdge {
-                ends: [point(p), point(q)],
-                values: [g[p] as f64, g[q] as f64],
-                samples,
-            };
-            (*x, *g_at) = edge.refined(refine, cell);
-        }
-    })?;
+    span.part(0.0, walked).advance(1.0);
+    let vertices = span.part(walked, refined);
+    in_parts(
+        parts,
+        threads,
+        "the vertices",
+        vertices,
+        |((xs, gs), (es, js))| {
+            for (((x, g_at), &(p, q)), &samples) in xs.iter_mut().zip(gs.iter_mut()).zip(es).zip(js)
+            {
+                let edge = GridEdge {
+                    ends: [point(p), point(q)],
+                    values: [g[p] as f64, g[q] as f64],
+                    samples,
+                };
+                (*x, *g_at) = edge.refined(refine, cell);
+            }
+        },
+    )?;
     let mut residual = found.iter().fold(0.0f64, |r, g| r.max(g.abs().min(cell)));
     // Creases: their edges split until each midpoint is within CREASE_TARGET cells.
     let exact = |x: DVec3, js: [u32; 2]| refine.exact_all(x, refine.exact_near(x, js));
@@ -1704,9 +1809,11 @@ fn contour(
         &mut out.triangles,
         CREASE_TARGET * cell,
         thread_count(threads),
+        span.part(refined, 1.0),
         &exact,
         &onto,
     );
+    span.check()?;
     residual = residual.max(moved);
     // The refinement reads the body at REFINE_POSES poses per sample interval, over which no
     // body point travels more than a cell (`DenseMotion::new`: the helix arc, linear in the
@@ -1757,15 +1864,21 @@ pub fn closed_work_mesh(
     closed_work(&body_for(vertices, triangles, poses)?, poses, options)
 }
 
-/// [`Body::new`] then [`sweep_closed`].
+/// [`Body::new`] then [`sweep_closed_watched`].
 ///
 /// # Errors
-/// Those of [`Body::new`] and [`sweep_closed`].
+/// Those of [`Body::new`] and [`sweep_closed_watched`].
 pub fn sweep_closed_mesh(
     vertices: &[DVec3],
     triangles: &[[i64; 3]],
     poses: &[Pose],
     options: &ClosedOptions,
+    progress: &Progress,
 ) -> Result<ClosedMesh> {
-    sweep_closed(&body_for(vertices, triangles, poses)?, poses, options)
+    sweep_closed_watched(
+        &body_for(vertices, triangles, poses)?,
+        poses,
+        options,
+        progress,
+    )
 }

@@ -257,7 +257,14 @@ fn the_narrow_band_gives_the_dense_grids_mesh() {
     for (name, body, poses) in cases().into_iter().take(2) {
         let time = |evaluation| {
             let start = std::time::Instant::now();
-            let out = sweep_closed_with(&body, &poses, &options(&body), evaluation).unwrap();
+            let out = sweep_closed_with(
+                &body,
+                &poses,
+                &options(&body),
+                evaluation,
+                &crate::Progress::new(),
+            )
+            .unwrap();
             (start.elapsed().as_secs_f64(), out)
         };
         let (dense_s, dense) = time(Evaluation::Dense);

@@ -215,3 +215,58 @@ fn bad_tolerances_are_refused() {
         }
     }
 }
+
+/// `sweep_closed_watched` reports its progress as it goes, never lower (a watcher on another
+/// thread reads it every millisecond), ends at 1 and gives `sweep_closed`'s mesh bit for bit;
+/// asked to stop before it starts or partway, it stops with `Error::Cancelled`, the rest of
+/// its work not done (its progress stays below 1; at 0 for a stop before it starts).
+#[test]
+fn progress_is_reported_and_a_stop_is_honoured() {
+    use crate::Progress;
+    use std::time::Duration;
+    let (name, body, poses) = cases().swap_remove(1);
+    let options = ClosedOptions {
+        tolerance: Some(TOLERANCE_REL * body.extent()),
+        threads: 2,
+        ..ClosedOptions::default()
+    };
+    let plain = sweep_closed(&body, &poses, &options).unwrap();
+    // Runs the sweep while a watcher reads the progress (and stops the run at `stop_at`).
+    let watched = |stop_at: f64| {
+        let progress = Progress::new();
+        let (out, seen) = std::thread::scope(|scope| {
+            let worker = scope.spawn(|| sweep_closed_watched(&body, &poses, &options, &progress));
+            let mut seen = vec![progress.fraction()];
+            while !worker.is_finished() {
+                std::thread::sleep(Duration::from_millis(1));
+                seen.push(progress.fraction());
+                if seen[seen.len() - 1] >= stop_at {
+                    progress.cancel();
+                }
+            }
+            (worker.join().unwrap(), seen)
+        });
+        (out, seen, progress.fraction())
+    };
+    let (out, seen, last) = watched(f64::INFINITY);
+    let distinct = seen.windows(2).filter(|w| w[1] != w[0]).count();
+    println!(
+        "{name}: {} reads of the progress, {distinct} changes",
+        seen.len()
+    );
+    assert!(seen.windows(2).all(|w| w[1] >= w[0]), "{name}: lowered");
+    assert!(distinct >= 10, "{name}: {distinct} changes of the progress");
+    assert_eq!(last, 1.0, "{name}");
+    assert_eq!(digest(&out.unwrap()), digest(&plain), "{name}");
+
+    let (out, _, at) = watched(0.3);
+    println!("{name}: stopped at {at:.3}");
+    assert!(matches!(out, Err(Error::Cancelled)), "{name}: {out:?}");
+    assert!((0.3..1.0).contains(&at), "{name}: stopped at {at}");
+
+    let early = Progress::new();
+    early.cancel();
+    let out = sweep_closed_watched(&body, &poses, &options, &early);
+    assert!(matches!(out, Err(Error::Cancelled)), "{name}: {out:?}");
+    assert_eq!(early.fraction(), 0.0, "{name}: work done after the stop");
+}

@@ -21,6 +21,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use super::closed::point_triangle_distance;
+use crate::progress::Span;
 
 /// Edges whose two triangles' normals differ by more than this angle (its cosine) are checked.
 /// A smooth sheet's chord between two vertices whose normals differ by `theta` is off it by
@@ -73,12 +74,18 @@ fn retarget(edges: &mut Edges, a: u32, b: u32, old: u32, new: u32) {
 /// another, do not depend on the count. The new vertex moves along its ends' normals as they
 /// were at the round's start, else its two triangles'. Returns the largest
 /// `|field|` at a new vertex (0 with none); a new vertex's `near` is its edge's first end's.
+/// `span` follows the rounds; once the computation is asked to stop, no round starts (the
+/// caller checks).
+// The mesh (three parts), the target, how to run (threads, progress) and the field's two
+// functions: grouping them would only name the group.
+#[allow(clippy::too_many_arguments)]
 pub fn split_creases(
     vertices: &mut Vec<DVec3>,
     near: &mut Vec<[u32; 2]>,
     triangles: &mut Vec<[u32; 3]>,
     target: f64,
     threads: usize,
+    span: Span<'_>,
     field: &(dyn Fn(DVec3, [u32; 2]) -> f64 + Sync),
     onto: &(dyn Fn(DVec3, DVec3, f64, [u32; 2]) -> Option<(DVec3, f64)> + Sync),
 ) -> f64 {
@@ -116,7 +123,11 @@ pub fn split_creases(
     let mut residual: f64 = 0.0;
     // Midpoint values read so far, by edge.
     let mut known: HashMap<(u32, u32), f64> = HashMap::new();
-    for _ in 0..CREASE_ROUNDS {
+    for round in 0..CREASE_ROUNDS {
+        if span.is_cancelled() {
+            break;
+        }
+        span.advance(round as f64 / CREASE_ROUNDS as f64);
         // Each candidate's midpoint value, most off first: read once per edge (an edge's
         // ends never move), the new ones on every core.
         let value = |&(a, b): &(u32, u32)| {
@@ -323,6 +334,7 @@ pub fn split_creases(
             .filter(|&e| creased(&edges, vertices, triangles, e))
             .collect();
     }
+    span.advance(1.0);
     residual
 }
 

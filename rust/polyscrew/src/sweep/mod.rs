@@ -64,8 +64,8 @@ pub use body::{
     ZERO_AREA_REL,
 };
 pub use closed::{
-    closed_work, sweep_closed, sweep_closed_mesh, ClosedMesh, ClosedOptions, ClosedWork,
-    DEFAULT_CELL_REL, DEFAULT_CLOSED_TOLERANCE_REL,
+    closed_work, sweep_closed, sweep_closed_mesh, sweep_closed_watched, ClosedMesh, ClosedOptions,
+    ClosedWork, DEFAULT_CELL_REL, DEFAULT_CLOSED_TOLERANCE_REL,
 };
 pub use generator::{
     Generator, Scratch, Segment, SegmentKind, Velocity, MOTIONLESS_REL, TANGENT_REL,
