@@ -74,14 +74,14 @@ stage "fuzz the module (Hypothesis, seeded; children under a 4 GB address-space 
 stage "pytest tests/packaging"
 "$py" -m pytest -q -p no:cacheprovider tests/packaging
 
-# The Blender versions run two at a time (each run is mostly one thread; these machines have
-# two cores), each into its own log, printed whole when its run ends; the run fails if any
-# version fails.
+# The Blender versions run two at a time (a run leaves a core idle much of the time; these
+# machines have two), each into its own log; the logs are printed whole, in order, when all
+# have run, and the run fails if any version fails.
 versions=()
 for row in "${BLENDER_MATRIX[@]}"; do read -r version _ <<<"$row"; versions+=("$version"); done
 stage "pytest tests/blender under bpy ${versions[*]} (two at a time)"
 logs=$(mktemp -d)
-lane() { # runs every other version from index $1; each version's log and its time per version
+lane() { # runs every other version from index $1, each into its log, with its time and result
   local i version began
   for ((i = $1; i < ${#versions[@]}; i += 2)); do
     version=${versions[$i]} began=$(date +%s)
@@ -90,12 +90,12 @@ lane() { # runs every other version from index $1; each version's log and its ti
     else
       echo "$version FAILED in $(($(date +%s) - began)) s" > "$logs/$version.status"
     fi
-    cat "$logs/$version.log"
   done
 }
 lane 0 & first=$!
 lane 1 & second=$!
 wait "$first" "$second"
+for version in "${versions[@]}"; do cat "$logs/$version.log" 2>/dev/null || true; done
 blender_failed=0 per_version=()
 for version in "${versions[@]}"; do
   per_version+=("bpy $(cat "$logs/$version.status" 2>/dev/null || echo "$version did not run")")
