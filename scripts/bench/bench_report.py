@@ -885,7 +885,7 @@ class Report:
         ("bench_sweep_blender", "Build Swept Region on a 100,000-triangle mesh against stroboscopic instancing"),
         ("bench_sweep_closed", "the closed boundary of the swept region against the open sweep on issue 29's cases"),
         ("measure_reduce", "key fractions of reduce_keys on synthetic and captured-like motion (issue 26)"),
-        ("memory_footprints", "the module's memory estimates beside the peaks measured"),
+        ("memory_footprints", "the module's memory estimates beside the peaks measured, and the CPU"),
         ("plot_smoothness", "the ScrewBender paper's smoothness figures (docs/smoothness_fig10.png, docs/circle_fig11.png)"),
     )
 
