@@ -453,9 +453,10 @@ from bench_shapes import spinning_playback as spins
 
 
 def test_analyse_spans_refuses_more_samples_than_its_cap_before_taking_any():
-    """16,000 spans each turning 10,000 radians took 28 to 39 s; now refused up front, before
-    any sample is taken (the refusals' peak grows by less than the accepted call's samples
-    need). The most the cap accepts (512 such spans, each a spin) is computed, finite."""
+    """16,000 spans each turning 10,000 radians took 28 to 39 s; now refused up front, from
+    the spans' sample counts alone (the message gives them), before any result is built (the
+    refusals' peak grows by under 16 MB, the accepted call's by its inserted frames). The most
+    the cap accepts (512 such spans, each a spin) is computed, finite."""
     assert polyscrew.MAX_ANALYSIS_SAMPLES == 512 * polyscrew.MAX_SPAN_SAMPLES == 2**21
     lines = run_peak(
         SPINS
@@ -476,7 +477,7 @@ print(json.dumps({"turn": float(out[2].min()), "inserted": len(out[3])}))
     hint = "analyse fewer key frames at once (a span takes one sample per few degrees its rotation channels turn)"
     assert many == {"error": "ValueError", "message": f"analyse_spans: frames: the 16000 key spans would take 65536000 samples of the playback, over the limit of 2097152 in one call: {hint}"}
     assert over == {"error": "ValueError", "message": f"analyse_spans: frames: the 513 key spans would take 2101248 samples of the playback, over the limit of 2097152 in one call: {hint}"}
-    # the 2,097,152 samples of nine channels take over 16 MB: a refusal that sampled would too
+    # the accepted call's ~5 million inserted frames take 40 MB; the refusals build nothing
     assert at_cap_peak["growth"] > 16 * MB
     assert many_peak["growth"] < 16 * MB and over_peak["growth"] < 16 * MB
     assert at_cap == {"finite": True}
