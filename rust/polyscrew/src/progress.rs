@@ -80,19 +80,22 @@ pub struct Span<'a> {
 }
 
 impl Span<'_> {
+    /// The whole's fraction at this stretch's `fraction`.
+    fn at(&self, fraction: f64) -> f64 {
+        self.from + (self.to - self.from) * fraction
+    }
+
     /// Raises the whole's fraction to this part's `fraction` (0 to 1) of its stretch.
     pub fn advance(&self, fraction: f64) {
-        self.progress
-            .advance(self.from + (self.to - self.from) * fraction.clamp(0.0, 1.0));
+        self.progress.advance(self.at(fraction.clamp(0.0, 1.0)));
     }
 
     /// The stretch from `from` to `to` of this one (fractions of it).
     pub fn part(&self, from: f64, to: f64) -> Self {
-        let at = |f: f64| self.from + (self.to - self.from) * f;
         Self {
             progress: self.progress,
-            from: at(from),
-            to: at(to),
+            from: self.at(from),
+            to: self.at(to),
         }
     }
 
