@@ -43,9 +43,16 @@ stage "cargo test (workspace; the closed sweep's tests run in release, next)"
 cargo test --workspace --quiet -- --skip sweep::closed
 
 # The closed sweep's tests check against slow references (minutes in a debug build), and its
-# face-point acceptance tests are ignored in a debug build.
-stage "cargo test (release): the closed sweep, with its face points"
-cargo test --release -p polyscrew --lib --quiet -- sweep::closed --include-ignored
+# face-point acceptance tests are ignored in a debug build. They are built here and run in
+# release beside the Python tests (below), which leave a core idle much of the time.
+stage "cargo test (release): build the closed sweep's tests"
+release_tests=$(cargo test --release -p polyscrew --lib --no-run --quiet --message-format=json-render-diagnostics |
+  "$py" -c 'import json, sys
+for line in sys.stdin:
+    m = json.loads(line)
+    if m.get("reason") == "compiler-artifact" and m["profile"]["test"] and m.get("executable"):
+        print(m["executable"])')
+[ -x "$release_tests" ] || { echo "test.sh: the release test binary was not built" >&2; exit 1; }
 
 stage "cargo doc (warnings are errors)"
 RUSTDOCFLAGS="-D warnings" cargo doc --no-deps --quiet -p polyscrew
@@ -63,8 +70,26 @@ if [ -x scripts/build_extension.sh ]; then
   scripts/build_extension.sh
 fi
 
-stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)'))"
-"$py" -m pytest -q -p no:cacheprovider tests/python
+# The closed sweep's release tests run in the background, into a log printed when they end:
+# together the two stages take about 0.7 of their times one after the other.
+release_log=$(mktemp)
+release_began=$(date +%s)
+(cd rust/polyscrew && "$release_tests" --include-ignored sweep::closed) > "$release_log" 2>&1 &
+release_pid=$!
+trap 'kill "$release_pid" 2>/dev/null || true' EXIT  # not left running if this run stops
+stage "pytest tests/python (numpy $("$py" -c 'import numpy; print(numpy.__version__)')), the closed sweep's release tests beside it"
+python_failed=0
+"$py" -m pytest -q -p no:cacheprovider --durations=15 tests/python || python_failed=1
+release_failed=0
+wait "$release_pid" || release_failed=1
+trap - EXIT
+release_took=$(($(date +%s) - release_began))
+timings+=("$(printf '%5d s  %s' "$release_took" "cargo test (release): the closed sweep, beside the Python tests")")
+echo "--- cargo test (release): the closed sweep, with its face points ($release_took s)"
+cat "$release_log"
+rm -f "$release_log"
+[ "$release_failed" = 0 ] || { echo "test.sh: the closed sweep's release tests failed (above)" >&2; exit 1; }
+[ "$python_failed" = 0 ] || { echo "test.sh: tests/python failed (above)" >&2; exit 1; }
 
 stage "fuzz the module (Hypothesis, seeded; children under a 4 GB address-space cap)"
 "$py" tests/python/fuzz.py

@@ -40,7 +40,7 @@ for row in "${BLENDER_MATRIX[@]}"; do
   env_py="$(matrix_venv "$cpython")/bin/python"
   numpy_version=$(PYTHONPATH="$dir" "$env_py" -c 'import numpy; print(numpy.__version__)')
   echo "--- tests/blender under bpy $version (CPython $cpython, numpy $numpy_version)"
-  PYTHONPATH="$dir" "$env_py" -m pytest -q -p no:cacheprovider tests/blender "$@"
+  PYTHONPATH="$dir" "$env_py" -m pytest -q -p no:cacheprovider --durations=10 tests/blender "$@"
   ran=$((ran + 1))
 done
 [ "$ran" -gt 0 ] || { echo "test_blender: no version $only in scripts/blender_matrix.sh" >&2; exit 1; }
