@@ -657,6 +657,17 @@ class Report:
             self.sweep_open_peers(json.loads(js.read_text()))
         self.sweep_cases()
 
+    @staticmethod
+    def body_note(c: dict) -> str:
+        """What body the case's reference sweeps, when it is not simply the mesh's closed form."""
+        if not c.get("body_error"):
+            return ""
+        within = f"{100 * c['body_error'] / c['size']:.3f} %"
+        if c.get("exact_body"):
+            return (f"; the reference sweeps the mesh itself (its exact distance), its surface found first on the "
+                    f"smooth torus (within {within} of the mesh; what sweep3d sweeps) then taken onto the mesh's")
+        return f"; the body mesh lies within {within} of the smooth torus the reference and sweep3d sweep"
+
     def sweep_open_peers(self, d: dict) -> None:
         case, ref = d["case"], d["reference"]
         self.w(f"`scripts/bench/bench_sweep_peers.py`{' (quick: a smoke run)' if d.get('quick') else ''}. Case: a "
@@ -786,8 +797,7 @@ class Report:
                    f"{ref['volume']:.4f}, {fmt_seconds(ref['cpu'])} CPU; its points within "
                    f"{100 * ref['max_error'] / c['size']:.4f} % of the size of the boundary (the flat marching-cubes "
                    f"faces between them: {100 * ref['mc_max_error'] / c['size']:.3f} %)"
-                   + (f"; the body mesh lies within {100 * c['body_error'] / c['size']:.3f} % of the smooth torus "
-                      "the reference and sweep3d sweep" if c.get("body_error") else "") + ".")
+                   + self.body_note(c) + ".")
         big = d.get("big")
         if big and big.get("unfinished"):
             self.w("- `sweep_closed` on the 100,000-triangle bumpy torus over 64 screws did not finish within the "

@@ -230,3 +230,79 @@ def test_the_report_quotes_the_issue_for_sweep3d_when_it_did_not_run(tmp_path):
 def test_the_bench_scripts_share_one_definition_of_the_cases():
     closed = (SCRIPTS / "bench_sweep_closed.py").read_text()
     assert "from bench_sweep_cases import cases" in closed and "def torus" not in closed
+
+
+def brute_sd(points, v, t):
+    """Signed distance to a closed mesh from every triangle, signed by the winding number."""
+    d = np.full(len(points), np.inf)
+    solid = np.zeros(len(points))
+    for a, b, c in v[t]:
+        d = np.minimum(d, sm.point_triangle_distance(points, *(np.broadcast_to(x, points.shape) for x in (a, b, c))))
+        ra, rb, rc = a - points, b - points, c - points
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (ra, rb, rc))
+        num = np.einsum("ij,ij->i", ra, np.cross(rb, rc))
+        den = (la * lb * lc + np.einsum("ij,ij->i", ra, rb) * lc + np.einsum("ij,ij->i", rb, rc) * la
+               + np.einsum("ij,ij->i", rc, ra) * lb)
+        solid += 2 * np.arctan2(num, den)
+    return np.where(solid / (4 * np.pi) > 0.5, -d, d)
+
+
+def torus_points(rng, count, offsets):
+    """Points at `offsets` along the smooth torus's normal from random points of it."""
+    u, w = rng.random(count) * 2 * np.pi, rng.random(count) * 2 * np.pi
+    r = cases.TORUS_r + offsets
+    return np.stack([(cases.TORUS_R + r * np.cos(w)) * np.cos(u), (cases.TORUS_R + r * np.cos(w)) * np.sin(u),
+                     r * np.sin(w)], axis=1)
+
+
+def test_the_polygon_torus_distance_is_every_triangles_and_the_winding_numbers():
+    """The reference's exact distance of the torus every tool is given, within its band (a third
+    of the points in the shell where the smooth torus's sign is not the polygon's), equals the
+    least distance over all 2,304 triangles signed by the winding number; beyond the band it is
+    the smooth torus's, within TORUS_SAG."""
+    rng = np.random.default_rng(7)
+    sag = cases.TORUS_SAG
+    offsets = np.r_[rng.uniform(-2 * sag, 2 * sag, 400), rng.uniform(-0.1, 0.1, 700), rng.uniform(0.1, 0.3, 150)]
+    pts = torus_points(rng, len(offsets), offsets)
+    v, t = cases.bench_shapes.torus(cases.TORUS_N, cases.TORUS_M, cases.TORUS_R, cases.TORUS_r)
+    mine, want = cases.polygon_torus_sd()(pts), brute_sd(pts, v, t)
+    band = np.abs(cases.torus_sd(pts)) <= 0.1
+    assert band.sum() > 1000 and (np.sign(cases.torus_sd(pts)) != np.sign(want)).sum() > 20  # the shell is hit
+    assert np.abs(mine - want)[band].max() < 1e-12
+    assert np.abs(mine - want)[~band].max() <= sag
+    # The array's shape is kept.
+    assert cases.polygon_torus_sd()(pts[:6].reshape(2, 3, 3)).shape == (2, 3)
+
+
+def test_the_smooth_unions_points_are_taken_onto_the_polygon_unions_boundary():
+    """Points on the boundary of the smooth torus's union over a few poses, taken onto the
+    polygon torus's union: there the polygon's exact region distance (from every pose, not the
+    pruned ones) is zero, and each point moved no more than TORUS_SAG."""
+    from test_sweep_closed import region_sd
+
+    poses = cases.dense(cases.SMOOTH, 2)
+    inv = np.linalg.inv(poses)
+    rng = np.random.default_rng(8)
+    # Points of the first pose's torus surface the other poses leave outside their bodies.
+    start = torus_points(rng, 400, np.zeros(400))
+    start = start[region_sd(start, inv, cases.torus_sd) > -1e-12][:150]
+    polygon = cases.polygon_torus_sd()
+    moved = cases.onto_exact(start, inv, cases.torus_sd, polygon, cases.TORUS_SAG)
+    assert len(start) > 50
+    assert np.abs(region_sd(moved, inv, polygon)).max() < 1e-9
+    assert np.linalg.norm(moved - start, axis=1).max() <= cases.TORUS_SAG
+    assert np.allclose(cases.exact_region_sd(moved, inv, cases.torus_sd, polygon, cases.TORUS_SAG),
+                       region_sd(moved, inv, polygon), atol=1e-15)
+
+
+def test_the_report_says_which_torus_the_reference_sweeps(tmp_path):
+    d = json.loads(json.dumps(CASES_JSON))
+    d["cases"][0].update(body_error=0.0036, size=2.361)
+    (tmp_path / "sweep.cases.json").write_text(json.dumps(d))
+    for exact, said in ((False, "of the smooth torus the reference and sweep3d sweep"),
+                        (True, "the reference sweeps the mesh itself (its exact distance)")):
+        d["cases"][0]["exact_body"] = exact
+        (tmp_path / "sweep.cases.json").write_text(json.dumps(d))
+        rep = report.Report(tmp_path, {})
+        rep.sweep_section()
+        assert any(said in line and "0.152 %" in line for line in rep.lines), exact
