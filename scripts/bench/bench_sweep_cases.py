@@ -168,22 +168,22 @@ def polygon_torus_sd(band: float = 0.1):
 
 def onto_exact(points: np.ndarray, inv: np.ndarray, smooth, exact, gap: float, steps: int = 3,
                chunk: int = 1024) -> np.ndarray:
-    """`points` near the boundary of the union of the smooth body `smooth` over the poses (world
-    -> body `inv`) taken onto that of the exact body `exact` (its signed distance within `gap` of
-    the smooth one's) by Newton steps on the minimum over the poses of `exact` (central
-    differences at the pose of the minimum). Only the poses whose smooth distance is within
-    `2 gap` (and a step's reach) of the smooth minimum can hold the exact minimum: only those are
-    read exactly."""
+    """`points` on the boundary of the union of the smooth body `smooth` over the poses (world ->
+    body `inv`) taken onto that of the exact body `exact` (its signed distance within `gap` of the
+    smooth one's) by Newton steps on the minimum over the poses of `exact` (central differences at
+    the pose of the minimum). Only the poses that can hold the exact minimum are read exactly:
+    first those whose smooth value is within `4 gap` of the smooth minimum (the exact minimum is
+    within `gap` of the smooth one there, and a step moves a point less than `gap`); after a step
+    of length `d`, those whose exact value was within `2 d` of the minimum (each pose's distance
+    is 1-Lipschitz)."""
     out = np.empty_like(points)
     rot, shift = inv[:, :3, :3], inv[:, :3, 3]
     for start in range(0, len(points), chunk):
         x = points[start:start + chunk].copy()
-        local = np.einsum("pij,nj->npi", rot, x) + shift[None]
-        s = smooth(local)
+        s = smooth(np.einsum("pij,nj->npi", rot, x) + shift[None])
         n_idx, p_idx = np.nonzero(s <= s.min(axis=1, keepdims=True) + 4 * gap)
         for _ in range(steps):
-            loc = np.einsum("kij,kj->ki", rot[p_idx], x[n_idx]) + shift[p_idx]
-            val = exact(loc)
+            val = exact(np.einsum("kij,kj->ki", rot[p_idx], x[n_idx]) + shift[p_idx])
             order = np.lexsort((val, n_idx))
             first = order[np.r_[True, n_idx[order][1:] != n_idx[order][:-1]]]
             f, best_pose = val[first], p_idx[first]
@@ -196,7 +196,10 @@ def onto_exact(points: np.ndarray, inv: np.ndarray, smooth, exact, gap: float, s
                 up = exact(np.einsum("nij,nj->ni", r_k, x + e) + s_k)
                 down = exact(np.einsum("nij,nj->ni", r_k, x - e) + s_k)
                 grad[:, axis] = (up - down) / (2 * e_len)
-            x = x - (f / np.maximum(np.sum(grad**2, axis=1), 1e-12))[:, None] * grad
+            move = -(f / np.maximum(np.sum(grad**2, axis=1), 1e-12))[:, None] * grad
+            x = x + move
+            keep = val <= f[n_idx] + 2 * np.linalg.norm(move, axis=1)[n_idx] + 1e-12
+            n_idx, p_idx = n_idx[keep], p_idx[keep]
         out[start:start + chunk] = x
     return out
 
