@@ -665,7 +665,7 @@ class Report:
         within = f"{100 * c['body_error'] / c['size']:.3f} %"
         if c.get("exact_body"):
             return (f"; the reference sweeps the mesh itself (its exact distance), its surface found first on the "
-                    f"smooth torus (within {within} of the mesh; what sweep3d sweeps) then taken onto the mesh's")
+                    f"smooth torus (within {within} of the mesh; what sweep3d sweeps), then taken onto the mesh's union")
         return f"; the body mesh lies within {within} of the smooth torus the reference and sweep3d sweep"
 
     def sweep_open_peers(self, d: dict) -> None:

@@ -119,7 +119,7 @@ def polygon_torus_sd(band: float = 0.1):
     TORUS_N x TORUS_M quads) at body points (..., 3). Within `band` of the smooth torus: the
     nearest of the 18 triangles of the 3 x 3 quads about the point's two angles (the point's own
     quad and its neighbours hold its nearest point that near: checked against every triangle and
-    the winding number in tests/python/test_bench_sweep.py), signed by the smooth torus where
+    the winding number in tests/python/test_sweep_measures.py), signed by the smooth torus where
     that is more than `TORUS_SAG` from the point (the two surfaces are within it of each other),
     else by the parity of the crossings of the segment from the tube's centre circle, at the
     point's angle about z, to the point (a segment of the meridian half-plane through the point,
