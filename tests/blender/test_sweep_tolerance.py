@@ -201,16 +201,18 @@ def test_defaults_keep_the_region_within_the_reported_tolerance(motion):
     v, t = region_arrays(region)
     pts = probes(v, t, 2500)
     worst = distance_along(Motion(poses), pts, 0.5).max()
-    # The same motion with 2 steps per span (the former default): far outside it.
-    h.select_only(body)
-    assert bpy.ops.screwbender.sweep(steps=2, tolerance=1e6, closed=False) == {"FINISHED"}
-    coarse = swept_region()
-    cv, ct = region_arrays(coarse)
-    worst_coarse = distance_along(Motion(poses), probes(cv, ct, 2500), 0.5).max()
     print(f"\n{motion}: {len(frames) - 1} screws, tolerance {tol:.3e}, bound {bound:.3e}, {len(t)} triangles, "
-          f"measured {worst:.3e} over {len(pts)} probes; 2 steps: {len(ct)} triangles, measured {worst_coarse:.3e}")
+          f"measured {worst:.3e} over {len(pts)} probes")
     assert worst <= tol * 1.01
     if motion == "long_screw":
+        # The same motion with 2 steps per span (the former default): far outside it. (Not
+        # measured on the smoothed motion, whose 23 short screws 2 steps already fit: 17 s of
+        # the oracle per Blender for a figure nothing asserted.)
+        h.select_only(body)
+        assert bpy.ops.screwbender.sweep(steps=2, tolerance=1e6, closed=False) == {"FINISHED"}
+        cv, ct = region_arrays(swept_region())
+        worst_coarse = distance_along(Motion(poses), probes(cv, ct, 2500), 0.5).max()
+        print(f"2 steps: {len(ct)} triangles, measured {worst_coarse:.3e}")
         assert worst_coarse > 10 * tol
 
 
