@@ -222,7 +222,8 @@ if ! PYTHONPATH="$pylib" "$py" -c 'import polyscrew, sys; sys.exit(0 if hasattr(
   echo "polyscrew.sweep_closed is not in this build" | tee "$run/sweep.cases.missing"
 else
   cases_args=(--out "$run/sweep.cases.json" --big); [ "$quick" = 1 ] && cases_args+=(--quick)
-  PYTHONPATH="$pylib" timeout 2400 "$py" scripts/bench/bench_sweep_cases.py "${cases_args[@]}" 2>&1 | grep --line-buffered -v '\[sweep\] \[info\]' || true
+  # (60 minutes: the torus's exact reference alone took 22 minutes of CPU at stop 39, before its pruning)
+  PYTHONPATH="$pylib" timeout 3600 "$py" scripts/bench/bench_sweep_cases.py "${cases_args[@]}" 2>&1 | grep --line-buffered -v '\[sweep\] \[info\]' || true
   [ -f "$run/sweep.cases.json" ] || echo "scripts/bench/bench_sweep_cases.py failed (see target/bench/log.txt)" | tee "$run/sweep.cases.missing"
 fi
 fi

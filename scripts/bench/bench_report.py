@@ -801,7 +801,7 @@ class Report:
         big = d.get("big")
         if big and big.get("unfinished"):
             self.w("- `sweep_closed` on the 100,000-triangle bumpy torus over 64 screws did not finish within the "
-                   "bench's time limit (bench.sh stops the script after 40 minutes).")
+                   "bench's time limit (bench.sh stops the script after 60 minutes).")
             big = None
         if big:
             self.w(f"- `sweep_closed` on the bumpy torus of {big['triangles']:,} triangles over {big['screws']} screws "
