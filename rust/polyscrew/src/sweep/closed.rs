@@ -932,16 +932,16 @@ fn contoured(
     g.resize(count, band as f32);
     let mut arg: Vec<u32> = try_vec(count, "the region's distance grid")?;
     arg.resize(count, u32::MAX);
+    // (The coarse grid is a small part of the grids' time.)
+    let coarse = BodyField::new(
+        body,
+        cell,
+        COARSE_BAND_CELLS * cell,
+        threads,
+        span.part(grids, grids),
+    )?;
     match evaluation {
         Evaluation::NarrowBand => {
-            // (The coarse grid is a small part of the grids' time.)
-            let coarse = BodyField::new(
-                body,
-                cell,
-                COARSE_BAND_CELLS * cell,
-                threads,
-                span.part(grids, grids),
-            )?;
             narrow_band(
                 &field,
                 &coarse,
@@ -957,7 +957,7 @@ fn contoured(
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
     let exact = exact_field(body, &field, cell)?;
-    let refine = Refiner::new(&field, exact, &motion, body, cell)?;
+    let refine = Refiner::new(&field, &coarse, exact, &motion, body, cell)?;
     settle_signs(
         &mut g,
         grid,
@@ -1246,10 +1246,21 @@ impl Band<'_> {
     }
 }
 
+/// No samples, for [`Refiner::exact_all`]'s `known`.
+const NONE: [u32; 2] = [u32::MAX; 2];
+
+/// Samples of the motion per run [`Refiner::exact_all`] can pass over at once.
+const SAMPLE_RUN: usize = 16;
+
 /// Evaluates the region's field between the motion's samples: by the body grid's trilinear
 /// reads, and by the body's exact distance for a vertex's last steps.
 struct Refiner<'a> {
     field: &'a BodyField,
+    /// The body's distance a world cell apart (small enough to stay in cache): its reads
+    /// rule out most samples of the motion before the fine grid is read there.
+    coarse: &'a BodyField,
+    /// The coarse read's error bound (as half of [`Refiner::spread`] for the fine one).
+    coarse_error: f64,
     exact: ExactField<'a>,
     /// World -> body at [`REFINE_POSES`] poses per sample interval (sample `j` at
     /// `j * REFINE_POSES`).
@@ -1261,13 +1272,19 @@ struct Refiner<'a> {
     centres: Vec<DVec3>,
     /// That sphere's radius.
     radius: f64,
+    /// Per run of [`SAMPLE_RUN`] samples: a ball holding their spheres' centres (its radius
+    /// rounded up), whose distance less the two radii bounds the run's distances from below.
+    runs: Vec<(DVec3, f64)>,
     /// The most a body point moves between a sample and a refined pose of its intervals.
     travel: f64,
+    /// Round-off allowance of the bounds between samples.
+    slack: f64,
 }
 
 impl<'a> Refiner<'a> {
     fn new(
         field: &'a BodyField,
+        coarse: &'a BodyField,
         exact: ExactField<'a>,
         motion: &DenseMotion,
         body: &Body,
@@ -1283,17 +1300,34 @@ impl<'a> Refiner<'a> {
             }
         }
         fine.push(motion.poses[motion.poses.len() - 1].inverse().to_affine());
-        let spread = 2.0 * (0.5 * 3f64.sqrt() * field.h + field.band * f32::EPSILON as f64)
-            + ROUNDOFF_REL * field.band;
+        let error = |f: &BodyField| 0.5 * 3f64.sqrt() * f.h + f.band * f32::EPSILON as f64;
+        let spread = 2.0 * error(field) + ROUNDOFF_REL * field.band;
+        let coarse_error = error(coarse) + ROUNDOFF_REL * coarse.band;
         let (centres, radius) = motion.spheres(body);
+        let runs = centres
+            .chunks(SAMPLE_RUN)
+            .map(|run| {
+                let (lo, hi) = run
+                    .iter()
+                    .fold((run[0], run[0]), |(lo, hi), &c| (lo.min(c), hi.max(c)));
+                let centre = 0.5 * (lo + hi);
+                let reach = run.iter().map(|c| c.distance(centre)).fold(0.0, f64::max);
+                let scale = centre.abs().max_element() + reach + radius;
+                (centre, reach + ROUNDOFF_REL * scale)
+            })
+            .collect();
         Ok(Self {
             field,
+            coarse,
+            coarse_error,
             exact,
             fine,
             spread,
             centres,
             radius,
+            runs,
             travel,
+            slack: ROUNDOFF_REL * (field.band + travel),
         })
     }
 
@@ -1377,18 +1411,44 @@ impl<'a> Refiner<'a> {
 }
 
 impl Refiner<'_> {
+    /// At most the distance at every pose of a sample interval whose ends' distances are at
+    /// least `a` and `b`: a pose a fraction `s` of the way is within `s travel` of the first
+    /// end and `(1 - s) travel` of the other (the helix arc is linear in the screw's parameter),
+    /// so its distance is at least `max(a - s travel, b - (1 - s) travel)`, least where the two
+    /// meet (or at the nearer end).
+    fn between(&self, a: f64, b: f64) -> f64 {
+        let t = self.travel;
+        let low = if (a - b).abs() <= t {
+            0.5 * (a + b - t)
+        } else {
+            a.max(b) - t
+        };
+        low - self.slack
+    }
+
+    /// Whether sample interval `m` (its poses from sample `m` to sample `m + 1`) is among the
+    /// poses [`Refiner::near`] reads at the samples `js`: within one interval of one.
+    fn within(m: usize, js: [u32; 2]) -> bool {
+        js.iter()
+            .any(|&j| j != u32::MAX && (m == j as usize || m + 1 == j as usize))
+    }
+
     /// The exact minimum at `x` over every refined pose of the motion; `upper` is at least
     /// that minimum (a value already found). An interval between two samples is skipped when
-    /// every pose in it is above `upper`: a body point moves at most `travel` across the
-    /// interval, so at most half of it from the nearer sample, and the distance at a sample is
-    /// at least its distance to the body's bounding sphere, at least its trilinear read less
-    /// the read's error, and at least the last sample read's bound less `travel` per interval
-    /// since (so a sample far off lets the next ones go unread). The intervals left are read
-    /// least bounded first, and a pose is read exactly only when its trilinear read, less its
-    /// error, is not above `upper` (the least reads first): the minimum found early bounds
-    /// out the rest. Which poses are read exactly changes nothing but the time: each one
+    /// every pose in it is above `upper` ([`Refiner::between`] bounds them from its ends), and
+    /// so is a pose its ends' bounds show above it; the distance at a sample is at least its
+    /// distance to the body's bounding sphere (to the ball of a run of samples' spheres), at
+    /// least its coarse or trilinear read less the read's error (the coarse grid read first),
+    /// and at least the last sample read's bound less `travel` per interval since (so a sample
+    /// far off lets the next ones go unread). The intervals left are read least bounded first,
+    /// and a pose is read exactly only when its trilinear read, less its error, is not above
+    /// `upper` (the least reads first): the minimum found early bounds out the rest. Which poses are read exactly changes nothing but the time: each one
     /// skipped is above the minimum.
-    fn exact_all(&self, x: DVec3, mut upper: f64) -> f64 {
+    ///
+    /// Where that minimum is above `upper`, the value returned is too (and may not be the
+    /// minimum). The intervals [`Refiner::exact_near`] reads at the samples `known` ([`NONE`]:
+    /// none) are left out: a caller passes them when `upper` is their minimum already.
+    fn exact_all(&self, x: DVec3, mut upper: f64, known: [u32; 2]) -> f64 {
         let half = 0.5 * self.spread;
         let floor = -self.field.band;
         let mut best = f64::INFINITY;
@@ -1398,50 +1458,97 @@ impl Refiner<'_> {
         let mut last = (0usize, f64::NEG_INFINITY);
         // The sample intervals (by their first sample) that may hold a pose below `upper`,
         // each with at most its poses' distances.
-        let mut intervals: Vec<(f64, usize)> = Vec::new();
-        for (i, c) in self.centres.iter().enumerate() {
-            // At most the distance at sample `i`: from the body's bounding sphere, and from the
-            // last read (a body point moves at most `travel` per sample interval).
-            let bound =
-                (c.distance(x) - self.radius).max(last.1 - (i - last.0) as f64 * self.travel);
-            let here = if bound - 0.5 * self.travel > upper {
+        let mut intervals: Vec<(f64, usize, [f64; 2])> = Vec::new();
+        // A sample is far when at most its distance, less half an interval's travel, is above
+        // `upper`: no pose between two far samples can be below `upper`. Any bound of a far
+        // sample's distance serves its intervals' bounds (`between`), so a run of far samples
+        // is passed over once its ball shows them all far, and a sample is far without its
+        // sphere once the last read shows it.
+        let far = |bound: f64| bound - 0.5 * self.travel > upper;
+        let mut i = 0;
+        while i < self.centres.len() {
+            if i % SAMPLE_RUN == 0 {
+                let (centre, reach) = self.runs[i / SAMPLE_RUN];
+                let bound = centre.distance(x) - reach - self.radius;
+                if far(bound) {
+                    // Only the interval before the run may be read (by the sample before it).
+                    let low = self.between(before, bound);
+                    if i > 0 && low <= upper && !Self::within(i - 1, known) {
+                        intervals.push((low, i - 1, [before, bound]));
+                    }
+                    before = bound;
+                    i += SAMPLE_RUN;
+                    continue;
+                }
+            }
+            // At most the distance at sample `i`: from the last read (a body point moves at
+            // most `travel` per sample interval), and from the body's bounding sphere.
+            let chain = last.1 - (i - last.0) as f64 * self.travel;
+            let bound = if far(chain) {
+                chain
+            } else {
+                (self.centres[i].distance(x) - self.radius).max(chain)
+            };
+            let here = if far(bound) {
                 bound
             } else {
-                let read = self
-                    .field
-                    .at(self.fine[i * REFINE_POSES].transform_point3(x));
-                // A read clamped below (deep inside) bounds nothing from below.
-                last = (
-                    i,
-                    if read > floor {
-                        read - half
-                    } else {
-                        f64::NEG_INFINITY
-                    },
-                );
-                read - half
+                let y = self.fine[i * REFINE_POSES].transform_point3(x);
+                // The coarse grid's read first (it stays in cache); the fine grid's only where
+                // that leaves the sample's interval able to hold a pose below `upper`. A read
+                // clamped below (deep inside) bounds nothing from below.
+                let coarse = self.coarse.at(y);
+                let low = if coarse > -self.coarse.band {
+                    (coarse - self.coarse_error).max(bound)
+                } else {
+                    bound
+                };
+                if far(low) {
+                    last = (i, low);
+                    low
+                } else {
+                    let read = self.field.at(y);
+                    last = (
+                        i,
+                        if read > floor {
+                            read - half
+                        } else {
+                            f64::NEG_INFINITY
+                        },
+                    );
+                    read - half
+                }
             };
-            let low = before.min(here) - 0.5 * self.travel;
-            before = here;
-            if i > 0 && low <= upper {
-                intervals.push((low, i - 1));
+            let low = self.between(before, here);
+            if i > 0 && low <= upper && !Self::within(i - 1, known) {
+                intervals.push((low, i - 1, [before, here]));
             }
+            before = here;
+            i += 1;
         }
         // The intervals least bounded first, and in each the poses read least first: the
         // minimum is found early and bounds out the rest.
         intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
         let mut reads = [(0.0f64, DVec3::ZERO); REFINE_POSES + 1];
-        for &(low, i) in &intervals {
+        for &(low, i, [a, b]) in &intervals {
             if low > upper {
                 break;
             }
             let first = i * REFINE_POSES;
-            for (slot, a) in reads
+            for (k, (slot, pose)) in reads
                 .iter_mut()
                 .zip(&self.fine[first..=first + REFINE_POSES])
+                .enumerate()
             {
-                let y = a.transform_point3(x);
-                *slot = (self.field.at(y), y);
+                // At most the pose's distance, from the interval's ends: one above `upper` is
+                // not read (and sorts last).
+                let s = k as f64 / REFINE_POSES as f64;
+                let bound = (a - s * self.travel).max(b - (1.0 - s) * self.travel) - self.slack;
+                *slot = if bound > upper {
+                    (f64::INFINITY, DVec3::ZERO)
+                } else {
+                    let y = pose.transform_point3(x);
+                    (self.field.at(y), y)
+                };
             }
             reads.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
             for &(read, y) in &reads {
@@ -1525,7 +1632,7 @@ fn settle_signs(
             if value + half < 0.0 || value - below > 0.0 {
                 continue;
             }
-            let exact = refine.exact_all(grid.point(s % nx, s / nx, k), value + half);
+            let exact = refine.exact_all(grid.point(s % nx, s / nx, k), value + half, NONE);
             *v = if exact < 0.0 {
                 (exact.max(-band) as f32).min(-f32::MIN_POSITIVE)
             } else {
@@ -1611,8 +1718,8 @@ impl GridEdge {
             (best, slope)
         };
         let ((local, t), slope) = secant(t, (gb - ga) / (tb - ta), &|x| refine.exact_near(x, js));
-        let all = |x: DVec3| refine.exact_all(x, refine.near(x, js) + refine.spread);
-        let (g, t) = if refine.exact_all(lerp(t), local) < local {
+        let all = |x: DVec3| refine.exact_all(x, refine.near(x, js) + refine.spread, NONE);
+        let (g, t) = if refine.exact_all(lerp(t), local, js) < local {
             secant(t, slope, &all).0
         } else {
             (local, t)
@@ -1620,8 +1727,8 @@ impl GridEdge {
         let (g, t) = if g.abs() > BRACKET_START * cell {
             let half = 0.5 * refine.spread;
             let ends = [
-                refine.exact_all(a, fa + half),
-                refine.exact_all(b, fb + half),
+                refine.exact_all(a, fa + half, NONE),
+                refine.exact_all(b, fb + half, NONE),
             ];
             bracketed(ends, (g, t), BRACKET_STOP * cell, &|t| all(lerp(t)))
         } else {
@@ -1783,7 +1890,10 @@ fn contour(
     )?;
     let mut residual = found.iter().fold(0.0f64, |r, g| r.max(g.abs().min(cell)));
     // Creases: their edges split until each midpoint is within CREASE_TARGET cells.
-    let exact = |x: DVec3, js: [u32; 2]| refine.exact_all(x, refine.exact_near(x, js));
+    let exact = |x: DVec3, js: [u32; 2]| {
+        let near = refine.exact_near(x, js);
+        near.min(refine.exact_all(x, near, js))
+    };
     let onto = |from: DVec3, dir: DVec3, value: f64, js: [u32; 2]| {
         // The zero along `dir` (out from inside, in from outside), else the other way,
         // bracketed by steps of growing length (at most a cell).

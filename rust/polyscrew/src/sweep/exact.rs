@@ -75,6 +75,10 @@ pub fn closest_on_triangle(p: DVec3, a: DVec3, b: DVec3, c: DVec3) -> (DVec3, Fe
 /// Round-off allowance of the lists' test, relative to the largest coordinate involved.
 const ROUNDOFF_REL: f64 = 1e-9;
 
+/// Relative slack of the triangles' bounding spheres in [`ExactField::at`]'s skip test (the
+/// distances involved are computed within about `1e-15` of theirs).
+const SPHERE_SLACK: f64 = 1e-9;
+
 /// The body's exact signed distance near its surface (see the module documentation).
 pub(super) struct ExactField<'a> {
     body: &'a Body,
@@ -90,6 +94,10 @@ pub(super) struct ExactField<'a> {
     start: Vec<u32>,
     items: Vec<u32>,
     far: Vec<f32>,
+    /// Per triangle: its corners, and the centre and radius of a sphere holding it (the
+    /// radius rounded up), whose distance bounds the triangle's from below.
+    corners: Vec<[DVec3; 3]>,
+    spheres: Vec<(DVec3, f64)>,
 }
 
 impl<'a> ExactField<'a> {
@@ -209,6 +217,17 @@ impl<'a> ExactField<'a> {
             }
         }
         start.push(items.len() as u32);
+        let mut corners: Vec<[DVec3; 3]> = try_vec(tris.len(), "the exact distance's lists")?;
+        corners.extend(tris.iter().map(|t| t.map(|i| verts[i as usize])));
+        let mut spheres: Vec<(DVec3, f64)> = try_vec(tris.len(), "the exact distance's lists")?;
+        spheres.extend(corners.iter().map(|&[a, b, c]| {
+            let centre = (a + b + c) / 3.0;
+            let radius = centre
+                .distance(a)
+                .max(centre.distance(b))
+                .max(centre.distance(c));
+            (centre, radius * (1.0 + SPHERE_SLACK) + roundoff)
+        }));
         Ok(Self {
             body,
             vertex_normals,
@@ -219,6 +238,8 @@ impl<'a> ExactField<'a> {
             start,
             items,
             far,
+            corners,
+            spheres,
         })
     }
 
@@ -240,11 +261,17 @@ impl<'a> ExactField<'a> {
         if a == b {
             return (self.far[cell] as f64, None);
         }
-        let verts = self.body.vertices();
         let tris = self.body.triangles();
         let mut best = (f64::INFINITY, DVec3::ZERO, 0u32, Feature::Face);
         for &t in &self.items[a..b] {
-            let [va, vb, vc] = tris[t as usize].map(|i| verts[i as usize]);
+            // A triangle whose sphere is farther than the nearest found cannot be nearer (nor
+            // as near: the list's first nearest is kept, so skipping changes nothing).
+            let (centre, radius) = self.spheres[t as usize];
+            let gap = p.distance(centre) - radius;
+            if gap > 0.0 && gap * gap > best.0 * (1.0 + SPHERE_SLACK) {
+                continue;
+            }
+            let [va, vb, vc] = self.corners[t as usize];
             let (x, feature) = closest_on_triangle(p, va, vb, vc);
             let d2 = p.distance_squared(x);
             if d2 < best.0 {
