@@ -593,6 +593,55 @@ pub(super) fn exact_distance(
     Ok(move |p| exact.at(p))
 }
 
+/// The refinement's minima at `points` over the motion sampled for `cell` (for the tests): per
+/// point, with `least` every refined pose's least exact distance there, `upper` that plus the
+/// point's entry of `lifts` and `j` the sample nearest the pose of `least` moved by the
+/// point's entry of `shifts` (within the motion), `[least, exact_all(upper), exact_near at j,
+/// the least exact distance over the poses exact_near reads at j, exact_all(that, known j)]`.
+#[cfg(test)]
+pub(super) fn motion_minima(
+    body: &Body,
+    poses: &[Pose],
+    cell: f64,
+    points: &[DVec3],
+    lifts: &[f64],
+    shifts: &[i64],
+) -> Result<Vec<[f64; 5]>> {
+    let motion = DenseMotion::new(body, poses, cell)?;
+    let progress = Progress::new();
+    let (h, band) = (cell / BODY_SUBCELLS, BAND_CELLS * cell);
+    let field = BodyField::new(body, h, band, 0, progress.span(0.0, 1.0))?;
+    let coarse_band = COARSE_BAND_CELLS * cell;
+    let coarse = BodyField::new(body, cell, coarse_band, 0, progress.span(0.0, 1.0))?;
+    let exact = exact_field(body, &field, cell)?;
+    let refine = Refiner::new(&field, &coarse, exact, &motion, body, cell)?;
+    let read = |x: DVec3, i: usize| refine.exact.at(refine.fine[i].transform_point3(x)).0;
+    Ok(points
+        .iter()
+        .zip(lifts.iter().zip(shifts))
+        .map(|(&x, (&lift, &shift))| {
+            let (least, at) = (0..refine.fine.len())
+                .map(|i| (read(x, i), i))
+                .fold((f64::INFINITY, 0), |a, b| if b.0 < a.0 { b } else { a });
+            let nearest = ((at + REFINE_POSES / 2) / REFINE_POSES) as i64;
+            let j = (nearest + shift).clamp(0, motion.steps.len() as i64) as u32;
+            let js = [j, u32::MAX];
+            let near = refine.exact_near(x, js);
+            let near_least = refine
+                .span(j)
+                .map(|i| read(x, i))
+                .fold(f64::INFINITY, f64::min);
+            [
+                least,
+                refine.exact_all(x, least + lift, NONE),
+                near,
+                near_least,
+                refine.exact_all(x, near, js),
+            ]
+        })
+        .collect())
+}
+
 /// The exact distance's lists over the body grid's box.
 fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<ExactField<'a>> {
     let last = DVec3::new(field.n[0] as f64, field.n[1] as f64, field.n[2] as f64) - 1.0;

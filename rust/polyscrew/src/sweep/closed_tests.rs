@@ -15,6 +15,7 @@ use super::closed::point_triangle_distance;
 use super::tests::{cuboid, torus};
 use super::tolerance_tests::{l_prism, min_over_motion, screw_pose, sd_box, smoothed_motion};
 use super::*;
+use crate::motion::screw::Screw;
 
 /// Signed distance from `p` to a closed body (negative inside: winding number above 1/2).
 fn sd_mesh(body: &Body, p: DVec3) -> f64 {
@@ -506,6 +507,86 @@ fn the_body_grid_holds_the_least_distance_over_every_triangle() {
             }
         }
         assert!(within > 1000, "{name}: {within} points in the band");
+    }
+}
+
+/// The refinement's bounds skip only poses above the minimum: at points near the swept
+/// boundary of the L-prism's half turn and the torus's smoothed motion (the tests' cell), the
+/// exact minimum over the motion (`exact_all`, given any upper bound of it) is bit for bit the
+/// least exact distance over every refined pose, the minimum near a sample (`exact_near`) is
+/// the least over the poses around it, and with those intervals left out (`known`) the
+/// minimum elsewhere is below it exactly when the least over every pose is.
+#[test]
+fn the_pruned_minima_are_every_poses_least() {
+    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+    let mut uniform = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for (name, body, poses) in cases().into_iter().filter(|c| !c.0.starts_with("cube")) {
+        let cell = 0.04 * body.extent();
+        // Points about the instances at the key poses and between them (world), near the
+        // boundary or inside: the body's box grown by two cells, at a point of each screw.
+        let (lo, hi) = body
+            .vertices()
+            .iter()
+            .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(a, b), &p| {
+                (a.min(p), b.max(p))
+            });
+        let (lo, hi) = (lo - DVec3::splat(2.0 * cell), hi + DVec3::splat(2.0 * cell));
+        let mut points = Vec::new();
+        while points.len() < 1500 {
+            let k = ((uniform() * (poses.len() - 1) as f64) as usize).min(poses.len() - 2);
+            let pose =
+                poses[k].mul_pose(&Screw::between(&poses[k], &poses[k + 1]).motion(uniform()));
+            let y = lo + (hi - lo) * DVec3::new(uniform(), uniform(), uniform());
+            points.push(pose.transform_point3(y));
+        }
+        let lifts: Vec<f64> = points.iter().map(|_| uniform() * cell).collect();
+        // Half the points read at the sample nearest their minimum, half up to 4 samples off.
+        let shifts: Vec<i64> = (0..points.len() as i64)
+            .map(|k| if k % 2 == 0 { 0 } else { (k / 2) % 9 - 4 })
+            .collect();
+        let minima =
+            super::closed::motion_minima(&body, &poses, cell, &points, &lifts, &shifts).unwrap();
+        // The exact distance is exact within this of the surface (the band less a list cell's
+        // reach: `the_exact_distance_equals_the_winding_number_reference`), clamped beyond.
+        let reach = super::closed::BAND_CELLS * cell - 3f64.sqrt() * (cell / 4.0 + cell / 12.0);
+        let (mut near, mut exact) = (0, 0);
+        for (x, [least, all, at_j, least_at_j, elsewhere]) in points.iter().zip(minima) {
+            near += usize::from(least.abs() < 2.0 * cell);
+            if least.abs() >= reach {
+                continue;
+            }
+            exact += 1;
+            assert_eq!(
+                all.to_bits(),
+                least.to_bits(),
+                "{name}: at {x:?} {all} against {least}"
+            );
+            assert_eq!(
+                at_j.to_bits(),
+                least_at_j.to_bits(),
+                "{name}: near, at {x:?}"
+            );
+            assert_eq!(
+                elsewhere < at_j,
+                least < at_j,
+                "{name}: elsewhere, at {x:?}"
+            );
+            assert_eq!(
+                at_j.min(elsewhere).to_bits(),
+                least.to_bits(),
+                "{name}: at {x:?}"
+            );
+        }
+        assert!(
+            near > 300,
+            "{name}: {near} points within two cells of the boundary"
+        );
+        assert!(exact > 500, "{name}: {exact} points within the exact reach");
     }
 }
 

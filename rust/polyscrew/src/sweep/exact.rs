@@ -159,8 +159,11 @@ impl<'a> ExactField<'a> {
                     let (v, q) = grid.nearest_node(c);
                     let delta = q.distance(c);
                     test.push(q);
-                    // The grid stores the clamp as the float32 of `band`.
-                    if v.abs() >= band as f32 as f64 {
+                    // The grid stores the clamp as the float32 of `band`, and reads `band`
+                    // itself off the grid (where the last cells' centres can be): either is
+                    // far. (With only the first, a last cell off the grid had no list and read
+                    // NaN when `band` rounds up to float32.)
+                    if v.abs() >= (band as f32 as f64).min(band) {
                         far.push(band.copysign(v) as f32);
                         reach.push(f64::NAN);
                     } else {
