@@ -510,6 +510,16 @@ fn the_body_grid_holds_the_least_distance_over_every_triangle() {
     }
 }
 
+/// Uniform numbers in `[0, 1)` from a xorshift generator seeded with `seed` (not 0).
+fn uniform_from(mut seed: u64) -> impl FnMut() -> f64 {
+    move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// The refinement's bounds skip only poses above the minimum: at points near the swept
 /// boundary of the L-prism's half turn and the torus's smoothed motion (the tests' cell), the
 /// exact minimum over the motion (`exact_all`, given any upper bound of it) is bit for bit the
@@ -518,13 +528,7 @@ fn the_body_grid_holds_the_least_distance_over_every_triangle() {
 /// minimum elsewhere is below it exactly when the least over every pose is.
 #[test]
 fn the_pruned_minima_are_every_poses_least() {
-    let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-    let mut uniform = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x9e37_79b9_7f4a_7c15);
     for (name, body, poses) in cases().into_iter().filter(|c| !c.0.starts_with("cube")) {
         let cell = 0.04 * body.extent();
         // Points about the instances at the key poses and between them (world), near the
@@ -601,13 +605,7 @@ fn the_exact_distance_equals_the_winding_number_reference() {
     let tilt = glam::DQuat::from_euler(glam::EulerRot::XYZ, 0.3, -0.7, 0.2);
     let tv: Vec<DVec3> = tv.iter().map(|&v| tilt * v).collect();
     let (lv, lt) = l_prism(0.5);
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut uniform = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = uniform_from(0x2545_f491_4f6c_dd1d);
     for (name, v, t) in [("torus", tv, tt), ("L-prism", lv, lt)] {
         let body = Body::new(&v, &t).unwrap();
         let cell = 0.04 * body.extent();
