@@ -1491,8 +1491,9 @@ impl Refiner<'_> {
     /// and at least the last sample read's bound less `travel` per interval since (so a sample
     /// far off lets the next ones go unread). The intervals left are read least bounded first,
     /// and a pose is read exactly only when its trilinear read, less its error, is not above
-    /// `upper` (the least reads first): the minimum found early bounds out the rest. Which poses are read exactly changes nothing but the time: each one
-    /// skipped is above the minimum.
+    /// `upper` (the least reads first): the minimum found early bounds out the rest. Which
+    /// poses are read exactly changes nothing but the time: each one skipped is above the
+    /// minimum.
     ///
     /// Where that minimum is above `upper`, the value returned is too (and may not be the
     /// minimum). The intervals [`Refiner::exact_near`] reads at the samples `known` ([`NONE`]:

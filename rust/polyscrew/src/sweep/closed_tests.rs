@@ -15,7 +15,6 @@ use super::closed::point_triangle_distance;
 use super::tests::{cuboid, torus};
 use super::tolerance_tests::{l_prism, min_over_motion, screw_pose, sd_box, smoothed_motion};
 use super::*;
-use crate::motion::screw::Screw;
 
 /// Signed distance from `p` to a closed body (negative inside: winding number above 1/2).
 fn sd_mesh(body: &Body, p: DVec3) -> f64 {
@@ -543,8 +542,7 @@ fn the_pruned_minima_are_every_poses_least() {
         let mut points = Vec::new();
         while points.len() < 1500 {
             let k = ((uniform() * (poses.len() - 1) as f64) as usize).min(poses.len() - 2);
-            let pose =
-                poses[k].mul_pose(&Screw::between(&poses[k], &poses[k + 1]).motion(uniform()));
+            let pose = crate::s(&poses[k], uniform(), &poses[k + 1]);
             let y = lo + (hi - lo) * DVec3::new(uniform(), uniform(), uniform());
             points.push(pose.transform_point3(y));
         }

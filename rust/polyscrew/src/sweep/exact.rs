@@ -94,8 +94,10 @@ pub(super) struct ExactField<'a> {
     start: Vec<u32>,
     items: Vec<u32>,
     far: Vec<f32>,
-    /// Per triangle: its corners, and the centre and radius of a sphere holding it (the
-    /// radius rounded up), whose distance bounds the triangle's from below.
+    /// Per triangle: its corners (kept together: reading them through the vertex indices
+    /// made the 2,304-triangle torus's whole sweep 1.3 times slower), and the centre and
+    /// radius of a sphere holding it (the radius rounded up), whose distance bounds the
+    /// triangle's from below.
     corners: Vec<[DVec3; 3]>,
     spheres: Vec<(DVec3, f64)>,
 }
