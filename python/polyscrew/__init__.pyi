@@ -569,6 +569,7 @@ def sweep_closed(
     tolerance: float | None = None,
     threads: int | None = None,
     progress: Callable[[float], object] | None = None,
+    decimate: bool = False,
 ) -> tuple[FloatArray, IntArray]: ...
 @overload
 def sweep_closed(
@@ -581,6 +582,7 @@ def sweep_closed(
     tolerance: float | None = None,
     threads: int | None = None,
     progress: Callable[[float], object] | None = None,
+    decimate: bool = False,
 ) -> tuple[FloatArray, IntArray, ClosedSweepInfo]:
     """The boundary of the region swept by a closed triangle mesh moving through ``poses``, as
     one closed, consistently oriented, self-intersection-free triangle mesh, every vertex within
@@ -607,6 +609,11 @@ def sweep_closed(
     its own; whatever it raises stops the sweep within a part of its work (a few thousand
     vertices, a round of crease splits) and is raised by ``sweep_closed``, as is a signal
     (Ctrl-C: ``KeyboardInterrupt``). None: no calls, and the sweep runs on the calling thread.
+
+    ``decimate``: fewer triangles (2.5 to 3 times fewer at the defaults), vertices removed
+    where the boundary is flat by collapses that keep every new edge's midpoint within
+    ``CLOSED_DECIMATE_TARGET`` cells of the boundary; the vertices left are some of those
+    without it, so ``error_bound`` still holds for them. It takes about twice as long.
 
     Returns ``(vertices (V', 3) float64, triangles (T', 3) int64)`` in world coordinates,
     triangles counter-clockwise seen from outside, every edge in exactly two; with
@@ -658,6 +665,9 @@ DEFAULT_CLOSED_TOLERANCE: float
 
 CLOSED_CELL_PER_TOLERANCE: float
 """The first cell of ``sweep_closed`` as a multiple of its tolerance (2)."""
+
+CLOSED_DECIMATE_TARGET: float
+"""How near the boundary, in cells, ``sweep_closed(decimate=True)`` keeps every new edge's midpoint (0.05)."""
 
 CurveSchemeName = Literal["variational", "four_point", "bspline", "jarek"]
 ParametrizationName = Literal["uniform", "centripetal"]

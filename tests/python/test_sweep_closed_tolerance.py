@@ -77,6 +77,38 @@ def test_several_threads_give_the_one_thread_mesh_byte_for_byte():
         assert many[2] == one[2]
 
 
+@pytest.mark.parametrize("name", ["L-prism, half turn", "torus, smoothed polyscrew"])
+def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_the_boundary(name):
+    """`decimate=True`: closed and oriented, at most 0.6 of the triangles, its vertices some of
+    the full mesh's (their bytes) with the same figures, and every new triangle's centre (one
+    not in the full mesh, whose faces the other tests check) within the bound plus what the
+    collapses allow (4/3 of CLOSED_DECIMATE_TARGET cells) of the boundary: the bodies' exact
+    distance over the motion sampled densely (scipy's screws)."""
+    v, t, sd, poses, body_error, _ = CASES[name]
+    tolerance = 0.02 * extent_of(v)
+    fv, ft, full = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True)
+    dv, dt, fewer = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True, decimate=True)
+    assert is_closed_oriented(dt)
+    assert len(dt) <= 0.6 * len(ft), (len(dt), len(ft))
+    assert fewer == full
+    index = {row.tobytes(): i for i, row in enumerate(fv)}
+    assert all(row.tobytes() in index for row in dv)
+    as_full = np.array([index[row.tobytes()] for row in dv])[dt]
+    old = {tuple(sorted(tri)) for tri in ft.tolist()}
+    new = np.array([tuple(sorted(tri)) not in old for tri in as_full.tolist()])
+    assert new.sum() > 0.2 * len(dt)
+    centres = dv[dt[new]].mean(axis=1)
+    centres = centres[np.random.default_rng(1).choice(len(centres), min(len(centres), 1500), replace=False)]
+    inv = np.linalg.inv(dense(poses, max(64, 8192 // (len(poses) - 1))))
+    worst = np.abs(region_sd(centres, inv, sd)).max()
+    allowed = fewer["error_bound"] + 4.0 / 3.0 * polyscrew.CLOSED_DECIMATE_TARGET * fewer["cell"] + body_error
+    print(f"\n{name}: {len(dt)} of {len(ft)} triangles ({new.sum()} new), worst new centre {worst:.2e} "
+          f"(allowed {allowed:.2e})")
+    assert worst <= allowed
+    with pytest.raises(TypeError, match="sweep_closed: decimate: expected a bool, got str"):
+        polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, decimate="yes")
+
+
 def test_bad_tolerances_and_heavy_work_are_refused():
     v, t, _, poses, _, _ = CASES["cube, 120-degree screw with slide"]
     with pytest.raises(ValueError, match="not both"):

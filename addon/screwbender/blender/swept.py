@@ -689,6 +689,7 @@ def compute_all(
     cell: float | None = None,
     fallback: bool = False,
     progress: Callable[[int, int], None] | None = None,
+    decimate: bool = False,
 ) -> list[Swept]:
     """:func:`compute` of every object of `objects`, their world poses read together
     (:func:`world_poses_all`: the curves evaluated in one call where they alone move the
@@ -698,7 +699,7 @@ def compute_all(
     the open sweep (its :attr:`Swept.fallback` set). The open sweeps are computed before the
     closed boundaries, so a refusal comes before the long work; the results are in the
     objects' order. `progress(done, total)` follows the closed boundaries (seconds each), in
-    thousandths of each."""
+    thousandths of each. `decimate`: the closed boundaries with fewer triangles where flat."""
     scene = context.scene
     read = {} if read is None else read
     prepared = []
@@ -752,7 +753,8 @@ def compute_all(
         try:
             if kinds[i]:
                 watch = _closed_progress(progress, closed_done, closed_total)
-                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, progress=watch, **grid)
+                v, t, info = polyscrew.sweep_closed(verts * scale, tris, poses, info=True, progress=watch,
+                                                    decimate=decimate, **grid)
                 closed_done += PROGRESS_STEPS
                 out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
                                info["error_bound"], info["cell"], info["attempts"])

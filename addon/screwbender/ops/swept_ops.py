@@ -51,6 +51,12 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         "live preview's fast superset (milliseconds; not closed). Left at its default, a mesh that is not "
         "closed gets the open sweep; turned on, it is refused",
     )
+    decimate: BoolProperty(
+        name="Fewer Triangles",
+        default=False,
+        description="Closed Volume: remove vertices where the boundary is flat (2.5 to 3 times fewer "
+        "triangles at the default tolerance, every vertex left still within it; about twice as long)",
+    )
     cell: FloatProperty(
         name="Cell Size",
         default=0.0,
@@ -88,6 +94,9 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
         layout.prop(self, "closed")
         layout.prop(self, "tolerance")
         row = layout.row()
+        row.enabled = self.closed
+        row.prop(self, "decimate")
+        row = layout.row()
         row.enabled = not self.closed
         row.prop(self, "caps")
 
@@ -102,7 +111,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
             # Closed Volume left at its default: a mesh that is not closed gets the open sweep.
             fallback = not self.properties.is_property_set("closed")
             computed = swept.compute_all(objects, context, self.steps, self.caps, tolerance, read, self.closed, cell,
-                                         fallback, progress)
+                                         fallback, progress, decimate=self.decimate)
             with transaction.atomic() as t:  # a failure removes every object and mesh made so far
                 created = [swept.create_object(s, context, t) for s in computed]
                 # Area, volume (a closed result) and the tolerance met, on each new object.

@@ -9,7 +9,8 @@
 //! triangle (`a b c`) and per pose (its 4 x 4 matrix, rows one after the other). Prints the
 //! closed mesh's counts, its bound, a digest of its vertices' bits and triangles (equal meshes,
 //! equal digests) and the process's CPU time (all threads) and wall time. `CELL` 0 or none:
-//! the default tolerance; `THREADS` 0 or none: the machine's.
+//! the default tolerance; `THREADS` 0 or none: the machine's; a fourth argument `decimate`:
+//! `ClosedOptions::decimate`.
 use glam::DVec3;
 use polyscrew::sweep::{sweep_closed_mesh, ClosedOptions};
 use polyscrew::Pose;
@@ -29,7 +30,7 @@ fn cpu_seconds() -> Option<f64> {
 fn main() {
     let path = std::env::args()
         .nth(1)
-        .expect("usage: count_sweep_closed CASE.txt [CELL [THREADS]]");
+        .expect("usage: count_sweep_closed CASE.txt [CELL [THREADS [decimate]]]");
     // A cell of 0 (or none): the default tolerance.
     let cell = std::env::args()
         .nth(2)
@@ -68,6 +69,7 @@ fn main() {
     let options = ClosedOptions {
         cell,
         threads,
+        decimate: std::env::args().nth(4).is_some_and(|d| d == "decimate"),
         ..ClosedOptions::default()
     };
     let out = sweep_closed_mesh(

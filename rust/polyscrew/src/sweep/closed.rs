@@ -143,6 +143,13 @@ pub const BRACKET_ITERATIONS: usize = 30;
 /// (`crease.rs`).
 pub const CREASE_TARGET: f64 = 0.025;
 
+/// Flat parts are collapsed (`decimate.rs`) while the midpoint of every new edge is within this
+/// many cells of the boundary.
+pub const DECIMATE_TARGET: f64 = 0.05;
+
+/// Collapses make no edge longer than this many cells.
+pub const DECIMATE_LONGEST: f64 = 8.0;
+
 /// The exact distance's triangle lists are kept per cube of side `cell /` this.
 pub const EXACT_LISTS_PER_CELL: f64 = 2.0;
 
@@ -173,9 +180,9 @@ pub const MAX_POSES: usize = 1 << 20;
 /// time on the L-prism at the defaults, one thread: 1.4, 2.0, 0.5 and 15 of 19 s).
 const STAGE_ENDS: [f64; 3] = [0.07, 0.18, 0.21];
 
-/// Within the contouring: where the walk over the grid and the vertices' refinement end (then
-/// the creases; 0.2, 8.3 and 6.5 s of its 15).
-const CONTOUR_STAGE_ENDS: [f64; 2] = [0.013, 0.57];
+/// Within the contouring: where the walk over the grid, the vertices' refinement and the
+/// creases end (then the flat parts' collapses; 0.2, 8.3, 6.5 and 4 s of its 19).
+const CONTOUR_STAGE_ENDS: [f64; 3] = [0.01, 0.45, 0.79];
 
 /// How to ask [`sweep_closed`] for less.
 const CELL_HINT: &str = "use a larger tolerance (or cell)";
@@ -203,6 +210,11 @@ pub struct ClosedOptions {
     /// [`std::thread::available_parallelism`]; at most [`MAX_THREADS`]. The mesh is the same,
     /// bit for bit, whatever the count.
     pub threads: usize,
+    /// Fewer triangles: vertices removed where the boundary is flat, by half-edge collapses
+    /// that keep every new edge's midpoint within [`DECIMATE_TARGET`] cells of the boundary
+    /// (`decimate.rs`). The vertices left are some of those without it, bit for bit, so
+    /// `error_bound` holds for them; it takes longer (about twice as long at the defaults).
+    pub decimate: bool,
 }
 
 /// The closed boundary and what it took.
@@ -860,7 +872,7 @@ pub(super) fn sweep_closed_with(
 ) -> Result<ClosedMesh> {
     let (cell, tolerance) = first_cell(body, poses, options)?;
     let whole = progress.span(0.0, 1.0);
-    let mut out = contoured(body, poses, cell, options.threads, evaluation, whole)?;
+    let mut out = contoured(body, poses, cell, options, evaluation, whole)?;
     out.attempts = 1;
     if tolerance > 0.0 && out.error_bound > tolerance {
         progress.restart();
@@ -868,7 +880,7 @@ pub(super) fn sweep_closed_with(
             body,
             poses,
             guaranteed_cell(tolerance),
-            options.threads,
+            options,
             evaluation,
             whole,
         )?;
@@ -947,10 +959,11 @@ fn contoured(
     body: &Body,
     poses: &[Pose],
     cell: f64,
-    threads: usize,
+    options: &ClosedOptions,
     evaluation: Evaluation,
     span: Span<'_>,
 ) -> Result<ClosedMesh> {
+    let threads = options.threads;
     let [grids, band_end, signs_end] = STAGE_ENDS;
     let band = BAND_CELLS * cell;
     let Plan {
@@ -1024,7 +1037,7 @@ fn contoured(
         &arg,
         grid,
         &refine,
-        threads,
+        (threads, options.decimate),
         span.part(signs_end, 1.0),
         &mut out,
     )?;
@@ -1794,11 +1807,11 @@ fn contour(
     arg: &[u32],
     grid: Grid,
     refine: &Refiner<'_>,
-    threads: usize,
+    (threads, decimate): (usize, bool),
     span: Span<'_>,
     out: &mut ClosedMesh,
 ) -> Result<()> {
-    let [walked, refined] = CONTOUR_STAGE_ENDS;
+    let [walked, refined, creased] = CONTOUR_STAGE_ENDS;
     let Grid { origin, cell, n } = grid;
     use std::collections::HashMap;
     let [nx, ny, nz] = n;
@@ -1969,12 +1982,27 @@ fn contour(
         &mut out.triangles,
         CREASE_TARGET * cell,
         thread_count(threads),
-        span.part(refined, 1.0),
+        span.part(refined, creased),
         &exact,
         &onto,
     );
     span.check()?;
     residual = residual.max(moved);
+    // Flat parts: vertices removed (none moves, so the bound below holds for those left).
+    if decimate {
+        super::decimate::collapse_flat(
+            &mut out.vertices,
+            &mut near,
+            &mut out.triangles,
+            DECIMATE_TARGET * cell,
+            DECIMATE_LONGEST * cell,
+            super::crease::TOUCH * CREASE_TARGET * cell,
+            thread_count(threads),
+            span.part(creased, 1.0),
+            &exact,
+        );
+        span.check()?;
+    }
     // The refinement reads the body at REFINE_POSES poses per sample interval, over which no
     // body point travels more than a cell (`DenseMotion::new`: the helix arc, linear in the
     // screw's parameter), so every instant of the motion is within `cell / (2 REFINE_POSES)` of

@@ -98,21 +98,27 @@ fn the_guaranteed_cell_meets_its_tolerance() {
 }
 
 /// Steps 1 and 2 on several threads (uneven shares: 2, 3 and 7 threads) give the one-thread
-/// mesh, every vertex's bits and every triangle, and the same bound and poses.
+/// mesh, every vertex's bits and every triangle, and the same bound and poses; decimated too
+/// (on 3 threads).
 #[test]
 fn several_threads_give_the_one_thread_mesh_bit_for_bit() {
-    for (name, body, poses) in cases() {
+    for ((name, body, poses), decimate) in cases()
+        .into_iter()
+        .flat_map(|case| [(case.clone(), false), (case, true)])
+    {
         let run = |threads| {
             let options = ClosedOptions {
                 tolerance: Some(TOLERANCE_REL * body.extent()),
                 threads,
+                decimate,
                 ..ClosedOptions::default()
             };
             sweep_closed(&body, &poses, &options).unwrap()
         };
         let one = run(1);
         assert!(!one.triangles.is_empty(), "{name}: empty");
-        for threads in [2, 3, 7] {
+        let counts: &[usize] = if decimate { &[3] } else { &[2, 3, 7] };
+        for &threads in counts {
             let many = run(threads);
             assert_eq!(digest(&many), digest(&one), "{name}: {threads} threads");
             assert_eq!(many.vertices.len(), one.vertices.len(), "{name}");

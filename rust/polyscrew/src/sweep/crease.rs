@@ -222,7 +222,14 @@ pub fn split_creases(
             let fits = |vertices: &mut Vec<DVec3>, at: DVec3, dir: DVec3| {
                 vertices.push(at);
                 let fits = new.iter().all(|&n| cross(vertices, n).dot(dir) > 0.0)
-                    && !buckets.crosses(vertices, triangles, &new, [p, q], TOUCH * target, Some(w));
+                    && !buckets.crosses(
+                        vertices,
+                        triangles,
+                        &new,
+                        &[p, q],
+                        TOUCH * target,
+                        Some(w),
+                    );
                 vertices.pop();
                 fits
             };
@@ -269,7 +276,14 @@ pub fn split_creases(
                     })
                 };
                 if gxy.abs() < g.abs()
-                    && !buckets.crosses(vertices, triangles, &flipped, [p, q], TOUCH * target, None)
+                    && !buckets.crosses(
+                        vertices,
+                        triangles,
+                        &flipped,
+                        &[p, q],
+                        TOUCH * target,
+                        None,
+                    )
                 {
                     let before = [p, q].map(|t| cross(vertices, triangles[t as usize]));
                     triangles[p as usize] = flipped[0];
@@ -339,7 +353,7 @@ pub fn split_creases(
 }
 
 /// `f` of every item, in order, computed on `threads` threads (contiguous chunks).
-fn in_chunks<T: Sync, R: Send>(
+pub(super) fn in_chunks<T: Sync, R: Send>(
     items: &[T],
     threads: usize,
     f: &(dyn Fn(&T) -> R + Sync),
@@ -362,7 +376,7 @@ fn in_chunks<T: Sync, R: Send>(
 
 /// The triangles by the cubes of side [`BUCKET`] their boxes meet (entries of a triangle
 /// since reshaped stay: each is read with its current corners).
-struct Buckets {
+pub(super) struct Buckets {
     map: HashMap<[i64; 3], Vec<u32>>,
     side: f64,
 }
@@ -378,9 +392,14 @@ impl Buckets {
                 (0..3).map(move |e| v[tri[e] as usize].distance(v[tri[(e + 1) % 3] as usize]))
             })
             .fold(0.0, f64::max);
+        Self::with_side(v, t, BUCKET * longest)
+    }
+
+    /// The triangles `t` by cubes of side `side`.
+    pub(super) fn with_side(v: &[DVec3], t: &[[u32; 3]], side: f64) -> Self {
         let mut out = Self {
             map: HashMap::with_capacity(t.len() / 4),
-            side: (BUCKET * longest).max(f64::MIN_POSITIVE),
+            side: side.max(f64::MIN_POSITIVE),
         };
         for (i, &tri) in t.iter().enumerate() {
             out.insert(v, tri, i as u32);
@@ -397,20 +416,29 @@ impl Buckets {
         })
     }
 
-    fn insert(&mut self, v: &[DVec3], tri: [u32; 3], id: u32) {
+    pub(super) fn insert(&mut self, v: &[DVec3], tri: [u32; 3], id: u32) {
         for c in self.cubes(v, tri).collect::<Vec<_>>() {
             self.map.entry(c).or_default().push(id);
         }
     }
 
+    /// Removes triangle `id`, whose corners are `tri`, from the cubes its box meets.
+    pub(super) fn remove(&mut self, v: &[DVec3], tri: [u32; 3], id: u32) {
+        for c in self.cubes(v, tri).collect::<Vec<_>>() {
+            if let Some(list) = self.map.get_mut(&c) {
+                list.retain(|&i| i != id);
+            }
+        }
+    }
+
     /// Whether a triangle of `new` crosses a triangle of the mesh other than those of
     /// `replaced` (other than along what they share: [`crosses`]).
-    fn crosses(
+    pub(super) fn crosses(
         &self,
         v: &[DVec3],
         t: &[[u32; 3]],
         new: &[[u32; 3]],
-        replaced: [u32; 2],
+        replaced: &[u32],
         margin: f64,
         apex: Option<u32>,
     ) -> bool {

@@ -54,6 +54,7 @@
 pub mod body;
 pub mod closed;
 mod crease;
+mod decimate;
 mod exact;
 pub mod generator;
 
