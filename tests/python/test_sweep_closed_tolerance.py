@@ -82,8 +82,9 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
     """`decimate=True`: closed and oriented, at most 0.6 of the triangles, its vertices some of
     the full mesh's (their bytes) with the same figures, and every new triangle's centre (one
     not in the full mesh, whose faces the other tests check) within the bound plus what the
-    collapses allow (4/3 of CLOSED_DECIMATE_TARGET cells) of the boundary: the bodies' exact
-    distance over the motion sampled densely (scipy's screws)."""
+    collapses allow (twice CLOSED_DECIMATE_TARGET cells: the most a flat triangle's distance
+    exceeds its edges' midpoints' on a sheet smooth or slightly kinked across it) of the
+    boundary: the bodies' exact distance over the motion sampled densely (scipy's screws)."""
     v, t, sd, poses, body_error, _ = CASES[name]
     tolerance = 0.02 * extent_of(v)
     fv, ft, full = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True)
@@ -101,7 +102,7 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
     centres = centres[np.random.default_rng(1).choice(len(centres), min(len(centres), 1500), replace=False)]
     inv = np.linalg.inv(dense(poses, max(64, 8192 // (len(poses) - 1))))
     worst = np.abs(region_sd(centres, inv, sd)).max()
-    allowed = fewer["error_bound"] + 4.0 / 3.0 * polyscrew.CLOSED_DECIMATE_TARGET * fewer["cell"] + body_error
+    allowed = fewer["error_bound"] + 2.0 * polyscrew.CLOSED_DECIMATE_TARGET * fewer["cell"] + body_error
     print(f"\n{name}: {len(dt)} of {len(ft)} triangles ({new.sum()} new), worst new centre {worst:.2e} "
           f"(allowed {allowed:.2e})")
     assert worst <= allowed

@@ -212,8 +212,9 @@ pub struct ClosedOptions {
     pub threads: usize,
     /// Fewer triangles: vertices removed where the boundary is flat, by half-edge collapses
     /// that keep every new edge's midpoint within [`DECIMATE_TARGET`] cells of the boundary
-    /// (`decimate.rs`). The vertices left are some of those without it, bit for bit, so
-    /// `error_bound` holds for them; it takes longer (about twice as long at the defaults).
+    /// (`decimate.rs`: the new faces then within about twice that, plus the vertices' bound).
+    /// The vertices left are some of those without it, bit for bit, so `error_bound` holds for
+    /// them; it takes longer (about twice as long at the defaults).
     pub decimate: bool,
 }
 
@@ -2002,6 +2003,8 @@ fn contour(
             &exact,
         );
         span.check()?;
+    } else {
+        span.part(creased, 1.0).advance(1.0);
     }
     // The refinement reads the body at REFINE_POSES poses per sample interval, over which no
     // body point travels more than a cell (`DenseMotion::new`: the helix arc, linear in the

@@ -502,11 +502,11 @@ fn every_face_point_lies_within_the_bound() {
 
 /// What a decimated mesh's faces may add to the vertices' bound: a collapse keeps every new
 /// edge's midpoint within [`DECIMATE_TARGET`] cells of the boundary, and a flat triangle's
-/// distance from a sheet smooth across it is at most 4/3 of the largest at its edges'
-/// midpoints (`decimate.rs`).
+/// distance from a sheet smooth across it, or kinked by less than the collapses allow, is at
+/// most twice the largest at its edges' midpoints (`decimate.rs`).
 fn decimated_faces(decimate: bool, cell: f64) -> f64 {
     if decimate {
-        4.0 / 3.0 * DECIMATE_TARGET * cell
+        2.0 * DECIMATE_TARGET * cell
     } else {
         0.0
     }

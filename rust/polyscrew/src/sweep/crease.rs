@@ -473,17 +473,24 @@ impl Buckets {
             let slack = margin + ROUNDING_SLACK * lo.abs().max(hi.abs()).max_element();
             (lo - slack, hi + slack)
         };
-        new.iter().any(|&n| {
-            let (lo, hi) = boxes(n);
-            near.iter().any(|&i| {
-                let s = t[i as usize];
-                let (slo, shi) = boxes(s);
-                if slo.cmpgt(hi).any() || lo.cmpgt(shi).any() {
-                    return false;
-                }
-                crosses(v, n, s) || (s.iter().all(|k| !n.contains(k)) && touches(n, s))
+        let new_boxes: Vec<(DVec3, DVec3)> = new.iter().map(|&n| boxes(n)).collect();
+        let (all_lo, all_hi) = new_boxes.iter().fold(
+            (DVec3::INFINITY, DVec3::NEG_INFINITY),
+            |(lo, hi), &(a, b)| (lo.min(a), hi.max(b)),
+        );
+        let apart = |(lo, hi): (DVec3, DVec3), (slo, shi): (DVec3, DVec3)| {
+            slo.cmpgt(hi).any() || lo.cmpgt(shi).any()
+        };
+        // Each near triangle's box once, those apart from every new triangle's left out.
+        near.into_iter()
+            .map(|i| (t[i as usize], boxes(t[i as usize])))
+            .filter(|&(_, b)| !apart((all_lo, all_hi), b))
+            .any(|(s, b)| {
+                new.iter().zip(&new_boxes).any(|(&n, &nb)| {
+                    !apart(nb, b)
+                        && (crosses(v, n, s) || (s.iter().all(|k| !n.contains(k)) && touches(n, s)))
+                })
             })
-        })
     }
 }
 

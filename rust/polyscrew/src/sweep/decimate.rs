@@ -9,9 +9,13 @@
 //! - every triangle around `u`, and every new one, is within [`FLAT_COSINE`] of their
 //!   area-weighted mean normal (so creases, which the crease pass refined, stay), and no new
 //!   triangle folds onto a neighbour (normals more than [`FOLD_COSINE`] apart);
-//! - the exact field at the midpoint of every new edge is within `target` of zero: on a
-//!   sheet that is smooth across the triangle, the triangle's distance from it is a quadratic
-//!   that vanishes at the corners, at most 4/3 of its largest value at the edges' midpoints;
+//! - the exact field at the midpoint of every new edge is within `target` of zero. A flat
+//!   triangle's distance from a sheet smooth across it is a quadratic that vanishes at the
+//!   corners (up to the vertices' own distance), at most 4/3 of its largest value at the
+//!   edges' midpoints; across a kink of the sheet (flatter than [`FLAT_COSINE`]) it is linear
+//!   on either side, largest where the kink meets an edge, at most twice that edge's midpoint
+//!   value. So the new faces are within about twice `target` of the boundary, plus the
+//!   vertices' bound;
 //! - no new edge is longer than `longest`, and the new triangles are no worse shaped than
 //!   [`LEAST_QUALITY`] (or the worst triangle they replace);
 //! - the mesh stays a closed manifold (the link condition: `u` and `w` share exactly the two
@@ -206,8 +210,7 @@ pub fn collapse_flat(
     // Collapses refused (midpoints off, a crossing, a fold) while the vertex's star stays.
     let mut refused: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
     // Midpoint values read so far, by edge (no vertex moves).
-    // (An edge by its ends, lower first, and `u32::MAX`; a triangle by its corners, sorted.)
-    let mut known: HashMap<[u32; 3], f64> = HashMap::new();
+    let mut known: HashMap<(u32, u32), f64> = HashMap::new();
     for round in 0..DECIMATE_ROUNDS {
         if span.is_cancelled() {
             break;
@@ -244,36 +247,25 @@ pub fn collapse_flat(
             centre[u as usize] = true;
             planned.push((u, w));
         }
-        // The new edges' midpoints and the new triangles' centres, each read once, on every
-        // core.
-        let new_points = |mesh: &Mesh<'_>, u: u32, w: u32| -> Vec<[u32; 3]> {
+        // The new edges' midpoints, each read once, on every core.
+        let new_edges = |mesh: &Mesh<'_>, u: u32, w: u32| -> Vec<(u32, u32)> {
             let ring_w = mesh.ring(w);
-            let edges = mesh
-                .ring(u)
+            mesh.ring(u)
                 .into_iter()
                 .filter(|&x| x != w && ring_w.binary_search(&x).is_err())
-                .map(|x| {
-                    let (a, b) = key(w, x);
-                    [a, b, u32::MAX]
-                });
-            let centres = mesh.moved(u, w).map(|(_, mut n)| {
-                n.sort_unstable();
-                n
-            });
-            edges.chain(centres).collect()
+                .map(|x| key(w, x))
+                .collect()
         };
-        let mut unread: Vec<[u32; 3]> = planned
+        let mut unread: Vec<(u32, u32)> = planned
             .iter()
-            .flat_map(|&(u, w)| new_points(&mesh, u, w))
+            .flat_map(|&(u, w)| new_edges(&mesh, u, w))
             .filter(|e| !known.contains_key(e))
             .collect();
         unread.sort_unstable();
         unread.dedup();
-        let read = |p: &[u32; 3]| {
-            let corners = p.iter().filter(|&&k| k != u32::MAX);
-            let centre = corners.clone().map(|&k| mesh.v[k as usize]).sum::<DVec3>()
-                / corners.count() as f64;
-            field(centre, near[p[0] as usize])
+        let read = |&(a, b): &(u32, u32)| {
+            let at = |k: u32| mesh.v[k as usize];
+            field(0.5 * (at(a) + at(b)), near[a as usize])
         };
         known.extend(
             unread
@@ -313,14 +305,14 @@ pub fn collapse_flat(
             {
                 continue;
             }
-            let points = new_points(&mesh, u, w);
+            let edges = new_edges(&mesh, u, w);
             let mut refuse = |u: u32, w: u32| {
                 refused.entry(u).or_default().push((u, w));
                 dirty[u as usize] = true;
             };
-            if !points
+            if !edges
                 .iter()
-                .all(|p| known.get(p).is_some_and(|g| g.abs() <= target))
+                .all(|e| known.get(e).is_some_and(|g| g.abs() <= target))
             {
                 refuse(u, w);
                 continue;
