@@ -99,13 +99,16 @@ fn the_guaranteed_cell_meets_its_tolerance() {
 
 /// Steps 1 and 2 on several threads (uneven shares: 2, 3 and 7 threads) give the one-thread
 /// mesh, every vertex's bits and every triangle, and the same bound and poses; decimated too
-/// (on 3 threads).
+/// (two cases, on 3 threads).
 #[test]
 fn several_threads_give_the_one_thread_mesh_bit_for_bit() {
-    for ((name, body, poses), decimate) in cases()
-        .into_iter()
-        .flat_map(|case| [(case.clone(), false), (case, true)])
-    {
+    // (Decimated on the L-prism and the torus: flat faces and curved ones.)
+    for ((name, body, poses), decimate) in cases().into_iter().flat_map(|case| {
+        let curved = matches!(case.0, "L-prism, half turn" | "torus, smoothed polyscrew");
+        [(case.clone(), false)]
+            .into_iter()
+            .chain(curved.then_some((case, true)))
+    }) {
         let run = |threads| {
             let options = ClosedOptions {
                 tolerance: Some(TOLERANCE_REL * body.extent()),

@@ -41,12 +41,12 @@ const ROUNDING_SLACK: f64 = 1e-6;
 /// An edge's two triangles (by index), the edge by its vertices, lower first.
 type Edges = HashMap<(u32, u32), [u32; 2]>;
 
-fn key(a: u32, b: u32) -> (u32, u32) {
+pub(super) fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
 /// Twice the area of triangle `t` along its normal.
-fn cross(v: &[DVec3], t: [u32; 3]) -> DVec3 {
+pub(super) fn cross(v: &[DVec3], t: [u32; 3]) -> DVec3 {
     let [a, b, c] = t.map(|i| v[i as usize]);
     (b - a).cross(c - a)
 }

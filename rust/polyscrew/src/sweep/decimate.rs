@@ -33,7 +33,7 @@ use std::collections::HashMap;
 
 use glam::DVec3;
 
-use super::crease::{in_chunks, Buckets};
+use super::crease::{cross, in_chunks, key, Buckets};
 use crate::progress::Span;
 
 /// A vertex is removed only where the triangles around it, before and after, are within this
@@ -53,16 +53,6 @@ pub const DECIMATE_ROUNDS: usize = 16;
 
 /// Rounds stop once one removes fewer than this fraction of the vertices left.
 const LEAST_GAIN: f64 = 0.002;
-
-fn key(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
-}
-
-/// Twice the area of triangle `t` along its normal.
-fn cross(v: &[DVec3], t: [u32; 3]) -> DVec3 {
-    let [a, b, c] = t.map(|i| v[i as usize]);
-    (b - a).cross(c - a)
-}
 
 /// `4 sqrt(3) area / (sum of squared edges)`: 1 for an equilateral triangle, 0 for a flat one.
 fn quality(v: &[DVec3], t: [u32; 3]) -> f64 {
