@@ -54,7 +54,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     decimate: BoolProperty(
         name="Fewer Triangles",
         default=False,
-        description="Closed Volume: remove vertices where the boundary is flat (2.5 to 3 times fewer "
+        description="Closed Volume: remove vertices where the boundary is flat (3 to 6 times fewer "
         "triangles at the default tolerance, every vertex left still within it; about twice as long)",
     )
     cell: FloatProperty(

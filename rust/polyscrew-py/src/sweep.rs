@@ -217,7 +217,7 @@ fn sweep<'py>(
 /// vertices, a round of crease splits) and is raised by ``sweep_closed``, as is a signal
 /// (Ctrl-C: ``KeyboardInterrupt``). None: no calls, and the sweep runs on the calling thread.
 ///
-/// ``decimate``: fewer triangles (2.8 to 4.4 times fewer at the defaults), vertices removed
+/// ``decimate``: fewer triangles (2.8 to 6.2 times fewer at the defaults), vertices removed
 /// where the boundary is flat by collapses that keep every new edge's midpoint within
 /// ``CLOSED_DECIMATE_TARGET`` cells of the boundary (the new faces then within about twice
 /// that, plus the bound); the vertices left are some of those without it, so ``error_bound``
