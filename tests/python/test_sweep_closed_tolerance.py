@@ -111,6 +111,14 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
         polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, decimate="yes")
 
 
+def test_a_non_bool_info_is_refused_naming_the_function():
+    v, t, _, poses, _, _ = CASES["L-prism, half turn"]
+    with pytest.raises(TypeError, match="sweep_closed: info: expected a bool, got str"):
+        polyscrew.sweep_closed(v, t, poses, info="yes")
+    with pytest.raises(TypeError, match="sweep: info: expected a bool, got str"):
+        polyscrew.sweep(v, t, poses, info="yes")
+
+
 def test_bad_tolerances_and_heavy_work_are_refused():
     v, t, _, poses, _, _ = CASES["cube, 120-degree screw with slide"]
     with pytest.raises(ValueError, match="not both"):

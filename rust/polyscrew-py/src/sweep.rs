@@ -242,7 +242,7 @@ fn sweep_closed<'py>(
     triangles: &Bound<'py, PyAny>,
     poses: &Bound<'py, PyAny>,
     cell: Option<&Bound<'py, PyAny>>,
-    #[pyo3(from_py_with = info_arg)] info: bool,
+    #[pyo3(from_py_with = closed_info_arg)] info: bool,
     tolerance: Option<&Bound<'py, PyAny>>,
     threads: Option<&Bound<'py, PyAny>>,
     progress: Option<&Bound<'py, PyAny>>,
@@ -411,6 +411,11 @@ fn mesh_arrays(
 /// `info`: a bool.
 fn info_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
     args::bool_arg(Sweep::NAME, "info", obj)
+}
+
+/// `sweep_closed`'s `info`, a bool.
+fn closed_info_arg(obj: &Bound<'_, PyAny>) -> PyResult<bool> {
+    args::bool_arg("sweep_closed", "info", obj)
 }
 
 /// `sweep_closed`'s `decimate`, a bool.
