@@ -228,15 +228,23 @@ fn bad_tolerances_are_refused() {
 /// `sweep_closed_watched` reports its progress as it goes, never lower (a watcher on another
 /// thread reads it every millisecond), ends at 1 and gives `sweep_closed`'s mesh bit for bit;
 /// asked to stop before it starts or partway, it stops with `Error::Cancelled`, the rest of
-/// its work not done (its progress stays below 1; at 0 for a stop before it starts).
+/// its work not done (its progress stays below 1; at 0 for a stop before it starts). The same
+/// decimated, stopped within the collapses.
 #[test]
 fn progress_is_reported_and_a_stop_is_honoured() {
+    for decimate in [false, true] {
+        progress_with(decimate);
+    }
+}
+
+fn progress_with(decimate: bool) {
     use crate::Progress;
     use std::time::Duration;
     let (name, body, poses) = cases().swap_remove(1);
     let options = ClosedOptions {
         tolerance: Some(TOLERANCE_REL * body.extent()),
         threads: 2,
+        decimate,
         ..ClosedOptions::default()
     };
     let plain = sweep_closed(&body, &poses, &options).unwrap();
@@ -268,10 +276,12 @@ fn progress_is_reported_and_a_stop_is_honoured() {
     assert_eq!(last, 1.0, "{name}");
     assert_eq!(digest(&out.unwrap()), digest(&plain), "{name}");
 
-    let (out, _, at) = watched(0.3);
+    // (Decimated, 0.6 is within the collapses: they start at 0.21 + 0.79 * 0.45.)
+    let stop_at = if decimate { 0.6 } else { 0.3 };
+    let (out, _, at) = watched(stop_at);
     println!("{name}: stopped at {at:.3}");
     assert!(matches!(out, Err(Error::Cancelled)), "{name}: {out:?}");
-    assert!((0.3..1.0).contains(&at), "{name}: stopped at {at}");
+    assert!((stop_at..1.0).contains(&at), "{name}: stopped at {at}");
 
     let early = Progress::new();
     early.cancel();

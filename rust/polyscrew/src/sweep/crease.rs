@@ -348,7 +348,9 @@ pub fn split_creases(
             .filter(|&e| creased(&edges, vertices, triangles, e))
             .collect();
     }
-    span.advance(1.0);
+    if !span.is_cancelled() {
+        span.advance(1.0);
+    }
     residual
 }
 

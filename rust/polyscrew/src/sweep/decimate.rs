@@ -355,8 +355,10 @@ pub fn collapse_flat(
             break;
         }
     }
-    span.advance(1.0);
-    // The vertices and triangles left, in their order.
+    if !span.is_cancelled() {
+        span.advance(1.0);
+    }
+    // The vertices and triangles left, in their order (a valid mesh after a stop too).
     let dead: Vec<bool> = mesh
         .t
         .iter()
