@@ -2001,7 +2001,7 @@ fn contour(
     if decimate {
         super::decimate::collapse_flat(
             &mut out.vertices,
-            &mut near,
+            &near,
             &mut out.triangles,
             DECIMATE_TARGET * cell,
             DECIMATE_LONGEST * cell,

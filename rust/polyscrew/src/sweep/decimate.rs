@@ -102,7 +102,7 @@ impl Mesh<'_> {
     /// The neighbour `w` of `u` to collapse `u` onto, with the edge's length: the one whose new
     /// triangles are best shaped, if the star of `u` is flat and some neighbour's new
     /// triangles keep it flat, short enough and well enough shaped.
-    fn target(&self, u: u32, longest: f64, refused: &[(u32, u32)]) -> Option<(u32, f64)> {
+    fn target(&self, u: u32, longest: f64, refused: &[u32]) -> Option<(u32, f64)> {
         let star = &self.around[u as usize];
         if star.len() < 4 {
             return None;
@@ -127,7 +127,7 @@ impl Mesh<'_> {
         let mut best: Option<(u32, f64)> = None;
         let mut best_quality = 0.0;
         for w in self.ring(u) {
-            if refused.contains(&(u, w)) {
+            if refused.contains(&w) {
                 continue;
             }
             let mut worst = f64::INFINITY;
@@ -155,7 +155,7 @@ impl Mesh<'_> {
 }
 
 /// Removes vertices where the closed mesh (`vertices`, `triangles`) is flat (see the module
-/// documentation), `near` following the vertices. `field(x, near)` is the region's exact
+/// documentation); `near`: each vertex's motion samples. `field(x, near)` is the region's exact
 /// field at `x`, `near` the motion samples near which to look first; a new edge's midpoint
 /// within `target` of zero, new edges no longer than `longest`; `margin`: the touch distance
 /// of [`Buckets::crosses`]. The midpoints are read on `threads` threads; the result does not
@@ -165,7 +165,7 @@ impl Mesh<'_> {
 #[allow(clippy::too_many_arguments)]
 pub fn collapse_flat(
     vertices: &mut Vec<DVec3>,
-    near: &mut Vec<[u32; 2]>,
+    near: &[[u32; 2]],
     triangles: &mut Vec<[u32; 3]>,
     target: f64,
     longest: f64,
@@ -197,8 +197,9 @@ pub fn collapse_flat(
     // Each vertex's collapse as last found, and whether its triangles changed since.
     let mut targets: Vec<Option<(u32, f64)>> = vec![None; count];
     let mut dirty = vec![true; count];
-    // Collapses refused (midpoints off, a crossing, a fold) while the vertex's star stays.
-    let mut refused: HashMap<u32, Vec<(u32, u32)>> = HashMap::new();
+    // The neighbours a vertex's collapse onto was refused (midpoints off, a crossing, a fold),
+    // while its star stays.
+    let mut refused: HashMap<u32, Vec<u32>> = HashMap::new();
     // Midpoint values read so far, by edge (no vertex moves).
     let mut known: HashMap<(u32, u32), f64> = HashMap::new();
     for round in 0..DECIMATE_ROUNDS {
@@ -297,7 +298,7 @@ pub fn collapse_flat(
             }
             let edges = new_edges(&mesh, u, w);
             let mut refuse = |u: u32, w: u32| {
-                refused.entry(u).or_default().push((u, w));
+                refused.entry(u).or_default().push(w);
                 dirty[u as usize] = true;
             };
             if !edges
@@ -370,12 +371,10 @@ pub fn collapse_flat(
         if !gone[k] {
             *slot = kept;
             vertices[kept as usize] = vertices[k];
-            near[kept as usize] = near[k];
             kept += 1;
         }
     }
     vertices.truncate(kept as usize);
-    near.truncate(kept as usize);
     let mut i = 0;
     triangles.retain(|_| {
         i += 1;
