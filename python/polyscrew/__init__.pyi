@@ -557,6 +557,7 @@ class ClosedSweepInfo(TypedDict):
     tolerance: float
     attempts: int
     poses: int
+    refined_cubes: int
 
 @overload
 def sweep_closed(
@@ -620,8 +621,10 @@ def sweep_closed(
     triangles counter-clockwise seen from outside, every edge in exactly two; with
     ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
     boundary: the distance left at a vertex plus the body grid's interpolation bound; at most
-    ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2)
-    and ``poses`` (the dense poses sampled).
+    ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2),
+    ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
+    because they hid a slab of outside space narrower than a cell between two sheets of the
+    boundary, which the grid's points alone would have filled).
 
     Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
     or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's

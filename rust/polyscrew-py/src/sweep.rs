@@ -166,6 +166,7 @@ fn sweep<'py>(
 // stub:     tolerance: float
 // stub:     attempts: int
 // stub:     poses: int
+// stub:     refined_cubes: int
 /// sweep_closed(
 ///     vertices: ArrayLike,
 ///     triangles: ArrayLike,
@@ -227,8 +228,10 @@ fn sweep<'py>(
 /// triangles counter-clockwise seen from outside, every edge in exactly two; with
 /// ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex within it of the swept
 /// boundary: the distance left at a vertex plus the body grid's interpolation bound; at most
-/// ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2)
-/// and ``poses`` (the dense poses sampled).
+/// ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2),
+/// ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
+/// because they hid a slab of outside space narrower than a cell between two sheets of the
+/// boundary, which the grid's points alone would have filled).
 ///
 /// Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
 /// or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
@@ -256,7 +259,7 @@ fn sweep_closed<'py>(
     let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
-    type Closed = (Array2<f64>, Array2<i64>, [f64; 3], [usize; 2]);
+    type Closed = (Array2<f64>, Array2<i64>, [f64; 3], [usize; 3]);
     let (vo, to, figures, counts) = watched(py, F, progress, |watch| -> PyResult<Closed> {
         let (va, ta, pa) = &views;
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
@@ -266,7 +269,12 @@ fn sweep_closed<'py>(
         drop((v, t, p));
         let (vo, to) = mesh_arrays(F, &out.vertices, &out.triangles)?;
         let figures = [out.cell, out.error_bound, out.tolerance];
-        Ok((vo, to, figures, [out.attempts, out.poses]))
+        Ok((
+            vo,
+            to,
+            figures,
+            [out.attempts, out.poses, out.refined_cubes],
+        ))
     })?;
     let (vo, to) = (vo.into_pyarray(py), to.into_pyarray(py));
     if !info {
@@ -278,6 +286,7 @@ fn sweep_closed<'py>(
     dict.set_item("tolerance", figures[2])?;
     dict.set_item("attempts", counts[0])?;
     dict.set_item("poses", counts[1])?;
+    dict.set_item("refined_cubes", counts[2])?;
     PyTuple::new(py, [vo.into_any(), to.into_any(), dict.into_any()])
 }
 

@@ -20,7 +20,10 @@
 //!    cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the main
 //!    diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where `g`
 //!    changes sign gives one triangle or a quad (two triangles) with its vertices on the
-//!    tetrahedron's edges;
+//!    tetrahedron's edges; grid cubes whose corners are all inside but where two sheets of the
+//!    boundary face each other are read on a lattice four times finer, and those where a
+//!    lattice point is outside (a slab of outside space narrower than a cell) are cut into
+//!    subcubes, their neighbours into tetrahedra that keep the whole conforming (`adaptive.rs`);
 //! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
 //!    the motion (the body at 8 poses per sample interval on each side of the sample that
 //!    gave the minimum at the edge's ends), kept strictly inside the edge: regula falsi on
@@ -45,10 +48,14 @@
 //! and the orientation is taken from which end of a crossed edge is inside. The outer layer
 //! of the grid is outside every instance, so the surface has no border.
 
+use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{DAffine3, DVec3};
 
+use super::adaptive::{
+    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, Key, Lattice, KUHN,
+};
 use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
 use crate::error::{Error, Expected, Result};
@@ -242,6 +249,9 @@ pub struct ClosedMesh {
     pub attempts: usize,
     /// Dense poses sampled.
     pub poses: usize,
+    /// Grid cubes cut finer because outside space narrower than a cell was found in them
+    /// (`adaptive.rs`).
+    pub refined_cubes: usize,
 }
 
 /// What [`sweep_closed`] will sample, known before it runs ([`closed_work`]): enough to
@@ -1516,10 +1526,16 @@ impl Refiner<'_> {
     /// Where that minimum is above `upper`, the value returned is too (and may not be the
     /// minimum). The intervals [`Refiner::exact_near`] reads at the samples `known` ([`NONE`]:
     /// none) are left out: a caller passes them when `upper` is their minimum already.
-    fn exact_all(&self, x: DVec3, mut upper: f64, known: [u32; 2]) -> f64 {
+    fn exact_all(&self, x: DVec3, upper: f64, known: [u32; 2]) -> f64 {
+        self.least(x, upper, known).0
+    }
+
+    /// [`Refiner::exact_all`] with the refined pose giving it (its index in
+    /// [`Refiner::fine`]; `usize::MAX` when no pose is below `upper`).
+    fn least(&self, x: DVec3, mut upper: f64, known: [u32; 2]) -> (f64, usize) {
         let half = 0.5 * self.spread;
         let floor = -self.field.band;
-        let mut best = f64::INFINITY;
+        let mut best = (f64::INFINITY, usize::MAX);
         // The sample before: at most its distance (its read less the read's error, or a bound).
         let mut before = f64::INFINITY;
         // The last sample read and at most its distance (none: minus infinity).
@@ -1596,7 +1612,7 @@ impl Refiner<'_> {
         // The intervals least bounded first, and in each the poses read least first: the
         // minimum is found early and bounds out the rest.
         intervals.sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        let mut reads = [(0.0f64, DVec3::ZERO); REFINE_POSES + 1];
+        let mut reads = [(0.0f64, DVec3::ZERO, 0usize); REFINE_POSES + 1];
         for &(low, i, [a, b]) in &intervals {
             if low > upper {
                 break;
@@ -1612,23 +1628,65 @@ impl Refiner<'_> {
                 let s = k as f64 / REFINE_POSES as f64;
                 let bound = (a - s * self.travel).max(b - (1.0 - s) * self.travel) - self.slack;
                 *slot = if bound > upper {
-                    (f64::INFINITY, DVec3::ZERO)
+                    (f64::INFINITY, DVec3::ZERO, first + k)
                 } else {
                     let y = pose.transform_point3(x);
-                    (self.field.at(y), y)
+                    (self.field.at(y), y, first + k)
                 };
             }
             reads.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-            for &(read, y) in &reads {
+            for &(read, y, pose) in &reads {
                 if read - half > upper {
                     break;
                 }
                 let d = self.exact.at(y).0;
-                best = best.min(d);
+                if d < best.0 {
+                    best = (d, pose);
+                }
                 upper = upper.min(d);
             }
         }
         best
+    }
+}
+
+impl Refiner<'_> {
+    /// Whether a thin channel of outside space may pass through the grid cube centred at `x`
+    /// (`reach` half its diagonal) whose corners' minima come from the samples `samples`: the
+    /// body's surfaces through two of them more than [`CHANNEL_GAP`] apart face each other
+    /// there (their outward normals at `x` more than 120 degrees apart: [`FACING_COSINE`])
+    /// and, taken as the
+    /// planes at `x`, leave outside space within the cube; and no one of them holds the whole
+    /// cube inside.
+    fn facing(&self, x: DVec3, reach: f64, mut samples: [u32; 8]) -> bool {
+        samples.sort_unstable();
+        // Each sample's outward normal and distance at `x`.
+        let mut sheets = [(0u32, DVec3::ZERO, 0.0f64); 8];
+        let mut count = 0;
+        for (m, &j) in samples.iter().enumerate() {
+            if (m > 0 && samples[m - 1] == j) || j == u32::MAX {
+                continue;
+            }
+            let a = &self.fine[j as usize * REFINE_POSES];
+            let (d, normal) = self.exact.at(a.transform_point3(x));
+            if d + reach + self.slack < 0.0 {
+                return false;
+            }
+            if let Some(n) = normal {
+                sheets[count] = (j, a.matrix3.transpose() * n, d);
+                count += 1;
+            }
+        }
+        let sheets = &sheets[..count];
+        // Two planes facing each other leave outside space within `reach` of `x` where
+        // `d + e + |n + o| reach` (the most their distances' sum reaches there) is not negative.
+        sheets.iter().enumerate().any(|(m, &(j, n, d))| {
+            sheets[m + 1..].iter().any(|&(k, o, e)| {
+                k - j > CHANNEL_GAP
+                    && n.dot(o) < FACING_COSINE
+                    && d + e + (n + o).length() * reach >= 0.0
+            })
+        })
     }
 }
 
@@ -1709,17 +1767,6 @@ fn settle_signs(
         }
     })
 }
-
-/// The six tetrahedra of Kuhn's triangulation of the unit cube, as corner codes
-/// (`x | y << 1 | z << 2`), each positively oriented.
-const KUHN: [[u8; 4]; 6] = [
-    [0, 1, 3, 7],
-    [0, 1, 5, 7],
-    [0, 2, 3, 7],
-    [0, 2, 6, 7],
-    [0, 4, 5, 7],
-    [0, 4, 6, 7],
-];
 
 /// A grid edge the contouring crosses: its ends, the region's field there and the motion
 /// samples that gave it.
@@ -1806,6 +1853,189 @@ impl GridEdge {
     }
 }
 
+/// The smallest gap, in samples of the motion, between the samples giving a cube's corners
+/// their minima for the cube to be refined ([`channel_cubes`]).
+pub const CHANNEL_GAP: u32 = 16;
+
+/// The most the cosine between two sheets' outward normals may be for a cube between them to
+/// be read finer ([`Refiner::facing`]): more than 120 degrees apart. A slab of outside space
+/// narrower than a cell lies between nearly opposed sheets; sheets less opposed meet in a
+/// wedge, whose tip the faces across the crease already cut (`crease.rs`).
+pub const FACING_COSINE: f64 = -0.5;
+
+/// The value and sample at an added lattice point `key` (as the grid's: `f32`, negative
+/// inside). Each grid point's value plus the read's error plus its distance is at least the
+/// region's exact minimum at `key` (the minimum over the poses is 1-Lipschitz): where the least
+/// of those is below zero, `key` is inside and takes it (with that grid point's sample); else
+/// the exact minimum over every refined pose is found below it (and its sample).
+fn added_value(
+    lattice: &Lattice,
+    key: Key,
+    g: &[f32],
+    arg: &[u32],
+    refine: &Refiner<'_>,
+) -> (f32, u32) {
+    let x = lattice.point(key);
+    let half = 0.5 * refine.spread;
+    let band = refine.field.band;
+    let (upper, near) = lattice
+        .corners(key)
+        .into_iter()
+        .map(|p| {
+            let at = lattice.point(grid_key(p));
+            (
+                f64::from(g[p]) + half + at.distance(x) + refine.slack,
+                arg[p],
+            )
+        })
+        .fold(
+            (f64::INFINITY, u32::MAX),
+            |a, b| if b.0 < a.0 { b } else { a },
+        );
+    if upper < 0.0 {
+        return ((upper.max(-band) as f32).min(-f32::MIN_POSITIVE), near);
+    }
+    let (least, pose) = refine.least(x, upper, NONE);
+    if pose == usize::MAX {
+        // Every pose is above `upper`, itself not below zero: outside.
+        return ((upper.min(band) as f32).max(0.0), near);
+    }
+    let samples = refine.centres.len();
+    let sample = ((pose + REFINE_POSES / 2) / REFINE_POSES).min(samples - 1) as u32;
+    let value = if least < 0.0 {
+        (least.max(-band) as f32).min(-f32::MIN_POSITIVE)
+    } else {
+        (least.min(band) as f32).max(0.0)
+    };
+    (value, sample)
+}
+
+/// [`added_value`] at every point of `keys`, on every core.
+fn lattice_values(
+    lattice: &Lattice,
+    keys: &[Key],
+    (g, arg): (&[f32], &[u32]),
+    refine: &Refiner<'_>,
+    threads: usize,
+    span: Span<'_>,
+) -> Result<Vec<(f32, u32)>> {
+    let mut values = vec![(0.0f32, 0u32); keys.len()];
+    let parts: Vec<_> = keys
+        .chunks(REFINE_CHUNK)
+        .zip(values.chunks_mut(REFINE_CHUNK))
+        .collect();
+    in_parts(parts, threads, "the refined cubes", span, |(keys, vs)| {
+        for (&key, v) in keys.iter().zip(vs) {
+            *v = added_value(lattice, key, g, arg, refine);
+        }
+    })?;
+    Ok(values)
+}
+
+/// Marching tetrahedra's state: the vertex on each crossed tetrahedron edge, made once.
+#[derive(Default)]
+struct Walk {
+    edges: HashMap<(Key, Key), u32>,
+    /// Each vertex's edge (its ends, lower first), refined once the mesh is walked.
+    ends: Vec<(Key, Key)>,
+}
+
+impl Walk {
+    /// The vertex on the edge from `p` to `q` (`p < q`), made once, at the edge's midpoint
+    /// for now: a triangle's orientation along a crossed edge is the same wherever its
+    /// vertices lie inside their edges.
+    fn vertex(
+        &mut self,
+        (p, q): (Key, Key),
+        position: &impl Fn(Key) -> DVec3,
+        out: &mut ClosedMesh,
+    ) -> Result<u32> {
+        if let Some(&v) = self.edges.get(&(p, q)) {
+            return Ok(v);
+        }
+        let v = out.vertices.len();
+        if v >= u32::MAX as usize {
+            return Err(Error::Limit {
+                what: "cell",
+                counted: "vertices",
+                count: v + 1,
+                limit: u32::MAX as usize,
+                hint: CELL_HINT,
+            });
+        }
+        out.vertices.push(position(p).lerp(position(q), 0.5));
+        self.ends.push((p, q));
+        self.edges.insert((p, q), v as u32);
+        Ok(v as u32)
+    }
+
+    /// The triangle or quad (two triangles) of tetrahedron `pts` where the field changes sign,
+    /// facing out.
+    fn march(
+        &mut self,
+        pts: [Key; 4],
+        inside: &impl Fn(Key) -> bool,
+        position: &impl Fn(Key) -> DVec3,
+        out: &mut ClosedMesh,
+    ) -> Result<()> {
+        let mut ins = [0; 4];
+        let mut outs = [0; 4];
+        let (mut ni, mut no) = (0, 0);
+        for &p in &pts {
+            if inside(p) {
+                ins[ni] = p;
+                ni += 1;
+            } else {
+                outs[no] = p;
+                no += 1;
+            }
+        }
+        // An edge by its ends, lower first.
+        let edge = |a: Key, b: Key| if a < b { (a, b) } else { (b, a) };
+        match ni {
+            1 | 3 => {
+                // One apex apart from the three others.
+                let (apex, rest, apex_in) = if ni == 1 {
+                    (ins[0], [outs[0], outs[1], outs[2]], true)
+                } else {
+                    (outs[0], [ins[0], ins[1], ins[2]], false)
+                };
+                let mut tri = [0u32; 3];
+                for (slot, &r) in tri.iter_mut().zip(&rest) {
+                    *slot = self.vertex(edge(apex, r), position, out)?;
+                }
+                // Outward: from the inside end of a crossed edge to its outside end.
+                let (from, to) = if apex_in {
+                    (apex, rest[0])
+                } else {
+                    (rest[0], apex)
+                };
+                push_oriented(out, tri, position(to) - position(from));
+            }
+            2 => {
+                let (a, b, c, d) = (ins[0], ins[1], outs[0], outs[1]);
+                let ac = self.vertex(edge(a, c), position, out)?;
+                let ad = self.vertex(edge(a, d), position, out)?;
+                let bd = self.vertex(edge(b, d), position, out)?;
+                let bc = self.vertex(edge(b, c), position, out)?;
+                // Both triangles hold the crossing of the edge a -> c.
+                let outward = position(c) - position(a);
+                let flip = orientation(out, [ac, ad, bd], outward);
+                let (t0, t1) = ([ac, ad, bd], [ac, bd, bc]);
+                if flip {
+                    out.triangles.push([t0[0], t0[2], t0[1]]);
+                    out.triangles.push([t1[0], t1[2], t1[1]]);
+                } else {
+                    out.triangles.push(t0);
+                    out.triangles.push(t1);
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+}
+
 /// Marching tetrahedra over the world grid (see the module documentation).
 fn contour(
     g: &[f32],
@@ -1822,118 +2052,108 @@ fn contour(
         CONTOUR_STAGE_ENDS
     };
     let Grid { origin, cell, n } = grid;
-    use std::collections::HashMap;
     let [nx, ny, nz] = n;
     let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
-    let point = |p: usize| {
+    let grid_position = |p: usize| {
         let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
         origin + DVec3::new(i as f64, j as f64, k as f64) * cell
     };
+    // Cubes cut finer where a channel of outside space can hide (`adaptive.rs`), and the
+    // values at the lattice points they add.
+    let walk_span = span.part(0.0, walked);
+    let half = 0.5 * refine.spread;
+    let deep = (3f64.sqrt() * cell + half) as f32;
+    let offsets = corner_offsets(n);
+    let reach = 0.5 * 3f64.sqrt() * cell;
+    let candidates = channel_cubes(g, arg, n, deep, CHANNEL_GAP);
+    let mut facing = vec![false; candidates.len()];
+    let parts: Vec<_> = candidates
+        .chunks(REFINE_CHUNK)
+        .zip(facing.chunks_mut(REFINE_CHUNK))
+        .collect();
+    in_parts(
+        parts,
+        threads,
+        "the refined cubes",
+        walk_span,
+        |(cubes, flags)| {
+            for (&c, flag) in cubes.iter().zip(flags) {
+                let centre = grid_position(c) + DVec3::splat(0.5 * cell);
+                *flag = refine.facing(centre, reach, offsets.map(|o| arg[c + o]));
+            }
+        },
+    )?;
+    let suspects: Vec<usize> = candidates
+        .iter()
+        .zip(&facing)
+        .filter_map(|(&c, &f)| f.then_some(c))
+        .collect();
+    // The suspects' lattice points, read; a suspect is refined only where one is outside
+    // (where none is, its subcubes would give no surface).
+    let mut lattice = Lattice::new(origin, cell, n, &[]);
+    let mut points: Vec<Key> = suspects.iter().flat_map(|&c| cube_points(n, c)).collect();
+    points.sort_unstable();
+    points.dedup();
+    let values = lattice_values(&lattice, &points, (g, arg), refine, threads, walk_span)?;
+    lattice.set_values(&points, &values);
+    let channels: Vec<usize> = suspects
+        .into_iter()
+        .filter(|&c| cube_points(n, c).any(|k| lattice.value(k).0 >= 0.0))
+        .collect();
+    out.refined_cubes = channels.len();
+    let read = std::mem::replace(&mut lattice, Lattice::new(origin, cell, n, &channels));
+    let added: Vec<Key> = lattice
+        .added_points()
+        .into_iter()
+        .filter(|&k| !read.has_value(k))
+        .collect();
+    lattice.take_values(read);
+    let values = lattice_values(&lattice, &added, (g, arg), refine, threads, walk_span)?;
+    lattice.set_values(&added, &values);
+    let position = |key: Key| match grid_point(key) {
+        Some(p) => grid_position(p),
+        None => lattice.point(key),
+    };
+    let value = |key: Key| match grid_point(key) {
+        Some(p) => g[p],
+        None => lattice.value(key).0,
+    };
+    let sample = |key: Key| match grid_point(key) {
+        Some(p) => arg[p],
+        None => lattice.value(key).1,
+    };
+    let mut walk = Walk::default();
     let offset = |code: u8| {
         (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
     };
-    let mut edges: HashMap<(usize, usize), u32> = HashMap::new();
-    // Each vertex's grid edge (its ends' points), refined once the mesh is walked.
-    let mut ends: Vec<(usize, usize)> = Vec::new();
-    // The vertex on the grid edge from point `p` to point `q` (`q` above `p` on every axis
-    // it differs in), made once, at the edge's midpoint for now: a triangle's orientation
-    // along a crossed edge is the same wherever its vertices lie inside their edges.
-    let mut vertex = |p: usize, q: usize, out: &mut ClosedMesh| -> Result<u32> {
-        let key = (p, q);
-        if let Some(&v) = edges.get(&key) {
-            return Ok(v);
-        }
-        let v = out.vertices.len();
-        if v >= u32::MAX as usize {
-            return Err(Error::Limit {
-                what: "cell",
-                counted: "vertices",
-                count: v + 1,
-                limit: u32::MAX as usize,
-                hint: CELL_HINT,
-            });
-        }
-        out.vertices.push(point(p).lerp(point(q), 0.5));
-        ends.push(key);
-        edges.insert(key, v as u32);
-        Ok(v as u32)
-    };
-    let inside = |p: usize| g[p] < 0.0;
+    let inside = |key: Key| value(key) < 0.0;
+    let mut tets = Vec::new();
     for k in 0..nz - 1 {
         for j in 0..ny - 1 {
             for i in 0..nx - 1 {
                 let base = index(i, j, k);
-                let corner = |c: u8| base + offset(c);
-                let first = inside(base);
+                if lattice.special(base) {
+                    tets.clear();
+                    lattice.tetrahedra(base, &mut tets);
+                    for &tet in &tets {
+                        walk.march(tet, &inside, &position, out)?;
+                    }
+                    continue;
+                }
+                let corner = |c: u8| grid_key(base + offset(c));
+                let first = inside(corner(0));
                 if (1..8u8).all(|c| inside(corner(c)) == first) {
                     continue;
                 }
                 for tet in KUHN {
-                    let pts = tet.map(corner);
-                    let ins: Vec<usize> = pts.iter().copied().filter(|&p| inside(p)).collect();
-                    let outs: Vec<usize> = pts.iter().copied().filter(|&p| !inside(p)).collect();
-                    // A grid edge by its ends, lower first.
-                    let edge = |a: usize, b: usize| if a < b { (a, b) } else { (b, a) };
-                    match ins.len() {
-                        1 | 3 => {
-                            // One apex apart from the three others.
-                            let (apex, rest, apex_in) = if ins.len() == 1 {
-                                (ins[0], [outs[0], outs[1], outs[2]], true)
-                            } else {
-                                (outs[0], [ins[0], ins[1], ins[2]], false)
-                            };
-                            let mut tri = [0u32; 3];
-                            for (slot, &r) in tri.iter_mut().zip(&rest) {
-                                let (p, q) = edge(apex, r);
-                                *slot = vertex(p, q, out)?;
-                            }
-                            // Outward: from the inside end of a crossed edge to its outside end.
-                            let (from, to) = if apex_in {
-                                (apex, rest[0])
-                            } else {
-                                (rest[0], apex)
-                            };
-                            push_oriented(out, tri, point(to) - point(from));
-                        }
-                        2 => {
-                            let (a, b, c, d) = (ins[0], ins[1], outs[0], outs[1]);
-                            let ac = {
-                                let (p, q) = edge(a, c);
-                                vertex(p, q, out)?
-                            };
-                            let ad = {
-                                let (p, q) = edge(a, d);
-                                vertex(p, q, out)?
-                            };
-                            let bd = {
-                                let (p, q) = edge(b, d);
-                                vertex(p, q, out)?
-                            };
-                            let bc = {
-                                let (p, q) = edge(b, c);
-                                vertex(p, q, out)?
-                            };
-                            // Both triangles hold the crossing of the edge a -> c.
-                            let outward = point(c) - point(a);
-                            let flip = orientation(out, [ac, ad, bd], outward);
-                            let (t0, t1) = ([ac, ad, bd], [ac, bd, bc]);
-                            if flip {
-                                out.triangles.push([t0[0], t0[2], t0[1]]);
-                                out.triangles.push([t1[0], t1[2], t1[1]]);
-                            } else {
-                                out.triangles.push(t0);
-                                out.triangles.push(t1);
-                            }
-                        }
-                        _ => {}
-                    }
+                    walk.march(tet.map(corner), &inside, &position, out)?;
                 }
             }
         }
     }
-    drop(edges);
+    let ends = walk.ends;
     // Every vertex moved onto the boundary along its edge, on every core: each is its own.
-    let mut near: Vec<[u32; 2]> = ends.iter().map(|&(p, q)| [arg[p], arg[q]]).collect();
+    let mut near: Vec<[u32; 2]> = ends.iter().map(|&(p, q)| [sample(p), sample(q)]).collect();
     let mut found = vec![0.0; ends.len()];
     let parts: Vec<_> = out
         .vertices
@@ -1941,7 +2161,7 @@ fn contour(
         .zip(found.chunks_mut(REFINE_CHUNK))
         .zip(ends.chunks(REFINE_CHUNK).zip(near.chunks(REFINE_CHUNK)))
         .collect();
-    span.part(0.0, walked).advance(1.0);
+    walk_span.advance(1.0);
     let vertices = span.part(walked, refined);
     in_parts(
         parts,
@@ -1952,8 +2172,8 @@ fn contour(
             for (((x, g_at), &(p, q)), &samples) in xs.iter_mut().zip(gs.iter_mut()).zip(es).zip(js)
             {
                 let edge = GridEdge {
-                    ends: [point(p), point(q)],
-                    values: [g[p] as f64, g[q] as f64],
+                    ends: [position(p), position(q)],
+                    values: [value(p) as f64, value(q) as f64],
                     samples,
                 };
                 (*x, *g_at) = edge.refined(refine, cell);

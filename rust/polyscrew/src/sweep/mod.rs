@@ -51,6 +51,7 @@
 //! Triangles whose area is below [`DEGENERATE_REL`] (points on the axis of a rotation, which
 //! do not move) are left out.
 
+mod adaptive;
 pub mod body;
 pub mod closed;
 mod crease;
