@@ -19,7 +19,7 @@ import polyscrew
 import pytest
 
 from pure_layer import module
-from test_sweep_closed import CASES, dense, is_closed_oriented, region_sd
+from test_sweep_closed import CASES, CUBE_T, CUBE_V, cube_sd, dense, is_closed_oriented, mesh_volume, region_sd
 
 sweep_report = module("sweep_report")  # the add-on's pure layer: no bpy
 
@@ -109,6 +109,45 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
     assert worst <= allowed
     with pytest.raises(TypeError, match="sweep_closed: decimate: expected a bool, got str"):
         polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, decimate="yes")
+
+
+def winding_numbers(v, t, points):
+    """The closed mesh's winding number about each point (Van Oosterom-Strackee solid angles)."""
+    out = []
+    for p in points:
+        a, b, c = (v[t[:, k]] - p for k in range(3))
+        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
+        num = np.einsum("ij,ij->i", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la
+               + np.einsum("ij,ij->i", c, a) * lb)
+        out.append(2 * np.arctan2(num, den).sum() / (4 * np.pi))
+    return np.array(out)
+
+
+def test_a_slab_of_outside_space_narrower_than_a_cell_stays_outside():
+    """A unit cube along x, up, over, down and back beside its first pass, 0.45 cells away: every
+    grid point around the slab between the passes is inside, so the grid alone fills it (the
+    world grid's planes across y fall outside it here). The cubes there are cut finer
+    (`refined_cubes`), and points on the slab's middle plane, outside the region by the exact
+    union, are outside the mesh; the volume is the union's, `10 + gap`, within a quarter of the
+    slab's `4 gap`."""
+    cell = 0.2
+    gap = 0.45 * cell
+    side = 1 + gap
+    moves = [(0, 0, 0), (2, 0, 0), (2, 0, 2), (2, side, 2), (2, side, 0), (0, side, 0)]
+    poses = np.array([np.eye(4)] * len(moves))
+    poses[:, :3, 3] = moves
+    cv, ct, info = polyscrew.sweep_closed(CUBE_V, CUBE_T, poses, cell=cell, info=True)
+    probes = np.array([(x, 1 + gap / 2, z) for x in (0.25, 1.0, 1.75) for z in (0.2, 0.5, 0.8)])
+    inv = np.linalg.inv(dense(poses, 64))
+    volume = mesh_volume(cv, ct)
+    print(f"\n{len(ct)} triangles, {info['refined_cubes']} refined cubes, volume {volume:.4f} "
+          f"(the union {10 + gap:.4f}, the slab filled {10 + 5 * gap:.4f})")
+    assert (region_sd(probes, inv, cube_sd) > 0.2 * gap).all()
+    assert info["refined_cubes"] > 0
+    assert is_closed_oriented(ct)
+    assert np.abs(winding_numbers(cv, ct, probes)).max() < 0.1
+    assert abs(volume - (10 + gap)) < gap
 
 
 def test_a_non_bool_info_is_refused_naming_the_function():
