@@ -177,7 +177,6 @@ impl Lattice {
     }
 
     /// How many cubes are refined, and how many are transition cubes.
-    #[cfg(test)]
     pub(super) fn counts(&self) -> (usize, usize) {
         (self.refined.len(), self.transition.len())
     }

@@ -54,7 +54,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::{DAffine3, DVec3};
 
 use super::adaptive::{
-    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, Key, Lattice, KUHN,
+    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, Key, Lattice, KUHN, SPLIT,
 };
 use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
@@ -1654,10 +1654,9 @@ impl Refiner<'_> {
     /// Whether a thin channel of outside space may pass through the grid cube centred at `x`
     /// (`reach` half its diagonal) whose corners' minima come from the samples `samples`: the
     /// body's surfaces through two of them more than [`CHANNEL_GAP`] apart face each other
-    /// there (their outward normals at `x` more than 120 degrees apart: [`FACING_COSINE`])
-    /// and, taken as the
-    /// planes at `x`, leave outside space within the cube; and no one of them holds the whole
-    /// cube inside.
+    /// there (their outward normals at `x` more than 120 degrees apart: [`FACING_COSINE`]) and,
+    /// taken as the planes at `x`, leave outside space within the cube; and no one of them holds
+    /// the whole cube inside.
     fn facing(&self, x: DVec3, reach: f64, mut samples: [u32; 8]) -> bool {
         samples.sort_unstable();
         // Each sample's outward normal and distance at `x`.
@@ -1854,11 +1853,11 @@ impl GridEdge {
 }
 
 /// The smallest gap, in samples of the motion, between the samples giving a cube's corners
-/// their minima for the cube to be refined ([`channel_cubes`]).
+/// their minima for the cube to be read finer (`adaptive.rs`'s `channel_cubes`).
 pub const CHANNEL_GAP: u32 = 16;
 
 /// The most the cosine between two sheets' outward normals may be for a cube between them to
-/// be read finer ([`Refiner::facing`]): more than 120 degrees apart. A slab of outside space
+/// be read finer (`Refiner::facing`): more than 120 degrees apart. A slab of outside space
 /// narrower than a cell lies between nearly opposed sheets; sheets less opposed meet in a
 /// wedge, whose tip the faces across the crease already cut (`crease.rs`).
 pub const FACING_COSINE: f64 = -0.5;
@@ -2036,6 +2035,82 @@ impl Walk {
     }
 }
 
+/// The lattice refining the grid cubes where a slab of outside space narrower than a cell
+/// hides (`adaptive.rs`), with the values at every point it adds: the cubes with every corner
+/// inside and far-apart samples ([`channel_cubes`]) whose sheets face each other
+/// ([`Refiner::facing`]) are read at their lattice points, and those where one is outside are
+/// refined (where none is, their subcubes would give no surface).
+fn channel_lattice(
+    (g, arg): (&[f32], &[u32]),
+    grid: Grid,
+    refine: &Refiner<'_>,
+    threads: usize,
+    span: Span<'_>,
+) -> Result<Lattice> {
+    let Grid { origin, cell, n } = grid;
+    let half = 0.5 * refine.spread;
+    let deep = (3f64.sqrt() * cell + half) as f32;
+    let offsets = corner_offsets(n);
+    let reach = 0.5 * 3f64.sqrt() * cell;
+    let candidates = channel_cubes(g, arg, n, deep, CHANNEL_GAP);
+    let mut facing = vec![false; candidates.len()];
+    let parts: Vec<_> = candidates
+        .chunks(REFINE_CHUNK)
+        .zip(facing.chunks_mut(REFINE_CHUNK))
+        .collect();
+    in_parts(
+        parts,
+        threads,
+        "the refined cubes",
+        span,
+        |(cubes, flags)| {
+            for (&c, flag) in cubes.iter().zip(flags) {
+                let centre = grid.point(c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1]));
+                *flag = refine.facing(
+                    centre + DVec3::splat(0.5 * cell),
+                    reach,
+                    offsets.map(|o| arg[c + o]),
+                );
+            }
+        },
+    )?;
+    let suspects: Vec<usize> = candidates
+        .iter()
+        .zip(&facing)
+        .filter_map(|(&c, &f)| f.then_some(c))
+        .collect();
+    // Each suspect adds at most `PER_CUBE_POINTS` points; a refined cube's neighbours add fewer.
+    Footprint::of::<LatticeEntry>(suspects.len().saturating_mul(3 * PER_CUBE_POINTS))
+        .check("the refined cubes' points", CLOSED_HINT)?;
+    let mut lattice = Lattice::new(origin, cell, n, &[]);
+    let mut points: Vec<Key> = suspects.iter().flat_map(|&c| cube_points(n, c)).collect();
+    points.sort_unstable();
+    points.dedup();
+    let values = lattice_values(&lattice, &points, (g, arg), refine, threads, span)?;
+    lattice.set_values(&points, &values);
+    let channels: Vec<usize> = suspects
+        .into_iter()
+        .filter(|&c| cube_points(n, c).any(|k| lattice.value(k).0 >= 0.0))
+        .collect();
+    let read = std::mem::replace(&mut lattice, Lattice::new(origin, cell, n, &channels));
+    let added: Vec<Key> = lattice
+        .added_points()
+        .into_iter()
+        .filter(|&k| !read.has_value(k))
+        .collect();
+    lattice.take_values(read);
+    let values = lattice_values(&lattice, &added, (g, arg), refine, threads, span)?;
+    lattice.set_values(&added, &values);
+    Ok(lattice)
+}
+
+/// What one added lattice point holds: its key, value and sample, and about as much again in
+/// the map's and the lists' overhead (for the memory check).
+type LatticeEntry = [u64; 4];
+
+/// The lattice points a suspect cube adds at most: `(SPLIT + 1)^3` less its corners.
+const PER_CUBE_POINTS: usize = (SPLIT + 1) * (SPLIT + 1) * (SPLIT + 1) - 8;
+
 /// Marching tetrahedra over the world grid (see the module documentation).
 fn contour(
     g: &[f32],
@@ -2058,58 +2133,11 @@ fn contour(
         let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
         origin + DVec3::new(i as f64, j as f64, k as f64) * cell
     };
-    // Cubes cut finer where a channel of outside space can hide (`adaptive.rs`), and the
-    // values at the lattice points they add.
+    // Cubes cut finer where a slab of outside space can hide (`adaptive.rs`), and the values
+    // at the lattice points they add.
     let walk_span = span.part(0.0, walked);
-    let half = 0.5 * refine.spread;
-    let deep = (3f64.sqrt() * cell + half) as f32;
-    let offsets = corner_offsets(n);
-    let reach = 0.5 * 3f64.sqrt() * cell;
-    let candidates = channel_cubes(g, arg, n, deep, CHANNEL_GAP);
-    let mut facing = vec![false; candidates.len()];
-    let parts: Vec<_> = candidates
-        .chunks(REFINE_CHUNK)
-        .zip(facing.chunks_mut(REFINE_CHUNK))
-        .collect();
-    in_parts(
-        parts,
-        threads,
-        "the refined cubes",
-        walk_span,
-        |(cubes, flags)| {
-            for (&c, flag) in cubes.iter().zip(flags) {
-                let centre = grid_position(c) + DVec3::splat(0.5 * cell);
-                *flag = refine.facing(centre, reach, offsets.map(|o| arg[c + o]));
-            }
-        },
-    )?;
-    let suspects: Vec<usize> = candidates
-        .iter()
-        .zip(&facing)
-        .filter_map(|(&c, &f)| f.then_some(c))
-        .collect();
-    // The suspects' lattice points, read; a suspect is refined only where one is outside
-    // (where none is, its subcubes would give no surface).
-    let mut lattice = Lattice::new(origin, cell, n, &[]);
-    let mut points: Vec<Key> = suspects.iter().flat_map(|&c| cube_points(n, c)).collect();
-    points.sort_unstable();
-    points.dedup();
-    let values = lattice_values(&lattice, &points, (g, arg), refine, threads, walk_span)?;
-    lattice.set_values(&points, &values);
-    let channels: Vec<usize> = suspects
-        .into_iter()
-        .filter(|&c| cube_points(n, c).any(|k| lattice.value(k).0 >= 0.0))
-        .collect();
-    out.refined_cubes = channels.len();
-    let read = std::mem::replace(&mut lattice, Lattice::new(origin, cell, n, &channels));
-    let added: Vec<Key> = lattice
-        .added_points()
-        .into_iter()
-        .filter(|&k| !read.has_value(k))
-        .collect();
-    lattice.take_values(read);
-    let values = lattice_values(&lattice, &added, (g, arg), refine, threads, walk_span)?;
-    lattice.set_values(&added, &values);
+    let lattice = channel_lattice((g, arg), grid, refine, threads, walk_span)?;
+    out.refined_cubes = lattice.counts().0;
     let position = |key: Key| match grid_point(key) {
         Some(p) => grid_position(p),
         None => lattice.point(key),
@@ -2151,7 +2179,8 @@ fn contour(
             }
         }
     }
-    let ends = walk.ends;
+    let Walk { edges, ends } = walk;
+    drop(edges);
     // Every vertex moved onto the boundary along its edge, on every core: each is its own.
     let mut near: Vec<[u32; 2]> = ends.iter().map(|&(p, q)| [sample(p), sample(q)]).collect();
     let mut found = vec![0.0; ends.len()];
