@@ -1,12 +1,14 @@
-//! Grid cubes cut finer where a thin channel of outside space can hide (issue 29;
-//! `docs/sweep.md`, "Thin channels of outside space").
+//! Grid cubes cut finer where the boundary has a feature narrower than a cell (issue 29;
+//! `docs/sweep.md`, "Slabs of outside space narrower than a cell").
 //!
 //! The contouring sees the region's sign at the grid's points only, so a slab of outside space
 //! narrower than a cell between two sheets of the boundary, with every grid point around it
-//! inside, is filled. Such a slab lies where two sheets of the motion meet: the grid points on
-//! either side of it take their minimum from poses far apart in the motion. The cubes where that
-//! happens near the boundary ([`channel_cubes`]) are cut into [`SPLIT`]`^3` subcubes, each into
-//! Kuhn's six tetrahedra, on a lattice [`SPLIT`] times finer than the grid.
+//! inside, is filled, and where such a slab opens to the outside the grid's surface passes over
+//! its mouth. Such slabs lie where two sheets of the motion meet: the grid points on either side
+//! take their minimum from poses far apart in the motion. The cubes where that happens near the
+//! boundary ([`channel_cubes`]) and the grid misses something (read on a lattice [`SPLIT`]
+//! times finer, by the caller) are cut into [`SPLIT`]`^3` subcubes, each into Kuhn's six
+//! tetrahedra.
 //!
 //! The tetrahedra stay conforming (every two that meet share a whole face, edge or corner), so
 //! marching tetrahedra still gives a closed, oriented, intersection-free surface:
@@ -63,11 +65,11 @@ pub(super) fn grid_point(key: Key) -> Option<usize> {
     (key % PER_CUBE == 0).then_some((key / PER_CUBE) as usize)
 }
 
-/// The cubes that may hide a channel: every corner inside (a channel with a corner outside is
-/// where the surface already passes) but none deeper than `deep` (no outside point can be in a
-/// cube with a corner deeper than its diagonal: the field is 1-Lipschitz), and their corners'
-/// minima from samples of the motion more than `gap` apart (two sheets meet there). `g` and
-/// `arg` are the grid's values and samples (`u32::MAX`: none), `n` its points per axis. Sorted.
+/// The cubes that may hide a feature of the boundary finer than a cell: none of their corners
+/// deeper than `deep` (no outside point can be in a cube with a corner deeper than its
+/// diagonal: the field is 1-Lipschitz), some inside, and their corners' minima from samples of
+/// the motion more than `gap` apart (two sheets meet there). `g` and `arg` are the grid's
+/// values and samples (`u32::MAX`: none), `n` its points per axis. Sorted.
 pub(super) fn channel_cubes(
     g: &[f32],
     arg: &[u32],
@@ -83,22 +85,50 @@ pub(super) fn channel_cubes(
             let row = (k * ny + j) * nx;
             'cube: for base in row..row + nx.saturating_sub(1) {
                 let (mut lo, mut hi) = (u32::MAX, 0u32);
+                let mut inside = false;
                 for &o in &offsets {
                     let v = g[base + o];
-                    if !(v < 0.0 && v >= -deep) {
+                    if v < -deep {
                         continue 'cube;
                     }
+                    inside |= v < 0.0;
                     let a = arg[base + o];
                     lo = lo.min(a);
                     hi = hi.max(a);
                 }
-                if hi != u32::MAX && hi - lo > gap {
+                if inside && hi != u32::MAX && hi - lo > gap {
                     found.push(base);
                 }
             }
         }
     }
     found
+}
+
+/// The value at `x` (in cells from a grid cube's lowest corner, each in `[0, 1]`) of the
+/// linear interpolation of the cube's corner values `corner` (by corner code) over the Kuhn
+/// tetrahedron holding `x`: the field the plain grid contours.
+pub(super) fn kuhn_value(corner: [f64; 8], x: [f64; 3]) -> f64 {
+    // The axes by decreasing coordinate: the tetrahedron 0, e_a, e_a + e_b, 7.
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| x[b].total_cmp(&x[a]));
+    let [a, b, c] = order;
+    let (ca, cb) = (1usize << a, (1usize << a) | (1usize << b));
+    (1.0 - x[a]) * corner[0]
+        + (x[a] - x[b]) * corner[ca]
+        + (x[b] - x[c]) * corner[cb]
+        + x[c] * corner[7]
+}
+
+/// The offset of lattice point `key` from grid cube `cube`'s lowest corner, in cells (both of
+/// a grid of `n` points per axis; `key` one of the cube's [`cube_points`]).
+pub(super) fn offset_in(n: [usize; 3], cube: usize, key: Key) -> [f64; 3] {
+    let c = [cube % n[0], (cube / n[0]) % n[1], cube / (n[0] * n[1])];
+    let k = (key / PER_CUBE) as usize;
+    let kc = [k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1])];
+    let o = (key % PER_CUBE) as usize;
+    let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
+    std::array::from_fn(|a| (kc[a] - c[a]) as f64 + off[a] as f64 / SPLIT as f64)
 }
 
 /// The index offsets of a grid cube's corners from its lowest, by corner code
@@ -410,6 +440,55 @@ impl Lattice {
 mod tests {
     use super::*;
     use std::collections::HashMap;
+
+    /// [`kuhn_value`] is the corner values at the corners and, inside each of Kuhn's
+    /// tetrahedra, the linear function through its four corners' values (barycentric
+    /// coordinates found by Cramer's rule).
+    #[test]
+    fn the_grids_linear_field_is_linear_on_each_kuhn_tetrahedron() {
+        let corner: [f64; 8] = std::array::from_fn(|c| ((c * 37 + 11) % 17) as f64 - 8.0);
+        let at = |c: u8| DVec3::new((c & 1) as f64, ((c >> 1) & 1) as f64, ((c >> 2) & 1) as f64);
+        for c in 0..8u8 {
+            assert_eq!(kuhn_value(corner, at(c).to_array()), corner[c as usize]);
+        }
+        let mut seed = 7u64;
+        let mut uniform = move || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..2000 {
+            let x = DVec3::new(uniform(), uniform(), uniform());
+            let tet = KUHN
+                .iter()
+                .find(|t| {
+                    let p = t.map(at);
+                    let whole = (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]);
+                    (0..4).all(|m| {
+                        let mut q = p;
+                        q[m] = x;
+                        (q[1] - q[0]).cross(q[2] - q[0]).dot(q[3] - q[0]) / whole >= -1e-12
+                    })
+                })
+                .unwrap();
+            let p = tet.map(at);
+            let whole = (p[1] - p[0]).cross(p[2] - p[0]).dot(p[3] - p[0]);
+            let expected: f64 = (0..4)
+                .map(|m| {
+                    let mut q = p;
+                    q[m] = x;
+                    let w = (q[1] - q[0]).cross(q[2] - q[0]).dot(q[3] - q[0]) / whole;
+                    w * corner[tet[m] as usize]
+                })
+                .sum();
+            let got = kuhn_value(corner, x.to_array());
+            assert!(
+                (got - expected).abs() < 1e-12,
+                "{x}: {got} against {expected}"
+            );
+        }
+    }
 
     /// Six times the signed volume of the tetrahedron `p`.
     fn det(p: [DVec3; 4]) -> f64 {

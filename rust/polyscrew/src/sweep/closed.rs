@@ -20,10 +20,11 @@
 //!    cube is cut into the six tetrahedra of Kuhn's triangulation (all sharing the main
 //!    diagonal, so neighbouring cubes agree on their faces) and each tetrahedron where `g`
 //!    changes sign gives one triangle or a quad (two triangles) with its vertices on the
-//!    tetrahedron's edges; grid cubes whose corners are all inside but where two sheets of the
-//!    boundary face each other are read on a lattice four times finer, and those where a
-//!    lattice point is outside (a slab of outside space narrower than a cell) are cut into
-//!    subcubes, their neighbours into tetrahedra that keep the whole conforming (`adaptive.rs`);
+//!    tetrahedron's edges; grid cubes where two sheets of the boundary face each other are read
+//!    on a lattice four times finer, and those where a lattice point shows what the grid misses
+//!    (outside where every corner is inside: a slab of outside space narrower than a cell; or a
+//!    quarter cell across the grid's linear field) are cut into subcubes, their neighbours into
+//!    tetrahedra that keep the whole conforming (`adaptive.rs`);
 //! 4. each vertex is moved along its edge to the zero of `g` refined between the samples of
 //!    the motion (the body at 8 poses per sample interval on each side of the sample that
 //!    gave the minimum at the edge's ends), kept strictly inside the edge: regula falsi on
@@ -54,7 +55,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::{DAffine3, DVec3};
 
 use super::adaptive::{
-    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, Key, Lattice, KUHN, SPLIT,
+    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, kuhn_value, offset_in, Key,
+    Lattice, KUHN, SPLIT,
 };
 use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
@@ -1651,7 +1653,7 @@ impl Refiner<'_> {
 }
 
 impl Refiner<'_> {
-    /// Whether a thin channel of outside space may pass through the grid cube centred at `x`
+    /// Whether a slab of outside space narrower than a cell may pass through the grid cube centred at `x`
     /// (`reach` half its diagonal) whose corners' minima come from the samples `samples`: the
     /// body's surfaces through two of them more than [`CHANNEL_GAP`] apart face each other
     /// there (their outward normals at `x` more than 120 degrees apart: [`FACING_COSINE`]) and,
@@ -1853,7 +1855,8 @@ impl GridEdge {
 }
 
 /// The smallest gap, in samples of the motion, between the samples giving a cube's corners
-/// their minima for the cube to be read finer (`adaptive.rs`'s `channel_cubes`).
+/// their minima for the cube to be read finer (`adaptive.rs`'s `channel_cubes`): two sheets
+/// of the boundary, from parts of the motion apart, meet there.
 pub const CHANNEL_GAP: u32 = 16;
 
 /// The most the cosine between two sheets' outward normals may be for a cube between them to
@@ -1861,6 +1864,12 @@ pub const CHANNEL_GAP: u32 = 16;
 /// narrower than a cell lies between nearly opposed sheets; sheets less opposed meet in a
 /// wedge, whose tip the faces across the crease already cut (`crease.rs`).
 pub const FACING_COSINE: f64 = -0.5;
+
+/// How far, in cells, a lattice point of a suspect cube with a corner outside must be on the
+/// other side of the grid's linear field for the cube to be refined: the plain grid's surface is
+/// then that far off the boundary there (a slab's mouth, a thin fin). Smaller margins refine the
+/// crease's own chords (on the cube at a 0.1 cell margin, 4 cubes; at this one, none).
+pub const FEATURE_MARGIN: f64 = 0.25;
 
 /// The value and sample at an added lattice point `key` (as the grid's: `f32`, negative
 /// inside). Each grid point's value plus the read's error plus its distance is at least the
@@ -2035,11 +2044,11 @@ impl Walk {
     }
 }
 
-/// The lattice refining the grid cubes where a slab of outside space narrower than a cell
-/// hides (`adaptive.rs`), with the values at every point it adds: the cubes with every corner
-/// inside and far-apart samples ([`channel_cubes`]) whose sheets face each other
-/// ([`Refiner::facing`]) are read at their lattice points, and those where one is outside are
-/// refined (where none is, their subcubes would give no surface).
+/// The lattice refining the grid cubes where the boundary has a feature narrower than a cell
+/// (`adaptive.rs`), with the values at every point it adds: the cubes with a corner inside,
+/// none deep, and far-apart samples ([`channel_cubes`]) whose sheets face each other
+/// ([`Refiner::facing`]) are read at their lattice points, and refined where one shows what the
+/// grid misses (where none does, their subcubes would give about the grid's own surface).
 fn channel_lattice(
     (g, arg): (&[f32], &[u32]),
     grid: Grid,
@@ -2088,9 +2097,23 @@ fn channel_lattice(
     points.dedup();
     let values = lattice_values(&lattice, &points, (g, arg), refine, threads, span)?;
     lattice.set_values(&points, &values);
+    // Refined where a lattice point shows what the grid misses: outside where every corner is
+    // inside (a slab), or on the other side of the grid's linear field by more than
+    // `FEATURE_MARGIN` cells.
+    let margin = FEATURE_MARGIN * cell;
     let channels: Vec<usize> = suspects
         .into_iter()
-        .filter(|&c| cube_points(n, c).any(|k| lattice.value(k).0 >= 0.0))
+        .filter(|&c| {
+            let corner = offsets.map(|o| f64::from(g[c + o]));
+            let inside = corner.iter().all(|&v| v < 0.0);
+            cube_points(n, c).any(|k| {
+                let v = f64::from(lattice.value(k).0);
+                let linear = kuhn_value(corner, offset_in(n, c, k));
+                (inside && v >= 0.0)
+                    || (linear < 0.0 && v >= margin)
+                    || (linear >= 0.0 && v < -margin)
+            })
+        })
         .collect();
     let read = std::mem::replace(&mut lattice, Lattice::new(origin, cell, n, &channels));
     let added: Vec<Key> = lattice
