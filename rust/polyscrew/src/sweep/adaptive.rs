@@ -123,12 +123,17 @@ pub(super) fn kuhn_value(corner: [f64; 8], x: [f64; 3]) -> f64 {
 /// The offset of lattice point `key` from grid cube `cube`'s lowest corner, in cells (both of
 /// a grid of `n` points per axis; `key` one of the cube's [`cube_points`]).
 pub(super) fn offset_in(n: [usize; 3], cube: usize, key: Key) -> [f64; 3] {
-    let c = [cube % n[0], (cube / n[0]) % n[1], cube / (n[0] * n[1])];
-    let k = (key / PER_CUBE) as usize;
-    let kc = [k % n[0], (k / n[0]) % n[1], k / (n[0] * n[1])];
+    let c = coords(n, cube);
+    let kc = coords(n, (key / PER_CUBE) as usize);
     let o = (key % PER_CUBE) as usize;
     let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
     std::array::from_fn(|a| (kc[a] - c[a]) as f64 + off[a] as f64 / SPLIT as f64)
+}
+
+/// The coordinates `(i, j, k)` of grid point `p` of a grid of `n` points per axis.
+#[inline]
+pub(super) fn coords(n: [usize; 3], p: usize) -> [usize; 3] {
+    [p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])]
 }
 
 /// The index offsets of a grid cube's corners from its lowest, by corner code
@@ -149,7 +154,7 @@ fn lattice_key(n: [usize; 3], l: [usize; 3]) -> Key {
 /// The lattice points of grid cube `cube` (by its lowest corner) and its faces, edges and
 /// corners, but for its corners (grid points), in a grid of `n` points per axis.
 pub(super) fn cube_points(n: [usize; 3], cube: usize) -> impl Iterator<Item = Key> {
-    let c = [cube % n[0], (cube / n[0]) % n[1], cube / (n[0] * n[1])].map(|x| x * SPLIT);
+    let c = coords(n, cube).map(|x| x * SPLIT);
     let m = SPLIT + 1;
     (0..m * m * m).filter_map(move |s| {
         let l = [c[0] + s % m, c[1] + (s / m) % m, c[2] + s / (m * m)];
@@ -176,7 +181,7 @@ impl Lattice {
         let refined: HashSet<usize> = refined.iter().copied().collect();
         let mut transition = HashSet::new();
         for &c in &refined {
-            let at = Self::coords(n, c);
+            let at = coords(n, c);
             for d in 0..27usize {
                 let step = [d % 3, (d / 3) % 3, d / 9].map(|s| s as isize - 1);
                 let moved = step.iter().filter(|&&s| s != 0).count();
@@ -218,17 +223,13 @@ impl Lattice {
         !self.refined.is_empty() && (self.refined.contains(&c) || self.transition.contains(&c))
     }
 
-    fn coords(n: [usize; 3], p: usize) -> [usize; 3] {
-        [p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])]
-    }
-
     fn key(&self, l: [usize; 3]) -> Key {
         lattice_key(self.n, l)
     }
 
     /// The lattice coordinates of `key`.
     fn lattice(&self, key: Key) -> [usize; 3] {
-        let cube = Self::coords(self.n, (key / PER_CUBE) as usize);
+        let cube = coords(self.n, (key / PER_CUBE) as usize);
         let o = (key % PER_CUBE) as usize;
         let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
         std::array::from_fn(|a| cube[a] * SPLIT + off[a])
@@ -363,7 +364,7 @@ impl Lattice {
     /// The tetrahedra of a refined or transition cube `cube` (by its lowest corner), as
     /// lattice keys, appended to `out`.
     pub(super) fn tetrahedra(&self, cube: usize, out: &mut Vec<[Key; 4]>) {
-        let c = Self::coords(self.n, cube);
+        let c = coords(self.n, cube);
         let l0 = c.map(|x| x * SPLIT);
         if self.refined.contains(&cube) {
             for sub in 0..SPLIT * SPLIT * SPLIT {

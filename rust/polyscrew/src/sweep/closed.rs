@@ -55,8 +55,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use glam::{DAffine3, DVec3};
 
 use super::adaptive::{
-    channel_cubes, corner_offsets, cube_points, grid_key, grid_point, kuhn_value, offset_in, Key,
-    Lattice, KUHN, SPLIT,
+    channel_cubes, coords, corner_offsets, cube_points, grid_key, grid_point, kuhn_value,
+    offset_in, Key, Lattice, KUHN, SPLIT,
 };
 use super::exact::{closest_on_triangle, ExactField};
 use super::{axis_distance, Body};
@@ -2074,7 +2074,8 @@ fn channel_lattice(
         span,
         |(cubes, flags)| {
             for (&c, flag) in cubes.iter().zip(flags) {
-                let centre = grid.point(c % n[0], (c / n[0]) % n[1], c / (n[0] * n[1]));
+                let [i, j, k] = coords(n, c);
+                let centre = grid.point(i, j, k);
                 *flag = refine.facing(
                     centre + DVec3::splat(0.5 * cell),
                     reach,
@@ -2149,12 +2150,12 @@ fn contour(
     } else {
         CONTOUR_STAGE_ENDS
     };
-    let Grid { origin, cell, n } = grid;
+    let Grid { cell, n, .. } = grid;
     let [nx, ny, nz] = n;
     let index = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
     let grid_position = |p: usize| {
-        let (i, j, k) = (p % nx, (p / nx) % ny, p / (nx * ny));
-        origin + DVec3::new(i as f64, j as f64, k as f64) * cell
+        let [i, j, k] = coords(n, p);
+        grid.point(i, j, k)
     };
     // Cubes cut finer where a slab of outside space can hide (`adaptive.rs`), and the values
     // at the lattice points they add.
@@ -2174,9 +2175,7 @@ fn contour(
         None => lattice.value(key).1,
     };
     let mut walk = Walk::default();
-    let offset = |code: u8| {
-        (code & 1) as usize + ((code >> 1) & 1) as usize * nx + ((code >> 2) & 1) as usize * nx * ny
-    };
+    let offsets = corner_offsets(n);
     let inside = |key: Key| value(key) < 0.0;
     let mut tets = Vec::new();
     for k in 0..nz - 1 {
@@ -2191,7 +2190,7 @@ fn contour(
                     }
                     continue;
                 }
-                let corner = |c: u8| grid_key(base + offset(c));
+                let corner = |c: u8| grid_key(base + offsets[c as usize]);
                 let first = inside(corner(0));
                 if (1..8u8).all(|c| inside(corner(c)) == first) {
                     continue;
