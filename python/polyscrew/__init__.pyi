@@ -623,8 +623,8 @@ def sweep_closed(
     boundary: the distance left at a vertex plus the body grid's interpolation bound; at most
     ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 or 2),
     ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
-    because they hid a slab of outside space narrower than a cell between two sheets of the
-    boundary, which the grid's points alone would have filled).
+    because the boundary has a feature narrower than a cell there, such as a slab of outside
+    space between two sheets, which the grid's points alone would have filled).
 
     Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
     or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's

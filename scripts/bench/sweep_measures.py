@@ -1,7 +1,7 @@
 """Measures of a swept region's mesh, shared by scripts/bench/bench_sweep_cases.py and by
 scripts/bench/bench_sweep_peers.py, tested in tests/python/test_sweep_measures.py (numpy and scipy
-only): surface samples, the directed Hausdorff distances between two point sets, degenerate and
-self-intersecting faces, and the reference
+only): surface samples, winding numbers, the directed Hausdorff distances between two point sets,
+degenerate and self-intersecting faces, and the reference
 surface of a region (marching cubes of the minimum over dense poses of the body's signed
 distance, evaluated only near the boundary)."""
 
@@ -29,6 +29,24 @@ def sample_surface(v: np.ndarray, t: np.ndarray, spacing: float, seed: int = 0, 
     pts = a[idx] + r1[:, None] * (b[idx] - a[idx]) + r2[:, None] * (c[idx] - a[idx])
     out = np.concatenate([(a + b + c) / 3, pts])
     return (out, np.concatenate([np.arange(len(t)), idx])) if faces else out
+
+
+def winding_numbers(v: np.ndarray, t: np.ndarray, points: np.ndarray, chunk: int = 1 << 20) -> np.ndarray:
+    """The closed mesh `(v, t)`'s winding number about each of `points`: its triangles' solid
+    angles seen from the point (Van Oosterom and Strackee), summed, over 4 pi; about `chunk`
+    point-triangle pairs at a time."""
+    points = np.asarray(points, float)
+    out = np.empty(len(points))
+    step = max(1, chunk // max(1, len(t)))
+    for lo in range(0, len(points), step):
+        p = points[lo:lo + step, None, :]
+        a, b, c = (v[t[:, k]][None] - p for k in range(3))
+        la, lb, lc = (np.linalg.norm(x, axis=2) for x in (a, b, c))
+        num = np.einsum("pij,pij->pi", a, np.cross(b, c))
+        den = (la * lb * lc + np.einsum("pij,pij->pi", a, b) * lc + np.einsum("pij,pij->pi", b, c) * la
+               + np.einsum("pij,pij->pi", c, a) * lb)
+        out[lo:lo + step] = 2 * np.arctan2(num, den).sum(axis=1) / (4 * np.pi)
+    return out
 
 
 def point_triangle_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray, c: np.ndarray) -> np.ndarray:

@@ -19,9 +19,11 @@ import polyscrew
 import pytest
 
 from pure_layer import module
+from test_bench_tools import load
 from test_sweep_closed import CASES, CUBE_T, CUBE_V, cube_sd, dense, is_closed_oriented, mesh_volume, region_sd
 
 sweep_report = module("sweep_report")  # the add-on's pure layer: no bpy
+sm = load("sweep_measures")
 
 #: The tests' tolerance: 1 % of the body's extent (the default, 0.5 %, takes 5 to 10 times as
 #: long; the Blender operator's test runs it on a short motion).
@@ -111,19 +113,6 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
         polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, decimate="yes")
 
 
-def winding_numbers(v, t, points):
-    """The closed mesh's winding number about each point (Van Oosterom-Strackee solid angles)."""
-    out = []
-    for p in points:
-        a, b, c = (v[t[:, k]] - p for k in range(3))
-        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (a, b, c))
-        num = np.einsum("ij,ij->i", a, np.cross(b, c))
-        den = (la * lb * lc + np.einsum("ij,ij->i", a, b) * lc + np.einsum("ij,ij->i", b, c) * la
-               + np.einsum("ij,ij->i", c, a) * lb)
-        out.append(2 * np.arctan2(num, den).sum() / (4 * np.pi))
-    return np.array(out)
-
-
 def test_a_slab_of_outside_space_narrower_than_a_cell_stays_outside():
     """A unit cube along x, up, over, down and back beside its first pass, 0.45 cells away: every
     grid point around the slab between the passes is inside, so the grid alone fills it (the
@@ -146,7 +135,7 @@ def test_a_slab_of_outside_space_narrower_than_a_cell_stays_outside():
     assert (region_sd(probes, inv, cube_sd) > 0.2 * gap).all()
     assert info["refined_cubes"] > 0
     assert is_closed_oriented(ct)
-    assert np.abs(winding_numbers(cv, ct, probes)).max() < 0.1
+    assert np.abs(sm.winding_numbers(cv, ct, probes)).max() < 0.1
     assert abs(volume - (10 + gap)) < gap
 
 

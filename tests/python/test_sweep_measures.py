@@ -235,16 +235,9 @@ def test_the_bench_scripts_share_one_definition_of_the_cases():
 def brute_sd(points, v, t):
     """Signed distance to a closed mesh from every triangle, signed by the winding number."""
     d = np.full(len(points), np.inf)
-    solid = np.zeros(len(points))
     for a, b, c in v[t]:
         d = np.minimum(d, sm.point_triangle_distance(points, *(np.broadcast_to(x, points.shape) for x in (a, b, c))))
-        ra, rb, rc = a - points, b - points, c - points
-        la, lb, lc = (np.linalg.norm(x, axis=1) for x in (ra, rb, rc))
-        num = np.einsum("ij,ij->i", ra, np.cross(rb, rc))
-        den = (la * lb * lc + np.einsum("ij,ij->i", ra, rb) * lc + np.einsum("ij,ij->i", rb, rc) * la
-               + np.einsum("ij,ij->i", rc, ra) * lb)
-        solid += 2 * np.arctan2(num, den)
-    return np.where(solid / (4 * np.pi) > 0.5, -d, d)
+    return np.where(sm.winding_numbers(v, t, points) > 0.5, -d, d)
 
 
 def torus_points(rng, count, offsets):

@@ -124,16 +124,20 @@ pub(super) fn kuhn_value(corner: [f64; 8], x: [f64; 3]) -> f64 {
 /// a grid of `n` points per axis; `key` one of the cube's [`cube_points`]).
 pub(super) fn offset_in(n: [usize; 3], cube: usize, key: Key) -> [f64; 3] {
     let c = coords(n, cube);
-    let kc = coords(n, (key / PER_CUBE) as usize);
-    let o = (key % PER_CUBE) as usize;
-    let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
-    std::array::from_fn(|a| (kc[a] - c[a]) as f64 + off[a] as f64 / SPLIT as f64)
+    let l = lattice_coords(n, key);
+    std::array::from_fn(|a| (l[a] - c[a] * SPLIT) as f64 / SPLIT as f64)
 }
 
 /// The coordinates `(i, j, k)` of grid point `p` of a grid of `n` points per axis.
 #[inline]
 pub(super) fn coords(n: [usize; 3], p: usize) -> [usize; 3] {
     [p % n[0], (p / n[0]) % n[1], p / (n[0] * n[1])]
+}
+
+/// The index of grid point `(i, j, k)` of a grid of `n` points per axis (`coords`' inverse).
+#[inline]
+fn index(n: [usize; 3], [i, j, k]: [usize; 3]) -> usize {
+    (k * n[1] + j) * n[0] + i
 }
 
 /// The index offsets of a grid cube's corners from its lowest, by corner code
@@ -145,10 +149,17 @@ pub(super) fn corner_offsets(n: [usize; 3]) -> [usize; 8] {
 /// The key of the lattice point at lattice coordinates `l` (`SPLIT` per cell) of a grid of
 /// `n` points per axis.
 fn lattice_key(n: [usize; 3], l: [usize; 3]) -> Key {
-    let [x, y, z] = l.map(|v| v / SPLIT);
     let [a, b, c] = l.map(|v| v % SPLIT);
-    let cube = (z * n[1] + y) * n[0] + x;
-    cube as u64 * PER_CUBE + ((c * SPLIT + b) * SPLIT + a) as u64
+    index(n, l.map(|v| v / SPLIT)) as u64 * PER_CUBE + ((c * SPLIT + b) * SPLIT + a) as u64
+}
+
+/// The lattice coordinates of `key` in a grid of `n` points per axis ([`lattice_key`]'s
+/// inverse).
+fn lattice_coords(n: [usize; 3], key: Key) -> [usize; 3] {
+    let cube = coords(n, (key / PER_CUBE) as usize);
+    let o = (key % PER_CUBE) as usize;
+    let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
+    std::array::from_fn(|a| cube[a] * SPLIT + off[a])
 }
 
 /// The lattice points of grid cube `cube` (by its lowest corner) and its faces, edges and
@@ -175,12 +186,26 @@ pub(super) struct Lattice {
 }
 
 impl Lattice {
-    /// The lattice over the grid (`origin`, `cell`, `n` points per axis) refining the cubes
-    /// `refined` (by their lowest corners).
-    pub(super) fn new(origin: DVec3, cell: f64, n: [usize; 3], refined: &[usize]) -> Self {
-        let refined: HashSet<usize> = refined.iter().copied().collect();
+    /// The lattice over the grid (`origin`, `cell`, `n` points per axis), no cube refined yet.
+    pub(super) fn new(origin: DVec3, cell: f64, n: [usize; 3]) -> Self {
+        Self {
+            origin,
+            cell,
+            n,
+            refined: HashSet::new(),
+            transition: HashSet::new(),
+            values: HashMap::new(),
+        }
+    }
+
+    /// Refines the cubes `cubes` (by their lowest corners), and makes their neighbours
+    /// sharing a face or an edge transition cubes.
+    pub(super) fn refine(&mut self, cubes: &[usize]) {
+        let n = self.n;
+        self.refined.extend(cubes);
+        let refined = &self.refined;
         let mut transition = HashSet::new();
-        for &c in &refined {
+        for &c in refined {
             let at = coords(n, c);
             for d in 0..27usize {
                 let step = [d % 3, (d / 3) % 3, d / 9].map(|s| s as isize - 1);
@@ -195,20 +220,13 @@ impl Lattice {
                     valid &= x >= 0 && (x as usize) + 1 < n[a];
                     there[a] = x.max(0) as usize;
                 }
-                let cube = (there[2] * n[1] + there[1]) * n[0] + there[0];
+                let cube = index(n, there);
                 if valid && !refined.contains(&cube) {
                     transition.insert(cube);
                 }
             }
         }
-        Self {
-            origin,
-            cell,
-            n,
-            refined,
-            transition,
-            values: HashMap::new(),
-        }
+        self.transition = transition;
     }
 
     /// How many cubes are refined, and how many are transition cubes.
@@ -227,17 +245,9 @@ impl Lattice {
         lattice_key(self.n, l)
     }
 
-    /// The lattice coordinates of `key`.
-    fn lattice(&self, key: Key) -> [usize; 3] {
-        let cube = coords(self.n, (key / PER_CUBE) as usize);
-        let o = (key % PER_CUBE) as usize;
-        let off = [o % SPLIT, (o / SPLIT) % SPLIT, o / (SPLIT * SPLIT)];
-        std::array::from_fn(|a| cube[a] * SPLIT + off[a])
-    }
-
     /// The position of `key` (a grid point's is the grid's own: `origin + (i, j, k) cell`).
     pub(super) fn point(&self, key: Key) -> DVec3 {
-        let l = self.lattice(key);
+        let l = lattice_coords(self.n, key);
         let at = l.map(|v| (v / SPLIT) as f64 + (v % SPLIT) as f64 / SPLIT as f64);
         self.origin + DVec3::new(at[0], at[1], at[2]) * self.cell
     }
@@ -245,13 +255,12 @@ impl Lattice {
     /// The grid points of the cube holding `key` (its last layer's: the cube before it),
     /// by their indices.
     pub(super) fn corners(&self, key: Key) -> [usize; 8] {
-        let l = self.lattice(key);
-        let base = l.map(|v| v / SPLIT);
-        let b: [usize; 3] = std::array::from_fn(|a| base[a].min(self.n[a] - 2));
-        std::array::from_fn(|c| {
-            let (x, y, z) = (b[0] + (c & 1), b[1] + ((c >> 1) & 1), b[2] + ((c >> 2) & 1));
-            (z * self.n[1] + y) * self.n[0] + x
-        })
+        let l = lattice_coords(self.n, key);
+        let base = index(
+            self.n,
+            std::array::from_fn(|a| (l[a] / SPLIT).min(self.n[a] - 2)),
+        );
+        corner_offsets(self.n).map(|o| base + o)
     }
 
     /// Whether the grid edge from grid point `at` along `axis` is split: an edge of a refined
@@ -269,11 +278,7 @@ impl Lattice {
             let mut c = at;
             c[u] -= du;
             c[v] -= dv;
-            c[u] + 1 < self.n[u]
-                && c[v] + 1 < self.n[v]
-                && self
-                    .refined
-                    .contains(&((c[2] * self.n[1] + c[1]) * self.n[0] + c[0]))
+            c[u] + 1 < self.n[u] && c[v] + 1 < self.n[v] && self.refined.contains(&index(self.n, c))
         })
     }
 
@@ -287,16 +292,18 @@ impl Lattice {
         } else {
             (0, 1)
         };
-        let mut other = c;
         let across = c[axis] + side;
-        let fine = self.refined.contains(&self.index(c))
-            || (side == 1 && across + 1 < self.n[axis] && {
-                other[axis] = across;
-                self.refined.contains(&self.index(other))
-            })
-            || (side == 0 && c[axis] > 0 && {
-                other[axis] = c[axis] - 1;
-                self.refined.contains(&self.index(other))
+        // The cube on the face's other side, if the grid has one.
+        let beyond = if side == 1 {
+            (across + 1 < self.n[axis]).then_some(across)
+        } else {
+            c[axis].checked_sub(1)
+        };
+        let fine = self.refined.contains(&index(self.n, c))
+            || beyond.is_some_and(|x| {
+                let mut other = c;
+                other[axis] = x;
+                self.refined.contains(&index(self.n, other))
             });
         let at = |a: usize, b: usize| {
             let mut l = c.map(|x| x * SPLIT);
@@ -357,10 +364,6 @@ impl Lattice {
         }
     }
 
-    fn index(&self, c: [usize; 3]) -> usize {
-        (c[2] * self.n[1] + c[1]) * self.n[0] + c[0]
-    }
-
     /// The tetrahedra of a refined or transition cube `cube` (by its lowest corner), as
     /// lattice keys, appended to `out`.
     pub(super) fn tetrahedra(&self, cube: usize, out: &mut Vec<[Key; 4]>) {
@@ -418,11 +421,6 @@ impl Lattice {
     pub(super) fn set_values(&mut self, keys: &[Key], values: &[(f32, u32)]) {
         self.values
             .extend(keys.iter().copied().zip(values.iter().copied()));
-    }
-
-    /// Takes the values `other` holds.
-    pub(super) fn take_values(&mut self, other: Lattice) {
-        self.values.extend(other.values);
     }
 
     /// Whether the added point `key` has its value already.
@@ -499,7 +497,8 @@ mod tests {
     /// Every cube's tetrahedra (Kuhn's six for a plain cube, [`Lattice::tetrahedra`] for the
     /// others) over a grid of `n` points with the cubes `refined` cut finer.
     fn all_tetrahedra(n: [usize; 3], refined: &[usize]) -> (Lattice, Vec<[Key; 4]>) {
-        let lattice = Lattice::new(DVec3::new(0.25, -1.0, 0.5), 0.5, n, refined);
+        let mut lattice = Lattice::new(DVec3::new(0.25, -1.0, 0.5), 0.5, n);
+        lattice.refine(refined);
         let offsets = corner_offsets(n);
         let mut tets = Vec::new();
         for k in 0..n[2] - 1 {

@@ -251,8 +251,9 @@ pub struct ClosedMesh {
     pub attempts: usize,
     /// Dense poses sampled.
     pub poses: usize,
-    /// Grid cubes cut finer because outside space narrower than a cell was found in them
-    /// (`adaptive.rs`).
+    /// Grid cubes cut finer because a feature of the boundary narrower than a cell was found
+    /// in them: outside space among inside corners, or a quarter cell across the grid's linear
+    /// field (`adaptive.rs`).
     pub refined_cubes: usize,
 }
 
@@ -2075,12 +2076,8 @@ fn channel_lattice(
         |(cubes, flags)| {
             for (&c, flag) in cubes.iter().zip(flags) {
                 let [i, j, k] = coords(n, c);
-                let centre = grid.point(i, j, k);
-                *flag = refine.facing(
-                    centre + DVec3::splat(0.5 * cell),
-                    reach,
-                    offsets.map(|o| arg[c + o]),
-                );
+                let centre = grid.point(i, j, k) + DVec3::splat(0.5 * cell);
+                *flag = refine.facing(centre, reach, offsets.map(|o| arg[c + o]));
             }
         },
     )?;
@@ -2092,7 +2089,7 @@ fn channel_lattice(
     // Each suspect adds at most `PER_CUBE_POINTS` points; a refined cube's neighbours add fewer.
     Footprint::of::<LatticeEntry>(suspects.len().saturating_mul(3 * PER_CUBE_POINTS))
         .check("the refined cubes' points", CLOSED_HINT)?;
-    let mut lattice = Lattice::new(origin, cell, n, &[]);
+    let mut lattice = Lattice::new(origin, cell, n);
     let mut points: Vec<Key> = suspects.iter().flat_map(|&c| cube_points(n, c)).collect();
     points.sort_unstable();
     points.dedup();
@@ -2116,13 +2113,12 @@ fn channel_lattice(
             })
         })
         .collect();
-    let read = std::mem::replace(&mut lattice, Lattice::new(origin, cell, n, &channels));
+    lattice.refine(&channels);
     let added: Vec<Key> = lattice
         .added_points()
         .into_iter()
-        .filter(|&k| !read.has_value(k))
+        .filter(|&k| !lattice.has_value(k))
         .collect();
-    lattice.take_values(read);
     let values = lattice_values(&lattice, &added, (g, arg), refine, threads, span)?;
     lattice.set_values(&added, &values);
     Ok(lattice)

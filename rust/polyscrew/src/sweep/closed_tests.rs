@@ -19,23 +19,33 @@ use super::*;
 /// Signed distance from `p` to a closed body (negative inside: winding number above 1/2).
 fn sd_mesh(body: &Body, p: DVec3) -> f64 {
     let v = body.vertices();
-    let mut d = f64::INFINITY;
+    let d = body
+        .triangles()
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            point_triangle_distance(p, a, b, c)
+        })
+        .fold(f64::INFINITY, f64::min);
+    if winding(v, body.triangles(), p) > 0.5 {
+        -d
+    } else {
+        d
+    }
+}
+
+/// The winding number of the closed mesh `(v, t)` about `p`: its triangles' solid angles seen
+/// from `p` (Van Oosterom and Strackee), summed, over 4 pi.
+fn winding(v: &[DVec3], t: &[[u32; 3]], p: DVec3) -> f64 {
     let mut solid = 0.0;
-    for t in body.triangles() {
-        let [a, b, c] = t.map(|i| v[i as usize]);
-        d = d.min(point_triangle_distance(p, a, b, c));
-        // Van Oosterom-Strackee: the solid angle of the triangle seen from p.
-        let (ra, rb, rc) = (a - p, b - p, c - p);
+    for tri in t {
+        let [ra, rb, rc] = tri.map(|i| v[i as usize] - p);
         let (la, lb, lc) = (ra.length(), rb.length(), rc.length());
         let num = ra.dot(rb.cross(rc));
         let den = la * lb * lc + ra.dot(rb) * lc + rb.dot(rc) * la + rc.dot(ra) * lb;
         solid += 2.0 * num.atan2(den);
     }
-    if solid / (4.0 * PI) > 0.5 {
-        -d
-    } else {
-        d
-    }
+    solid / (4.0 * PI)
 }
 
 /// Every directed edge once and its reverse once: closed and consistently oriented.
@@ -733,19 +743,6 @@ fn the_exact_distance_equals_the_winding_number_reference() {
         }
         assert!(near > 2000, "{name}: {near} points within reach");
     }
-}
-
-/// The winding number of the closed mesh `(v, t)` about `p` (Van Oosterom-Strackee).
-fn winding(v: &[DVec3], t: &[[u32; 3]], p: DVec3) -> f64 {
-    let mut solid = 0.0;
-    for tri in t {
-        let [ra, rb, rc] = tri.map(|i| v[i as usize] - p);
-        let (la, lb, lc) = (ra.length(), rb.length(), rc.length());
-        let num = ra.dot(rb.cross(rc));
-        let den = la * lb * lc + ra.dot(rb) * lc + rb.dot(rc) * la + rc.dot(ra) * lb;
-        solid += 2.0 * num.atan2(den);
-    }
-    solid / (4.0 * PI)
 }
 
 /// A unit cube passes along x, climbs, crosses over and comes back down and along beside its
