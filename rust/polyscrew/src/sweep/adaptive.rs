@@ -26,7 +26,7 @@
 //! split edge cuts it at the same points, so neighbours agree. With no cube refined nothing
 //! changes: the plain cubes are the grid's own.
 
-use std::collections::{HashMap, HashSet};
+use super::hash::{FastMap, FastSet};
 
 use glam::DVec3;
 
@@ -179,10 +179,10 @@ pub(super) struct Lattice {
     origin: DVec3,
     cell: f64,
     n: [usize; 3],
-    refined: HashSet<usize>,
-    transition: HashSet<usize>,
+    refined: FastSet<usize>,
+    transition: FastSet<usize>,
     /// The added points' values and samples (as the grid's: `f32`, negative inside).
-    values: HashMap<Key, (f32, u32)>,
+    values: FastMap<Key, (f32, u32)>,
 }
 
 impl Lattice {
@@ -192,9 +192,9 @@ impl Lattice {
             origin,
             cell,
             n,
-            refined: HashSet::new(),
-            transition: HashSet::new(),
-            values: HashMap::new(),
+            refined: FastSet::default(),
+            transition: FastSet::default(),
+            values: FastMap::default(),
         }
     }
 
@@ -204,7 +204,7 @@ impl Lattice {
         let n = self.n;
         self.refined.extend(cubes);
         let refined = &self.refined;
-        let mut transition = HashSet::new();
+        let mut transition = FastSet::default();
         for &c in refined {
             let at = coords(n, c);
             for d in 0..27usize {
@@ -406,7 +406,7 @@ impl Lattice {
             .collect();
         cubes.sort_unstable();
         let mut tets = Vec::new();
-        let mut keys = HashSet::new();
+        let mut keys = FastSet::default();
         for c in cubes {
             tets.clear();
             self.tetrahedra(c, &mut tets);
@@ -438,7 +438,7 @@ impl Lattice {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::collections::HashMap;
+    use std::collections::{HashMap, HashSet};
 
     /// [`kuhn_value`] is the corner values at the corners and, inside each of Kuhn's
     /// tetrahedra, the linear function through its four corners' values (barycentric

@@ -49,10 +49,11 @@
 //! and the orientation is taken from which end of a crossed edge is inside. The outer layer
 //! of the grid is outside every instance, so the surface has no border.
 
-use std::collections::HashMap;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{DAffine3, DVec3};
+
+use super::hash::FastMap;
 
 use super::adaptive::{
     channel_cubes, coords, corner_offsets, cube_points, grid_key, grid_point, kuhn_value,
@@ -223,9 +224,10 @@ pub struct ClosedOptions {
     /// [`std::thread::available_parallelism`]; at most [`MAX_THREADS`]. The mesh is the same,
     /// bit for bit, whatever the count.
     pub threads: usize,
-    /// Fewer triangles: vertices removed where the boundary is flat, by half-edge collapses
-    /// that keep every new edge's midpoint within [`DECIMATE_TARGET`] cells of the boundary
-    /// (`decimate.rs`: the new faces then within about twice that, plus the vertices' bound).
+    /// Fewer triangles: vertices removed where the boundary is flat and along its creases, by
+    /// half-edge collapses that keep every new edge's midpoint within [`DECIMATE_TARGET`] cells
+    /// of the boundary (`decimate.rs`: the new faces then within about twice that, plus the
+    /// vertices' bound).
     /// The vertices left are some of those without it, bit for bit, so `error_bound` holds for
     /// them; it takes longer (about twice as long at the defaults).
     pub decimate: bool,
@@ -1944,7 +1946,7 @@ fn lattice_values(
 /// Marching tetrahedra's state: the vertex on each crossed tetrahedron edge, made once.
 #[derive(Default)]
 struct Walk {
-    edges: HashMap<(Key, Key), u32>,
+    edges: FastMap<(Key, Key), u32>,
     /// Each vertex's edge (its ends, lower first), refined once the mesh is walked.
     ends: Vec<(Key, Key)>,
 }

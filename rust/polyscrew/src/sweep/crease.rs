@@ -16,7 +16,7 @@
 //! midpoint is nearer the boundary, under the same checks: where neighbours split in earlier
 //! rounds block the move, the flip mostly lines the edge up with the crease.
 
-use std::collections::HashMap;
+use super::hash::FastMap;
 
 use glam::DVec3;
 
@@ -39,7 +39,7 @@ pub const TOUCH: f64 = 0.04;
 const ROUNDING_SLACK: f64 = 1e-6;
 
 /// An edge's two triangles (by index), the edge by its vertices, lower first.
-type Edges = HashMap<(u32, u32), [u32; 2]>;
+type Edges = FastMap<(u32, u32), [u32; 2]>;
 
 pub(super) fn key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
@@ -89,7 +89,8 @@ pub fn split_creases(
     field: &(dyn Fn(DVec3, [u32; 2]) -> f64 + Sync),
     onto: &(dyn Fn(DVec3, DVec3, f64, [u32; 2]) -> Option<(DVec3, f64)> + Sync),
 ) -> f64 {
-    let mut edges: Edges = HashMap::with_capacity(triangles.len() * 3 / 2);
+    let mut edges: Edges =
+        FastMap::with_capacity_and_hasher(triangles.len() * 3 / 2, Default::default());
     for (i, t) in triangles.iter().enumerate() {
         for e in 0..3 {
             let slot = edges
@@ -122,7 +123,7 @@ pub fn split_creases(
     let mut buckets = Buckets::new(vertices, triangles);
     let mut residual: f64 = 0.0;
     // Midpoint values read so far, by edge.
-    let mut known: HashMap<(u32, u32), f64> = HashMap::new();
+    let mut known: FastMap<(u32, u32), f64> = FastMap::default();
     for round in 0..CREASE_ROUNDS {
         if span.is_cancelled() {
             break;
@@ -183,7 +184,7 @@ pub fn split_creases(
             let moved = (dir != DVec3::ZERO).then(|| onto(mid, dir, g, near[a as usize]));
             ((a, b), moved.flatten())
         };
-        let ahead: HashMap<(u32, u32), Option<(DVec3, f64)>> =
+        let ahead: FastMap<(u32, u32), Option<(DVec3, f64)>> =
             in_chunks(&planned, threads, &ahead).into_iter().collect();
         // At most one split per triangle per round.
         let mut taken = vec![false; triangles.len()];
@@ -379,7 +380,7 @@ pub(super) fn in_chunks<T: Sync, R: Send>(
 /// The triangles by the cubes of side [`BUCKET`] their boxes meet (entries of a triangle
 /// since reshaped stay: each is read with its current corners).
 pub(super) struct Buckets {
-    map: HashMap<[i64; 3], Vec<u32>>,
+    map: FastMap<[i64; 3], Vec<u32>>,
     side: f64,
 }
 
@@ -400,7 +401,7 @@ impl Buckets {
     /// The triangles `t` by cubes of side `side`.
     pub(super) fn with_side(v: &[DVec3], t: &[[u32; 3]], side: f64) -> Self {
         let mut out = Self {
-            map: HashMap::with_capacity(t.len() / 4),
+            map: FastMap::with_capacity_and_hasher(t.len() / 4, Default::default()),
             side: side.max(f64::MIN_POSITIVE),
         };
         for (i, &tri) in t.iter().enumerate() {

@@ -58,6 +58,7 @@ mod crease;
 mod decimate;
 mod exact;
 pub mod generator;
+mod hash;
 
 use glam::DVec3;
 
