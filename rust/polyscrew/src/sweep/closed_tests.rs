@@ -223,10 +223,15 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
 /// `ClosedOptions::decimate`: the mesh is still closed, oriented and uncrossed (at the float32
 /// Blender keeps), its vertices are some of the full mesh's, bit for bit, with the same bound,
 /// at most 0.6 of its triangles, its volume within 0.2 % of the full mesh's, and every face
-/// point of 120 of its triangles (20 on the torus) within the bound plus what the collapses
-/// allow of the swept boundary: twice [`DECIMATE_TARGET`] cells, the most a flat triangle's
-/// distance from a sheet smooth or slightly kinked across it exceeds its edges' midpoints'
-/// (`decimate.rs`). Slow in a debug build (`scripts/test.sh` runs it in release).
+/// point of 120 of the triangles the collapses made (20 on the torus) within the bound plus
+/// what the collapses allow of the swept boundary: twice [`DECIMATE_TARGET`] cells, the most a
+/// flat triangle's distance from a sheet smooth or slightly kinked across it exceeds its edges'
+/// midpoints' (`decimate.rs`). The triangles kept from the full mesh are held to its own rule
+/// (`every_face_point_lies_within_the_bound`: within that or half a cell; a creased edge whose
+/// split would cross the mesh stays, and its faces are up to about 0.4 cells off: the cube's
+/// corner-cutting triangle 0.30 cells off came into the sample when stop 43's crease collapses
+/// changed which triangles are left). Slow in a debug build (`scripts/test.sh` runs it in
+/// release).
 #[test]
 #[ignore = "slow in a debug build: scripts/test.sh runs it in release"]
 fn decimation_keeps_some_of_the_vertices_closed_uncrossed_and_near() {
@@ -263,11 +268,42 @@ fn decimation_keeps_some_of_the_vertices_closed_uncrossed_and_near() {
             full.triangles.len()
         );
         assert!((v_out / v_full - 1.0).abs() <= 0.002, "{name}");
+        // The triangles the collapses made, and those kept from the full mesh (by their
+        // corners' bits).
+        let corners = |m: &ClosedMesh, t: &[u32; 3]| {
+            let mut k = t.map(|i| bits(&m.vertices[i as usize]));
+            k.sort_unstable();
+            k
+        };
+        let before: std::collections::HashSet<[[u64; 3]; 3]> =
+            full.triangles.iter().map(|t| corners(&full, t)).collect();
+        let (kept, made): (Vec<[u32; 3]>, Vec<[u32; 3]>) = out
+            .triangles
+            .iter()
+            .partition(|t| before.contains(&corners(&out, t)));
         let allowed = out.error_bound + 2.0 * DECIMATE_TARGET * out.cell;
-        let d = mesh_face_distances((name, &body, &poses), &out, [120, 20], allowed);
-        let worst = d[d.len() - 1] * body.extent();
-        println!("{name}: worst face point {worst:e}, allowed {allowed:e}");
-        assert!(worst <= allowed, "{name}: a face point {worst:e} off");
+        let extent = body.extent();
+        let worst = |triangles: Vec<[u32; 3]>, enough: f64| {
+            let part = ClosedMesh {
+                triangles,
+                ..out.clone()
+            };
+            let d = mesh_face_distances((name, &body, &poses), &part, [120, 20], enough);
+            d[d.len() - 1] * extent
+        };
+        let (worst_made, worst_kept) = (worst(made, allowed), worst(kept, 0.5 * out.cell));
+        println!(
+            "{name}: worst face point {worst_made:e} on the collapses' triangles (allowed \
+             {allowed:e}), {worst_kept:e} on those kept"
+        );
+        assert!(
+            worst_made <= allowed,
+            "{name}: a face point {worst_made:e} off"
+        );
+        assert!(
+            worst_kept <= allowed.max(0.5 * out.cell),
+            "{name}: a kept face point {worst_kept:e} off"
+        );
     }
 }
 
