@@ -227,10 +227,10 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
 /// what the collapses allow of the swept boundary: twice [`DECIMATE_TARGET`] cells, the most a
 /// flat triangle's distance from a sheet smooth or slightly kinked across it exceeds its edges'
 /// midpoints' (`decimate.rs`). The triangles kept from the full mesh are held to its own rule
-/// (`every_face_point_lies_within_the_bound`: within that or half a cell; a creased edge whose
-/// split would cross the mesh stays, and its faces are up to about 0.4 cells off: the cube's
-/// corner-cutting triangle 0.30 cells off came into the sample when stop 43's crease collapses
-/// changed which triangles are left). Slow in a debug build (`scripts/test.sh` runs it in
+/// (`every_face_point_lies_within_the_bound`: within that or half a cell): the cube's
+/// corner-cutting triangle 0.30 cells off, one of a strip of coplanar triangles across a crease
+/// whose inner edges the crease pass never splits (their two triangles face the same way), came
+/// into the sample when stop 43's crease collapses changed which triangles are left. Slow in a debug build (`scripts/test.sh` runs it in
 /// release).
 #[test]
 #[ignore = "slow in a debug build: scripts/test.sh runs it in release"]
