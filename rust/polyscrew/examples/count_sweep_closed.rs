@@ -7,8 +7,8 @@
 //!
 //! The file: a line `vertices triangles poses`, then one line per vertex (`x y z`), per
 //! triangle (`a b c`) and per pose (its 4 x 4 matrix, rows one after the other). Prints the
-//! closed mesh's counts, its volume, its bound, a digest of its vertices' bits and triangles (equal meshes,
-//! equal digests) and the process's CPU time (all threads) and wall time. `CELL` 0 or none:
+//! closed mesh's counts, its volume, its bound, a digest of its vertices' bits and triangles
+//! (equal meshes, equal digests) and the process's CPU time (all threads) and wall time. `CELL` 0 or none:
 //! the default tolerance; `THREADS` 0 or none: the machine's; a fourth argument `decimate`:
 //! `ClosedOptions::decimate`.
 use glam::DVec3;
@@ -91,15 +91,7 @@ fn main() {
         .fold(0xcbf2_9ce4_8422_2325u64, |h, x| {
             (h ^ x).wrapping_mul(0x0100_0000_01b3)
         });
-    // The enclosed volume (the divergence theorem over the closed, outward-facing triangles).
-    let volume = out
-        .triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|k| out.vertices[k as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum::<f64>();
+    let volume = out.volume();
     println!(
         "{path}: {} vertices, {} triangles, volume {volume:.6}, cell {:.4}, bound {:.3e}, {} attempt(s), {} poses, digest {digest:016x}, CPU {:.3} s, wall {wall:.3} s",
         out.vertices.len(),

@@ -14,6 +14,24 @@ use glam::DVec3;
 use crate::error::{At, Error, Result};
 use crate::memory::Footprint;
 
+/// `sum a . (b x c) / 6` over the triangles, the corners taken from the first triangle's first
+/// (less round-off far from the origin): the enclosed volume of a closed, consistently
+/// oriented mesh, negative when it is inside out; 0 with no triangles.
+pub fn enclosed_volume(vertices: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
+    let Some(first) = triangles.first() else {
+        return 0.0;
+    };
+    let o = vertices[first[0] as usize];
+    triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|k| vertices[k as usize] - o);
+            a.dot(b.cross(c))
+        })
+        .sum::<f64>()
+        / 6.0
+}
+
 /// A triangle whose cross product `|(b - a) x (c - a)|` is at most this fraction of the
 /// square of its longest edge (its smallest angle below about `1e-12` radians, or a repeated
 /// vertex) has no normal and is rejected as zero-area.
@@ -328,18 +346,9 @@ impl Body {
         }
     }
 
-    /// `sum a . (b x c) / 6` over the triangles: the enclosed volume of a closed mesh,
-    /// negative when it is inside out.
+    /// The body's [`enclosed_volume`]: negative when it is inside out.
     pub fn signed_volume(&self) -> f64 {
-        let o = self.vertices[self.triangles[0][0] as usize];
-        self.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|k| self.vertices[k as usize] - o);
-                a.dot(b.cross(c))
-            })
-            .sum::<f64>()
-            / 6.0
+        enclosed_volume(&self.vertices, &self.triangles)
     }
 
     /// The vertices (body frame).

@@ -53,13 +53,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{DAffine3, DVec3};
 
-use super::hash::FastMap;
-
 use super::adaptive::{
     channel_cubes, coords, corner_offsets, cube_points, grid_key, grid_point, kuhn_value,
     offset_in, Key, Lattice, KUHN, SPLIT,
 };
 use super::exact::{closest_on_triangle, ExactField};
+use super::hash::FastMap;
 use super::{axis_distance, Body};
 use crate::error::{Error, Expected, Result};
 use crate::memory::{try_vec, Footprint};
@@ -257,6 +256,13 @@ pub struct ClosedMesh {
     /// in them: outside space among inside corners, or a quarter cell across the grid's linear
     /// field (`adaptive.rs`).
     pub refined_cubes: usize,
+}
+
+impl ClosedMesh {
+    /// The volume it encloses ([`super::body::enclosed_volume`]).
+    pub fn volume(&self) -> f64 {
+        super::body::enclosed_volume(&self.vertices, &self.triangles)
+    }
 }
 
 /// What [`sweep_closed`] will sample, known before it runs ([`closed_work`]): enough to

@@ -137,15 +137,6 @@ fn crossing_pairs(out: &ClosedMesh) -> usize {
     self_intersections(&rounded, &out.triangles, 2.0 * out.cell)
 }
 
-fn volume(v: &[DVec3], t: &[[u32; 3]]) -> f64 {
-    t.iter()
-        .map(|tri| {
-            let [a, b, c] = tri.map(|k| v[k as usize]);
-            a.dot(b.cross(c)) / 6.0
-        })
-        .sum()
-}
-
 /// The cases of issue 29: a unit cube on a 120-degree screw with a slide, an L-prism on a
 /// half turn, a torus and a cube on a smoothed polyscrew (4 keys, 24 screws).
 /// The tests' cell: 4 % of the body's extent (coarser than the default, to keep the debug
@@ -207,16 +198,13 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
             out.triangles.len(),
             out.cell,
             out.poses,
-            volume(&out.vertices, &out.triangles),
+            out.volume(),
             out.error_bound
         );
         assert!(!out.triangles.is_empty(), "{name}: empty");
         assert!(is_closed_oriented(&out.triangles), "{name}: not closed");
         assert_eq!(crossing, 0, "{name}: self-intersecting triangles");
-        assert!(
-            volume(&out.vertices, &out.triangles) > body.signed_volume(),
-            "{name}"
-        );
+        assert!(out.volume() > body.signed_volume(), "{name}");
     }
 }
 
@@ -230,8 +218,8 @@ fn the_closed_boundary_is_closed_oriented_and_without_self_intersections() {
 /// (`every_face_point_lies_within_the_bound`: within that or half a cell): the cube's
 /// corner-cutting triangle 0.30 cells off, one of a strip of coplanar triangles across a crease
 /// whose inner edges the crease pass never splits (their two triangles face the same way), came
-/// into the sample when stop 43's crease collapses changed which triangles are left. Slow in a debug build (`scripts/test.sh` runs it in
-/// release).
+/// into the sample when stop 43's crease collapses changed which triangles are left. Slow in a
+/// debug build (`scripts/test.sh` runs it in release).
 #[test]
 #[ignore = "slow in a debug build: scripts/test.sh runs it in release"]
 fn decimation_keeps_some_of_the_vertices_closed_uncrossed_and_near() {
@@ -243,10 +231,7 @@ fn decimation_keeps_some_of_the_vertices_closed_uncrossed_and_near() {
         };
         let out = sweep_closed(&body, &poses, &fewer).unwrap();
         let crossing = crossing_pairs(&out);
-        let (v_full, v_out) = (
-            volume(&full.vertices, &full.triangles),
-            volume(&out.vertices, &out.triangles),
-        );
+        let (v_full, v_out) = (full.volume(), out.volume());
         println!(
             "{name}: {} of {} triangles, volume {v_out:.5} against {v_full:.5},              self-intersecting pairs {crossing}",
             out.triangles.len(),
@@ -542,7 +527,7 @@ fn face_report(
                 100.0 * worst,
                 100.0 * p99,
                 100.0 * mesh.error_bound / extent,
-                volume(&mesh.vertices, &mesh.triangles)
+                mesh.volume()
             );
             (
                 name,
@@ -816,7 +801,7 @@ fn a_channel_narrower_than_a_cell_between_two_passes_stays_outside() {
         },
     )
     .unwrap();
-    let v = volume(&out.vertices, &out.triangles);
+    let v = out.volume();
     println!(
         "{} triangles, volume {v:.5} (exact {:.5}, with the slab filled {:.5}), bound {:.2e}",
         out.triangles.len(),

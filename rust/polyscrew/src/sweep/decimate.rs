@@ -84,8 +84,8 @@ fn along(c: DVec3, axis: DVec3) -> bool {
 /// What a planned collapse comes to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Verdict {
-    /// Not a collapse the mesh allows now (the link condition): not refused, tried again
-    /// once its star changes.
+    /// Not a collapse the mesh allows now (the link condition): not refused, so planned
+    /// again in the next round.
     Skip,
     /// Refused (a midpoint off, a fold or a crossing): not planned again onto this `w` until
     /// the star of `u` changes.
@@ -585,13 +585,7 @@ mod tests {
             });
             assert!(shared, "{tri:?} spans two faces of the box");
         }
-        let volume: f64 = t
-            .iter()
-            .map(|tri| {
-                let [p, q, r] = tri.map(|k| v[k as usize]);
-                p.dot(q.cross(r)) / 6.0
-            })
-            .sum();
+        let volume = crate::sweep::enclosed_volume(&v, &t);
         assert!(
             (volume - size.x * size.y * size.z).abs() < 1e-12,
             "{volume}"

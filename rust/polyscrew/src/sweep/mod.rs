@@ -63,8 +63,8 @@ mod hash;
 use glam::DVec3;
 
 pub use body::{
-    body_footprint, Body, Edge, EdgeKind, FLAT_REL, MAX_VERTEX_COORDINATE, NO_FACE, SWEEP_HINT,
-    ZERO_AREA_REL,
+    body_footprint, enclosed_volume, Body, Edge, EdgeKind, FLAT_REL, MAX_VERTEX_COORDINATE,
+    NO_FACE, SWEEP_HINT, ZERO_AREA_REL,
 };
 pub use closed::{
     closed_work, sweep_closed, sweep_closed_mesh, sweep_closed_watched, ClosedMesh, ClosedOptions,
