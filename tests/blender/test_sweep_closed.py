@@ -186,7 +186,7 @@ def short_motion(obj):
 
 
 def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance(monkeypatch):
-    """The operator with no options: Closed Volume, the tolerance 0.5 % of the object's
+    """The operator with no options: Closed Volume with Fewer Triangles, the tolerance 0.5 % of the object's
     bounding-box diagonal, the bound reported within it, closed, no two triangles crossing,
     every sampled vertex within the bound of the region's boundary. The seconds it takes
     move Blender's progress indicator: the add-on gives `sweep_closed` a progress callable,
@@ -216,7 +216,8 @@ def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance(monke
     tol, bound, cell = (region[k] for k in ("screwbender_tolerance", "screwbender_error_bound", "screwbender_cell"))
     assert tol == pytest.approx(0.005 * np.sqrt(3.0), rel=1e-6)
     assert 0.0 < bound <= tol
-    assert cell == pytest.approx(2.0 * tol, rel=1e-6) or cell < tol
+    # The first cell (3 tolerances), else a retry's, finer.
+    assert cell == pytest.approx(3.0 * tol, rel=1e-6) or cell < 3.0 * tol
     v, t = region_arrays(region)
     closed, volume, overlaps, touching = blender_checks(region, v, t)
     pts = v[np.random.default_rng(0).choice(len(v), min(len(v), 1500), replace=False)]

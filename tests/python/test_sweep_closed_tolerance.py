@@ -48,7 +48,9 @@ def test_the_bound_reported_is_within_the_tolerance(name):
     assert info["tolerance"] == tolerance
     assert info["error_bound"] <= tolerance
     rule = polyscrew.CLOSED_CELL_PER_TOLERANCE * tolerance
-    assert info["cell"] == rule if info["attempts"] == 1 else info["cell"] < tolerance
+    # The retries (attempts 2 and 3): a finer cell (from the first bound), then one under the tolerance.
+    assert info["cell"] == rule if info["attempts"] == 1 else info["cell"] < rule
+    assert info["attempts"] < 3 or info["cell"] < tolerance
     assert worst <= info["error_bound"] + body_error
     assert is_closed_oriented(ct)
 
@@ -62,7 +64,7 @@ def test_the_default_tolerance_is_half_a_percent_of_the_extent(name):
     assert work["tolerance"] == pytest.approx(0.005 * extent, rel=1e-12)
     assert work["cell"] == pytest.approx(polyscrew.CLOSED_CELL_PER_TOLERANCE * work["tolerance"], rel=1e-12)
     coarse = polyscrew.sweep_closed_work(v, t, poses, tolerance=2 * work["tolerance"])
-    assert coarse["grid_points"] * 6 < work["grid_points"] and coarse["poses"] < work["poses"]
+    assert coarse["grid_points"] * 5 < work["grid_points"] and coarse["poses"] < work["poses"]
     # The operator runs every default case (none is refused).
     assert sweep_report.closed_refusal(work) is None
 
@@ -80,7 +82,7 @@ def test_several_threads_give_the_one_thread_mesh_byte_for_byte():
 
 
 def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_the_boundary():
-    """`decimate=True`: closed and oriented, at most 0.6 of the triangles, its vertices some of
+    """`decimate=True` (the default): closed and oriented, at most 0.6 of the triangles, its vertices some of
     the full mesh's (their bytes) with the same figures, and every new triangle's centre (one
     not in the full mesh, whose faces the other tests check) within the bound plus what the
     collapses allow (twice CLOSED_DECIMATE_TARGET cells: the most a flat triangle's distance
@@ -90,8 +92,8 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
     name = "L-prism, half turn"
     v, t, sd, poses, body_error, _ = CASES[name]
     tolerance = 0.02 * extent_of(v)
-    fv, ft, full = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True)
-    dv, dt, fewer = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True, decimate=True)
+    fv, ft, full = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True, decimate=False)
+    dv, dt, fewer = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True)
     assert is_closed_oriented(dt)
     assert len(dt) <= 0.6 * len(ft), (len(dt), len(ft))
     assert fewer == full

@@ -689,7 +689,7 @@ def compute_all(
     cell: float | None = None,
     fallback: bool = False,
     progress: Callable[[int, int], None] | None = None,
-    decimate: bool = False,
+    decimate: bool = True,
 ) -> list[Swept]:
     """:func:`compute` of every object of `objects`, their world poses read together
     (:func:`world_poses_all`: the curves evaluated in one call where they alone move the

@@ -53,10 +53,10 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
     )
     decimate: BoolProperty(
         name="Fewer Triangles",
-        default=False,
-        description="Closed Volume: remove vertices where the boundary is flat and along its creases (3.6 "
-        "to 6.5 times fewer triangles at the default tolerance, every vertex left still within it; about "
-        "twice as long)",
+        default=True,
+        description="Closed Volume: remove vertices where the boundary is flat and along its creases "
+        "(3.8 to 5.7 times fewer triangles at the default tolerance, every vertex left still within it; "
+        "1.6 to 2.1 times as long). Off: the contoured mesh as it is",
     )
     cell: FloatProperty(
         name="Cell Size",

@@ -79,11 +79,21 @@ pub const DEFAULT_CLOSED_TOLERANCE_REL: f64 = 0.005;
 
 /// The first cell tried for a tolerance, as a multiple of it. The reported bound (the exact
 /// residual left at a vertex, capped at one cell, plus [`motion_gap`]: see [`guaranteed_cell`])
-/// is, measured on issue 29's cases since the refinement ends on the body's exact distance,
-/// `0.08` to `0.32` cells plus the gap's `0.0625` (cube, L-prism, torus, smoothed cube at 1.5 %
-/// and 4 % of the extent): a cell of `2` tolerances meets the tolerance in one attempt there (a
-/// bound above `0.5` cells would exceed it and take a second attempt at [`guaranteed_cell`]).
-pub const CELL_PER_TOLERANCE: f64 = 2.0;
+/// is, measured on issue 29's cases since stop 36's exact signs, `0.09` to `0.10` cells with
+/// the gap's `0.0625` (cube, L-prism, torus, smoothed cube at 1 %, 2 % and 4 % of the extent).
+/// Since stop 44 the bound covers every edge's midpoint too (`crease.rs` reads them all and
+/// splits those more than a fortieth of a cell off; a split a neighbouring sheet blocks
+/// leaves its edge up to about a third of a cell off): `0.26` to `0.41` cells with the gap on
+/// `bench_sweep_closed.py`'s cube, torus and L-prism at a cell of 4 tolerances. A cell of `3`
+/// tolerances meets the tolerance in one attempt on most; where the bound exceeds it, the grid
+/// is contoured again at the cell [`RETRY_SPARE`] makes of the bound, and if that bound exceeds
+/// it too, at [`guaranteed_cell`] (`attempts` 2 and 3). Up to stop 43: `2` tolerances, and only
+/// edges between triangles at an angle were read and bounded by nothing.
+pub const CELL_PER_TOLERANCE: f64 = 3.0;
+
+/// The second attempt's cell is this fraction of the cell at which the first attempt's bound
+/// would have been the tolerance (the bound grows about as the cell does).
+pub const RETRY_SPARE: f64 = 0.9;
 
 /// The cell at which the reported bound is within `tolerance` whatever the body and the
 /// motion: the bound is the exact residual left at a vertex, at most one cell (a vertex stays
@@ -209,15 +219,15 @@ const WORLD_BYTES_PER_POINT: usize = 8;
 const GRID_JITTER: [f64; 3] = [0.313_725_49, 0.271_826_3, 0.141_4];
 
 /// Options of [`sweep_closed`].
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClosedOptions {
     /// The world grid's cell (body units, `> 0`), for scripts that fix it; `None`: derived
     /// from `tolerance`. Not both.
     pub cell: Option<f64>,
     /// The largest distance, reported as `error_bound`, of a vertex from the swept boundary
     /// (body units, `> 0`); `None` (and no `cell`): [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
-    /// body's extent. The cell is [`CELL_PER_TOLERANCE`] times it, and
-    /// [`guaranteed_cell`] if that cell's bound exceeds it (a second attempt).
+    /// body's extent. The cell is [`CELL_PER_TOLERANCE`] times it, then finer while the bound
+    /// exceeds it (`ClosedMesh::attempts`; see [`sweep_closed`]).
     pub tolerance: Option<f64>,
     /// Threads for the body's distance grids and the region's field (steps 1 and 2); `0`:
     /// [`std::thread::available_parallelism`]; at most [`MAX_THREADS`]. The mesh is the same,
@@ -228,8 +238,21 @@ pub struct ClosedOptions {
     /// of the boundary (`decimate.rs`: the new faces then within about twice that, plus the
     /// vertices' bound).
     /// The vertices left are some of those without it, bit for bit, so `error_bound` holds for
-    /// them; it takes longer (about twice as long at the defaults).
+    /// them; it takes longer (1.6 to 2.1 times the CPU at the defaults). On by default since
+    /// stop 44.
     pub decimate: bool,
+}
+
+impl Default for ClosedOptions {
+    /// The default tolerance, every core, fewer triangles.
+    fn default() -> Self {
+        Self {
+            cell: None,
+            tolerance: None,
+            threads: 0,
+            decimate: true,
+        }
+    }
 }
 
 /// The closed boundary and what it took.
@@ -241,14 +264,19 @@ pub struct ClosedMesh {
     pub triangles: Vec<[u32; 3]>,
     /// The world grid's cell.
     pub cell: f64,
-    /// A bound on the distance of every vertex from the exact swept boundary: the largest
-    /// `|g|` left at a vertex, `g` read with the body's exact distance at the motion refined
-    /// [`REFINE_POSES`] times, plus the motion's gap ([`motion_gap`]). Faces are not bounded
-    /// by it: they are measured (`closed_tests.rs`: within the tolerance at the defaults).
+    /// A bound on the distance of every vertex, and of every edge's midpoint, from the exact
+    /// swept boundary: the largest `|g|` left at a vertex or at the midpoint of an edge of the
+    /// contoured mesh (since stop 44; the collapses of `decimate` keep their new edges'
+    /// midpoints within [`DECIMATE_TARGET`] cells, under the gap), `g` read with the body's
+    /// exact distance at the motion refined [`REFINE_POSES`] times, plus the motion's gap
+    /// ([`motion_gap`]). Faces elsewhere are not bounded by it: they are measured
+    /// (`closed_tests.rs`: within the bound on the contoured mesh, within the tolerance at the
+    /// defaults).
     pub error_bound: f64,
     /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
     pub tolerance: f64,
-    /// Grids contoured: 1, or 2 when the first cell's bound exceeded the tolerance.
+    /// Grids contoured: 1, or 2 and 3 when the first and the second cell's bound exceeded the
+    /// tolerance.
     pub attempts: usize,
     /// Dense poses sampled.
     pub poses: usize,
@@ -776,8 +804,8 @@ impl DenseMotion {
 ///
 /// With a tolerance (`options.tolerance`, by default [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
 /// body's extent) the cell is [`CELL_PER_TOLERANCE`] times it; if the bound reported there
-/// exceeds the tolerance, the grid is contoured again at [`guaranteed_cell`], where it cannot
-/// (`attempts` 2). With `options.cell`, that cell, once.
+/// exceeds the tolerance, the grid is contoured again at the cell [`RETRY_SPARE`] makes of that
+/// bound (`attempts` 2), then at [`guaranteed_cell`], where it cannot exceed it (`attempts` 3). With `options.cell`, that cell, once.
 ///
 /// # Errors
 /// - [`Error::TooFew`] for fewer than 2 poses; [`Error::BadPose`] for a pose out of range;
@@ -899,19 +927,21 @@ pub(super) fn sweep_closed_with(
     let (cell, tolerance) = first_cell(body, poses, options)?;
     let whole = progress.span(0.0, 1.0);
     let mut out = contoured(body, poses, cell, options, evaluation, whole)?;
-    out.attempts = 1;
-    if tolerance > 0.0 && out.error_bound > tolerance {
+    let mut attempts = 1;
+    while tolerance > 0.0 && out.error_bound > tolerance && attempts < 3 {
+        // The bound grows about as the cell does: the second cell is the one that would meet
+        // the tolerance with a tenth to spare; the third, the one that cannot miss it.
+        let least = guaranteed_cell(tolerance);
+        let retry = if attempts == 1 {
+            (RETRY_SPARE * out.cell * tolerance / out.error_bound).max(least)
+        } else {
+            least
+        };
         progress.restart();
-        out = contoured(
-            body,
-            poses,
-            guaranteed_cell(tolerance),
-            options,
-            evaluation,
-            whole,
-        )?;
-        out.attempts = 2;
+        out = contoured(body, poses, retry, options, evaluation, whole)?;
+        attempts += 1;
     }
+    out.attempts = attempts;
     out.tolerance = tolerance;
     Ok(out)
 }
@@ -2271,7 +2301,9 @@ fn contour(
         &onto,
     );
     span.check()?;
-    residual = residual.max(moved);
+    // The bound covers the edges' midpoints too (each read exactly): where a split is refused
+    // the face stays off, by up to a third of a cell (stop 44, the L-prism), more than a vertex.
+    residual = residual.max(moved.0).max(moved.1);
     // Flat parts: vertices removed (none moves, so the bound below holds for those left).
     if decimate {
         super::decimate::collapse_flat(

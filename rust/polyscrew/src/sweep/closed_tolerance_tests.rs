@@ -59,18 +59,21 @@ fn the_bound_reported_is_within_the_tolerance() {
             "{name}: bound {} over the tolerance {tolerance}",
             out.error_bound
         );
-        let rule = if out.attempts == 1 {
-            CELL_PER_TOLERANCE * tolerance
-        } else {
-            guaranteed_cell(tolerance)
+        // The first cell, else a finer one (the second attempt's, from the first bound), else
+        // the one that cannot miss.
+        let (first, least) = (CELL_PER_TOLERANCE * tolerance, guaranteed_cell(tolerance));
+        let rule = match out.attempts {
+            1 => out.cell == first,
+            2 => least <= out.cell && out.cell < first,
+            _ => out.cell == least,
         };
-        assert_eq!(out.cell, rule, "{name}: the cell is not the rule's");
+        assert!(rule, "{name}: the cell {} is not the rule's", out.cell);
         assert!(worst <= out.error_bound, "{name}: a vertex {worst} off");
         assert!(is_closed_oriented(&out.triangles), "{name}: not closed");
     }
 }
 
-/// The second attempt's cell keeps the bound within the tolerance whatever the case: the
+/// The last attempt's cell keeps the bound within the tolerance whatever the case: the
 /// bound at `guaranteed_cell(tolerance)` on every case, the cube's at a tolerance whose first
 /// cell is two thirds of the tests' (0.02 of the extent).
 #[test]
@@ -181,7 +184,7 @@ fn the_work_told_before_is_the_work_done() {
         )
         .unwrap();
         assert!(
-            coarse.grid_points * 6 < default.grid_points,
+            coarse.grid_points * 5 < default.grid_points,
             "{name}: {coarse:?} {default:?}"
         );
         assert!(coarse.poses < default.poses, "{name}");
