@@ -194,9 +194,13 @@ def test_closed_boundary_is_closed_exact_and_holds_the_volume(name):
     extent = np.linalg.norm(v.max(axis=0) - v.min(axis=0))
     start = time.process_time()
     # The cell given (None: the former default, 1.5 %; the tolerance's default is checked in
-    # test_sweep_closed_tolerance.py and tests/blender/test_sweep_closed.py).
+    # test_sweep_closed_tolerance.py and tests/blender/test_sweep_closed.py), the contoured mesh
+    # as it is (Fewer Triangles, the default, is checked against it there). The torus's
+    # reference sweeps the smooth torus the body is inscribed in: the contoured mesh is 0.44 %
+    # short of it at the 1.5 % cell, and the collapses' chords on its curved parts cut another
+    # 0.10 %, over this test's 0.5 % (measured at stop 44).
     cell = (cell_rel or polyscrew.DEFAULT_CLOSED_CELL) * extent
-    cv, ct, info = polyscrew.sweep_closed(v, t, poses, cell=cell, info=True)
+    cv, ct, info = polyscrew.sweep_closed(v, t, poses, cell=cell, info=True, decimate=False)
     cpu = time.process_time() - start
     assert info["cell"] == cell and info["tolerance"] == 0.0 and info["attempts"] == 1
     assert cv.dtype == np.float64 and ct.dtype == np.int64 and ct.min() >= 0 and ct.max() < len(cv)
@@ -226,9 +230,10 @@ def test_closed_refusals():
 
 
 def test_a_finer_cell_is_closer():
-    """Halving the cell shrinks the bound and the volume's departure (the cube on the long screw)."""
-    coarse = polyscrew.sweep_closed(CUBE_V, CUBE_T, LONG, cell=0.05, info=True)
-    fine = polyscrew.sweep_closed(CUBE_V, CUBE_T, LONG, cell=0.025, info=True)
+    """Halving the cell shrinks the bound and the volume's departure (the cube on the long screw),
+    the contoured mesh: the triangles grow as the cell's square."""
+    coarse = polyscrew.sweep_closed(CUBE_V, CUBE_T, LONG, cell=0.05, info=True, decimate=False)
+    fine = polyscrew.sweep_closed(CUBE_V, CUBE_T, LONG, cell=0.025, info=True, decimate=False)
     assert fine[2]["error_bound"] < coarse[2]["error_bound"]
     assert len(fine[1]) > 3 * len(coarse[1])
     assert is_closed_oriented(coarse[1]) and is_closed_oriented(fine[1])
