@@ -87,8 +87,8 @@ pub const DEFAULT_CLOSED_TOLERANCE_REL: f64 = 0.005;
 /// `bench_sweep_closed.py`'s cube, torus and L-prism at a cell of 4 tolerances. A cell of `3`
 /// tolerances meets the tolerance in one attempt on most; where the bound exceeds it, the grid
 /// is contoured again at the cell [`RETRY_SPARE`] makes of the bound, and if that bound exceeds
-/// it too, at [`guaranteed_cell`] (`attempts` 2 and 3). Up to stop 43: `2` tolerances, and only
-/// edges between triangles at an angle were read and bounded by nothing.
+/// it too, at [`guaranteed_cell`] (`attempts` 2 and 3). Up to stop 43: `2` tolerances, only
+/// the midpoints of edges between triangles at an angle read, and none of them in the bound.
 pub const CELL_PER_TOLERANCE: f64 = 3.0;
 
 /// The second attempt's cell is this fraction of the cell at which the first attempt's bound
@@ -805,7 +805,8 @@ impl DenseMotion {
 /// With a tolerance (`options.tolerance`, by default [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
 /// body's extent) the cell is [`CELL_PER_TOLERANCE`] times it; if the bound reported there
 /// exceeds the tolerance, the grid is contoured again at the cell [`RETRY_SPARE`] makes of that
-/// bound (`attempts` 2), then at [`guaranteed_cell`], where it cannot exceed it (`attempts` 3). With `options.cell`, that cell, once.
+/// bound (`attempts` 2), then at [`guaranteed_cell`], where it cannot exceed it (`attempts` 3).
+/// With `options.cell`, that cell, once.
 ///
 /// # Errors
 /// - [`Error::TooFew`] for fewer than 2 poses; [`Error::BadPose`] for a pose out of range;

@@ -10,8 +10,9 @@
 //! across a crease, its inner edges between triangles of one plane and their midpoints inside
 //! the region by a quarter of a cell. On the L-prism at a cell of 4 tolerances the worst
 //! sampled face point was 0.96 tolerances off with only the angled edges read, 0.48 with every
-//! edge (stop 44, `closed_tests.rs`'s face points at a cell of 2 % of the extent). An edge is read once (its ends
-//! never move); the edges a split or a flip makes or changes are read in the next round.
+//! edge (stop 44, `closed_tests.rs`'s face points at a cell of 2 % of the extent). An edge is
+//! read once (its ends never move); the edges a split or a flip makes or changes are read in
+//! the next round, and after the last.
 //!
 //! Splitting an edge splits both its triangles, so the mesh stays closed and consistently
 //! oriented. The new vertex moves onto the boundary along the mean normal at the edge's ends
@@ -142,23 +143,7 @@ pub fn split_creases(
         span.advance(round as f64 / CREASE_ROUNDS as f64);
         // Each candidate's midpoint value, most off first: read once per edge (an edge's
         // ends never move), the new ones on every core.
-        let value = |&(a, b): &(u32, u32)| {
-            field(
-                0.5 * (vertices[a as usize] + vertices[b as usize]),
-                near[a as usize],
-            )
-        };
-        let unread: Vec<(u32, u32)> = candidates
-            .iter()
-            .copied()
-            .filter(|e| !known.contains_key(e))
-            .collect();
-        known.extend(
-            unread
-                .iter()
-                .copied()
-                .zip(in_chunks(&unread, threads, &value)),
-        );
+        read_midpoints(&mut known, &candidates, (vertices, near), threads, field);
         let mut off: Vec<(f64, (u32, u32))> = candidates
             .iter()
             .map(|e| (known[e], *e))
@@ -357,16 +342,47 @@ pub fn split_creases(
         // (A split or flip later in the round may have removed an edge listed before it.)
         candidates = next.into_iter().filter(|e| edges.contains_key(e)).collect();
     }
-    if !span.is_cancelled() {
-        span.advance(1.0);
+    if span.is_cancelled() {
+        return (residual, 0.0);
     }
-    // The midpoints read of the edges left: the splits refused (a neighbouring sheet in the
-    // way) and those the rounds did not reach keep theirs.
+    // The edges the last round made or changed, read too: the bound covers every edge's
+    // midpoint, those of the splits refused (a neighbouring sheet in the way) and of the edges
+    // the rounds did not reach.
+    read_midpoints(&mut known, &candidates, (vertices, near), threads, field);
+    span.advance(1.0);
     let left = known
         .iter()
         .filter(|(e, _)| edges.contains_key(e))
         .fold(0.0f64, |m, (_, g)| m.max(g.abs()));
     (residual, left)
+}
+
+/// Reads into `known`, on `threads` threads, the field at the midpoints of the `edges` it does
+/// not hold yet (near the samples of each edge's first end).
+fn read_midpoints(
+    known: &mut FastMap<(u32, u32), f64>,
+    edges: &[(u32, u32)],
+    (vertices, near): (&[DVec3], &[[u32; 2]]),
+    threads: usize,
+    field: &(dyn Fn(DVec3, [u32; 2]) -> f64 + Sync),
+) {
+    let unread: Vec<(u32, u32)> = edges
+        .iter()
+        .copied()
+        .filter(|e| !known.contains_key(e))
+        .collect();
+    let value = |&(a, b): &(u32, u32)| {
+        field(
+            0.5 * (vertices[a as usize] + vertices[b as usize]),
+            near[a as usize],
+        )
+    };
+    known.extend(
+        unread
+            .iter()
+            .copied()
+            .zip(in_chunks(&unread, threads, &value)),
+    );
 }
 
 /// `f` of every item, in order, computed on `threads` threads (contiguous chunks).
