@@ -66,7 +66,7 @@ def test_the_default_tolerance_is_half_a_percent_of_the_extent(name):
     coarse = polyscrew.sweep_closed_work(v, t, poses, tolerance=2 * work["tolerance"])
     assert coarse["grid_points"] * 5 < work["grid_points"] and coarse["poses"] < work["poses"]
     # The operator runs every default case (none is refused).
-    assert sweep_report.closed_refusal(work) is None
+    assert sweep_report.closed_refusal(work, polyscrew.memory_budget()) is None
 
 
 def test_several_threads_give_the_one_thread_mesh_byte_for_byte():
@@ -169,6 +169,19 @@ def test_bad_tolerances_and_heavy_work_are_refused():
     many_poses = dict(heavy, grid_points=1, poses=sweep_report.MAX_CLOSED_POSES + 1)
     assert sweep_report.closed_refusal(many_poses) is not None
     assert sweep_report.closed_refusal(dict(heavy, grid_points=1, poses=1)) is None
+    # A tolerance 0.2 % of the extent: within the grid-point limit, but the grids (the body's,
+    # six times finer than the cell, above all) need more than the memory budget. The add-on
+    # refuses it first, with what to change, as the core itself refuses it.
+    budget = polyscrew.memory_budget()
+    tight = polyscrew.sweep_closed_work(v, t, poses, tolerance=0.002 * extent_of(v))
+    assert tight["grid_points"] <= sweep_report.MAX_CLOSED_GRID_POINTS
+    message = sweep_report.closed_refusal(tight, budget)
+    assert message is not None and "memory budget" in message and "raise the Tolerance" in message
+    assert sweep_report.closed_refusal(tight) is None  # no budget given: the points and poses alone
+    with pytest.raises(ValueError, match="memory budget"):
+        polyscrew.sweep_closed(v, t, poses, tolerance=0.002 * extent_of(v))
+    roomy = polyscrew.sweep_closed_work(v, t, poses, tolerance=0.003 * extent_of(v))
+    assert sweep_report.closed_refusal(roomy, budget) is None
 
 
 def test_the_report_names_the_closed_tolerance_and_what_met_it():

@@ -738,7 +738,7 @@ def compute_all(
             work = polyscrew.sweep_closed_work(verts * scale, tris, poses, **grid)
         except ValueError as err:
             raise SweepError(f"{obj.name}: {err}") from err
-        refusal = sweep_report.closed_refusal(work)
+        refusal = sweep_report.closed_refusal(work, polyscrew.memory_budget())
         if refusal is not None:
             raise SweepError(f"{obj.name}: {refusal}")
     # The open sweeps (milliseconds) before the closed boundaries (seconds): an object the open

@@ -20,26 +20,36 @@ import numpy as np
 #: The most world-grid points a closed boundary may sample from the operator: at the rate
 #: measured on issue 29's three cases at the default tolerance (docs/sweep.md: 0.6 to 0.8 CPU
 #: seconds per million grid points, 20 to 66 million of them) about a minute to a minute and a
-#: half of CPU; beyond it the call would run for minutes with Blender waiting. The memory
-#: budget (1 GiB: 8 bytes per grid point, 4 per body-grid point) refuses more anyway.
+#: half of CPU; beyond it the call would run for minutes with Blender waiting.
 MAX_CLOSED_GRID_POINTS = 100_000_000
+#: Bytes per world-grid point and per body-grid point of a closed boundary (`closed.rs`: a
+#: value and a pose per world point, a float32 per body point), against `polyscrew`'s memory
+#: budget. Since the cell became three tolerances (stop 44), the body's grid, six times finer
+#: than the cell, can pass the budget before the world grid passes its limit.
+CLOSED_BYTES_PER_GRID_POINT, CLOSED_BYTES_PER_BODY_POINT = 8, 4
 #: The most dense poses a closed boundary may sample from the operator (the longest default
 #: case, the smoothed torus, samples 1,230).
 MAX_CLOSED_POSES = 20_000
 
 
-def closed_refusal(work: dict) -> str | None:
+def closed_refusal(work: dict, budget: int | None = None) -> str | None:
     """None when the closed boundary's work (`polyscrew.sweep_closed_work`'s dict: ``cell``,
-    ``tolerance``, ``poses``, ``grid_points``) is within :data:`MAX_CLOSED_GRID_POINTS` and
-    :data:`MAX_CLOSED_POSES`; otherwise why not and what to change (a coarser tolerance, or
-    the open sweep, which takes milliseconds)."""
+    ``tolerance``, ``poses``, ``grid_points``, ``body_points``) is within
+    :data:`MAX_CLOSED_GRID_POINTS` and :data:`MAX_CLOSED_POSES`, and its grids within `budget`
+    bytes (`polyscrew.memory_budget()`; None: not checked); otherwise why not and what to
+    change (a coarser tolerance, or the open sweep, which takes milliseconds)."""
     grid, poses = int(work["grid_points"]), int(work["poses"])
-    if grid <= MAX_CLOSED_GRID_POINTS and poses <= MAX_CLOSED_POSES:
+    needed = CLOSED_BYTES_PER_GRID_POINT * grid + CLOSED_BYTES_PER_BODY_POINT * int(work.get("body_points", 0))
+    over_budget = budget is not None and needed > budget
+    if grid <= MAX_CLOSED_GRID_POINTS and poses <= MAX_CLOSED_POSES and not over_budget:
         return None
     asked = f"tolerance {work['tolerance']:.3g}" if work["tolerance"] > 0.0 else f"cell {work['cell']:.3g}"
-    return (f"Closed Volume at {asked} would sample {grid:,} grid points over {poses:,} poses (at most "
-            f"{MAX_CLOSED_GRID_POINTS:,} and {MAX_CLOSED_POSES:,}: minutes of work); raise the Tolerance (the "
-            f"work grows as its cube), shorten the frame range, or turn Closed Volume off for the open sweep")
+    what = (f"would need {needed / 1e9:.2f} GB for its grids (the memory budget: {budget / 1e9:.2f} GB)"
+            if over_budget and grid <= MAX_CLOSED_GRID_POINTS and poses <= MAX_CLOSED_POSES else
+            f"would sample {grid:,} grid points over {poses:,} poses (at most {MAX_CLOSED_GRID_POINTS:,} and "
+            f"{MAX_CLOSED_POSES:,}: minutes of work)")
+    return (f"Closed Volume at {asked} {what}; raise the Tolerance (the work grows as its cube), shorten the "
+            f"frame range, or turn Closed Volume off for the open sweep")
 
 
 #: Why a mesh cannot have a closed boundary (the core's own rule: `Body::is_closed`).
