@@ -268,10 +268,11 @@ pub struct ClosedMesh {
     pub cell: f64,
     /// A bound on the distance of every vertex, and of every edge's midpoint, from the exact
     /// swept boundary: the largest `|g|` left at a vertex or at the midpoint of an edge of the
-    /// contoured mesh (since stop 44; the collapses of `decimate` keep their new edges'
-    /// midpoints within [`DECIMATE_TARGET`] cells, under the gap), `g` read with the body's
-    /// exact distance at the motion refined [`REFINE_POSES`] times, plus the motion's gap
-    /// ([`motion_gap`]). Faces elsewhere are not bounded by it: they are measured
+    /// contoured mesh (since stop 44), `g` read with the body's exact distance at the motion
+    /// refined [`REFINE_POSES`] times, plus the motion's gap ([`motion_gap`]). The collapses
+    /// of `decimate` hold their new edges' midpoints within [`DECIMATE_TARGET`] cells on the
+    /// poses read: covered when the largest `|g|` is at least that, as on every case measured
+    /// (not by proof). Faces elsewhere are not bounded by it: they are measured
     /// (`closed_tests.rs`: within the bound on the contoured mesh, within the tolerance at the
     /// defaults).
     pub error_bound: f64,
