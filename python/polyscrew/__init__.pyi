@@ -554,6 +554,7 @@ def sweep(
 class ClosedSweepInfo(TypedDict):
     cell: float
     error_bound: float
+    vertex_bound: float
     tolerance: float
     attempts: int
     poses: int
@@ -623,7 +624,8 @@ def sweep_closed(
     triangles counter-clockwise seen from outside, every edge in exactly two; with
     ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex and every edge's
     midpoint within it of the swept boundary: the largest distance left at one, read exactly,
-    plus the motion's gap between the poses read; at most ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
+    plus the motion's gap between the poses read; at most ``tolerance``), ``vertex_bound``
+    (its part that covers the vertices alone), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
     ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
     because the boundary has a feature narrower than a cell there, such as a slab of outside
     space between two sheets, which the grid's points alone would have filled).

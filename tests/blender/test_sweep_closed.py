@@ -111,7 +111,8 @@ def test_closed_volume_is_the_closed_boundary_within_its_bound(motion):
     assert closed
     assert overlaps == 0
     assert region["screwbender_volume"] == pytest.approx(volume, rel=1e-5)
-    assert worst <= bound + 1e-6  # float32 vertices
+    assert worst <= region["screwbender_vertex_bound"] + 1e-6  # float32 vertices
+    assert region["screwbender_vertex_bound"] <= bound
     assert volume > 1.0  # more than the cube
 
 
@@ -226,7 +227,8 @@ def test_build_swept_region_at_its_defaults_is_closed_within_its_tolerance(monke
           f"{worst:.2e}, volume {volume:.4f}, intersecting pairs {overlaps} (and {touching} sharing a corner)")
     assert closed
     assert overlaps == 0
-    assert worst <= bound + 1e-6  # float32 vertices
+    assert worst <= region["screwbender_vertex_bound"] + 1e-6  # float32 vertices
+    assert region["screwbender_vertex_bound"] <= bound
     assert region["screwbender_volume"] == pytest.approx(volume, rel=1e-5)
     assert volume > 1.0
 

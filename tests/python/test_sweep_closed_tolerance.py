@@ -51,7 +51,7 @@ def test_the_bound_reported_is_within_the_tolerance(name):
     # The retries (attempts 2 and 3): a finer cell (from the first bound), then one under the tolerance.
     assert info["cell"] == rule if info["attempts"] == 1 else info["cell"] < rule
     assert info["attempts"] < 3 or info["cell"] < tolerance
-    assert worst <= info["error_bound"] + body_error
+    assert worst <= info["vertex_bound"] + body_error
     assert is_closed_oriented(ct)
 
 
@@ -107,7 +107,7 @@ def test_decimate_keeps_some_of_the_vertices_with_the_bound_and_new_faces_near_t
     centres = centres[np.random.default_rng(1).choice(len(centres), min(len(centres), 1500), replace=False)]
     inv = np.linalg.inv(dense(poses, max(64, 8192 // (len(poses) - 1))))
     worst = np.abs(region_sd(centres, inv, sd)).max()
-    allowed = fewer["error_bound"] + 2.0 * polyscrew.CLOSED_DECIMATE_TARGET * fewer["cell"] + body_error
+    allowed = fewer["vertex_bound"] + 2.0 * polyscrew.CLOSED_DECIMATE_TARGET * fewer["cell"] + body_error
     print(f"\n{name}: {len(dt)} of {len(ft)} triangles ({new.sum()} new), worst new centre {worst:.2e} "
           f"(allowed {allowed:.2e})")
     assert worst <= allowed

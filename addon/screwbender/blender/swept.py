@@ -70,10 +70,12 @@ class Swept:
     tolerance: float = 0.0
     error_bound: float = 0.0
     #: The grid cell of a closed boundary (`polyscrew.sweep_closed`; 0 for the open sweep):
-    #: every vertex then within `error_bound` of the exact swept boundary; `attempts`: the
-    #: grids it contoured (2 when the first cell's bound exceeded the tolerance).
+    #: every vertex and every edge's midpoint then within `error_bound` of the exact swept
+    #: boundary; `attempts`: the grids it contoured (1 to 3, finer while the bound exceeded the
+    #: tolerance); `vertex_bound`: the bound's part for the vertices alone.
     cell: float = 0.0
     attempts: int = 0
+    vertex_bound: float = 0.0
     #: Closed Volume at its default on a mesh that is not closed: the open sweep instead
     #: (:func:`sweep_report.closed_choice`).
     fallback: bool = False
@@ -757,7 +759,7 @@ def compute_all(
                                                     decimate=decimate, **grid)
                 closed_done += PROGRESS_STEPS
                 out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
-                               info["error_bound"], info["cell"], info["attempts"])
+                               info["error_bound"], info["cell"], info["attempts"], info["vertex_bound"])
                 continue
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:

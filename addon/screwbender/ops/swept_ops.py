@@ -122,6 +122,7 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                     obj["screwbender_error_bound"] = s.error_bound
                     if s.cell > 0.0:
                         obj["screwbender_cell"] = s.cell
+                        obj["screwbender_vertex_bound"] = s.vertex_bound
                     obj["screwbender_area"] = m.area
                     if m.volume is not None:
                         obj["screwbender_volume"] = m.volume

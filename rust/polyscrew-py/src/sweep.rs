@@ -163,6 +163,7 @@ fn sweep<'py>(
 // stub: class ClosedSweepInfo(TypedDict):
 // stub:     cell: float
 // stub:     error_bound: float
+// stub:     vertex_bound: float
 // stub:     tolerance: float
 // stub:     attempts: int
 // stub:     poses: int
@@ -230,7 +231,8 @@ fn sweep<'py>(
 /// triangles counter-clockwise seen from outside, every edge in exactly two; with
 /// ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex and every edge's
 /// midpoint within it of the swept boundary: the largest distance left at one, read exactly,
-/// plus the motion's gap between the poses read; at most ``tolerance``), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
+/// plus the motion's gap between the poses read; at most ``tolerance``), ``vertex_bound``
+/// (its part that covers the vertices alone), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
 /// ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
 /// because the boundary has a feature narrower than a cell there, such as a slab of outside
 /// space between two sheets, which the grid's points alone would have filled).
@@ -261,7 +263,7 @@ fn sweep_closed<'py>(
     let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
-    type Closed = (Array2<f64>, Array2<i64>, [f64; 3], [usize; 3]);
+    type Closed = (Array2<f64>, Array2<i64>, [f64; 4], [usize; 3]);
     let (vo, to, figures, counts) = watched(py, F, progress, |watch| -> PyResult<Closed> {
         let (va, ta, pa) = &views;
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
@@ -270,7 +272,7 @@ fn sweep_closed<'py>(
         let out = sweep_closed_mesh(&v, &t, &p, &options, watch).map_err(|e| to_py_err(F, e))?;
         drop((v, t, p));
         let (vo, to) = mesh_arrays(F, &out.vertices, &out.triangles)?;
-        let figures = [out.cell, out.error_bound, out.tolerance];
+        let figures = [out.cell, out.error_bound, out.tolerance, out.vertex_bound];
         Ok((
             vo,
             to,
@@ -285,6 +287,7 @@ fn sweep_closed<'py>(
     let dict = PyDict::new(py);
     dict.set_item("cell", figures[0])?;
     dict.set_item("error_bound", figures[1])?;
+    dict.set_item("vertex_bound", figures[3])?;
     dict.set_item("tolerance", figures[2])?;
     dict.set_item("attempts", counts[0])?;
     dict.set_item("poses", counts[1])?;

@@ -32,6 +32,14 @@ pub fn enclosed_volume(vertices: &[DVec3], triangles: &[[u32; 3]]) -> f64 {
         / 6.0
 }
 
+/// The square of the longest edge of the triangle `[a, b, c]`.
+pub(super) fn longest_edge_squared([a, b, c]: [DVec3; 3]) -> f64 {
+    (b - a)
+        .length_squared()
+        .max((c - b).length_squared())
+        .max((a - c).length_squared())
+}
+
 /// A triangle whose cross product `|(b - a) x (c - a)|` is at most this fraction of the
 /// square of its longest edge (its smallest angle below about `1e-12` radians, or a repeated
 /// vertex) has no normal and is rejected as zero-area.
@@ -188,10 +196,7 @@ impl Body {
             }
             let [a, b, c] = idx.map(|k| vertices[k as usize]);
             let cross = (b - a).cross(c - a);
-            let longest = (b - a)
-                .length_squared()
-                .max((c - b).length_squared())
-                .max((a - c).length_squared());
+            let longest = longest_edge_squared([a, b, c]);
             if idx[0] == idx[1]
                 || idx[1] == idx[2]
                 || idx[2] == idx[0]

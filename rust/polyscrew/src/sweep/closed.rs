@@ -276,6 +276,9 @@ pub struct ClosedMesh {
     /// (`closed_tests.rs`: within the bound on the contoured mesh, within the tolerance at the
     /// defaults).
     pub error_bound: f64,
+    /// The part of `error_bound` that covers the vertices alone (as `error_bound` did up to
+    /// stop 43): the largest `|g|` left at a vertex, plus the motion's gap.
+    pub vertex_bound: f64,
     /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
     pub tolerance: f64,
     /// Grids contoured: 1, or 2 and 3 when the first and the second cell's bound exceeded the
@@ -2307,7 +2310,8 @@ fn contour(
     span.check()?;
     // The bound covers the edges' midpoints too (each read exactly): where a split is refused
     // the face stays off, by up to a third of a cell (stop 44, the L-prism), more than a vertex.
-    residual = residual.max(moved.0).max(moved.1);
+    let vertices_residual = residual.max(moved.0);
+    residual = vertices_residual.max(moved.1);
     // Flat parts: vertices removed (none moves, so the bound below holds for those left).
     if decimate {
         super::decimate::collapse_flat(
@@ -2329,6 +2333,7 @@ fn contour(
     // travel from a pose read: the continuous motion's minimum is at most that below the one
     // found (the body's distance is 1-Lipschitz).
     out.error_bound = residual + motion_gap(cell);
+    out.vertex_bound = vertices_residual + motion_gap(cell);
     Ok(())
 }
 

@@ -68,7 +68,7 @@ fn the_bound_reported_is_within_the_tolerance() {
             _ => out.cell == least,
         };
         assert!(rule, "{name}: the cell {} is not the rule's", out.cell);
-        assert!(worst <= out.error_bound, "{name}: a vertex {worst} off");
+        assert!(worst <= out.vertex_bound, "{name}: a vertex {worst} off");
         assert!(is_closed_oriented(&out.triangles), "{name}: not closed");
     }
 }

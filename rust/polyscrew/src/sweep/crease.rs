@@ -29,6 +29,7 @@ use super::hash::FastMap;
 
 use glam::DVec3;
 
+use super::body::longest_edge_squared;
 use super::closed::point_triangle_distance;
 use crate::progress::Span;
 
@@ -63,12 +64,7 @@ const FLAT: f64 = 1e-9;
 
 /// Whether triangle `t` faces along the unit `dir`, by more than [`FLAT`].
 fn faces_along(v: &[DVec3], t: [u32; 3], dir: DVec3) -> bool {
-    let [a, b, c] = t.map(|i| v[i as usize]);
-    let longest = (b - a)
-        .length_squared()
-        .max((c - b).length_squared())
-        .max((a - c).length_squared());
-    (b - a).cross(c - a).dot(dir) > FLAT * longest
+    cross(v, t).dot(dir) > FLAT * longest_edge_squared(t.map(|i| v[i as usize]))
 }
 
 fn normal(v: &[DVec3], t: [u32; 3]) -> DVec3 {
