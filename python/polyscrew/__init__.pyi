@@ -559,6 +559,7 @@ class ClosedSweepInfo(TypedDict):
     attempts: int
     poses: int
     refined_cubes: int
+    finer_refused: str | None
 
 @overload
 def sweep_closed(
@@ -624,11 +625,15 @@ def sweep_closed(
     triangles counter-clockwise seen from outside, every edge in exactly two; with
     ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex and every edge's
     midpoint within it of the swept boundary: the largest distance left at one, read exactly,
-    plus the motion's gap between the poses read; at most ``tolerance``), ``vertex_bound``
+    plus the motion's gap between the poses read; at most ``tolerance`` unless
+    ``finer_refused``), ``vertex_bound``
     (its part that covers the vertices alone), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
-    ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
+    ``poses`` (the dense poses sampled), ``refined_cubes`` (grid cubes cut four times finer
     because the boundary has a feature narrower than a cell there, such as a slab of outside
-    space between two sheets, which the grid's points alone would have filled).
+    space between two sheets, which the grid's points alone would have filled) and
+    ``finer_refused`` (None, or why no finer grid was contoured though ``error_bound`` exceeds
+    ``tolerance``: its grids over the memory budget or a limit; the mesh is then the last
+    attempt's, closed and within ``error_bound``).
 
     Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
     or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
@@ -641,6 +646,7 @@ class ClosedSweepWork(TypedDict):
     poses: int
     grid_points: int
     body_points: int
+    bytes: int
 
 def sweep_closed_work(
     vertices: ArrayLike,
@@ -653,8 +659,9 @@ def sweep_closed_work(
     """What ``sweep_closed`` with the same arguments will sample, without sampling it (the
     arguments checked as it checks them; the dense poses counted, milliseconds): ``cell`` and
     ``tolerance`` (of its first attempt), ``poses`` (dense poses), ``grid_points`` (the world
-    grid over the instances' boxes) and ``body_points`` (the body's fine distance grid). For a
-    caller to refuse work that would run for minutes before it starts.
+    grid over the instances' boxes), ``body_points`` (the body's fine distance grid) and
+    ``bytes`` (the two grids', which ``sweep_closed`` checks against ``memory_budget()`` before
+    sampling either). For a caller to refuse work that would run for minutes before it starts.
 
     Raises ``ValueError`` as ``sweep_closed`` does (but for the memory budget of its grids).
     """

@@ -247,3 +247,54 @@ def test_heavy_closed_work_is_refused_before_it_starts_with_nothing_created():
     assert (len(bpy.data.objects), len(bpy.data.meshes)) == before
     h.select_only(body)
     assert bpy.ops.screwbender.sweep(tolerance=0.0025, closed=False) == {"FINISHED"}
+
+
+def test_a_finer_grid_over_the_memory_budget_keeps_the_region_and_warns(capfd):
+    """An L-prism on a half turn at a tolerance whose first grid's bound exceeds it (a 3 % cell):
+    the operator would contour a finer grid, but the memory budget holds only the first. The
+    region made is kept (closed, no two triangles crossing, its first cell, its bound over the
+    tolerance) and the operator warns, naming the object, the tolerance missed and the one met."""
+    from conftest import addon_module
+
+    library = addon_module("blender.swept").polyscrew  # the polyscrew the add-on calls
+    l_shape = [(0, 0), (2, 0), (2, 1), (1, 1), (1, 2), (0, 2)]
+    verts = [(x, y, 0.0) for x, y in l_shape] + [(x, y, 0.5) for x, y in l_shape]
+    faces = [f for a, b in [(4, 5), (5, 0), (0, 1), (1, 2)] for f in ((3, b, a), (9, a + 6, b + 6))]
+    faces += [f for i in range(6) for f in ((i, (i + 1) % 6, (i + 1) % 6 + 6), (i, (i + 1) % 6 + 6, i + 6))]
+    mesh = bpy.data.meshes.new("Prism")
+    mesh.from_pydata(verts, [], faces)
+    mesh.update()
+    prism = bpy.data.objects.new("Prism", mesh)
+    bpy.context.scene.collection.objects.link(prism)
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 2
+    key(prism, 1, Matrix.Identity(4))
+    key(prism, 2, Matrix(screw_matrix((0.3, 0.2, 1.0), (3.0, 0.0, 0.0), 0.999 * np.pi, 0.5).tolist()))
+    poses = played_poses(prism, [1.0, 2.0])
+    v, f = np.array(verts), np.array(faces)
+    tol = 0.03 / 3.0 * float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    work = library.sweep_closed_work(v, f, poses, tolerance=tol)
+    # With the default budget a second grid, finer, meets the tolerance.
+    h.select_only(prism)
+    assert bpy.ops.screwbender.sweep(tolerance=tol, closed=True, decimate=False) == {"FINISHED"}
+    retried = swept_region()
+    assert retried["screwbender_cell"] < 0.99 * work["cell"]
+    assert retried["screwbender_error_bound"] <= tol
+    capfd.readouterr()
+    h.select_only(prism)
+    old = library.set_memory_budget(int(1.1 * work["bytes"]))
+    try:
+        assert bpy.ops.screwbender.sweep(tolerance=tol, closed=True, decimate=False) == {"FINISHED"}
+    finally:
+        library.set_memory_budget(old)
+    region = swept_region()
+    bound, cell = region["screwbender_error_bound"], region["screwbender_cell"]
+    assert cell == pytest.approx(work["cell"], rel=1e-6)  # the first grid's (float32 vertices), kept
+    assert bound > tol
+    warned = [line for line in capfd.readouterr().out.splitlines() if line.startswith("Warning:")]
+    print(f"\n{warned}")
+    assert warned and "Prism is within" in warned[-1] and f"over the Tolerance {tol:.3g}" in warned[-1]
+    assert "memory budget" in warned[-1] and f"A Tolerance of {bound:.3g} or more" in warned[-1]
+    rv, rt = region_arrays(region)
+    closed, _, overlaps, _ = blender_checks(region, rv, rt)
+    assert closed and overlaps == 0

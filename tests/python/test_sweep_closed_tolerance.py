@@ -9,7 +9,9 @@
   `scripts/bench/sweep_measures.py`), told by `sweep_closed_work` before any sampling;
 - the mesh is the same, byte for byte, on one thread and on several;
 - a cell with a tolerance, or a bad tolerance, is refused; so is heavy work, by the add-on's
-  pure `sweep_report.closed_refusal`, with what to change.
+  pure `sweep_report.closed_refusal`, with what to change;
+- a finer grid over the memory budget keeps the mesh already made (closed, within its bound,
+  over the tolerance) with the reason, which the add-on's warning tells.
 """
 
 from __future__ import annotations
@@ -182,6 +184,36 @@ def test_bad_tolerances_and_heavy_work_are_refused():
         polyscrew.sweep_closed(v, t, poses, tolerance=0.002 * extent_of(v))
     roomy = polyscrew.sweep_closed_work(v, t, poses, tolerance=0.003 * extent_of(v))
     assert sweep_report.closed_refusal(roomy, budget) is None
+
+
+def test_a_finer_grid_over_the_budget_keeps_the_mesh_made_and_the_report_says_why():
+    """At a tolerance whose first bound exceeds it (a 4 % cell on the L-prism), a second grid is
+    contoured; with a memory budget that holds the first grids only, the first mesh is returned,
+    closed and within its bound, with the budget's refusal as the reason, and the add-on's
+    warning names it, the tolerance missed and the one met."""
+    v, t, _, poses, _, _ = CASES["L-prism, half turn"]
+    tolerance = 0.04 / 3.0 * extent_of(v)
+    _, _, retried = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True, decimate=False)
+    assert retried["attempts"] == 2 and retried["finer_refused"] is None
+    work = polyscrew.sweep_closed_work(v, t, poses, tolerance=tolerance)
+    old = polyscrew.set_memory_budget(work["bytes"])
+    try:
+        kv, kt, kept = polyscrew.sweep_closed(v, t, poses, tolerance=tolerance, info=True, decimate=False)
+    finally:
+        polyscrew.set_memory_budget(old)
+    assert kept["attempts"] == 1 and kept["cell"] == work["cell"]
+    assert kept["error_bound"] > tolerance
+    assert "over the memory budget" in kept["finer_refused"]
+    # The first attempt's mesh, byte for byte: the one its cell gives.
+    fv, ft, first = polyscrew.sweep_closed(v, t, poses, cell=work["cell"], info=True, decimate=False)
+    assert np.array_equal(kv, fv) and np.array_equal(kt, ft) and kept["error_bound"] == first["error_bound"]
+    assert is_closed_oriented(kt)
+    note = sweep_report.over_tolerance_note([("Prism", tolerance, kept["error_bound"], kept["finer_refused"])])
+    print(f"\n{note}")
+    assert note.startswith("Closed Volume: Prism is within")
+    assert f"over the Tolerance {tolerance:.3g}" in note and kept["finer_refused"] in note
+    assert note.endswith(f"A Tolerance of {kept['error_bound']:.3g} or more is met as it is")
+    assert sweep_report.over_tolerance_note([]) is None
 
 
 def test_the_report_names_the_closed_tolerance_and_what_met_it():

@@ -76,6 +76,9 @@ class Swept:
     cell: float = 0.0
     attempts: int = 0
     vertex_bound: float = 0.0
+    #: Why no finer grid was contoured though `error_bound` exceeds the tolerance (its memory),
+    #: else None (`polyscrew.sweep_closed`'s ``finer_refused``).
+    finer_refused: str | None = None
     #: Closed Volume at its default on a mesh that is not closed: the open sweep instead
     #: (:func:`sweep_report.closed_choice`).
     fallback: bool = False
@@ -759,7 +762,8 @@ def compute_all(
                                                     decimate=decimate, **grid)
                 closed_done += PROGRESS_STEPS
                 out[i] = Swept(obj, v, t, poses, time.perf_counter() - start, info["tolerance"],
-                               info["error_bound"], info["cell"], info["attempts"], info["vertex_bound"])
+                               info["error_bound"], info["cell"], info["attempts"], info["vertex_bound"],
+                               info["finer_refused"])
                 continue
             v, t, info = polyscrew.sweep(verts * scale, tris, poses, steps=steps, caps=caps, tolerance=tolerance, info=True)
         except ValueError as err:

@@ -154,9 +154,12 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
                     cell=max(s.cell for s in main), attempts=max(s.attempts for s in main), open_sweep=beside,
                 ),
             )
-            note = sweep_report.fallback_note([s.obj.name for s in fell])
-            if note is not None:  # last: the status bar shows the last report
-                self.report({"WARNING"}, note)
+            notes = [sweep_report.fallback_note([s.obj.name for s in fell]),
+                     sweep_report.over_tolerance_note([(s.obj.name, s.tolerance, s.error_bound, s.finer_refused)
+                                                       for s in computed if s.finer_refused])]
+            for note in notes:  # last: the status bar shows the last report
+                if note is not None:
+                    self.report({"WARNING"}, note)
             return {"FINISHED"}
 
         return pipeline.run(self, "Build Swept Region", work, report, context, refusals=(swept.SweepError,))

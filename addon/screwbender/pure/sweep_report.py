@@ -22,11 +22,6 @@ import numpy as np
 #: seconds per million grid points, 20 to 66 million of them) about a minute to a minute and a
 #: half of CPU; beyond it the call would run for minutes with Blender waiting.
 MAX_CLOSED_GRID_POINTS = 100_000_000
-#: Bytes per world-grid point and per body-grid point of a closed boundary (`closed.rs`: a
-#: value and a pose per world point, a float32 per body point), against `polyscrew`'s memory
-#: budget. Since the cell became three tolerances (stop 44), the body's grid, six times finer
-#: than the cell, can pass the budget before the world grid passes its limit.
-CLOSED_BYTES_PER_GRID_POINT, CLOSED_BYTES_PER_BODY_POINT = 8, 4
 #: The most dense poses a closed boundary may sample from the operator (the longest default
 #: case, the smoothed torus, samples 1,230).
 MAX_CLOSED_POSES = 20_000
@@ -34,12 +29,13 @@ MAX_CLOSED_POSES = 20_000
 
 def closed_refusal(work: dict, budget: int | None = None) -> str | None:
     """None when the closed boundary's work (`polyscrew.sweep_closed_work`'s dict: ``cell``,
-    ``tolerance``, ``poses``, ``grid_points``, ``body_points``) is within
-    :data:`MAX_CLOSED_GRID_POINTS` and :data:`MAX_CLOSED_POSES`, and its grids within `budget`
-    bytes (`polyscrew.memory_budget()`; None: not checked); otherwise why not and what to
-    change (a coarser tolerance, or the open sweep, which takes milliseconds)."""
-    grid, poses = int(work["grid_points"]), int(work["poses"])
-    needed = CLOSED_BYTES_PER_GRID_POINT * grid + CLOSED_BYTES_PER_BODY_POINT * int(work.get("body_points", 0))
+    ``tolerance``, ``poses``, ``grid_points``, ``bytes``) is within
+    :data:`MAX_CLOSED_GRID_POINTS` and :data:`MAX_CLOSED_POSES`, and its grids' ``bytes`` within
+    `budget` (`polyscrew.memory_budget()`; None: not checked); otherwise why not and what to
+    change (a coarser tolerance, or the open sweep, which takes milliseconds). Since the cell
+    became three tolerances (stop 44), the body's grid, six times finer than the cell, can
+    pass the budget before the world grid passes its limit."""
+    grid, poses, needed = int(work["grid_points"]), int(work["poses"]), int(work["bytes"])
     over_budget = budget is not None and needed > budget
     if grid <= MAX_CLOSED_GRID_POINTS and poses <= MAX_CLOSED_POSES and not over_budget:
         return None
@@ -87,6 +83,19 @@ def fallback_note(names: list[str]) -> str | None:
     if not names:
         return None
     return f"{_not_closed(names)}, built the open sweep (Closed Volume needs a closed mesh: {NOT_CLOSED_WHY})"
+
+
+def over_tolerance_note(over: list[tuple[str, float, float, str]]) -> str | None:
+    """The warning for the closed boundaries whose bound is over the Tolerance because the
+    finer grid that would have met it was refused (its memory; `polyscrew.sweep_closed`'s
+    ``finer_refused``): for each, `(name, tolerance, bound, reason)`, in one line, with what to
+    change; None when there are none. The meshes are kept: closed, within their bounds."""
+    if not over:
+        return None
+    each = "; ".join(f"{name} is within {bound:.3g} of the swept boundary, over the Tolerance {tolerance:.3g} "
+                     f"(the finer grid was not tried: {reason})" for name, tolerance, bound, reason in over)
+    least = max(bound for _, _, bound, _ in over)
+    return f"Closed Volume: {each}. A Tolerance of {least:.3g} or more is met as it is"
 
 
 @dataclass

@@ -159,6 +159,16 @@ fn sweep<'py>(
     PyTuple::new(py, [vo.into_any(), to.into_any(), dict.into_any()])
 }
 
+/// `sweep_closed`'s result off the watched thread: the mesh, its figures (cell, bound,
+/// tolerance, vertices' bound), counts (attempts, poses, refined cubes) and `finer_refused`.
+type Closed = (
+    Array2<f64>,
+    Array2<i64>,
+    [f64; 4],
+    [usize; 3],
+    Option<String>,
+);
+
 // stub:
 // stub: class ClosedSweepInfo(TypedDict):
 // stub:     cell: float
@@ -168,6 +178,7 @@ fn sweep<'py>(
 // stub:     attempts: int
 // stub:     poses: int
 // stub:     refined_cubes: int
+// stub:     finer_refused: str | None
 /// sweep_closed(
 ///     vertices: ArrayLike,
 ///     triangles: ArrayLike,
@@ -231,11 +242,15 @@ fn sweep<'py>(
 /// triangles counter-clockwise seen from outside, every edge in exactly two; with
 /// ``info=True`` also a dict: ``cell``, ``error_bound`` (every vertex and every edge's
 /// midpoint within it of the swept boundary: the largest distance left at one, read exactly,
-/// plus the motion's gap between the poses read; at most ``tolerance``), ``vertex_bound``
+/// plus the motion's gap between the poses read; at most ``tolerance`` unless
+/// ``finer_refused``), ``vertex_bound``
 /// (its part that covers the vertices alone), ``tolerance`` (0 with a ``cell``), ``attempts`` (grids contoured: 1 to 3),
-/// ``poses`` (the dense poses sampled) and ``refined_cubes`` (grid cubes cut four times finer
+/// ``poses`` (the dense poses sampled), ``refined_cubes`` (grid cubes cut four times finer
 /// because the boundary has a feature narrower than a cell there, such as a slab of outside
-/// space between two sheets, which the grid's points alone would have filled).
+/// space between two sheets, which the grid's points alone would have filled) and
+/// ``finer_refused`` (None, or why no finer grid was contoured though ``error_bound`` exceeds
+/// ``tolerance``: its grids over the memory budget or a limit; the mesh is then the last
+/// attempt's, closed and within ``error_bound``).
 ///
 /// Raises ``ValueError`` for the errors of ``sweep``, a body that is not closed, a ``cell``
 /// or ``tolerance`` that is not positive or too fine (a cell below 1/1000 of the body's
@@ -263,8 +278,7 @@ fn sweep_closed<'py>(
     let (vertices, triangles, poses) = body_and_poses(F, vertices, triangles, poses, CLOSED_HINT)?;
     let (vertices, triangles, poses) = (vertices.read()?, triangles.read()?, poses.read()?);
     let views = (vertices.as_array(), triangles.as_array(), poses.as_array());
-    type Closed = (Array2<f64>, Array2<i64>, [f64; 4], [usize; 3]);
-    let (vo, to, figures, counts) = watched(py, F, progress, |watch| -> PyResult<Closed> {
+    let closed = watched(py, F, progress, |watch| -> PyResult<Closed> {
         let (va, ta, pa) = &views;
         let v: Vec<DVec3> = read_rows3(F, "vertices", va, "(N, 3)")?;
         let t = read_triangles(F, "triangles", ta)?;
@@ -278,8 +292,10 @@ fn sweep_closed<'py>(
             to,
             figures,
             [out.attempts, out.poses, out.refined_cubes],
+            out.finer_refused.map(|e| e.to_string()),
         ))
     })?;
+    let (vo, to, figures, counts, refused) = closed;
     let (vo, to) = (vo.into_pyarray(py), to.into_pyarray(py));
     if !info {
         return PyTuple::new(py, [vo.into_any(), to.into_any()]);
@@ -292,6 +308,7 @@ fn sweep_closed<'py>(
     dict.set_item("attempts", counts[0])?;
     dict.set_item("poses", counts[1])?;
     dict.set_item("refined_cubes", counts[2])?;
+    dict.set_item("finer_refused", refused)?;
     PyTuple::new(py, [vo.into_any(), to.into_any(), dict.into_any()])
 }
 
@@ -302,6 +319,7 @@ fn sweep_closed<'py>(
 // stub:     poses: int
 // stub:     grid_points: int
 // stub:     body_points: int
+// stub:     bytes: int
 /// sweep_closed_work(
 ///     vertices: ArrayLike,
 ///     triangles: ArrayLike,
@@ -314,8 +332,9 @@ fn sweep_closed<'py>(
 /// What ``sweep_closed`` with the same arguments will sample, without sampling it (the
 /// arguments checked as it checks them; the dense poses counted, milliseconds): ``cell`` and
 /// ``tolerance`` (of its first attempt), ``poses`` (dense poses), ``grid_points`` (the world
-/// grid over the instances' boxes) and ``body_points`` (the body's fine distance grid). For a
-/// caller to refuse work that would run for minutes before it starts.
+/// grid over the instances' boxes), ``body_points`` (the body's fine distance grid) and
+/// ``bytes`` (the two grids', which ``sweep_closed`` checks against ``memory_budget()`` before
+/// sampling either). For a caller to refuse work that would run for minutes before it starts.
 ///
 /// Raises ``ValueError`` as ``sweep_closed`` does (but for the memory budget of its grids).
 #[pyfunction]
@@ -346,6 +365,7 @@ fn sweep_closed_work<'py>(
     dict.set_item("poses", work.poses)?;
     dict.set_item("grid_points", work.grid_points)?;
     dict.set_item("body_points", work.body_points)?;
+    dict.set_item("bytes", work.bytes)?;
     Ok(dict)
 }
 

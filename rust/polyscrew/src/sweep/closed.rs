@@ -279,11 +279,17 @@ pub struct ClosedMesh {
     /// The part of `error_bound` that covers the vertices alone (as `error_bound` did up to
     /// stop 43): the largest `|g|` left at a vertex, plus the motion's gap.
     pub vertex_bound: f64,
-    /// The tolerance asked for (0 when a cell was given): `error_bound` is within it.
+    /// The tolerance asked for (0 when a cell was given): `error_bound` is within it, unless
+    /// `finer_refused` says why not.
     pub tolerance: f64,
     /// Grids contoured: 1, or 2 and 3 when the first and the second cell's bound exceeded the
     /// tolerance.
     pub attempts: usize,
+    /// Why the grid was not contoured again at a finer cell though `error_bound` exceeds the
+    /// tolerance: the finer grids over the memory budget ([`Error::Memory`]) or past a limit
+    /// ([`Error::Limit`]). The mesh is then the last attempt's, closed and within its bound,
+    /// which is over the tolerance. `None` otherwise.
+    pub finer_refused: Option<Error>,
     /// Dense poses sampled.
     pub poses: usize,
     /// Grid cubes cut finer because a feature of the boundary narrower than a cell was found
@@ -314,6 +320,14 @@ pub struct ClosedWork {
     pub grid_points: usize,
     /// Points of the body's fine distance grid.
     pub body_points: usize,
+    /// The bytes of the two grids, which the memory budget is checked against before either
+    /// is sampled (saturated at `usize::MAX`).
+    pub bytes: usize,
+}
+
+/// The bytes of a world grid of `grid_points` points and a body grid of `body_points`.
+fn grids_footprint(grid_points: usize, body_points: usize) -> Footprint {
+    Footprint::bytes(WORLD_BYTES_PER_POINT).times(grid_points) + Footprint::of::<f32>(body_points)
 }
 
 /// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
@@ -812,6 +826,8 @@ impl DenseMotion {
 /// body's extent) the cell is [`CELL_PER_TOLERANCE`] times it; if the bound reported there
 /// exceeds the tolerance, the grid is contoured again at the cell [`RETRY_SPARE`] makes of that
 /// bound (`attempts` 2), then at [`guaranteed_cell`], where it cannot exceed it (`attempts` 3).
+/// A finer grid over the memory budget or past a limit is not an error: the last attempt's
+/// mesh is returned, its bound over the tolerance, with the reason (`finer_refused`).
 /// With `options.cell`, that cell, once.
 ///
 /// # Errors
@@ -851,12 +867,15 @@ pub fn closed_work(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Resu
     let (cell, tolerance) = first_cell(body, poses, options)?;
     let plan = Plan::new(body, poses, cell)?;
     let count = |n: [usize; 3]| n[0].saturating_mul(n[1]).saturating_mul(n[2]);
+    let grid_points = count(plan.grid.n);
+    let body_points = count(BodyField::dims(body, cell / BODY_SUBCELLS, BAND_CELLS * cell).1);
     Ok(ClosedWork {
         cell,
         tolerance,
         poses: plan.motion.poses.len(),
-        grid_points: count(plan.grid.n),
-        body_points: count(BodyField::dims(body, cell / BODY_SUBCELLS, BAND_CELLS * cell).1),
+        grid_points,
+        body_points,
+        bytes: grids_footprint(grid_points, body_points).get(),
     })
 }
 
@@ -945,7 +964,17 @@ pub(super) fn sweep_closed_with(
             least
         };
         progress.restart();
-        out = contoured(body, poses, retry, options, evaluation, whole)?;
+        match contoured(body, poses, retry, options, evaluation, whole) {
+            Ok(finer) => out = finer,
+            // A finer grid the budget or a limit refuses (checked before its work starts): the
+            // mesh so far is kept, its bound over the tolerance and the reason told, rather than
+            // the work done lost to an error.
+            Err(refused @ (Error::Memory { .. } | Error::Limit { .. })) => {
+                out.finer_refused = Some(refused);
+                break;
+            }
+            Err(e) => return Err(e),
+        }
         attempts += 1;
     }
     out.attempts = attempts;
@@ -1038,9 +1067,8 @@ fn contoured(
     let count = n[0] * n[1] * n[2];
     // Both grids checked before either is sampled: an oversized request costs no work.
     let [bx, by, bz] = BodyField::dims(body, cell / BODY_SUBCELLS, band).1;
-    (Footprint::bytes(WORLD_BYTES_PER_POINT).times(count)
-        + Footprint::of::<f32>(bx.saturating_mul(by).saturating_mul(bz)))
-    .check("the region's distance grid", CLOSED_HINT)?;
+    grids_footprint(count, bx.saturating_mul(by).saturating_mul(bz))
+        .check("the region's distance grid", CLOSED_HINT)?;
     let field = BodyField::new(
         body,
         cell / BODY_SUBCELLS,

@@ -471,10 +471,13 @@ impl Buckets {
         margin: f64,
         apex: Option<u32>,
     ) -> bool {
-        let mut near: Vec<u32> = new
+        // The cubes the new triangles meet, each once (a fan's boxes overlap).
+        let mut cubes: Vec<[i64; 3]> = new.iter().flat_map(|&n| self.cubes(v, n)).collect();
+        cubes.sort_unstable();
+        cubes.dedup();
+        let mut near: Vec<u32> = cubes
             .iter()
-            .flat_map(|&n| self.cubes(v, n))
-            .filter_map(|c| self.map.get(&c))
+            .filter_map(|c| self.map.get(c))
             .flatten()
             .copied()
             .filter(|i| !replaced.contains(i))
@@ -488,11 +491,15 @@ impl Buckets {
             let at = |k: u32| v[k as usize];
             let [a, b, c] = s.map(at);
             let [d, e, f] = n.map(at);
-            apex.is_some_and(|w| {
-                !s.contains(&w) && point_triangle_distance(at(w), a, b, c) < margin
-            }) || s
-                .iter()
-                .any(|&k| !n.contains(&k) && point_triangle_distance(at(k), d, e, f) < margin)
+            // (A point outside a triangle's box grown by the margin is further than that.)
+            let near = |p: DVec3, [a, b, c]: [DVec3; 3]| {
+                let (lo, hi) = (a.min(b).min(c) - margin, a.max(b).max(c) + margin);
+                p.cmpge(lo).all()
+                    && p.cmple(hi).all()
+                    && point_triangle_distance(p, a, b, c) < margin
+            };
+            apex.is_some_and(|w| !s.contains(&w) && near(at(w), [a, b, c]))
+                || s.iter().any(|&k| !n.contains(&k) && near(at(k), [d, e, f]))
         };
         // Triangles whose boxes (grown by the margin and the float32 rounding) are apart
         // neither cross nor touch.
@@ -527,10 +534,11 @@ fn orient(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     (b - a).cross(c - a).dot(d - a)
 }
 
-/// Whether the segment `(p, q)` crosses the triangle: its ends on either side of the
-/// triangle's plane and the crossing inside it, each by more than round-off (a volume of
-/// 1e-12 times the cube of the longest length involved).
-fn segment_crosses(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
+/// Whether the segment from `p` to `q` (its ends' orientations `sp` and `sq` against the
+/// triangle's plane) crosses the triangle: its ends on either side of the triangle's plane and
+/// the crossing inside it, each by more than round-off (a volume of 1e-12 times the cube of the
+/// longest length involved).
+fn segment_crosses((p, q): (DVec3, DVec3), (sp, sq): (f64, f64), [a, b, c]: [DVec3; 3]) -> bool {
     const ROUNDOFF: f64 = 1e-12;
     let l = (q - p)
         .length()
@@ -538,7 +546,6 @@ fn segment_crosses(p: DVec3, q: DVec3, [a, b, c]: [DVec3; 3]) -> bool {
         .max((c - b).length())
         .max((a - c).length());
     let eps = ROUNDOFF * l * l * l;
-    let (sp, sq) = (orient(a, b, c, p), orient(a, b, c, q));
     if !((sp > eps && sq < -eps) || (sp < -eps && sq > eps)) {
         return false;
     }
@@ -554,14 +561,20 @@ fn crosses(v: &[DVec3], s: [u32; 3], t: [u32; 3]) -> bool {
         return false;
     }
     let at = |k: u32| v[k as usize].as_vec3().as_dvec3();
-    let one_way = |a: [u32; 3], b: [u32; 3]| {
-        let pb = b.map(at);
+    let (ps, pt) = (s.map(at), t.map(at));
+    // Each corner's orientation against the other triangle's plane is read once: an edge
+    // whose ends are not on either side of it crosses nothing.
+    let one_way = |a: [u32; 3], pa: [DVec3; 3], b: [u32; 3], pb: [DVec3; 3]| {
+        let [x, y, z] = pb;
+        let o = pa.map(|p| orient(x, y, z, p));
         (0..3).any(|e| {
-            let (x, y) = (a[e], a[(e + 1) % 3]);
-            !(b.contains(&x) || b.contains(&y)) && segment_crosses(at(x), at(y), pb)
+            let f = (e + 1) % 3;
+            ((o[e] > 0.0 && o[f] < 0.0) || (o[e] < 0.0 && o[f] > 0.0))
+                && !(b.contains(&a[e]) || b.contains(&a[f]))
+                && segment_crosses((pa[e], pa[f]), (o[e], o[f]), pb)
         })
     };
-    one_way(s, t) || one_way(t, s)
+    one_way(s, ps, t, pt) || one_way(t, pt, s, ps)
 }
 
 #[cfg(test)]
