@@ -57,18 +57,14 @@ fn closed_oriented(triangles: &[[u32; 3]]) -> bool {
 fn a_finer_grid_over_the_budget_keeps_the_mesh_made_and_says_why() {
     let body = l_prism();
     let poses = half_turn();
-    // A coarse tolerance (a 4 % cell) at which the first bound exceeds the tolerance.
+    // A coarse tolerance (a 4 % cell) at which the first bound exceeds the tolerance: with the
+    // default budget a second grid meets it (tests/python/test_sweep_closed_tolerance.py).
     let options = ClosedOptions {
         tolerance: Some(0.04 / 3.0 * body.extent()),
         decimate: false,
         threads: 2,
         ..ClosedOptions::default()
     };
-    let retried = sweep_closed(&body, &poses, &options).unwrap();
-    assert_eq!(retried.attempts, 2, "the case no longer retries");
-    assert!(retried.finer_refused.is_none());
-    assert!(retried.error_bound <= retried.tolerance);
-
     // A budget that holds the first attempt's grids, not the finer ones.
     let first = closed_work(&body, &poses, &options).unwrap();
     let old = polyscrew::set_memory_budget(first.bytes);
