@@ -253,7 +253,7 @@ def test_a_finer_grid_over_the_memory_budget_keeps_the_region_and_warns(capfd):
     """An L-prism on a half turn at a tolerance whose first grid's bound exceeds it (a 3 % cell):
     the operator would contour a finer grid, but the memory budget holds only the first. The
     region made is kept (closed, no two triangles crossing, its first cell, its bound over the
-    tolerance) and the operator warns, naming the object, the tolerance missed and the one met."""
+    tolerance) and the operator warns, naming the object, the tolerance missed, the bound met and why."""
     from conftest import addon_module
 
     library = addon_module("blender.swept").polyscrew  # the polyscrew the add-on calls
@@ -294,7 +294,7 @@ def test_a_finer_grid_over_the_memory_budget_keeps_the_region_and_warns(capfd):
     warned = [line for line in capfd.readouterr().out.splitlines() if line.startswith("Warning:")]
     print(f"\n{warned}")
     assert warned and "Prism is within" in warned[-1] and f"over the Tolerance {tol:.3g}" in warned[-1]
-    assert "memory budget" in warned[-1] and f"A Tolerance of {bound:.3g} or more" in warned[-1]
+    assert f"within {bound:.3g} of the swept boundary" in warned[-1] and "memory budget" in warned[-1]
     rv, rt = region_arrays(region)
     closed, _, overlaps, _ = blender_checks(region, rv, rt)
     assert closed and overlaps == 0

@@ -88,14 +88,14 @@ def fallback_note(names: list[str]) -> str | None:
 def over_tolerance_note(over: list[tuple[str, float, float, str]]) -> str | None:
     """The warning for the closed boundaries whose bound is over the Tolerance because the
     finer grid that would have met it was refused (its memory; `polyscrew.sweep_closed`'s
-    ``finer_refused``): for each, `(name, tolerance, bound, reason)`, in one line, with what to
-    change; None when there are none. The meshes are kept: closed, within their bounds."""
+    ``finer_refused``): for each, `(name, tolerance, bound, reason)`, in one line, the reason
+    saying what to change; None when there are none. The meshes are kept: closed, within their
+    bounds."""
     if not over:
         return None
     each = "; ".join(f"{name} is within {bound:.3g} of the swept boundary, over the Tolerance {tolerance:.3g} "
                      f"(the finer grid was not tried: {reason})" for name, tolerance, bound, reason in over)
-    least = max(bound for _, _, bound, _ in over)
-    return f"Closed Volume: {each}. A Tolerance of {least:.3g} or more is met as it is"
+    return f"Closed Volume: {each}. Kept as made: closed, within that bound"
 
 
 @dataclass

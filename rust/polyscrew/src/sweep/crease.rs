@@ -492,14 +492,15 @@ impl Buckets {
             let [a, b, c] = s.map(at);
             let [d, e, f] = n.map(at);
             // (A point outside a triangle's box grown by the margin is further than that.)
-            let near = |p: DVec3, [a, b, c]: [DVec3; 3]| {
+            let within = |p: DVec3, [a, b, c]: [DVec3; 3]| {
                 let (lo, hi) = (a.min(b).min(c) - margin, a.max(b).max(c) + margin);
                 p.cmpge(lo).all()
                     && p.cmple(hi).all()
                     && point_triangle_distance(p, a, b, c) < margin
             };
-            apex.is_some_and(|w| !s.contains(&w) && near(at(w), [a, b, c]))
-                || s.iter().any(|&k| !n.contains(&k) && near(at(k), [d, e, f]))
+            apex.is_some_and(|w| !s.contains(&w) && within(at(w), [a, b, c]))
+                || s.iter()
+                    .any(|&k| !n.contains(&k) && within(at(k), [d, e, f]))
         };
         // Triangles whose boxes (grown by the margin and the float32 rounding) are apart
         // neither cross nor touch.
