@@ -675,8 +675,24 @@ pub(super) fn exact_distance(
         0,
         Progress::new().span(0.0, 1.0),
     )?;
-    let exact = exact_field(body, &field, cell)?;
+    let exact = exact_field(body, &field, cell, 0)?;
     Ok(move |p| exact.at(p))
+}
+
+/// The exact distance's lists for `body` at `cell`, made on `threads` threads: each list
+/// cell's start, and the triangles (for the tests).
+#[cfg(test)]
+pub(super) fn exact_lists(body: &Body, cell: f64, threads: usize) -> Result<(Vec<u32>, Vec<u32>)> {
+    let field = BodyField::new(
+        body,
+        cell / BODY_SUBCELLS,
+        BAND_CELLS * cell,
+        0,
+        Progress::new().span(0.0, 1.0),
+    )?;
+    let exact = exact_field(body, &field, cell, threads)?;
+    let (start, items) = exact.lists();
+    Ok((start.to_vec(), items.to_vec()))
 }
 
 /// The refinement's minima at `points` over the motion sampled for `cell` (for the tests): per
@@ -699,7 +715,7 @@ pub(super) fn motion_minima(
     let field = BodyField::new(body, h, band, 0, progress.span(0.0, 1.0))?;
     let coarse_band = COARSE_BAND_CELLS * cell;
     let coarse = BodyField::new(body, cell, coarse_band, 0, progress.span(0.0, 1.0))?;
-    let exact = exact_field(body, &field, cell)?;
+    let exact = exact_field(body, &field, cell, 0)?;
     let refine = Refiner::new(&field, &coarse, exact, &motion, body, cell)?;
     let read = |x: DVec3, i: usize| refine.exact.at(refine.fine[i].transform_point3(x)).0;
     Ok(points
@@ -728,8 +744,14 @@ pub(super) fn motion_minima(
         .collect())
 }
 
-/// The exact distance's lists over the body grid's box.
-fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<ExactField<'a>> {
+/// The exact distance's lists over the body grid's box, made on [`thread_count`]`(threads)`
+/// threads (the same lists whatever the count).
+fn exact_field<'a>(
+    body: &'a Body,
+    field: &BodyField,
+    cell: f64,
+    threads: usize,
+) -> Result<ExactField<'a>> {
     let last = DVec3::new(field.n[0] as f64, field.n[1] as f64, field.n[2] as f64) - 1.0;
     ExactField::new(
         body,
@@ -737,6 +759,7 @@ fn exact_field<'a>(body: &'a Body, field: &BodyField, cell: f64) -> Result<Exact
         field.origin,
         field.origin + last * field.h,
         cell / EXACT_LISTS_PER_CELL,
+        thread_count(threads),
     )
 }
 
@@ -1109,7 +1132,7 @@ fn contoured(
         }
         Evaluation::Dense => dense(&field, &to_body, &boxes, grid, &mut g, &mut arg),
     }
-    let exact = exact_field(body, &field, cell)?;
+    let exact = exact_field(body, &field, cell, threads)?;
     let refine = Refiner::new(&field, &coarse, exact, &motion, body, cell)?;
     settle_signs(
         &mut g,

@@ -737,6 +737,30 @@ fn the_pruned_minima_are_every_poses_least() {
 /// its lists (`|d|` below the band less a list cell's reach), and elsewhere has the sign of
 /// the reference and at least that magnitude; its gradient is a unit vector along which the
 /// reference grows at rate 1.
+/// The exact distance's lists, made slab by slab on several threads (stop 45), are those of
+/// one thread, each in triangle order (what they hold is checked by the next test, against
+/// the winding number).
+#[test]
+fn the_exact_lists_do_not_depend_on_the_thread_count() {
+    let (tv, tt) = torus(0.6, 0.22, 24, 12);
+    let body = Body::new(&tv, &tt).unwrap();
+    let cell = 0.02 * body.extent();
+    let (start, items) = super::closed::exact_lists(&body, cell, 1).unwrap();
+    assert!(items.len() > 10_000, "{} items", items.len());
+    assert_eq!(start.last().map(|&s| s as usize), Some(items.len()));
+    for list in start.windows(2) {
+        let cell_items = &items[list[0] as usize..list[1] as usize];
+        assert!(
+            cell_items.windows(2).all(|w| w[0] < w[1]),
+            "not in triangle order"
+        );
+    }
+    for threads in [2, 3, 7] {
+        let many = super::closed::exact_lists(&body, cell, threads).unwrap();
+        assert!(many == (start.clone(), items.clone()), "{threads} threads");
+    }
+}
+
 #[test]
 fn the_exact_distance_equals_the_winding_number_reference() {
     let (tv, tt) = torus(0.6, 0.22, 16, 8);
