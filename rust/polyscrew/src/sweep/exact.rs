@@ -15,9 +15,9 @@
 //! A cell whose `q` is beyond the distance grid's band holds no list: its points are at
 //! least `band - R` from the surface, and read as `+-band` (the sign of the grid's value).
 
-use glam::DVec3;
-
 use std::ops::Range;
+
+use glam::DVec3;
 
 use super::closed::{BodyField, CLOSED_HINT};
 use super::Body;
