@@ -660,14 +660,10 @@ pub(super) fn body_distance_grid(
     Ok((field.origin, field.n, field.values))
 }
 
-/// The body's exact signed distance as the closed sweep builds it for a cell (`band`,
-/// spacings as [`sweep_closed`] takes them): a reader of `(distance, gradient)` (for the
-/// tests).
+/// The body's exact distance as the closed sweep builds it for a cell (`band`, spacings as
+/// [`sweep_closed`] takes them), its lists made on `threads` threads (for the tests).
 #[cfg(test)]
-pub(super) fn exact_distance(
-    body: &Body,
-    cell: f64,
-) -> Result<impl Fn(DVec3) -> (f64, Option<DVec3>) + '_> {
+fn exact_for_tests(body: &Body, cell: f64, threads: usize) -> Result<ExactField<'_>> {
     let field = BodyField::new(
         body,
         cell / BODY_SUBCELLS,
@@ -675,7 +671,17 @@ pub(super) fn exact_distance(
         0,
         Progress::new().span(0.0, 1.0),
     )?;
-    let exact = exact_field(body, &field, cell, 0)?;
+    exact_field(body, &field, cell, threads)
+}
+
+/// The body's exact signed distance as the closed sweep builds it for a cell: a reader of
+/// `(distance, gradient)` (for the tests).
+#[cfg(test)]
+pub(super) fn exact_distance(
+    body: &Body,
+    cell: f64,
+) -> Result<impl Fn(DVec3) -> (f64, Option<DVec3>) + '_> {
+    let exact = exact_for_tests(body, cell, 0)?;
     Ok(move |p| exact.at(p))
 }
 
@@ -683,14 +689,7 @@ pub(super) fn exact_distance(
 /// cell's start, and the triangles (for the tests).
 #[cfg(test)]
 pub(super) fn exact_lists(body: &Body, cell: f64, threads: usize) -> Result<(Vec<u32>, Vec<u32>)> {
-    let field = BodyField::new(
-        body,
-        cell / BODY_SUBCELLS,
-        BAND_CELLS * cell,
-        0,
-        Progress::new().span(0.0, 1.0),
-    )?;
-    let exact = exact_field(body, &field, cell, threads)?;
+    let exact = exact_for_tests(body, cell, threads)?;
     let (start, items) = exact.lists();
     Ok((start.to_vec(), items.to_vec()))
 }
