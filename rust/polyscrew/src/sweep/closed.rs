@@ -988,9 +988,10 @@ pub(super) fn sweep_closed_with(
         progress.restart();
         match contoured(body, poses, retry, options, evaluation, whole) {
             Ok(finer) => out = finer,
-            // A finer grid the budget or a limit refuses (checked before its work starts): the
-            // mesh so far is kept, its bound over the tolerance and the reason told, rather than
-            // the work done lost to an error.
+            // A finer grid the budget or a limit refuses (the grids' budget and the grid-point
+            // and pose limits are checked before its sampling starts): the mesh so far is kept,
+            // its bound over the tolerance and the reason told, rather than the work done lost
+            // to an error.
             Err(refused @ (Error::Memory { .. } | Error::Limit { .. })) => {
                 out.finer_refused = Some(refused);
                 break;
