@@ -599,8 +599,8 @@ def sweep_closed(
     every vertex moved along its grid edge to the zero of the distance refined between the
     samples. ``tolerance`` (a length; None: ``DEFAULT_CLOSED_TOLERANCE`` (0.5 %) of the body's
     extent, its bounding box's diagonal) sets the cell: ``CLOSED_CELL_PER_TOLERANCE`` times
-    it, contoured again at a finer cell (from the bound found), then at one where the bound
-    cannot exceed it, while the bound does.
+    it, contoured again at a finer cell (from the bound found), then at one where the vertices'
+    part of the bound cannot exceed it, while the bound does.
     ``cell`` (scripts) fixes the cell instead; not both. ``threads``: the body's distance
     grid and the region's field are computed on this many threads (0: all the machine has;
     at most 64);

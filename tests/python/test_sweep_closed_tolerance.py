@@ -214,6 +214,10 @@ def test_a_finer_grid_over_the_budget_keeps_the_mesh_made_and_the_report_says_wh
     assert f"over the Tolerance {tolerance:.3g}" in note and kept["finer_refused"] in note
     assert note.endswith("Kept as made: closed, within that bound")
     assert sweep_report.over_tolerance_note([]) is None
+    # A bound still over the Tolerance after the finest grid (none measured so far) is told too.
+    missed = sweep_report.over_tolerance_note([("Prism", 0.01, 0.012, None)])
+    assert missed == ("Closed Volume: Prism is within 0.012 of the swept boundary, over the Tolerance 0.01 "
+                      "(after the finest grid). Kept as made: closed, within that bound")
 
 
 def test_the_report_names_the_closed_tolerance_and_what_met_it():

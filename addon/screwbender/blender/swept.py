@@ -77,7 +77,8 @@ class Swept:
     attempts: int = 0
     vertex_bound: float = 0.0
     #: Why no finer grid was contoured though `error_bound` exceeds the tolerance (its memory),
-    #: else None (`polyscrew.sweep_closed`'s ``finer_refused``).
+    #: else None (`polyscrew.sweep_closed`'s ``finer_refused``; a bound over the tolerance
+    #: without it: the finest grid missed it).
     finer_refused: str | None = None
     #: Closed Volume at its default on a mesh that is not closed: the open sweep instead
     #: (:func:`sweep_report.closed_choice`).

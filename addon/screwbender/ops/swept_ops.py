@@ -156,7 +156,8 @@ class SCREWBENDER_OT_sweep(bpy.types.Operator):
             )
             notes = [sweep_report.fallback_note([s.obj.name for s in fell]),
                      sweep_report.over_tolerance_note([(s.obj.name, s.tolerance, s.error_bound, s.finer_refused)
-                                                       for s in computed if s.finer_refused])]
+                                                       for s in computed
+                                                       if s.cell > 0.0 and 0.0 < s.tolerance < s.error_bound])]
             for note in notes:  # last: the status bar shows the last report
                 if note is not None:
                     self.report({"WARNING"}, note)

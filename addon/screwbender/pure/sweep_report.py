@@ -85,16 +85,20 @@ def fallback_note(names: list[str]) -> str | None:
     return f"{_not_closed(names)}, built the open sweep (Closed Volume needs a closed mesh: {NOT_CLOSED_WHY})"
 
 
-def over_tolerance_note(over: list[tuple[str, float, float, str]]) -> str | None:
-    """The warning for the closed boundaries whose bound is over the Tolerance because the
-    finer grid that would have met it was refused (its memory; `polyscrew.sweep_closed`'s
-    ``finer_refused``): for each, `(name, tolerance, bound, reason)`, in one line, the reason
-    saying what to change; None when there are none. The meshes are kept: closed, within their
-    bounds."""
+def over_tolerance_note(over: list[tuple[str, float, float, str | None]]) -> str | None:
+    """The warning for the closed boundaries whose bound is over their Tolerance: for each,
+    `(name, tolerance, bound, reason)`, in one line; `reason` why no finer grid was tried
+    (`polyscrew.sweep_closed`'s ``finer_refused``: its memory, saying what to change), or None
+    when the finest grid was contoured and still missed it. None when there are none. The
+    meshes are kept: closed, within their bounds."""
     if not over:
         return None
+
+    def why(reason: str | None) -> str:
+        return f"the finer grid was not tried: {reason}" if reason else "after the finest grid"
+
     each = "; ".join(f"{name} is within {bound:.3g} of the swept boundary, over the Tolerance {tolerance:.3g} "
-                     f"(the finer grid was not tried: {reason})" for name, tolerance, bound, reason in over)
+                     f"({why(reason)})" for name, tolerance, bound, reason in over)
     return f"Closed Volume: {each}. Kept as made: closed, within that bound"
 
 

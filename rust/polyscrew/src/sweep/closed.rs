@@ -226,8 +226,8 @@ pub struct ClosedOptions {
     /// The world grid's cell (body units, `> 0`), for scripts that fix it; `None`: derived
     /// from `tolerance`. Not both.
     pub cell: Option<f64>,
-    /// The largest distance, reported as `error_bound`, of a vertex from the swept boundary
-    /// (body units, `> 0`); `None` (and no `cell`): [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
+    /// The largest distance, reported as `error_bound`, of a vertex or an edge's midpoint from
+    /// the swept boundary (body units, `> 0`); `None` (and no `cell`): [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
     /// body's extent. The cell is [`CELL_PER_TOLERANCE`] times it, then finer while the bound
     /// exceeds it (`ClosedMesh::attempts`; see [`sweep_closed`]).
     pub tolerance: Option<f64>,
@@ -325,9 +325,15 @@ pub struct ClosedWork {
     pub bytes: usize,
 }
 
-/// The bytes of a world grid of `grid_points` points and a body grid of `body_points`.
-fn grids_footprint(grid_points: usize, body_points: usize) -> Footprint {
-    Footprint::bytes(WORLD_BYTES_PER_POINT).times(grid_points) + Footprint::of::<f32>(body_points)
+/// The points of the world grid `grid` and of the body's fine distance grid for `cell`, and
+/// the bytes of the two (what the memory budget is checked against before either is sampled).
+fn grid_sizes(body: &Body, grid: &Grid, cell: f64) -> (usize, usize, Footprint) {
+    let count = |n: [usize; 3]| n[0].saturating_mul(n[1]).saturating_mul(n[2]);
+    let grid_points = count(grid.n);
+    let body_points = count(BodyField::dims(body, cell / BODY_SUBCELLS, BAND_CELLS * cell).1);
+    let bytes = Footprint::bytes(WORLD_BYTES_PER_POINT).times(grid_points)
+        + Footprint::of::<f32>(body_points);
+    (grid_points, body_points, bytes)
 }
 
 /// The body's signed distance sampled on a grid (body frame), clamped to `+-band`.
@@ -847,7 +853,9 @@ impl DenseMotion {
 /// With a tolerance (`options.tolerance`, by default [`DEFAULT_CLOSED_TOLERANCE_REL`] of the
 /// body's extent) the cell is [`CELL_PER_TOLERANCE`] times it; if the bound reported there
 /// exceeds the tolerance, the grid is contoured again at the cell [`RETRY_SPARE`] makes of that
-/// bound (`attempts` 2), then at [`guaranteed_cell`], where it cannot exceed it (`attempts` 3).
+/// bound (`attempts` 2), then at [`guaranteed_cell`] (`attempts` 3), where the vertices' part
+/// of the bound cannot exceed it and the midpoints' has not on any case measured; a bound still
+/// over the tolerance is returned as it is.
 /// A finer grid over the memory budget or past a limit is not an error: the last attempt's
 /// mesh is returned, its bound over the tolerance, with the reason (`finer_refused`).
 /// With `options.cell`, that cell, once.
@@ -888,16 +896,14 @@ pub fn sweep_closed_watched(
 pub fn closed_work(body: &Body, poses: &[Pose], options: &ClosedOptions) -> Result<ClosedWork> {
     let (cell, tolerance) = first_cell(body, poses, options)?;
     let plan = Plan::new(body, poses, cell)?;
-    let count = |n: [usize; 3]| n[0].saturating_mul(n[1]).saturating_mul(n[2]);
-    let grid_points = count(plan.grid.n);
-    let body_points = count(BodyField::dims(body, cell / BODY_SUBCELLS, BAND_CELLS * cell).1);
+    let (grid_points, body_points, bytes) = grid_sizes(body, &plan.grid, cell);
     Ok(ClosedWork {
         cell,
         tolerance,
         poses: plan.motion.poses.len(),
         grid_points,
         body_points,
-        bytes: grids_footprint(grid_points, body_points).get(),
+        bytes: bytes.get(),
     })
 }
 
@@ -978,7 +984,7 @@ pub(super) fn sweep_closed_with(
     let mut attempts = 1;
     while tolerance > 0.0 && out.error_bound > tolerance && attempts < 3 {
         // The bound grows about as the cell does: the second cell is the one that would meet
-        // the tolerance with a tenth to spare; the third, the one that cannot miss it.
+        // the tolerance with a tenth to spare; the third, the one whose vertices cannot miss it.
         let least = guaranteed_cell(tolerance);
         let retry = if attempts == 1 {
             (RETRY_SPARE * out.cell * tolerance / out.error_bound).max(least)
@@ -1086,12 +1092,9 @@ fn contoured(
         boxes,
         grid,
     } = Plan::new(body, poses, cell)?;
-    let n = grid.n;
-    let count = n[0] * n[1] * n[2];
     // Both grids checked before either is sampled: an oversized request costs no work.
-    let [bx, by, bz] = BodyField::dims(body, cell / BODY_SUBCELLS, band).1;
-    grids_footprint(count, bx.saturating_mul(by).saturating_mul(bz))
-        .check("the region's distance grid", CLOSED_HINT)?;
+    let (count, _, bytes) = grid_sizes(body, &grid, cell);
+    bytes.check("the region's distance grid", CLOSED_HINT)?;
     let field = BodyField::new(
         body,
         cell / BODY_SUBCELLS,
